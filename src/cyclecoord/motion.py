@@ -1,0 +1,208 @@
+"""The motion object: a capture as frames of channel values with its skeleton and rate."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from .errors import ParameterError
+from .skeleton import DOF_NAMES, Skeleton
+
+__all__ = ["Motion", "DEFAULT_FPS"]
+
+#: CMU captures are recorded at 120 Hz; AMC files do not store a rate.
+DEFAULT_FPS = 120.0
+
+Channel = tuple[str, str]
+
+
+@dataclass(frozen=True, eq=False)
+class Motion:
+    """A capture: ``T`` frames of ``D`` channel values.
+
+    Attributes
+    ----------
+    frames : ndarray, shape (T, D)
+        Channel values per frame; angles in degrees, translations in the skeleton's
+        length units.
+    channels : tuple of (str, str)
+        ``(joint, dof)`` per column, dof one of ``tx ty tz rx ry rz`` (or any string for
+        captures without a skeleton, e.g. a CSV's free-form columns).
+    fps : float
+        Frames per second.
+    skeleton : Skeleton or None
+        The joint hierarchy when known (ASF or BVH); needed for forward kinematics.
+    source : str or None
+        Where the frames came from (a path, ``"synthetic:..."``, ...).
+    start_frame : int
+        Index of ``frames[0]`` in the original capture (0-based), kept through slicing so
+        reports can speak in the capture's own frame numbers.
+    metadata : dict
+        Free-form extras (e.g. the AMC header lines); never used in computations.
+    """
+
+    frames: np.ndarray
+    channels: tuple[Channel, ...]
+    fps: float = DEFAULT_FPS
+    skeleton: Skeleton | None = None
+    source: str | None = None
+    start_frame: int = 0
+    metadata: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        frames = np.array(self.frames, dtype=float)  # own copy: the caller's array is never frozen
+        if frames.ndim == 1:
+            frames = frames[:, None]
+        if frames.ndim != 2:
+            raise ParameterError(f"frames must be a (T, D) array, got shape {frames.shape}")
+        channels = tuple((str(j), str(d)) for j, d in self.channels)
+        if len(channels) != frames.shape[1]:
+            raise ParameterError(
+                f"{len(channels)} channel names for {frames.shape[1]} columns of frames"
+            )
+        if len(set(channels)) != len(channels):
+            dup = sorted({c for c in channels if channels.count(c) > 1})
+            raise ParameterError(f"duplicate channels: {dup}")
+        if not np.isfinite(self.fps) or self.fps <= 0:
+            raise ParameterError(f"fps must be a positive number, got {self.fps}")
+        frames.flags.writeable = False
+        object.__setattr__(self, "frames", frames)
+        object.__setattr__(self, "channels", channels)
+        object.__setattr__(self, "fps", float(self.fps))
+
+    # ---------------------------------------------------------------- basics
+    @property
+    def n_frames(self) -> int:
+        return int(self.frames.shape[0])
+
+    @property
+    def n_channels(self) -> int:
+        return int(self.frames.shape[1])
+
+    @property
+    def duration(self) -> float:
+        """Length in seconds (frames / fps)."""
+        return self.n_frames / self.fps
+
+    def __len__(self) -> int:
+        return self.n_frames
+
+    def __repr__(self) -> str:
+        skel = f", skeleton={len(self.skeleton.joints)} joints" if self.skeleton else ""
+        src = f", source={self.source!r}" if self.source else ""
+        return (
+            f"Motion({self.n_frames} frames x {self.n_channels} channels, "
+            f"{self.fps:g} fps{skel}{src})"
+        )
+
+    def channel_index(self, joint: str, dof: str) -> int:
+        """Column of channel ``(joint, dof)``."""
+        try:
+            return self.channels.index((joint, dof))
+        except ValueError:
+            raise KeyError(f"no channel ({joint!r}, {dof!r}) in this motion") from None
+
+    def channel_names(self, sep: str = ".") -> list[str]:
+        """Flat names such as ``"root.tx"``."""
+        return [f"{j}{sep}{d}" for j, d in self.channels]
+
+    # --------------------------------------------------------------- slicing
+    def __getitem__(self, key: int | slice | Sequence[int] | np.ndarray) -> "Motion":
+        """Select frames; everything else (channels, skeleton, rate) is kept.
+
+        ``motion[200:450]`` gives frames 200..449 with ``start_frame`` advanced.
+        """
+        if isinstance(key, tuple):
+            raise TypeError("index a Motion by frames only; use select() for channels")
+        if isinstance(key, (int, np.integer)):
+            n = self.n_frames
+            k = int(key) + n if key < 0 else int(key)
+            if not 0 <= k < n:
+                raise IndexError(f"frame {key} out of range for {n} frames")
+            key = slice(k, k + 1)
+        if isinstance(key, slice):
+            start, stop, step = key.indices(self.n_frames)
+            if step != 1:
+                fps = self.fps / abs(step)
+            else:
+                fps = self.fps
+            sub = self.frames[key]
+            return replace(self, frames=sub, fps=fps, start_frame=self.start_frame + start)
+        idx = np.asarray(key)
+        if idx.dtype == bool:
+            idx = np.flatnonzero(idx)
+        sub = self.frames[idx]
+        first = int(idx[0]) if idx.size else 0
+        return replace(self, frames=sub, start_frame=self.start_frame + first)
+
+    def select(self, channels: Iterable[Channel | str]) -> "Motion":
+        """Keep only some channels (``(joint, dof)`` pairs, ``"joint.dof"`` or a joint
+        name for all its channels), in the order given."""
+        wanted: list[Channel] = []
+        for c in channels:
+            if isinstance(c, str):
+                if "." in c:
+                    j, d = c.rsplit(".", 1)
+                    wanted.append((j, d))
+                else:
+                    found = [ch for ch in self.channels if ch[0] == c]
+                    if not found:
+                        raise KeyError(f"no channels for joint {c!r} in this motion")
+                    wanted.extend(found)
+            else:
+                wanted.append((str(c[0]), str(c[1])))
+        cols = [self.channel_index(j, d) for j, d in wanted]
+        return replace(self, frames=self.frames[:, cols], channels=tuple(wanted))
+
+    def with_frames(self, frames: np.ndarray, **changes) -> "Motion":
+        """A copy with new frame values (same channels unless ``channels=`` is given)."""
+        return replace(self, frames=frames, **changes)
+
+    @staticmethod
+    def concatenate(motions: Sequence["Motion"]) -> "Motion":
+        """Join captures end to end; they must share channels and frame rate."""
+        if not motions:
+            raise ParameterError("nothing to concatenate")
+        first = motions[0]
+        for i, m in enumerate(motions[1:], start=1):
+            if m.channels != first.channels:
+                missing = set(first.channels) ^ set(m.channels)
+                detail = f" (differing: {sorted(missing)[:4]})" if missing else " (order differs)"
+                raise ParameterError(f"motion {i} has different channels from motion 0{detail}")
+            if abs(m.fps - first.fps) > 1e-9:
+                raise ParameterError(
+                    f"motion {i} is at {m.fps:g} fps, motion 0 at {first.fps:g} fps; resample first"
+                )
+        frames = np.concatenate([m.frames for m in motions], axis=0)
+        sources = [m.source for m in motions if m.source]
+        return replace(
+            first,
+            frames=frames,
+            start_frame=0,
+            source=" + ".join(sources) if sources else None,
+            metadata={"parts": [(m.source, m.n_frames) for m in motions]},
+        )
+
+    # ---------------------------------------------------------- conveniences
+    def positions(self):
+        """Forward kinematics: world positions of every joint (see
+        :func:`cyclecoord.skeleton.forward_kinematics`)."""
+        from .skeleton import forward_kinematics
+
+        return forward_kinematics(self)
+
+    def root_channels(self) -> list[int]:
+        """Columns of the root joint's translation and rotation channels.
+
+        The root is the skeleton's first joint when known, otherwise the joint of the
+        first channel if it carries translation dofs.
+        """
+        if self.skeleton is not None:
+            root = self.skeleton.joints[0].name
+        elif self.channels and any(d.startswith("t") for j, d in self.channels if j == self.channels[0][0]):
+            root = self.channels[0][0]
+        else:
+            return []
+        return [i for i, (j, d) in enumerate(self.channels) if j == root and d in DOF_NAMES]
