@@ -1,0 +1,334 @@
+"""Vietoris-Rips filtration and persistent cohomology barcode (with cocycles) via ripser.
+
+The barcode holds H0 and H1 bars and, for every H1 bar, a representative cocycle over
+Z/p.  Bars are reported in the units of the analysed point cloud; deaths beyond the
+threshold are ``inf``.  This module also decides which class to use and at which scale
+(paper §4.2: high in the bar, below its death) and whether any class stands clear.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial.distance import pdist, squareform
+
+from .errors import ParameterError
+
+__all__ = [
+    "Barcode",
+    "BarSelection",
+    "compute_barcode",
+    "default_max_scale",
+    "check_prime",
+    "select_bar",
+    "DEFAULT_PRIME",
+    "temporal_distance_matrix",
+]
+
+#: Coefficient field used by default: a prime well above 11 (the paper asks for p > 11).
+DEFAULT_PRIME = 47
+
+#: A bar is "clear" when death/birth (death capped at the threshold) reaches this ...
+CLEAR_RATIO = 2.0
+#: ... and its persistence is at least this many times the next-longest H1 bar's.
+CLEAR_GAP = 2.0
+
+
+def check_prime(p: int) -> int:
+    """Validate the coefficient prime: an integer prime strictly greater than 11."""
+    try:
+        q = int(p)
+    except (TypeError, ValueError):
+        raise ParameterError(f"prime must be an integer, got {p!r}") from None
+    if q != p:
+        raise ParameterError(f"prime must be an integer, got {p!r}")
+    if q <= 11:
+        raise ParameterError(
+            f"prime must be greater than 11 (circular coordinates need a field Z/p whose lift "
+            f"to the integers is unambiguous), got {q}"
+        )
+    if any(q % d == 0 for d in range(2, int(q**0.5) + 1)):
+        raise ParameterError(f"prime must be a prime number, {q} is not")
+    return q
+
+
+@dataclass(frozen=True)
+class Barcode:
+    """Persistence barcode of a Vietoris-Rips filtration, with H1 cocycles.
+
+    Attributes
+    ----------
+    h0, h1 : ndarray, shape (n, 2)
+        ``(birth, death)`` per bar in the analysed space's units; ``death`` is ``inf`` when
+        the class is still alive at ``threshold``.  H1 bars are sorted by decreasing
+        persistence (death capped at the threshold).
+    cocycles : list of ndarray, each (m, 3) int
+        Representative cocycle of each H1 bar: rows ``(i, j, value)`` with ``i < j``
+        point indices and ``value`` in ``[0, prime)`` on the edge oriented ``i -> j``.
+    threshold : float
+        Largest filtration value built.
+    prime : int
+        The coefficient field Z/p.
+    n_points : int
+        Number of points in the filtration (landmarks, when subsampled).
+    n_edges : int
+        Edges ripser added.
+    """
+
+    h0: np.ndarray
+    h1: np.ndarray
+    cocycles: list
+    threshold: float
+    prime: int
+    n_points: int
+    n_edges: int = 0
+    point_indices: np.ndarray | None = None
+    extras: dict = field(default_factory=dict)
+
+    def persistence(self, dim: int = 1) -> np.ndarray:
+        """Bar lengths with deaths capped at the threshold."""
+        bars = self.h1 if dim == 1 else self.h0
+        if bars.size == 0:
+            return np.zeros(0)
+        return np.minimum(bars[:, 1], self.threshold) - bars[:, 0]
+
+    def long_h0(self, min_length: float) -> int:
+        """Number of H0 bars (the infinite one included) longer than ``min_length``."""
+        return int(np.sum(self.persistence(0) > min_length))
+
+    def to_dict(self) -> dict:
+        """JSON-ready form: ``{"h0": [[b, d], ...], "h1": [...]}`` with ``None`` for inf."""
+
+        def bars(a: np.ndarray) -> list:
+            return [[float(b), None if not np.isfinite(d) else float(d)] for b, d in a]
+
+        return {"h0": bars(self.h0), "h1": bars(self.h1)}
+
+
+def temporal_distance_matrix(points: np.ndarray) -> np.ndarray:
+    """Euclidean distances with consecutive frames set to distance 0 (paper §3.2).
+
+    Adjacent frames are then always joined first, so the filtration follows the time
+    series and only the loop's closing has to be found geometrically.
+    """
+    d = squareform(pdist(points))
+    i = np.arange(len(points) - 1)
+    d[i, i + 1] = 0.0
+    d[i + 1, i] = 0.0
+    return d
+
+
+def default_max_scale(points: np.ndarray, distances: np.ndarray | None = None, max_pairs: int = 250_000, random_state: int = 0) -> float:
+    """Automatic filtration threshold.
+
+    Half the diameter of the point cloud (estimated on at most ``max_pairs`` sampled
+    pairs for large clouds), and never less than twice the largest step between
+    consecutive frames, so the trajectory is connected in the complex.
+
+    For a loop of radius ``r`` sampled densely, the dominant H1 class is born near the
+    sampling gap and dies near ``r * sqrt(3)``; a threshold of about ``r`` keeps the class
+    alive (its bar is reported as infinite) while building only the edges that matter.
+    """
+    n = len(points)
+    if distances is not None:
+        diam = float(np.max(distances))
+        steps = np.diagonal(distances, offset=1)
+    else:
+        if n * (n - 1) // 2 <= max_pairs:
+            diam = float(pdist(points).max()) if n > 1 else 0.0
+        else:
+            rng = np.random.default_rng(random_state)
+            i = rng.integers(0, n, max_pairs)
+            j = rng.integers(0, n, max_pairs)
+            diam = float(np.linalg.norm(points[i] - points[j], axis=1).max())
+        steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    step = float(steps.max()) if steps.size else 0.0
+    return max(0.5 * diam, 2.0 * step, 1e-9)
+
+
+def compute_barcode(
+    points: np.ndarray,
+    max_scale: float | None = None,
+    prime: int = DEFAULT_PRIME,
+    distance_matrix: bool = False,
+    n_landmarks: int | None = None,
+) -> Barcode:
+    """Vietoris-Rips persistent cohomology in dimensions 0 and 1 with cocycles.
+
+    Parameters
+    ----------
+    points : ndarray, shape (T, K) or (T, T)
+        Point cloud, or a distance matrix when ``distance_matrix`` is True.
+    max_scale : float, optional
+        Filtration threshold; :func:`default_max_scale` when omitted.
+    prime : int, default 47
+        Coefficient field Z/p; must be a prime greater than 11.
+    n_landmarks : int, optional
+        Greedy max-min subsample size (ripser's ``n_perm``); ``None`` uses every point.
+
+    Returns
+    -------
+    Barcode
+    """
+    import ripser  # local import keeps `import cyclecoord` light
+
+    p = check_prime(prime)
+    x = np.asarray(points, dtype=float)
+    if x.ndim != 2 or x.shape[0] < 3:
+        raise ParameterError(f"need at least 3 points in a (T, K) array, got shape {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise ParameterError("points contain NaN or infinite values")
+    if max_scale is None:
+        max_scale = default_max_scale(x, x if distance_matrix else None)
+    max_scale = float(max_scale)
+    if not np.isfinite(max_scale) or max_scale <= 0:
+        raise ParameterError(f"max scale must be a positive number, got {max_scale}")
+    kwargs = {}
+    if n_landmarks is not None and n_landmarks < x.shape[0]:
+        kwargs["n_perm"] = int(n_landmarks)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # ripser warns about greedy permutations on distance matrices
+        res = ripser.ripser(
+            x,
+            maxdim=1,
+            thresh=max_scale,
+            coeff=p,
+            do_cocycles=True,
+            distance_matrix=distance_matrix,
+            **kwargs,
+        )
+    h0 = np.asarray(res["dgms"][0], dtype=float).reshape(-1, 2)
+    h1 = np.asarray(res["dgms"][1], dtype=float).reshape(-1, 2)
+    cocycles = [np.asarray(c, dtype=np.int64).reshape(-1, 3) for c in res["cocycles"][1]]
+    # orient every cocycle entry i < j, value mod p
+    oriented = []
+    for c in cocycles:
+        c = c.copy()
+        swap = c[:, 0] > c[:, 1]
+        c[swap, 0], c[swap, 1] = c[swap, 1], c[swap, 0].copy()
+        c[swap, 2] = -c[swap, 2]
+        c[:, 2] %= p
+        oriented.append(c)
+    pers = np.minimum(h1[:, 1], max_scale) - h1[:, 0] if h1.size else np.zeros(0)
+    order = np.argsort(-pers, kind="stable")
+    h1 = h1[order]
+    oriented = [oriented[k] for k in order]
+    idx = res.get("idx_perm")
+    extras = {}
+    if "r_cover" in res and kwargs:
+        extras["covering_radius"] = float(res["r_cover"])
+    return Barcode(
+        h0=h0,
+        h1=h1,
+        cocycles=oriented,
+        threshold=max_scale,
+        prime=p,
+        n_points=int(len(idx)) if (idx is not None and kwargs) else int(x.shape[0]),
+        n_edges=int(res.get("num_edges", 0)),
+        point_indices=np.asarray(idx) if (idx is not None and kwargs) else None,
+        extras=extras,
+    )
+
+
+@dataclass(frozen=True)
+class BarSelection:
+    """The H1 class chosen for a circular coordinate and the scale it is read at.
+
+    Attributes
+    ----------
+    index : int
+        Position in :attr:`Barcode.h1` (0 = most persistent).
+    birth, death : float
+        The bar (``death`` is ``inf`` when alive at the threshold).
+    scale : float
+        Filtration value at which the cocycle is used, ``birth < scale < death``.
+    clear : bool
+        Whether the bar stands clear of the rest (see :func:`select_bar`).
+    ratio : float
+        ``min(death, threshold) / birth``.
+    gap : float
+        Its persistence over the next-longest bar's persistence (``inf`` if alone).
+    """
+
+    index: int
+    birth: float
+    death: float
+    scale: float
+    clear: bool
+    ratio: float
+    gap: float
+
+    def to_dict(self) -> dict:
+        return {
+            "index": self.index,
+            "birth": self.birth,
+            "death": None if not np.isfinite(self.death) else self.death,
+            "scale": self.scale,
+            "clear": self.clear,
+            "ratio": self.ratio,
+            "gap": None if not np.isfinite(self.gap) else self.gap,
+        }
+
+
+def select_bar(
+    barcode: Barcode,
+    class_index: int = 0,
+    scale: float | None = None,
+    scale_fraction: float = 0.9,
+) -> BarSelection:
+    """Choose an H1 class and the scale at which to read its cocycle.
+
+    Parameters
+    ----------
+    class_index : int, default 0
+        Which bar, by decreasing persistence (death capped at the threshold).
+    scale : float, optional
+        Explicit scale; must lie inside the bar (``birth <= scale < death``) and not above
+        the threshold.
+    scale_fraction : float, default 0.9
+        Otherwise ``scale = birth + scale_fraction * (min(death, threshold) - birth)``: high
+        in the bar as the paper recommends, strictly below the death where the cocycle is
+        still valid.
+
+    Notes
+    -----
+    The bar is *clear* when both hold:
+
+    * ``min(death, threshold) / birth >= 2`` — the class lives at least twice as long as
+      it took to appear (bars of sampling noise in Rips filtrations rarely reach 1.5);
+    * its persistence is at least twice that of the next-longest H1 bar (for
+      ``class_index > 0``, of the next-longest bar after it).
+    """
+    n = len(barcode.h1)
+    if n == 0:
+        raise ParameterError("the barcode has no H1 bar at this threshold")
+    if not 0 <= class_index < n:
+        raise ParameterError(f"class index {class_index} out of range: the barcode has {n} H1 bars")
+    birth, death = (float(v) for v in barcode.h1[class_index])
+    top = min(death, barcode.threshold)
+    pers = barcode.persistence(1)
+    nxt = pers[class_index + 1] if class_index + 1 < n else 0.0
+    gap = float(pers[class_index] / nxt) if nxt > 0 else float("inf")
+    ratio = float(top / birth) if birth > 0 else float("inf")
+    if scale is None:
+        if not 0.0 < scale_fraction < 1.0:
+            raise ParameterError(f"scale fraction must be in (0, 1), got {scale_fraction}")
+        s = birth + scale_fraction * (top - birth)
+    else:
+        s = float(scale)
+        if not (birth <= s < death) or s > barcode.threshold:
+            raise ParameterError(
+                f"scale {s:g} is outside H1 bar {class_index} [{birth:g}, {death:g}) "
+                f"(threshold {barcode.threshold:g}); the cocycle is only valid inside its bar"
+            )
+    return BarSelection(
+        index=int(class_index),
+        birth=birth,
+        death=death,
+        scale=float(s),
+        clear=bool(ratio >= CLEAR_RATIO and gap >= CLEAR_GAP),
+        ratio=ratio,
+        gap=gap,
+    )
