@@ -1,0 +1,367 @@
+"""The ``cyclecoord`` command line: subcommands over the library, JSON reports, exit codes.
+
+Exit codes: 0 success, 1 bad input or failure (one-line message, no traceback),
+2 usage error, 3 no periodic motion found (the report is still written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError
+
+__all__ = ["main", "build_parser"]
+
+EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_NO_PERIODIC = 0, 1, 2, 3
+
+EXAMPLES = ("walk", "jog", "jumping_jack", "arm_circles", "squat", "chain")
+
+
+# ----------------------------------------------------------------- helpers
+def _frame_range(text: str) -> tuple[int | None, int | None]:
+    """Parse ``A:B`` (0-based, half-open; either side may be empty)."""
+    if ":" not in text:
+        raise argparse.ArgumentTypeError(f"expected A:B (0-based, half-open), got {text!r}")
+    a, b = text.split(":", 1)
+    try:
+        start = int(a) if a.strip() else None
+        stop = int(b) if b.strip() else None
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"frame range must be integers A:B, got {text!r}") from None
+    if start is not None and start < 0 or stop is not None and stop < 0:
+        raise argparse.ArgumentTypeError(f"frame numbers must be >= 0, got {text!r}")
+    return start, stop
+
+
+def _positive_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"expected a number >= 1, got {v}")
+    return v
+
+
+def _positive_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not np.isfinite(v) or v <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
+    return v
+
+
+def load_input(path: str, skeleton: str | None = None, fps: float | None = None):
+    """Load a capture, or a built-in example when ``path`` is ``example[:kind]``."""
+    from . import datasets
+    from .io import load
+
+    if (path == "example" or path.startswith("example:")) and not Path(path).exists():
+        kind = path.split(":", 1)[1] if ":" in path else "walk"
+        if kind not in EXAMPLES:
+            raise ParameterError(f"unknown built-in example {kind!r}; choose from {', '.join(EXAMPLES)}")
+        if kind == "walk":
+            cap = datasets.example_capture()
+        elif kind == "chain":
+            cap = datasets.make_motion_chain(random_state=0)
+        else:
+            cap = datasets.make_periodic_capture(kind=kind, n_frames=480, random_state=0)
+        m = cap.motion
+        if fps is not None:
+            from dataclasses import replace
+
+            m = replace(m, fps=fps)
+        return m
+    return load(path, skeleton=skeleton, fps=fps)
+
+
+def _write_json(path: str, payload: dict) -> None:
+    from .io._atomic import atomic_write
+
+    with atomic_write(path, "w") as fh:
+        json.dump(payload, fh, indent=1, allow_nan=False, default=_json_default)
+        fh.write("\n")
+
+
+def _json_default(o):
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, (np.floating,)):
+        v = float(o)
+        return v if np.isfinite(v) else None
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+def _clean(obj):
+    """Replace non-finite floats by None so the JSON is strict."""
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if np.isfinite(obj) else None
+    return obj
+
+
+def _add_selection_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("what to analyse and how")
+    g.add_argument("--skeleton", metavar="ASF", help="ASF skeleton for an AMC input (default: found beside the AMC)")
+    g.add_argument("--frames", type=_frame_range, metavar="A:B", help="0-based half-open frame range, e.g. 200:450")
+    g.add_argument("--fps", type=_positive_float, metavar="F", help="frame rate (AMC files carry none; default 120)")
+    g.add_argument("--pca", type=_positive_int, metavar="K", help="project poses onto K principal components first")
+    g.add_argument("--normalize", action="store_true", help="scale each channel by its standard deviation")
+    g.add_argument("--temporal", action="store_true", help="time-aware metric: consecutive frames at distance 0")
+    g.add_argument("--no-root-diff", action="store_true", help="keep root translation/orientation as they are")
+    g.add_argument("--prime", type=int, default=47, metavar="P", help="coefficient field Z/P, a prime > 11 (default 47)")
+    g.add_argument(
+        "--max-scale", type=_positive_float, metavar="E",
+        help="Rips threshold in the analysed space's units (default: half the point cloud's diameter)",
+    )
+
+
+def _summary_barcode(bc, sel=None) -> str:
+    pers = bc.persistence(1)
+    lines = [f"barcode up to {bc.threshold:.4g} (Z/{bc.prime}): {len(bc.h0)} H0 bars, {len(bc.h1)} H1 bars"]
+    for k, (b, d) in enumerate(bc.h1[:5]):
+        mark = "  <- selected" if sel is not None and k == sel.index else ""
+        ds = "inf" if not np.isfinite(d) else f"{d:.4g}"
+        lines.append(f"  H1 #{k}: [{b:.4g}, {ds})  persistence {pers[k]:.4g}{mark}")
+    if len(bc.h1) > 5:
+        lines.append(f"  ... {len(bc.h1) - 5} shorter H1 bars (longest {pers[5]:.4g})")
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------- commands
+def cmd_extract(args: argparse.Namespace) -> int:
+    from .io import save
+    from .pipeline import extract
+
+    motion = load_input(args.input, args.skeleton, args.fps)
+    report_payload = None
+    code = EXIT_OK
+    try:
+        res = extract(
+            motion,
+            frames=args.frames,
+            pca=args.pca,
+            normalize=args.normalize,
+            temporal=args.temporal,
+            difference_root=not args.no_root_diff,
+            prime=args.prime,
+            max_scale=args.max_scale,
+            scale=args.scale,
+            class_index=args.class_index,
+            n_samples=args.samples,
+            n_neighbors=args.neighbors,
+            weighting=args.weighting,
+            sampling=args.sampling,
+            random_state=args.seed,
+        )
+    except NoPeriodicMotionError as exc:
+        partial = exc.result
+        print(f"cyclecoord: {exc}", file=sys.stderr)
+        if partial is not None:
+            print(_summary_barcode(partial.barcode))
+            report_payload = {
+                "source": partial.motion.source,
+                "frames": [partial.motion.start_frame, partial.motion.start_frame + partial.motion.n_frames],
+                "n_frames": partial.motion.n_frames,
+                "dims": int(partial.prepared.points.shape[1]),
+                "threshold": partial.barcode.threshold,
+                "prime": partial.barcode.prime,
+                "barcode": partial.barcode.to_dict(),
+                "selected": None,
+                "error": str(exc),
+                "timings": partial.timings,
+                "warnings": partial.warnings,
+            }
+        code = EXIT_NO_PERIODIC
+    else:
+        m = res.motion
+        sel = res.selection
+        print(
+            f"{m.source or args.input}: frames {m.start_frame}:{m.start_frame + m.n_frames} "
+            f"({m.n_frames} frames, {res.prepared.points.shape[1]} dims analysed, {m.fps:g} fps)"
+        )
+        print(_summary_barcode(res.barcode, sel))
+        ds = "inf" if not np.isfinite(sel.death) else f"{sel.death:.4g}"
+        gap = "alone" if not np.isfinite(sel.gap) else f"{sel.gap:.1f}x the next bar"
+        print(
+            f"class #{sel.index} [{sel.birth:.4g}, {ds}) read at scale {sel.scale:.4g}: "
+            f"death/birth {sel.ratio:.2f}, persistence {gap}"
+        )
+        chk = res.estimator.cocycle_check_
+        print(f"cocycle check: {chk.n_violations} of {chk.n_triangles} triangles violate (prime {res.estimator.prime_})")
+        per = ", ".join(f"{v:.1f}" for v in res.cycle_frames[:8])
+        print(
+            f"coordinate: {res.cycles:.2f} cycles in the clip, period {res.period_frames:.1f} frames "
+            f"({res.period_frames / m.fps:.3f} s)" + (f"; complete cycles: {per}" if per else "")
+        )
+        ratio = res.jerk["cycle"] / res.jerk["original"] if res.jerk["original"] > 0 else float("nan")
+        print(
+            f"cycle: {res.cycle.n_frames} frames, loop closure {res.loop_closure:.2f} (1 = seamless), "
+            f"jerk {res.jerk['cycle']:.4g} vs original {res.jerk['original']:.4g} (ratio {ratio:.2f})"
+        )
+        print(
+            f"frames to cycle: median distance {res.distance['median']:.3g} "
+            f"(median frame step {res.distance['median_frame_step']:.3g})"
+        )
+        for w in res.warnings:
+            print(f"warning: {w}")
+        if args.output:
+            save(res.cycle, args.output)
+            print(f"wrote {args.output}")
+        report_payload = res.to_report()
+        t = res.timings
+        print("time: " + ", ".join(f"{k} {v:.3f}s" for k, v in t.items()))
+    if args.report and report_payload is not None:
+        _write_json(args.report, _clean(report_payload))
+        print(f"wrote {args.report}")
+    return code
+
+
+def cmd_barcode(args: argparse.Namespace) -> int:
+    from .barcode import compute_barcode
+    from .preprocess import Preprocessor
+    from .barcode import temporal_distance_matrix
+
+    motion = load_input(args.input, args.skeleton, args.fps)
+    if args.frames is not None:
+        a, b = args.frames
+        n = motion.n_frames
+        a = 0 if a is None else a
+        b = n if b is None else b
+        if not 0 <= a < b <= n:
+            raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames")
+        motion = motion[a:b]
+    prep = Preprocessor(difference_root=not args.no_root_diff, normalize=args.normalize, pca=args.pca)
+    pts = prep.fit_transform(motion).points
+    if args.temporal:
+        bc = compute_barcode(temporal_distance_matrix(pts), args.max_scale, args.prime, distance_matrix=True)
+    else:
+        bc = compute_barcode(pts, args.max_scale, args.prime)
+    if args.json:
+        payload = {"threshold": bc.threshold, "prime": bc.prime, "n_points": bc.n_points, **bc.to_dict()}
+        print(json.dumps(_clean(payload)))
+    else:
+        print(_summary_barcode(bc))
+    return EXIT_OK
+
+
+def cmd_convert(args: argparse.Namespace) -> int:
+    from .io import save
+
+    motion = load_input(args.input, args.skeleton, args.fps)
+    if args.frames is not None:
+        a, b = args.frames
+        motion = motion[slice(a, b)]
+    if Path(args.output).resolve() == Path(args.input).resolve():
+        raise ParameterError(f"{args.output}: refusing to overwrite the input file")
+    save(motion, args.output)
+    print(f"{args.input} -> {args.output}: {motion.n_frames} frames, {motion.n_channels} channels, {motion.fps:g} fps")
+    return EXIT_OK
+
+
+# ------------------------------------------------------------------ parser
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="cyclecoord",
+        description=(
+            "Find, parameterise and reuse periodic motion in motion capture with persistent "
+            "cohomology. INPUT is an .amc (skeleton found beside it), .bvh, .npz or .csv file, "
+            "or 'example' for the built-in synthetic walk (example:jog, example:chain, ...)."
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=(
+            "examples:\n"
+            "  cyclecoord extract example -o walk_cycle.bvh --report report.json\n"
+            "  cyclecoord extract 69_01.amc --frames 200:450 --max-scale 50 -o cycle.bvh\n"
+            "  cyclecoord barcode 69_01.amc --frames 200:450 --json\n"
+            "  cyclecoord convert 69_01.amc -o 69_01.bvh\n"
+            "exit codes: 0 ok, 1 error, 2 usage, 3 no periodic motion found"
+        ),
+    )
+    from . import __version__
+
+    p.add_argument("--version", action="version", version=f"cyclecoord {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+
+    e = sub.add_parser(
+        "extract",
+        help="find the dominant periodic motion and write its typical cycle",
+        description=(
+            "Barcode -> most persistent H1 class -> circular coordinate per frame -> periodic "
+            "density -> typical cycle (k-nearest-neighbour centroids), resampled to the capture's "
+            "frame rate and written as a loopable clip. Exit code 3 when no H1 bar stands clear "
+            "(death/birth >= 2 and at least 2x the next bar's persistence); the report is still written."
+        ),
+    )
+    e.add_argument("input", metavar="INPUT")
+    _add_selection_options(e)
+    g = e.add_argument_group("class, scale and cycle")
+    g.add_argument("--scale", type=_positive_float, metavar="E", help="read the cocycle at this scale (inside the bar)")
+    g.add_argument("--class", dest="class_index", type=int, default=0, metavar="I",
+                   help="use the I-th most persistent H1 class (default 0)")
+    g.add_argument("--samples", type=_positive_int, default=500, metavar="N", help="phases sampled from the density (500)")
+    g.add_argument("--neighbors", type=_positive_int, default=10, metavar="K", help="frames averaged per phase (10)")
+    g.add_argument("--weighting", choices=("mean", "gaussian"), default="mean", help="centroid weighting (mean)")
+    g.add_argument("--sampling", choices=("quantile", "random"), default="quantile",
+                   help="density quantiles (default, smooth) or random draws as in the paper")
+    g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (0)")
+    o = e.add_argument_group("output")
+    o.add_argument("-o", "--output", metavar="OUT", help="write the cycle (.bvh, .amc, .npz or .csv)")
+    o.add_argument("--report", metavar="R.json", help="write a JSON report (barcode, coordinate, figures, timings)")
+    e.set_defaults(func=cmd_extract)
+
+    b = sub.add_parser("barcode", help="print the H0/H1 barcode of a capture",
+                       description="Vietoris-Rips persistent cohomology barcode (H0, H1) of the prepared poses.")
+    b.add_argument("input", metavar="INPUT")
+    _add_selection_options(b)
+    b.add_argument("--json", action="store_true", help="print JSON ({'h0': [[b, d], ...], 'h1': ...}; d null = infinite)")
+    b.set_defaults(func=cmd_barcode)
+
+    c = sub.add_parser("convert", help="convert between ASF/AMC, BVH, NPZ and CSV",
+                       description="Convert a capture between formats, chosen by the file suffixes.")
+    c.add_argument("input", metavar="INPUT")
+    c.add_argument("-o", "--output", required=True, metavar="OUT")
+    c.add_argument("--skeleton", metavar="ASF", help="ASF skeleton for an AMC input")
+    c.add_argument("--fps", type=_positive_float, metavar="F", help="frame rate to record in the output")
+    c.add_argument("--frames", type=_frame_range, metavar="A:B", help="only these frames")
+    c.set_defaults(func=cmd_convert)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "command", None):
+        parser.print_help()
+        return EXIT_USAGE
+    try:
+        return int(args.func(args))
+    except CycleCoordError as exc:
+        print(f"cyclecoord: error: {exc}", file=sys.stderr)
+        return EXIT_ERROR
+    except FileNotFoundError as exc:
+        print(f"cyclecoord: error: {exc}", file=sys.stderr)
+        return EXIT_ERROR
+    except PermissionError as exc:
+        print(f"cyclecoord: error: {exc}", file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        print("cyclecoord: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

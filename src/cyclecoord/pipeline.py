@@ -1,0 +1,372 @@
+"""The periodic pipeline end to end: capture -> barcode -> circular coordinate -> typical cycle.
+
+:func:`extract` runs every stage and returns an :class:`ExtractionResult` holding each
+stage's output, the quality figures and per-stage timings; ``result.cycle`` is the
+typical cycle as a loopable :class:`~cyclecoord.motion.Motion`.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .barcode import DEFAULT_PRIME, CLEAR_GAP, CLEAR_RATIO, Barcode, BarSelection
+from .coordinates import CircularCoordinates, unwrap
+from .cycle import TypicalCycle, integrate_root, typical_cycle
+from .density import PeriodicDensity
+from .errors import NoPeriodicMotionError, ParameterError
+from .metrics import distance_to_cycle, jerk_summary, loop_closure
+from .motion import Motion
+from .preprocess import PreparedData, Preprocessor
+
+__all__ = ["extract", "ExtractionResult", "cycle_lengths"]
+
+
+def cycle_lengths(unwrapped: np.ndarray) -> np.ndarray:
+    """Frames taken by each complete cycle.
+
+    The unwrapped coordinate ``u`` starts at ``u[0]``; cycle ``k`` ends where ``u`` first
+    reaches ``u[0] + k`` (linearly interpolated between frames).  Returns the differences
+    between successive crossing times, starting from frame 0.
+    """
+    u = np.asarray(unwrapped, dtype=float)
+    if u.size < 2:
+        return np.zeros(0)
+    total = u[-1] - u[0]
+    ends = []
+    for k in range(1, int(np.floor(total)) + 1):
+        level = u[0] + k
+        i = int(np.argmax(u >= level))
+        if u[i] < level:
+            break
+        if i == 0:
+            ends.append(0.0)
+            continue
+        f = (level - u[i - 1]) / (u[i] - u[i - 1]) if u[i] != u[i - 1] else 0.0
+        ends.append(i - 1 + f)
+    return np.diff(np.concatenate([[0.0], ends])) if ends else np.zeros(0)
+
+
+@dataclass
+class ExtractionResult:
+    """Everything :func:`extract` computed.
+
+    Attributes
+    ----------
+    motion : Motion
+        The analysed frames (after ``frames`` selection).
+    prepared : PreparedData
+        Points (T, K) analysed and poses (T, D) with differenced root channels.
+    barcode : Barcode
+    selection : BarSelection
+        Chosen H1 class and scale.
+    coordinate : ndarray, shape (T,)
+        Circular coordinate per analysed frame, in [0, 1), increasing with time.
+    unwrapped : ndarray, shape (T,)
+        The coordinate unwrapped along frame order (in cycles).
+    cycles : float
+        Number of cycles in the clip (unwrapped change from first to last frame).
+    period_frames : float
+        Mean period in frames, ``(T - 1) / cycles``.
+    cycle_frames : ndarray
+        Length in frames of each complete cycle.
+    density : PeriodicDensity
+    typical : TypicalCycle
+        The cycle in the prepared space (root as differences).
+    cycle : Motion
+        The typical cycle as a motion at the capture's rate, root re-integrated so it
+        travels like the original; loops.
+    jerk : dict
+        ``{"original": ..., "cycle": ...}`` mean jerk norm (channel units / s³).
+    loop_closure : float
+        Last-to-first step of the cycle over its median step (prepared space).
+    distance : dict
+        Distance of the clip's frames to the cycle (median, 90th percentile, max), in
+        the prepared space's units, next to the median frame-to-frame step.
+    timings : dict
+        Seconds per stage.
+    warnings : list of str
+        Anything the user should know (H0 components, cocycle repairs, ...).
+    """
+
+    motion: Motion
+    prepared: PreparedData
+    barcode: Barcode
+    selection: BarSelection
+    coordinate: np.ndarray
+    unwrapped: np.ndarray
+    cycles: float
+    period_frames: float
+    cycle_frames: np.ndarray
+    density: PeriodicDensity
+    typical: TypicalCycle
+    cycle: Motion
+    jerk: dict
+    loop_closure: float
+    distance: dict
+    timings: dict
+    parameters: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    estimator: CircularCoordinates | None = None
+
+    def to_report(self) -> dict[str, Any]:
+        """JSON-ready summary (see the CLI's ``--report``)."""
+        return {
+            "source": self.motion.source,
+            "frames": [int(self.motion.start_frame), int(self.motion.start_frame + self.motion.n_frames)],
+            "n_frames": int(self.motion.n_frames),
+            "fps": self.motion.fps,
+            "dims": int(self.prepared.points.shape[1]),
+            "parameters": self.parameters,
+            "threshold": self.barcode.threshold,
+            "prime": int(self.barcode.prime),
+            "barcode": self.barcode.to_dict(),
+            "selected": self.selection.to_dict(),
+            "clear_criterion": {"min_ratio": CLEAR_RATIO, "min_gap": CLEAR_GAP},
+            "coordinate": [float(v) for v in self.coordinate],
+            "cycles": float(self.cycles),
+            "period_frames": float(self.period_frames),
+            "period_seconds": float(self.period_frames / self.motion.fps),
+            "cycle_frames": [float(v) for v in self.cycle_frames],
+            "cycle_length": int(self.cycle.n_frames),
+            "jerk": self.jerk,
+            "loop_closure": float(self.loop_closure),
+            "distance_to_cycle": self.distance,
+            "cocycle_check": {
+                "triangles": int(self.estimator.cocycle_check_.n_triangles) if self.estimator else None,
+                "violations": int(self.estimator.cocycle_check_.n_violations) if self.estimator else None,
+                "primes_tried": [int(p) for p, _ in self.estimator.primes_tried_] if self.estimator else [],
+            },
+            "timings": {k: round(float(v), 6) for k, v in self.timings.items()},
+            "warnings": list(self.warnings),
+        }
+
+
+def _root_displacement(motion: Motion, root_cols: np.ndarray, cycles: float) -> np.ndarray:
+    """Mean root change per cycle (rotations summed as wrapped differences)."""
+    f = motion.frames[:, root_cols]
+    d = np.diff(f, axis=0)
+    rot = np.array([motion.channels[c][1].startswith("r") for c in root_cols], dtype=bool)
+    d[:, rot] = (d[:, rot] + 180.0) % 360.0 - 180.0
+    return d.sum(axis=0) / cycles
+
+
+def extract(
+    motion: Motion,
+    frames: tuple[int | None, int | None] | None = None,
+    *,
+    pca: int | None = None,
+    normalize: bool = False,
+    temporal: bool = False,
+    difference_root: bool = True,
+    prime: int = DEFAULT_PRIME,
+    max_scale: float | None = None,
+    scale: float | None = None,
+    class_index: int = 0,
+    scale_fraction: float = 0.9,
+    n_samples: int = 500,
+    n_neighbors: int = 10,
+    weighting: str = "mean",
+    sampling: str = "quantile",
+    n_components: int = 30,
+    require_clear: bool = True,
+    random_state: int | None = 0,
+) -> ExtractionResult:
+    """Find the dominant periodic motion of a capture and its typical cycle.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture (angles in degrees).
+    frames : (start, stop), optional
+        0-based half-open frame range to analyse.
+    pca : int, optional
+        Project onto this many principal components before the filtration.
+    normalize : bool
+        Scale each channel by its standard deviation first.
+    temporal : bool
+        Use the time-aware metric (consecutive frames at distance 0).
+    difference_root : bool, default True
+        Replace root translation/orientation by first differences.
+    prime : int, default 47
+        Coefficient field Z/p, a prime greater than 11.
+    max_scale : float, optional
+        Filtration threshold in the analysed space's units (default: half the point
+        cloud's diameter, see :func:`cyclecoord.barcode.default_max_scale`).
+    scale : float, optional
+        Scale to read the cocycle at (default: ``scale_fraction`` of the way up the bar).
+    class_index : int, default 0
+        Which H1 class by decreasing persistence.
+    n_samples : int, default 500
+        Phases sampled from the periodic density for the centroid curve.
+    n_neighbors : int, default 10
+        Frames averaged per sampled phase.
+    weighting : {"mean", "gaussian"}
+    sampling : {"quantile", "random"}
+        Deterministic density quantiles (default, less jitter) or random draws (paper).
+    n_components : int, default 30
+        Gaussian mixture components of the periodic density.
+    require_clear : bool, default True
+        Raise :class:`NoPeriodicMotionError` when the chosen bar does not stand clear.
+    random_state : int, optional
+        Seed for the density fit and sampling.
+
+    Returns
+    -------
+    ExtractionResult
+
+    Raises
+    ------
+    NoPeriodicMotionError
+        When the chosen H1 bar does not stand clear (its ``result`` attribute holds a
+        partial :class:`ExtractionResult` with ``cycle`` None and the barcode).
+    ParameterError
+        For invalid arguments.
+    """
+    if not isinstance(motion, Motion):
+        raise ParameterError(f"extract() takes a Motion, got {type(motion).__name__}")
+    if weighting not in ("mean", "gaussian"):
+        raise ParameterError(f"weighting must be 'mean' or 'gaussian', got {weighting!r}")
+    if sampling not in ("quantile", "random"):
+        raise ParameterError(f"sampling must be 'quantile' or 'random', got {sampling!r}")
+    if n_samples < 10:
+        raise ParameterError(f"n_samples must be at least 10, got {n_samples}")
+    if n_neighbors < 1:
+        raise ParameterError(f"n_neighbors must be at least 1, got {n_neighbors}")
+    timings: dict[str, float] = {}
+    notes: list[str] = []
+    params = dict(
+        frames=None if frames is None else list(frames), pca=pca, normalize=normalize, temporal=temporal,
+        difference_root=difference_root, prime=prime, max_scale=max_scale, scale=scale,
+        class_index=class_index, scale_fraction=scale_fraction, n_samples=n_samples,
+        n_neighbors=n_neighbors, weighting=weighting, sampling=sampling, n_components=n_components,
+        random_state=random_state,
+    )
+    if frames is not None:
+        a, b = frames
+        n = motion.n_frames
+        a = 0 if a is None else int(a)
+        b = n if b is None else int(b)
+        if not (0 <= a < b <= n):
+            raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames (0-based, half-open)")
+        motion = motion[a:b]
+    if motion.n_frames < 2 * n_neighbors or motion.n_frames < 10:
+        raise ParameterError(
+            f"{motion.n_frames} frames are too few to find a cycle (need at least {max(10, 2 * n_neighbors)})"
+        )
+
+    t0 = time.perf_counter()
+    prep = Preprocessor(difference_root=difference_root, normalize=normalize, pca=pca)
+    prepared = prep.fit_transform(motion)
+    timings["prepare"] = time.perf_counter() - t0
+
+    est = CircularCoordinates(
+        max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
+        scale_fraction=scale_fraction, temporal=temporal,
+    )
+    t0 = time.perf_counter()
+    barcode = est.fit_barcode(prepared.points)
+    timings["barcode"] = time.perf_counter() - t0
+
+    from .barcode import select_bar
+
+    def fail(msg: str) -> NoPeriodicMotionError:
+        partial = ExtractionResult(
+            motion=motion, prepared=prepared, barcode=barcode, selection=None, coordinate=None,
+            unwrapped=None, cycles=float("nan"), period_frames=float("nan"), cycle_frames=np.zeros(0),
+            density=None, typical=None, cycle=None, jerk={}, loop_closure=float("nan"), distance={},
+            timings=timings, parameters=params, warnings=notes, estimator=est,
+        )
+        return NoPeriodicMotionError(msg, result=partial)
+
+    if len(barcode.h1) == 0:
+        raise fail(f"no periodic motion found: the barcode has no H1 bar up to scale {barcode.threshold:.4g}")
+    if class_index >= len(barcode.h1):
+        raise ParameterError(f"class index {class_index} out of range: the barcode has {len(barcode.h1)} H1 bars")
+    pre_sel = select_bar(barcode, class_index, scale, scale_fraction)
+    if require_clear and not pre_sel.clear:
+        raise fail(
+            "no periodic motion found: the most persistent H1 bar "
+            f"[{pre_sel.birth:.4g}, {pre_sel.death:.4g}) does not stand clear (death/birth {pre_sel.ratio:.2f} "
+            f"< {CLEAR_RATIO} or persistence {pre_sel.gap:.2f}x the next bar's < {CLEAR_GAP}); "
+            "try --max-scale, --pca or --frames"
+        )
+
+    t0 = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        est.fit_coordinate()
+    for w in caught:
+        notes.append(str(w.message))
+    timings["coordinate"] = time.perf_counter() - t0
+    sel = est.selection_
+    barcode = est.barcode_
+    if est.n_components_ > 1:
+        notes.append(
+            f"the complex at scale {sel.scale:.4g} has {est.n_components_} connected components: "
+            "frames in different components get unrelated coordinates; raise --max-scale or --scale"
+        )
+    long_h0 = int(np.sum(np.isfinite(barcode.h0[:, 1]) & (barcode.h0[:, 1] > sel.birth)))
+    if long_h0:
+        notes.append(
+            f"H0 shows {long_h0 + 1} components still apart when the H1 class is born (at {sel.birth:.4g}); "
+            "the capture may hold separate pieces"
+        )
+    theta = est.coordinates_
+    u = unwrap(theta)
+    cycles = float(u[-1] - u[0])
+    if cycles <= 0.5:
+        notes.append(f"the coordinate covers only {cycles:.2f} cycles over the clip; the period estimate is unreliable")
+    if cycles <= 0:
+        raise fail("no periodic motion found: the circular coordinate does not advance along the clip")
+    period = (motion.n_frames - 1) / cycles
+    lengths = cycle_lengths(u)
+
+    t0 = time.perf_counter()
+    density = PeriodicDensity(n_components=n_components, random_state=random_state).fit(theta)
+    timings["density"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    k = min(n_neighbors, motion.n_frames)
+    typ = typical_cycle(
+        theta, prepared.poses, period, density=density, n_samples=n_samples, k=k,
+        weighting=weighting, sampling=sampling, random_state=random_state,
+    )
+    cyc = np.array(typ.frames, dtype=float)
+    root = prepared.root_columns
+    if root.size:
+        disp = _root_displacement(motion, root, cycles)
+        cyc[:, root] = integrate_root(typ.frames[:, root], motion.frames[0, root], disp)
+    cycle_motion = motion.with_frames(
+        cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}",
+        metadata={"period_frames": period, "cycles_in_source": cycles},
+    )
+    timings["cycle"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    fps = motion.fps
+    jerk = {
+        "original": float(jerk_summary(prepared.poses, fps)),
+        "cycle": float(jerk_summary(typ.frames, fps, cyclic=True)),
+    }
+    closure = float(loop_closure(typ.frames))
+    dist = distance_to_cycle(prepared.poses, typ.frames)
+    step = np.linalg.norm(np.diff(prepared.poses, axis=0), axis=1)
+    distance = {
+        "median": float(np.median(dist)),
+        "p90": float(np.percentile(dist, 90)),
+        "max": float(np.max(dist)),
+        "median_frame_step": float(np.median(step)),
+    }
+    timings["metrics"] = time.perf_counter() - t0
+    timings["total"] = sum(timings.values())
+    return ExtractionResult(
+        motion=motion, prepared=prepared, barcode=barcode, selection=sel, coordinate=theta,
+        unwrapped=u, cycles=cycles, period_frames=float(period), cycle_frames=lengths, density=density,
+        typical=typ, cycle=cycle_motion, jerk=jerk, loop_closure=closure, distance=distance,
+        timings=timings, parameters=params, warnings=notes, estimator=est,
+    )
