@@ -1,0 +1,163 @@
+"""Barcode, cocycle lift and check, and circular coordinates on point clouds with known answers."""
+
+import numpy as np
+import pytest
+
+from cyclecoord.barcode import check_prime, compute_barcode, select_bar, temporal_distance_matrix
+from cyclecoord.coordinates import (
+    CircularCoordinates,
+    _edge_values,
+    check_cocycle,
+    harmonic_coordinate,
+    lift_cocycle,
+    orient_with_time,
+    rips_edges,
+    unwrap,
+)
+from cyclecoord.errors import ParameterError
+
+
+def circular_error(a, b):
+    """Largest circular distance between two coordinates after the best rotation."""
+    d = np.mod(a - b, 1.0)
+    shift = np.angle(np.mean(np.exp(2j * np.pi * d))) / (2 * np.pi)
+    r = np.mod(d - shift + 0.5, 1.0) - 0.5
+    return float(np.max(np.abs(r)))
+
+
+def noisy_circle(n=300, turns=3.0, noise=0.03, dim=5, seed=0, uneven=0.0):
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, turns, n, endpoint=False)
+    phase = t + uneven / (2 * np.pi) * np.sin(2 * np.pi * t)
+    ang = 2 * np.pi * phase
+    x = np.zeros((n, dim))
+    x[:, 0], x[:, 1] = np.cos(ang), np.sin(ang)
+    x += noise * rng.standard_normal(x.shape)
+    return x, np.mod(phase, 1.0)
+
+
+@pytest.mark.parametrize("p", [2, 3, 11, 12, 49, 1.5, "x", -13])
+def test_bad_primes_are_refused(p):
+    with pytest.raises(ParameterError):
+        check_prime(p)
+
+
+@pytest.mark.parametrize("p", [13, 47, 97])
+def test_good_primes(p):
+    assert check_prime(p) == p
+
+
+def test_circle_has_one_clear_bar_and_recovers_the_angle():
+    x, phase = noisy_circle()
+    est = CircularCoordinates().fit(x)
+    bc = est.barcode_
+    sel = est.selection_
+    assert sel.index == 0 and sel.clear
+    assert sel.birth < 0.3  # born at the sampling gap, far below the radius
+    assert bc.persistence(1)[0] > 5 * bc.persistence(1)[1]
+    assert est.cocycle_check_.ok
+    theta = est.coordinates_
+    assert theta.min() >= 0 and theta.max() < 1
+    assert theta[0] == 0.0
+    assert circular_error(theta, phase) < 0.03
+    u = unwrap(theta)
+    assert u[-1] - u[0] == pytest.approx(3.0 * 299 / 300, abs=0.05)
+
+
+def test_uneven_sampling_gives_a_monotone_coordinate():
+    # The harmonic coordinate follows the geometry, not time: with uneven sampling it is
+    # a monotone (not linear) function of the angle.
+    x, phase = noisy_circle(uneven=0.5, noise=0.01)
+    theta = CircularCoordinates().fit(x).coordinates_
+    assert circular_error(theta, phase) < 0.2
+    ut, up = unwrap(theta), unwrap(phase)
+    assert np.corrcoef(ut, up)[0, 1] > 0.99
+    order = np.argsort(phase[:100])  # first turn: coordinate sorted by true phase rises
+    steps = np.diff(np.unwrap(2 * np.pi * theta[:100][order]))
+    assert np.mean(steps > 0) > 0.95
+
+
+def test_reversed_time_gives_increasing_coordinate():
+    x, phase = noisy_circle()
+    theta = CircularCoordinates().fit(x[::-1]).coordinates_
+    u = unwrap(theta)
+    assert u[-1] - u[0] > 2.5  # increases with frame order although the points run backwards
+
+
+def test_lift_is_centred():
+    c = np.array([[0, 1, 0], [0, 2, 1], [0, 3, 23], [0, 4, 24], [0, 5, 46]])
+    assert lift_cocycle(c, 47).tolist() == [0, 1, 23, -23, -1]
+
+
+def test_cocycle_check_finds_a_broken_lift():
+    x, _ = noisy_circle(n=120, turns=1.0, dim=2)
+    bc = compute_barcode(x, prime=47)
+    sel = select_bar(bc, 0)
+    edges = rips_edges(x, sel.scale)
+    z, _ = _edge_values(edges, bc.cocycles[0], lift_cocycle(bc.cocycles[0], 47).astype(float), len(x))
+    ok = check_cocycle(edges, z, len(x))
+    assert ok.ok and ok.n_triangles > 0
+    broken = z.copy()
+    k = np.flatnonzero(broken)[0]
+    broken[k] += 47  # still a cocycle mod 47, no longer over the integers
+    bad = check_cocycle(edges, broken, len(x))
+    assert bad.n_violations > 0
+
+
+def test_harmonic_coordinate_on_a_polygon_is_uniform():
+    n = 12
+    edges = np.array([[i, i + 1] for i in range(n - 1)] + [[0, n - 1]])
+    z = np.zeros(len(edges))
+    z[-1] = 1.0  # the closing edge 0 -> n-1 carries the winding
+    theta, harmonic = harmonic_coordinate(edges, z, n)
+    theta = orient_with_time(theta)
+    np.testing.assert_allclose(theta, np.arange(n) / n, atol=1e-9)
+    np.testing.assert_allclose(np.abs(harmonic), 1.0 / n, atol=1e-9)
+
+
+def test_temporal_metric_zeroes_consecutive_frames():
+    x, _ = noisy_circle(n=50, turns=1.0)
+    d = temporal_distance_matrix(x)
+    assert np.all(np.diagonal(d, 1) == 0)
+    assert d[0, 2] > 0
+    est = CircularCoordinates(temporal=True).fit(x)
+    assert est.selection_.clear
+
+
+def test_scale_outside_the_bar_is_refused():
+    x, _ = noisy_circle(n=100, turns=1.0)
+    bc = compute_barcode(x)
+    b, d = bc.h1[0]
+    with pytest.raises(ParameterError, match="outside"):
+        select_bar(bc, 0, scale=b / 2)
+    with pytest.raises(ParameterError, match="out of range"):
+        select_bar(bc, len(bc.h1))
+
+
+def test_noise_has_no_clear_bar():
+    rng = np.random.default_rng(3)
+    x = rng.standard_normal((200, 6))
+    bc = compute_barcode(x)
+    assert not select_bar(bc, 0).clear
+
+
+def test_transform_of_new_points_matches_fit():
+    x, phase = noisy_circle(n=600, turns=4.0, noise=0.02, seed=1)
+    train, test = x[::2], x[1::2]
+    est = CircularCoordinates().fit(train)
+    np.testing.assert_array_equal(est.transform(train), est.coordinates_)
+    pred = est.transform(test)
+    # neighbours in time: each held-back frame lies between two training frames
+    ref = est.coordinates_
+    mid = np.angle(np.exp(2j * np.pi * ref[:-1]) + np.exp(2j * np.pi * ref[1:])) / (2 * np.pi)
+    err = np.abs(np.mod(pred[:-1] - mid + 0.5, 1.0) - 0.5)
+    assert np.median(err) < 0.02
+
+
+def test_invalid_points():
+    with pytest.raises(ParameterError):
+        CircularCoordinates().fit(np.array([[0.0, np.nan], [1, 2], [3, 4]]))
+    with pytest.raises(ParameterError):
+        CircularCoordinates().fit(np.zeros((2, 3)))
+    with pytest.raises(ParameterError, match="not fitted"):
+        CircularCoordinates().transform(np.zeros((5, 3)))

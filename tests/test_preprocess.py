@@ -1,0 +1,63 @@
+"""Preparation: root differencing (with angle wrap), scaling and PCA."""
+
+import numpy as np
+import pytest
+
+from cyclecoord import Motion
+from cyclecoord.errors import ParameterError
+from cyclecoord.preprocess import Preprocessor
+
+ROOT = [("root", d) for d in ("tx", "ty", "tz", "rx", "ry", "rz")]
+
+
+def make(frames):
+    ch = ROOT + [(f"j{i}", "rx") for i in range(frames.shape[1] - 6)]
+    return Motion(frames, ch)
+
+
+def test_root_is_differenced_and_wrapped():
+    t = np.arange(10, dtype=float)
+    f = np.zeros((10, 8))
+    f[:, 2] = 3.0 * t  # tz walks forward
+    f[:, 4] = np.mod(170 + 5 * t + 180, 360) - 180  # heading crosses +180 -> -180
+    f[:, 6] = np.sin(t)
+    prep = Preprocessor().fit_transform(make(f))
+    np.testing.assert_allclose(prep.poses[:, 2], 3.0)
+    np.testing.assert_allclose(prep.poses[:, 4], 5.0)  # no 360 jump
+    np.testing.assert_allclose(prep.poses[:, 6], np.sin(t))  # joints untouched
+    assert prep.root_columns.tolist() == [0, 1, 2, 3, 4, 5]
+    np.testing.assert_array_equal(prep.points, prep.poses)
+
+
+def test_input_is_not_modified():
+    f = np.random.default_rng(0).standard_normal((20, 9))
+    keep = f.copy()
+    m = make(f)
+    Preprocessor(normalize=True, pca=3).fit_transform(m)
+    np.testing.assert_array_equal(m.frames, keep)
+    np.testing.assert_array_equal(f, keep)
+
+
+def test_normalize_and_pca():
+    rng = np.random.default_rng(1)
+    f = rng.standard_normal((100, 10)) * np.arange(1, 11)
+    prep = Preprocessor(difference_root=False, normalize=True)
+    out = prep.fit_transform(make(f))
+    np.testing.assert_allclose(out.points.std(axis=0), 1.0)
+    p = Preprocessor(difference_root=False, pca=2)
+    out = p.fit_transform(make(f))
+    assert out.points.shape == (100, 2)
+    assert p.explained_variance_ratio_[0] >= p.explained_variance_ratio_[1]
+    # PCA is a projection: variance captured equals the sum of the top singular values squared
+    z = f - f.mean(0)
+    s = np.linalg.svd(z, compute_uv=False)
+    assert out.points.var(axis=0, ddof=0).sum() * 100 == pytest.approx((s[:2] ** 2).sum())
+
+
+def test_bad_settings():
+    f = np.zeros((10, 8))
+    with pytest.raises(ParameterError, match="pca"):
+        Preprocessor(pca=50).fit(make(f))
+    f[3, 7] = np.nan
+    with pytest.raises(ParameterError, match="frame 3"):
+        Preprocessor().fit(make(f))
