@@ -1,0 +1,460 @@
+"""The typical cycle: one loopable period averaged from all repetitions (paper §4.4).
+
+Given each frame's circular coordinate ``theta`` (phase in ``[0, 1)``) and its pose, the
+typical cycle is built in three steps:
+
+1. phases are drawn from the periodic density of ``theta``
+   (:class:`~cyclecoord.density.PeriodicDensity`); the density is proportional to the time
+   the motion spends at each phase, so the drawn phases are (about) equally spaced in
+   *time*;
+2. each phase gets an average pose: by default a periodic Gaussian kernel average over
+   all frames whose width holds about ``k`` frames (:func:`kernel_centroids`), which is
+   smooth in the phase; or, as in the paper, the centroid of the ``k`` frames nearest in
+   circular distance (:func:`knn_centroids`), whose neighbour set changes abruptly and
+   so adds jerk where repetitions differ;
+3. the centroid curve is resampled, as a closed curve, to the capture's frame rate
+   (:func:`resample_cyclic`).
+
+Root channels stay as per-frame differences throughout (the prepared space);
+:func:`integrate_root` turns them back into absolute values.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from numbers import Integral, Real
+
+import numpy as np
+
+from .density import PeriodicDensity, _as_generator
+from .errors import ParameterError
+
+__all__ = [
+    "TypicalCycle",
+    "knn_centroids",
+    "kernel_centroids",
+    "resample_cyclic",
+    "integrate_root",
+    "typical_cycle",
+]
+
+_WEIGHTINGS = ("kernel", "mean", "gaussian")
+_SAMPLINGS = ("quantile", "random")
+
+
+# --------------------------------------------------------------------------- helpers
+def _finite_array(x: object, name: str, ndim: int | tuple[int, ...]) -> np.ndarray:
+    try:
+        arr = np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(f"{name} must be an array of numbers: {exc}") from None
+    allowed = (ndim,) if isinstance(ndim, int) else ndim
+    if arr.ndim not in allowed:
+        raise ParameterError(f"{name} must have {' or '.join(map(str, allowed))} dimension(s), got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ParameterError(f"{name} holds NaN or infinite values")
+    return arr
+
+
+def _positive_int(value: object, name: str, minimum: int = 1) -> int:
+    if isinstance(value, bool) or not isinstance(value, Integral) or value < minimum:
+        raise ParameterError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def _wrap01(x: np.ndarray) -> np.ndarray:
+    """``x mod 1`` guaranteed to lie in [0, 1) (``-1e-17 % 1`` is 1.0 in floating point)."""
+    out = np.mod(x, 1.0)
+    out[out >= 1.0] = 0.0
+    return out
+
+
+# ------------------------------------------------------------------------ centroids
+def knn_centroids(
+    theta: np.ndarray,
+    poses: np.ndarray,
+    phases: np.ndarray,
+    k: int = 10,
+    weighting: str = "mean",
+    bandwidth: float | None = None,
+) -> np.ndarray:
+    """Centroid of the ``k`` frames nearest in circular coordinate to each phase.
+
+    Distances are circular: ``min(|a - b|, 1 - |a - b|)``, so phases near 0 find
+    neighbours just below 1 and vice versa.  The ``k`` nearest frames of a phase are
+    always a run of consecutive frames in ``theta``-sorted order (cyclically), so after
+    one sort the best run is chosen among the ``k + 1`` runs that contain the phase's
+    insertion point -- all phases at once, no loop.
+
+    Parameters
+    ----------
+    theta : array_like, shape (T,)
+        Circular coordinate of every frame (phase units, taken modulo 1).
+    poses : array_like, shape (T, D) or (T,)
+        The frames (any units); a 1-D array is one channel.
+    phases : array_like, shape (N,)
+        Phases at which to compute centroids (taken modulo 1).
+    k : int, default 10
+        Number of neighbours, ``1 <= k <= T`` (paper: 10).
+    weighting : {"mean", "gaussian"}
+        ``"mean"``: coordinate-wise arithmetic mean (paper).  ``"gaussian"``: mean
+        weighted by ``exp(-d**2 / (2 * bandwidth**2))`` of the circular distance ``d``.
+    bandwidth : float, optional
+        Gaussian bandwidth in phase units; default the median, over the phases, of the
+        distance to the ``k``-th neighbour.  Ignored for ``"mean"``.
+
+    Returns
+    -------
+    ndarray, shape (N, D)
+        One centroid pose per phase, in the units of ``poses``.
+
+    Raises
+    ------
+    ParameterError
+        For mismatched shapes, non-finite values, ``k`` outside ``1..T``, an unknown
+        weighting or a non-positive bandwidth.
+    """
+    theta = _finite_array(theta, "theta", 1)
+    poses = _finite_array(poses, "poses", (1, 2))
+    if poses.ndim == 1:
+        poses = poses[:, None]
+    phases = _finite_array(phases, "phases", 1)
+    n_frames = theta.shape[0]
+    if poses.shape[0] != n_frames:
+        raise ParameterError(f"theta has {n_frames} values but poses has {poses.shape[0]} frames")
+    if isinstance(k, bool) or not isinstance(k, Integral) or k < 1:
+        raise ParameterError(f"k must be a positive integer, got {k!r}")
+    if k > n_frames:
+        raise ParameterError(f"k={k} neighbours requested but only {n_frames} frames are available")
+    if weighting not in _WEIGHTINGS:
+        raise ParameterError(f"weighting must be one of {_WEIGHTINGS}, got {weighting!r}")
+    if bandwidth is not None and (
+        isinstance(bandwidth, bool) or not isinstance(bandwidth, Real) or not np.isfinite(bandwidth) or bandwidth <= 0
+    ):
+        raise ParameterError(f"bandwidth must be a positive number, got {bandwidth!r}")
+    k = int(k)
+
+    theta = _wrap01(theta)
+    phases = _wrap01(phases)
+    order = np.argsort(theta, kind="stable")
+    sorted_theta = theta[order]
+    # extended sorted coordinates: k values wrapped from the top below 0, k from the
+    # bottom above 1; position e of `ext` is sorted frame (e - k) mod T.
+    ext = np.concatenate(
+        [sorted_theta[n_frames - k :] - 1.0, sorted_theta, sorted_theta[:k] + 1.0]
+    )
+    insert = np.searchsorted(ext, phases)  # in [k, T + k]
+    # candidate runs ext[s : s + k] with s = insert - k .. insert
+    starts = insert[:, None] + np.arange(-k, 1)[None, :]  # (N, k + 1)
+    left = phases[:, None] - ext[starts]
+    right = ext[starts + (k - 1)] - phases[:, None]
+    reach = np.maximum(left, right)
+    best = starts[np.arange(phases.size), np.argmin(reach, axis=1)]  # (N,)
+    ext_idx = best[:, None] + np.arange(k)[None, :]  # (N, k)
+    frames = order[(ext_idx - k) % n_frames]
+    neighbours = poses[frames]  # (N, k, D)
+
+    if weighting == "mean":
+        return neighbours.mean(axis=1)
+
+    gap = np.abs(ext[ext_idx] - phases[:, None])
+    dist = np.minimum(gap, 1.0 - gap)
+    if bandwidth is None:
+        bandwidth = float(np.median(dist.max(axis=1)))
+    if bandwidth <= 0.0:  # every neighbour sits exactly on its phase
+        return neighbours.mean(axis=1)
+    sq = dist * dist
+    weights = np.exp(-(sq - sq.min(axis=1, keepdims=True)) / (2.0 * bandwidth * bandwidth))
+    weights /= weights.sum(axis=1, keepdims=True)
+    return np.einsum("nk,nkd->nd", weights, neighbours)
+
+
+# ------------------------------------------------------------------------ resampling
+def kernel_centroids(
+    theta: np.ndarray,
+    poses: np.ndarray,
+    phases: np.ndarray,
+    k: int = 10,
+    chunk_elements: int = 4_000_000,
+) -> np.ndarray:
+    """Kernel-weighted average pose at each phase (Nadaraya-Watson on the circle).
+
+    Every frame contributes with weight ``exp(-d² / (2 σ²))``, ``d`` its circular phase
+    distance to the query; ``σ = k / (T √(2π))`` so that, for evenly spread coordinates,
+    the weights add up to about ``k`` frames — the same amount of averaging as ``k``
+    nearest neighbours, but varying smoothly with the phase (no frame enters or leaves
+    the average abruptly), so the curve adds no jerk of its own.
+
+    Parameters
+    ----------
+    theta : array_like, shape (T,)
+    poses : array_like, shape (T, D)
+    phases : array_like, shape (N,)
+    k : int, default 10
+        Effective number of frames per average.
+
+    Returns
+    -------
+    ndarray, shape (N, D)
+    """
+    theta = _wrap01(_finite_array(theta, "theta", 1))
+    poses = _finite_array(poses, "poses", 2)
+    phases = _wrap01(_finite_array(phases, "phases", 1))
+    T = theta.shape[0]
+    if poses.shape[0] != T:
+        raise ParameterError(f"theta has {T} values but poses has {poses.shape[0]} rows")
+    k = _positive_int(k, "k")
+    if k > T:
+        raise ParameterError(f"k must be between 1 and the number of frames ({T}), got {k}")
+    sigma = k / (T * np.sqrt(2.0 * np.pi))
+    out = np.empty((phases.shape[0], poses.shape[1]))
+    step = max(1, chunk_elements // max(T, 1))
+    for a in range(0, phases.shape[0], step):
+        q = phases[a : a + step]
+        d = np.mod(q[:, None] - theta[None, :] + 0.5, 1.0) - 0.5
+        w = np.exp(-0.5 * (d / sigma) ** 2)
+        tot = w.sum(axis=1, keepdims=True)
+        # a phase far from every frame (a gap in the coordinate): fall back to the nearest
+        empty = tot[:, 0] < 1e-300
+        if empty.any():
+            near = np.argmin(np.abs(d[empty]), axis=1)
+            w[empty] = 0.0
+            w[np.flatnonzero(empty), near] = 1.0
+            tot[empty] = 1.0
+        out[a : a + step] = (w / tot) @ poses
+    return out
+
+
+def resample_cyclic(curve: np.ndarray, n_out: int, times: np.ndarray | None = None) -> np.ndarray:
+    """Resample a closed curve at ``n_out`` equally spaced times by linear interpolation.
+
+    Parameters
+    ----------
+    curve : array_like, shape (N, D) or (N,)
+        Samples of a closed curve; after the last sample (in time) the curve runs on to
+        the first.
+    n_out : int
+        Number of output frames, at least 2.
+    times : array_like, shape (N,), optional
+        Time of each sample as a fraction of the period, in ``[0, 1)`` (taken modulo 1;
+        need not be sorted).  Default ``i / N``.
+
+    Returns
+    -------
+    ndarray, shape (n_out, D)
+        The curve at times ``j / n_out``, ``j = 0 .. n_out - 1``; a 1-D ``curve`` gives
+        shape (n_out, 1).
+
+    Raises
+    ------
+    ParameterError
+        For an empty curve, mismatched ``times``, non-finite values or ``n_out < 2``.
+    """
+    curve = _finite_array(curve, "curve", (1, 2))
+    if curve.ndim == 1:
+        curve = curve[:, None]
+    n_in = curve.shape[0]
+    if n_in == 0:
+        raise ParameterError("curve is empty")
+    n_out = _positive_int(n_out, "n_out", 2)
+    if times is None:
+        t = np.arange(n_in) / n_in
+        c = curve
+    else:
+        t = _finite_array(times, "times", 1)
+        if t.shape[0] != n_in:
+            raise ParameterError(f"times has {t.shape[0]} values for {n_in} curve samples")
+        t = _wrap01(t)
+        order = np.argsort(t, kind="stable")
+        t, c = t[order], curve[order]
+    # closed curve: one wrapped sample before the start and one after the end
+    ext_t = np.concatenate([[t[-1] - 1.0], t, [t[0] + 1.0]])
+    ext_c = np.concatenate([c[-1:], c, c[:1]], axis=0)
+    query = np.arange(n_out) / n_out
+    lo = np.searchsorted(ext_t, query, side="right") - 1  # ext_t[lo] <= q < ext_t[lo + 1]
+    lo = np.clip(lo, 0, ext_t.size - 2)
+    span = ext_t[lo + 1] - ext_t[lo]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        w = np.where(span > 0, (query - ext_t[lo]) / span, 0.0)
+    w = np.clip(w, 0.0, 1.0)[:, None]
+    return ext_c[lo] * (1.0 - w) + ext_c[lo + 1] * w
+
+
+# --------------------------------------------------------------------- root channels
+def integrate_root(
+    deltas: np.ndarray,
+    start: np.ndarray,
+    displacement: np.ndarray | None = None,
+    convention: str = "forward",
+) -> np.ndarray:
+    """Absolute root channels from per-frame differences over one cycle.
+
+    Parameters
+    ----------
+    deltas : array_like, shape (P, R)
+        Per-frame differences of ``R`` root channels over one cycle of ``P`` frames.
+        With ``convention="forward"`` (default) ``deltas[i]`` is the step from frame
+        ``i`` to frame ``i + 1``, and ``deltas[P - 1]`` the step from the last frame to
+        the next cycle's first frame.  With ``"backward"`` ``deltas[i]`` is the step
+        *into* frame ``i`` (``x[i] - x[i - 1]``), so ``deltas[0]`` is the wrap step.
+    start : array_like, shape (R,)
+        Value of frame 0.
+    displacement : array_like, shape (R,), optional
+        Wanted travel per cycle.  When given, the same constant is added to every
+        delta so that the ``P`` deltas sum to exactly ``displacement``: looping the
+        cycle then advances by ``displacement`` per cycle.
+
+    Returns
+    -------
+    ndarray, shape (P, R)
+        Absolute values; ``result[0] == start``.
+
+    Raises
+    ------
+    ParameterError
+        For mismatched shapes, non-finite values or an unknown convention.
+    """
+    deltas = _finite_array(deltas, "deltas", (1, 2))
+    if deltas.ndim == 1:
+        deltas = deltas[:, None]
+    n, r = deltas.shape
+    if n == 0:
+        raise ParameterError("deltas is empty")
+    start = _finite_array(start, "start", (0, 1)).reshape(-1)
+    if start.shape[0] != r:
+        raise ParameterError(f"start has {start.shape[0]} values for {r} root channels")
+    if convention not in ("forward", "backward"):
+        raise ParameterError(f"convention must be 'forward' or 'backward', got {convention!r}")
+    steps = deltas if convention == "forward" else np.roll(deltas, -1, axis=0)
+    if displacement is not None:
+        target = _finite_array(displacement, "displacement", (0, 1)).reshape(-1)
+        if target.shape[0] != r:
+            raise ParameterError(f"displacement has {target.shape[0]} values for {r} root channels")
+        steps = steps + (target - steps.sum(axis=0)) / n
+    out = np.empty((n, r))
+    out[0] = start
+    np.cumsum(steps[:-1], axis=0, out=out[1:])
+    out[1:] += start
+    return out
+
+
+# --------------------------------------------------------------------- typical cycle
+@dataclass(frozen=True, eq=False)
+class TypicalCycle:
+    """One typical period of a motion.
+
+    Attributes
+    ----------
+    frames : ndarray, shape (P, D)
+        The cycle at the capture's frame rate, in the *prepared* space (root channels
+        still as per-frame differences).  Frame ``j`` is at time ``j / P`` of the period;
+        frame ``P - 1`` is followed by frame 0 when looping.
+    phases : ndarray, shape (P,)
+        Circular coordinate of each frame, in ``[0, 1)``, increasing; ``phases[0] = 0``.
+    curve : ndarray, shape (N, D)
+        Centroid curve at the sampled phases.
+    sample_phases : ndarray, shape (N,)
+        The sampled phases, sorted ascending, in ``[0, 1)``.
+    """
+
+    frames: np.ndarray
+    phases: np.ndarray
+    curve: np.ndarray
+    sample_phases: np.ndarray
+
+    @property
+    def n_frames(self) -> int:
+        """Number of frames ``P`` in one cycle."""
+        return int(self.frames.shape[0])
+
+
+def typical_cycle(
+    theta: np.ndarray,
+    poses: np.ndarray,
+    period_frames: float,
+    density: PeriodicDensity | None = None,
+    n_samples: int = 500,
+    k: int = 10,
+    weighting: str = "kernel",
+    sampling: str = "quantile",
+    random_state: None | int | np.random.Generator = None,
+) -> TypicalCycle:
+    """Build the typical cycle of a motion from its circular coordinate.
+
+    Parameters
+    ----------
+    theta : array_like, shape (T,)
+        Circular coordinate of each frame (phase units, taken modulo 1).
+    poses : array_like, shape (T, D)
+        The frames in the prepared space.
+    period_frames : float
+        Length of one period in frames; the cycle has ``P = round(period_frames)``
+        frames (at least 2).
+    density : PeriodicDensity, optional
+        A density fitted to ``theta``; by default one is fitted with the paper's
+        settings (and ``random_state``).
+    n_samples : int, default 500
+        Number of sampled phases ``N`` (paper: 500).
+    k : int, default 10
+        Neighbours per centroid (paper: 10).
+    weighting : {"kernel", "mean", "gaussian"}
+        ``"kernel"`` (default): smooth periodic kernel average holding about ``k`` frames
+        (:func:`kernel_centroids`); ``"mean"``: the paper's centroid of the ``k`` nearest
+        frames; ``"gaussian"``: those ``k`` frames Gaussian-weighted
+        (:func:`knn_centroids`).
+    sampling : {"quantile", "random"}
+        ``"quantile"`` (default): deterministic phases ``ppf((i + 0.5) / N)``, which are
+        at times ``(i + 0.5) / N`` of the period.  ``"random"``: the paper's random
+        draws from the density, placed in time by the density's cdf.
+    random_state : None, int or numpy Generator
+        Seed for the density fit and the random sampling.
+
+    Returns
+    -------
+    TypicalCycle
+
+    Raises
+    ------
+    ParameterError
+        For bad shapes or values, ``period_frames < 2``, an unfitted density, an unknown
+        sampling or weighting, or ``k`` larger than the number of frames.
+    """
+    if isinstance(period_frames, bool) or not isinstance(period_frames, Real) or not np.isfinite(period_frames):
+        raise ParameterError(f"period_frames must be a finite number, got {period_frames!r}")
+    n_cycle = int(round(float(period_frames)))
+    if period_frames < 2 or n_cycle < 2:
+        raise ParameterError(f"period_frames must be at least 2, got {period_frames!r}")
+    n_samples = _positive_int(n_samples, "n_samples", 2)
+    if sampling not in _SAMPLINGS:
+        raise ParameterError(f"sampling must be one of {_SAMPLINGS}, got {sampling!r}")
+    if weighting not in _WEIGHTINGS:
+        raise ParameterError(f"weighting must be one of {_WEIGHTINGS}, got {weighting!r}")
+    theta = _finite_array(theta, "theta", 1)
+    if isinstance(k, bool) or not isinstance(k, Integral) or not 1 <= k <= theta.shape[0]:
+        raise ParameterError(f"k must be an integer between 1 and the number of frames ({theta.shape[0]}), got {k!r}")
+    rng = _as_generator(random_state)
+
+    if density is None:
+        density = PeriodicDensity(random_state=rng).fit(theta)
+    elif not isinstance(density, PeriodicDensity):
+        raise ParameterError(f"density must be a PeriodicDensity, got {type(density).__name__}")
+    elif not hasattr(density, "weights_"):
+        raise ParameterError("density is not fitted: call density.fit(theta) first")
+
+    if sampling == "quantile":
+        sample_phases = density.quantiles(n_samples)
+        times = (np.arange(n_samples) + 0.5) / n_samples
+    else:
+        sample_phases = density.sample(n_samples, random_state=rng)
+        times = density.cdf(sample_phases)
+    sample_phases = _wrap01(sample_phases)
+
+    if weighting == "kernel":
+        curve = kernel_centroids(theta, poses, sample_phases, k=k)
+    else:
+        curve = knn_centroids(theta, poses, sample_phases, k=k, weighting=weighting)
+    frames = resample_cyclic(curve, n_cycle, times=times)
+    phases = _wrap01(density.ppf(np.arange(n_cycle) / n_cycle))
+    for arr in (frames, phases, curve, sample_phases):
+        arr.flags.writeable = False
+    return TypicalCycle(frames=frames, phases=phases, curve=curve, sample_phases=sample_phases)

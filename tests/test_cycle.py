@@ -1,0 +1,280 @@
+"""Tests of the typical-cycle construction: neighbours, resampling, root integration."""
+
+from __future__ import annotations
+
+
+import numpy as np
+import pytest
+
+from cyclecoord.cycle import (
+    TypicalCycle,
+    integrate_root,
+    kernel_centroids,
+    knn_centroids,
+    resample_cyclic,
+    typical_cycle,
+)
+from cyclecoord.density import PeriodicDensity
+from cyclecoord.errors import ParameterError
+from cyclecoord.metrics import circular_distance, distance_to_cycle
+
+PERIOD = 100  # frames per period of the synthetic motion
+WARP = 0.5  # phase speed varies between 1 - WARP and 1 + WARP
+
+
+def curve(phi: np.ndarray) -> np.ndarray:
+    """A closed 5-D Lissajous curve, shape (len(phi), 5)."""
+    a = 2 * np.pi * np.asarray(phi, dtype=float)
+    return np.stack(
+        [np.cos(a), np.sin(a), 0.5 * np.cos(2 * a), 0.3 * np.sin(3 * a), 0.4 * np.cos(a + 1.0)], axis=1
+    )
+
+
+def warp(tau: np.ndarray) -> np.ndarray:
+    """Phase (unwrapped) at time tau (in periods): monotone, uneven speed."""
+    return tau + WARP * np.sin(2 * np.pi * tau) / (2 * np.pi)
+
+
+@pytest.fixture(scope="module")
+def noisy_motion():
+    rng = np.random.default_rng(11)
+    t = np.arange(4 * PERIOD)
+    phase = warp(t / PERIOD)
+    clean = curve(phase)
+    poses = clean + 0.05 * rng.standard_normal(clean.shape)
+    return np.mod(phase, 1.0), poses, clean
+
+
+# ------------------------------------------------------------------- knn_centroids
+def brute_force_centroids(theta, poses, phases, k):
+    out = []
+    for p in phases:
+        d = circular_distance(theta, p)
+        out.append(poses[np.argsort(d, kind="stable")[:k]].mean(axis=0))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("k", [1, 3, 10, 37])
+def test_knn_centroids_match_brute_force(k):
+    rng = np.random.default_rng(k)
+    theta = rng.random(37)
+    poses = rng.standard_normal((37, 4))
+    phases = np.concatenate([rng.random(200), [0.0, 1e-9, 0.5, 1 - 1e-9]])
+    np.testing.assert_allclose(
+        knn_centroids(theta, poses, phases, k=k), brute_force_centroids(theta, poses, phases, k), atol=1e-12
+    )
+
+
+def test_knn_centroids_use_both_sides_of_the_seam():
+    n = 100
+    theta = (np.arange(n) + 0.5) / n
+    signed = np.where(theta < 0.5, theta, theta - 1.0)  # signed offset from phase 0
+    poses = np.stack([signed, np.cos(2 * np.pi * theta)], axis=1)
+    out = knn_centroids(theta, poses, np.array([0.0, 0.999999, 1e-6]), k=10)
+    # neighbours 0.005..0.045 and 0.955..0.995: symmetric, mean offset 0
+    np.testing.assert_allclose(out[:, 0], 0.0, atol=1e-5)
+    assert np.all(out[:, 1] > np.cos(2 * np.pi * 0.05))
+    # the neighbours of phase 0 at k=10 are exactly the 5 lowest and 5 highest frames
+    single = knn_centroids(theta, np.arange(n, dtype=float), [0.0], k=10)
+    assert single[0, 0] == pytest.approx(np.mean([0, 1, 2, 3, 4, 95, 96, 97, 98, 99]))
+
+
+def test_gaussian_weighting_pulls_towards_nearest():
+    theta = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9])
+    poses = np.arange(10.0)[:, None]
+    mean = knn_centroids(theta, poses, [0.21], k=3, weighting="mean")
+    gauss = knn_centroids(theta, poses, [0.21], k=3, weighting="gaussian", bandwidth=0.02)
+    assert mean[0, 0] == pytest.approx(2.0)
+    assert 2.0 < gauss[0, 0] < 2.2  # dominated by frame 2, pulled towards frame 3
+    wide = knn_centroids(theta, poses, [0.21], k=3, weighting="gaussian", bandwidth=100.0)
+    assert wide[0, 0] == pytest.approx(2.0, abs=1e-3)
+    default = knn_centroids(theta, poses, [0.21, 0.5], k=3, weighting="gaussian")
+    assert default.shape == (2, 1)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"k": 0},
+        {"k": 11},
+        {"k": 2.5},
+        {"weighting": "median"},
+        {"weighting": "gaussian", "bandwidth": -1.0},
+    ],
+)
+def test_knn_centroids_bad_parameters(kwargs):
+    theta = np.linspace(0, 1, 10, endpoint=False)
+    with pytest.raises(ParameterError):
+        knn_centroids(theta, np.zeros((10, 2)), [0.5], **kwargs)
+
+
+def test_knn_centroids_bad_arrays():
+    theta = np.linspace(0, 1, 10, endpoint=False)
+    with pytest.raises(ParameterError):
+        knn_centroids(theta, np.zeros((9, 2)), [0.5])
+    with pytest.raises(ParameterError):
+        knn_centroids(theta, np.zeros((10, 2)), [np.nan])
+    with pytest.raises(ParameterError):
+        knn_centroids(theta[:, None], np.zeros((10, 2)), [0.5])
+
+
+# ----------------------------------------------------------------- resample_cyclic
+def test_resample_circle_exact_to_interpolation_error():
+    rng = np.random.default_rng(3)
+    times = np.sort(rng.random(64))
+    circle = np.stack([np.cos(2 * np.pi * times), np.sin(2 * np.pi * times)], axis=1)
+    out = resample_cyclic(circle[::-1], 100, times=times[::-1])  # order does not matter
+    q = np.arange(100) / 100
+    exact = np.stack([np.cos(2 * np.pi * q), np.sin(2 * np.pi * q)], axis=1)
+    gaps = np.diff(np.concatenate([times, [times[0] + 1]]))
+    sagitta = 1 - np.cos(np.pi * gaps.max())  # largest chord-to-arc distance
+    assert np.abs(np.linalg.norm(out - exact, axis=1)).max() <= sagitta + 1e-12
+    # and the resampled points lie on the chords: |x| between cos(pi gap) and 1
+    assert np.all(np.linalg.norm(out, axis=1) <= 1 + 1e-12)
+
+
+def test_resample_polygon_is_exact_including_wrap():
+    # a closed square traversed at constant speed; samples include the corners
+    corners = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    times = np.array([0.0, 0.25, 0.5, 0.75, 0.1, 0.9])
+    def square(t):
+        t = np.mod(t, 1.0) * 4
+        i = np.floor(t).astype(int) % 4
+        f = (t - np.floor(t))[:, None]
+        return corners[i] * (1 - f) + corners[(i + 1) % 4] * f
+    out = resample_cyclic(square(times), 40, times=times)
+    np.testing.assert_allclose(out, square(np.arange(40) / 40), atol=1e-12)
+    # default times i / N
+    np.testing.assert_allclose(resample_cyclic(corners, 8), square(np.arange(8) / 8), atol=1e-12)
+
+
+def test_resample_bad_input():
+    with pytest.raises(ParameterError):
+        resample_cyclic(np.zeros((5, 2)), 1)
+    with pytest.raises(ParameterError):
+        resample_cyclic(np.zeros((5, 2)), 10, times=np.zeros(4))
+    with pytest.raises(ParameterError):
+        resample_cyclic(np.zeros((0, 2)), 10)
+
+
+# ------------------------------------------------------------------ integrate_root
+def test_integrate_root_cumulative_sum():
+    deltas = np.array([[1.0, 0.0], [2.0, 1.0], [3.0, -1.0]])
+    out = integrate_root(deltas, start=[10.0, 5.0])
+    np.testing.assert_allclose(out, [[10, 5], [11, 5], [13, 6]])
+    back = integrate_root(deltas, start=[10.0, 5.0], convention="backward")
+    np.testing.assert_allclose(back, [[10, 5], [12, 6], [15, 5]])
+
+
+def test_integrate_root_hits_displacement_exactly():
+    rng = np.random.default_rng(0)
+    deltas = rng.normal(1.0, 0.3, size=(97, 3))
+    target = np.array([40.0, -2.5, 0.0])
+    out = integrate_root(deltas, start=[1.0, 2.0, 3.0], displacement=target)
+    np.testing.assert_array_equal(out[0], [1.0, 2.0, 3.0])
+    steps = np.diff(out, axis=0)
+    const = steps - deltas[:-1]
+    np.testing.assert_allclose(const, const[0][None, :].repeat(96, axis=0), atol=1e-12)  # same shift
+    last_step = deltas[-1] + const[0]
+    np.testing.assert_allclose(out[-1] + last_step - out[0], target, atol=1e-10)
+    # looping: next cycle starts exactly one displacement further
+    np.testing.assert_allclose(steps.sum(axis=0) + last_step, target, atol=1e-10)
+
+
+def test_integrate_root_bad_shapes():
+    with pytest.raises(ParameterError):
+        integrate_root(np.zeros((5, 2)), start=[0.0])
+    with pytest.raises(ParameterError):
+        integrate_root(np.zeros((5, 2)), start=[0.0, 0.0], displacement=[1.0])
+    with pytest.raises(ParameterError):
+        integrate_root(np.zeros((5, 2)), start=[0.0, 0.0], convention="sideways")
+
+
+# -------------------------------------------------------------------- typical_cycle
+@pytest.mark.parametrize("weighting", ["kernel", "mean", "gaussian"])
+@pytest.mark.parametrize("sampling", ["quantile", "random"])
+def test_typical_cycle_is_closer_to_truth_than_frames(noisy_motion, sampling, weighting):
+    theta, poses, clean = noisy_motion
+    cyc = typical_cycle(theta, poses, PERIOD, sampling=sampling, weighting=weighting, random_state=0)
+    assert isinstance(cyc, TypicalCycle)
+    assert cyc.frames.shape == (PERIOD, 5)
+    assert cyc.curve.shape == (500, 5)
+    assert cyc.sample_phases.shape == (500,)
+    assert np.all(np.diff(cyc.sample_phases) >= 0)
+    assert cyc.phases[0] == 0.0 and np.all(np.diff(cyc.phases) > 0) and cyc.phases[-1] < 1
+
+    noise_err = np.linalg.norm(poses - clean, axis=1).mean()
+    curve_err = np.linalg.norm(cyc.curve - curve(cyc.sample_phases), axis=1).mean()
+    frame_err = np.linalg.norm(cyc.frames - curve(cyc.phases), axis=1).mean()
+    assert curve_err < 0.5 * noise_err
+    assert frame_err < 0.5 * noise_err
+    # the cycle's polyline runs through the true curve: the clean poses lie close to it
+    assert distance_to_cycle(clean, cyc.frames).mean() < 0.5 * noise_err
+
+
+@pytest.mark.parametrize("sampling", ["quantile", "random"])
+def test_typical_cycle_keeps_the_timing(noisy_motion, sampling):
+    """Frame j sits at time j / P: its phase follows the motion's uneven speed."""
+    theta, poses, _ = noisy_motion
+    cyc = typical_cycle(theta, poses, PERIOD, sampling=sampling, random_state=1)
+    expected = np.mod(warp(np.arange(PERIOD) / PERIOD), 1.0)  # warp(0) = 0
+    assert circular_distance(cyc.phases, expected).max() < 0.02
+    # an even-speed (uniform) parameterisation would be far off
+    assert circular_distance(np.arange(PERIOD) / PERIOD, expected).max() > 0.05
+
+
+def test_typical_cycle_reuses_density_and_is_deterministic(noisy_motion):
+    theta, poses, _ = noisy_motion
+    density = PeriodicDensity(random_state=4).fit(theta)
+    a = typical_cycle(theta, poses, 99.6, density=density, n_samples=300, k=5)
+    b = typical_cycle(theta, poses, 99.6, density=density, n_samples=300, k=5)
+    assert a.frames.shape == (100, 5)
+    np.testing.assert_array_equal(a.frames, b.frames)
+    c = typical_cycle(theta, poses, 50, sampling="random", random_state=9)
+    d = typical_cycle(theta, poses, 50, sampling="random", random_state=9)
+    np.testing.assert_array_equal(c.frames, d.frames)
+    with pytest.raises(ValueError):
+        a.frames[0, 0] = 1.0  # read-only result
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"period_frames": 1.2},
+        {"period_frames": float("nan")},
+        {"sampling": "grid"},
+        {"weighting": "max"},
+        {"n_samples": 0},
+        {"k": 10_000},
+        {"density": PeriodicDensity()},  # not fitted
+    ],
+)
+def test_typical_cycle_bad_parameters(noisy_motion, kwargs):
+    theta, poses, _ = noisy_motion
+    args = {"period_frames": 100, **kwargs}
+    with pytest.raises(ParameterError):
+        typical_cycle(theta, poses, **args)
+
+
+
+def test_kernel_centroids_are_smooth_where_knn_jumps():
+    """Two repetitions that differ: the k-nearest mean jumps as frames enter and leave,
+    the kernel average changes smoothly (small second differences along the phase)."""
+    T = 400
+    theta = np.mod(np.arange(T) / 200.0, 1.0)  # two cycles
+    poses = np.zeros((T, 1))
+    poses[200:, 0] = 1.0  # the second repetition is offset
+    poses[:, 0] += np.sin(2 * np.pi * theta)
+    q = np.linspace(0, 1, 2000, endpoint=False)
+    knn = knn_centroids(theta, poses, q, k=10)
+    ker = kernel_centroids(theta, poses, q, k=10)
+    # both average the two repetitions
+    np.testing.assert_allclose(ker[:, 0], 0.5 + np.sin(2 * np.pi * q), atol=0.01)
+    assert np.abs(np.diff(ker[:, 0], 2)).max() < 0.2 * np.abs(np.diff(knn[:, 0], 2)).max()
+
+
+def test_kernel_centroids_validate():
+    with pytest.raises(ParameterError):
+        kernel_centroids(np.zeros(5), np.zeros((4, 2)), np.zeros(3))
+    with pytest.raises(ParameterError):
+        kernel_centroids(np.zeros(5), np.zeros((5, 2)), np.zeros(3), k=6)

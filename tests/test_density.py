@@ -1,0 +1,167 @@
+"""Tests of the periodic (wrapped Gaussian mixture) density of circular coordinates."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from scipy.stats import vonmises
+
+from cyclecoord.density import PeriodicDensity
+from cyclecoord.errors import ParameterError
+
+# A bimodal circular distribution on [0, 1): two von Mises bumps of unequal width.
+_MIX = ((0.6, 0.25, 8.0), (0.4, 0.70, 15.0))  # (weight, centre, concentration)
+
+
+def true_pdf(x: np.ndarray) -> np.ndarray:
+    x = np.asarray(x, dtype=float)
+    return sum(w * 2 * np.pi * vonmises.pdf(2 * np.pi * x, kappa, loc=2 * np.pi * mu) for w, mu, kappa in _MIX)
+
+
+def draw(n: int, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    first = rng.random(n) < _MIX[0][0]
+    angles = np.where(
+        first,
+        rng.vonmises(2 * np.pi * _MIX[0][1], _MIX[0][2], n),
+        rng.vonmises(2 * np.pi * _MIX[1][1], _MIX[1][2], n),
+    )
+    return np.mod(angles / (2 * np.pi), 1.0)
+
+
+@pytest.fixture(scope="module")
+def fitted() -> PeriodicDensity:
+    return PeriodicDensity(random_state=0).fit(draw(750, seed=1))
+
+
+GRID = (np.arange(20000) + 0.5) / 20000  # midpoint rule on [0, 1)
+
+
+def test_pdf_integrates_to_one(fitted):
+    assert fitted.pdf(GRID).mean() == pytest.approx(1.0, abs=1e-6)
+    assert np.all(fitted.pdf(GRID) >= 0)
+
+
+def test_pdf_is_periodic_without_seam(fitted):
+    eps = 1e-7
+    assert fitted.pdf(0.0) == pytest.approx(float(fitted.pdf(1.0 - eps)), rel=1e-4)
+    # values outside [0, 1) are taken modulo 1
+    np.testing.assert_allclose(fitted.pdf(GRID + 1.0), fitted.pdf(GRID), rtol=1e-9)
+    np.testing.assert_allclose(fitted.pdf(GRID - 3.0), fitted.pdf(GRID), rtol=1e-9)
+
+
+def test_pdf_close_to_true_density(fitted):
+    l1 = np.abs(fitted.pdf(GRID) - true_pdf(GRID)).mean()
+    assert l1 < 0.15
+    # the two modes are found where they are
+    peaks = GRID[np.argmax(fitted.pdf(GRID))]
+    assert abs(peaks - 0.70) < 0.03 or abs(peaks - 0.25) < 0.03
+
+
+def test_cdf_and_ppf(fitted):
+    assert float(fitted.cdf(0.0)) == 0.0
+    assert float(fitted.cdf(1.0)) == pytest.approx(1.0, abs=1e-12)
+    x = np.linspace(0, 1, 501)
+    c = fitted.cdf(x)
+    assert np.all(np.diff(c) >= 0)
+    # cdf is the integral of the pdf
+    np.testing.assert_allclose(fitted.cdf(0.5), fitted.pdf(GRID[GRID < 0.5]).sum() / GRID.size, atol=1e-6)
+    # inverse both ways, accurate to 1e-4
+    np.testing.assert_allclose(fitted.ppf(c), x, atol=1e-4)
+    q = np.linspace(0, 1, 777)
+    np.testing.assert_allclose(fitted.cdf(fitted.ppf(q)), q, atol=1e-9)
+    assert np.all(np.diff(fitted.ppf(q)) >= 0)
+    # lifted to the real line
+    assert float(fitted.cdf(2.3)) == pytest.approx(2.0 + float(fitted.cdf(0.3)))
+    assert float(fitted.ppf(1.4)) == pytest.approx(1.0 + float(fitted.ppf(0.4)))
+
+
+def test_quantiles_sorted_and_follow_density(fitted):
+    q = fitted.quantiles(500)
+    assert q.shape == (500,)
+    assert np.all(np.diff(q) > 0)
+    assert q[0] > 0 and q[-1] < 1
+    np.testing.assert_allclose(fitted.cdf(q), (np.arange(500) + 0.5) / 500, atol=1e-9)
+    # denser where the density is high: each bin holds its probability mass times n
+    edges = np.linspace(0, 1, 21)
+    counts = np.histogram(q, bins=edges)[0]
+    expected = 500 * np.diff(fitted.cdf(edges))
+    assert np.all(np.abs(counts - expected) <= 1.0 + 1e-9)
+    assert counts.max() > 4 * counts.min() + 1  # and the density is far from uniform
+
+
+def test_sample_follows_density(fitted):
+    s = fitted.sample(4000, random_state=3)
+    assert s.shape == (4000,)
+    assert np.all((s >= 0) & (s < 1))
+    assert np.all(np.diff(s) >= 0)
+    # Kolmogorov-Smirnov distance to the fitted cdf
+    ks = np.abs(fitted.cdf(s) - (np.arange(4000) + 0.5) / 4000).max()
+    assert ks < 0.03
+    np.testing.assert_array_equal(s, fitted.sample(4000, random_state=3))
+    assert not np.array_equal(s, fitted.sample(4000, random_state=4))
+
+
+def test_same_seed_same_fit():
+    theta = draw(300, seed=5)
+    a = PeriodicDensity(random_state=7).fit(theta)
+    b = PeriodicDensity(random_state=7).fit(theta)
+    np.testing.assert_array_equal(a.pdf(GRID), b.pdf(GRID))
+    np.testing.assert_array_equal(a.quantiles(100), b.quantiles(100))
+
+
+def test_values_outside_unit_interval_are_wrapped():
+    theta = draw(300, seed=5)
+    a = PeriodicDensity(random_state=2).fit(theta)
+    b = PeriodicDensity(random_state=2).fit(theta + 2.0)
+    np.testing.assert_allclose(a.pdf(GRID), b.pdf(GRID), rtol=1e-6, atol=1e-9)
+
+
+def test_few_points_cap_components_and_no_warning_noise():
+    theta = np.array([0.1, 0.4, 0.45, 0.8])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # any warning (e.g. ConvergenceWarning) fails
+        d = PeriodicDensity(random_state=0, max_iter=1).fit(theta)
+    assert d.n_components_ == 4
+    assert d.converged_ in (True, False)
+    assert d.pdf(GRID).mean() == pytest.approx(1.0, abs=1e-6)
+    one = PeriodicDensity(random_state=0).fit(np.full(10, 0.3))
+    assert one.n_components_ == 1
+    assert one.pdf(GRID).mean() == pytest.approx(1.0, abs=1e-6)
+
+
+def test_not_converged_is_recorded():
+    d = PeriodicDensity(random_state=0, max_iter=1).fit(draw(300, seed=5))
+    assert d.converged_ is False
+    assert d.n_iter_ == 1
+
+
+@pytest.mark.parametrize(
+    "theta",
+    [np.array([]), np.array([0.1, np.nan]), np.array([0.2, np.inf]), np.zeros((3, 2)), ["a", "b"]],
+)
+def test_bad_theta(theta):
+    with pytest.raises(ParameterError):
+        PeriodicDensity().fit(theta)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [{"n_components": 0}, {"max_iter": -1}, {"reg_covar": 0.0}, {"reg_covar": float("nan")}, {"n_copies": 2}],
+)
+def test_bad_parameters(kwargs):
+    with pytest.raises(ParameterError):
+        PeriodicDensity(**kwargs).fit(draw(50, seed=0))
+
+
+def test_unfitted_and_bad_counts(fitted):
+    with pytest.raises(ParameterError):
+        PeriodicDensity().pdf(0.5)
+    with pytest.raises(ParameterError):
+        fitted.quantiles(0)
+    with pytest.raises(ParameterError):
+        fitted.sample(-3)
+    with pytest.raises(ParameterError):
+        fitted.ppf([0.2, np.nan])

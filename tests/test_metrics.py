@@ -1,0 +1,198 @@
+"""Tests of the quality measures: jerk, loop closure, distance to cycle, phase agreement."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cyclecoord.errors import ParameterError
+from cyclecoord.metrics import (
+    PhaseAgreement,
+    circular_distance,
+    distance_to_cycle,
+    finite_difference_coefficients,
+    jerk,
+    jerk_summary,
+    loop_closure,
+    monotonicity,
+)
+
+
+# ------------------------------------------------------------ finite differences
+def test_known_third_derivative_rows():
+    np.testing.assert_allclose(finite_difference_coefficients(3, 1), [-1, 3, -3, 1], atol=1e-14)
+    np.testing.assert_allclose(finite_difference_coefficients(3, 2), [-5 / 2, 9, -12, 7, -3 / 2], atol=1e-14)
+
+
+@pytest.mark.parametrize("derivative,accuracy", [(1, 1), (1, 2), (2, 3), (3, 4), (4, 2)])
+def test_coefficients_satisfy_taylor_conditions(derivative, accuracy):
+    c = finite_difference_coefficients(derivative, accuracy)
+    j = np.arange(c.size, dtype=float)
+    moments = np.array([(c * j**m).sum() for m in range(c.size)])
+    expected = np.zeros(c.size)
+    expected[derivative] = float(np.prod(np.arange(1, derivative + 1)))
+    np.testing.assert_allclose(moments, expected, atol=1e-8)
+    assert c.size == derivative + accuracy
+    assert abs(c.sum()) < 1e-10 or derivative == 0
+
+
+def test_first_derivative_rows():
+    np.testing.assert_allclose(finite_difference_coefficients(1, 1), [-1, 1])
+    np.testing.assert_allclose(finite_difference_coefficients(1, 2), [-1.5, 2, -0.5])
+
+
+@pytest.mark.parametrize("args", [(-1, 2), (3, 0), (3, 40), (2.5, 2)])
+def test_bad_coefficient_orders(args):
+    with pytest.raises(ParameterError):
+        finite_difference_coefficients(*args)
+
+
+# --------------------------------------------------------------------------- jerk
+def test_jerk_exact_on_cubics_and_zero_on_quadratics():
+    fps = 120.0
+    t = np.arange(50) / fps
+    cubic = np.stack([2.0 * t**3 - t**2 + 5, -0.5 * t**3 + 3 * t], axis=1)
+    j = jerk(cubic, fps)
+    assert j.shape == (50 - 7 + 1, 2)
+    np.testing.assert_allclose(j[:, 0], 12.0, rtol=1e-6)
+    np.testing.assert_allclose(j[:, 1], -3.0, rtol=1e-6)
+    quad = 4 * t**2 - t + 1
+    np.testing.assert_allclose(jerk(quad, fps), 0.0, atol=1e-5)
+    # other accuracies are exact on cubics too
+    np.testing.assert_allclose(jerk(cubic, fps, accuracy=1)[:, 0], 12.0, rtol=1e-6)
+
+
+def test_cyclic_jerk_of_a_sine_matches_analytic():
+    fps = 120.0
+    n = 96  # one period of 0.8 s
+    t = np.arange(n) / fps
+    omega = 2 * np.pi * fps / n
+    x = 3.0 * np.sin(omega * t)
+    analytic = -3.0 * omega**3 * np.cos(omega * t)
+    j = jerk(x, fps, cyclic=True)
+    assert j.shape == (n, 1)
+    assert np.abs(j[:, 0] - analytic).max() < 0.01 * np.abs(analytic).max()
+    # the seam counts: an open arc of the same sine has a huge jerk at the wrap
+    arc = 3.0 * np.sin(0.8 * omega * t)
+    assert np.abs(jerk(arc, fps, cyclic=True)).max() > 10 * np.abs(analytic).max()
+
+
+def test_jerk_summary_units():
+    fps = 100.0
+    t = np.arange(30) / fps
+    frames = np.stack([t**3, 2 * t**3], axis=1)  # jerk (6, 12): norm 6 sqrt 5
+    assert jerk_summary(frames, fps) == pytest.approx(6 * np.sqrt(5), rel=1e-5)
+    # doubling the frame rate of the same motion leaves the jerk unchanged (units / s^3)
+    t2 = np.arange(60) / (2 * fps)
+    frames2 = np.stack([t2**3, 2 * t2**3], axis=1)
+    assert jerk_summary(frames2, 2 * fps) == pytest.approx(6 * np.sqrt(5), rel=1e-5)
+
+
+def test_jerk_bad_input():
+    with pytest.raises(ParameterError):
+        jerk(np.zeros((6, 2)), 120.0)  # 7-point stencil
+    with pytest.raises(ParameterError):
+        jerk(np.zeros((20, 2)), 0.0)
+    with pytest.raises(ParameterError):
+        jerk(np.full((20, 2), np.nan), 120.0)
+
+
+# --------------------------------------------------------------------- loop closure
+def test_loop_closure_circle_and_arc():
+    a = 2 * np.pi * np.arange(60) / 60
+    circle = np.stack([np.cos(a), np.sin(a)], axis=1)
+    assert loop_closure(circle) == pytest.approx(1.0, abs=1e-9)
+    arc = circle[:40]
+    assert loop_closure(arc) > 10
+    assert loop_closure(np.ones((5, 3))) == 1.0
+    with pytest.raises(ParameterError):
+        loop_closure(np.zeros((1, 3)))
+
+
+# ---------------------------------------------------------------- distance to cycle
+def test_distance_to_cycle_on_and_off_the_polyline():
+    square = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]) + 100.0
+    on = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 1.3], [0.0, 0.5], [0.7, 2.0]]) + 100.0
+    np.testing.assert_allclose(distance_to_cycle(on, square), 0.0, atol=1e-12)
+    # the closing segment (last -> first) counts: (0, 1) lies on it
+    assert distance_to_cycle([[100.0, 101.0]], square)[0] == pytest.approx(0.0, abs=1e-12)
+    off = np.array([[1.0, 1.0], [3.0, 3.0], [1.0, -0.5], [-1.0, 1.0]]) + 100.0
+    np.testing.assert_allclose(distance_to_cycle(off, square), [1.0, np.sqrt(2), 0.5, 1.0], atol=1e-12)
+
+
+def test_distance_to_cycle_matches_brute_force_in_chunks(monkeypatch):
+    import cyclecoord.metrics as metrics
+
+    rng = np.random.default_rng(0)
+    cycle = rng.standard_normal((17, 6))
+    frames = rng.standard_normal((300, 6))
+    monkeypatch.setattr(metrics, "_CHUNK_ELEMENTS", 17 * 7)  # force many chunks
+    got = distance_to_cycle(frames, cycle)
+    a, b = cycle, np.roll(cycle, -1, axis=0)
+    v = b - a
+    s = np.clip(np.einsum("tpd,pd->tp", frames[:, None] - a, v) / (v * v).sum(1), 0, 1)
+    brute = np.linalg.norm(frames[:, None] - a - s[..., None] * v, axis=2).min(axis=1)
+    np.testing.assert_allclose(got, brute, atol=1e-12)
+
+
+def test_distance_to_cycle_bad_input():
+    with pytest.raises(ParameterError):
+        distance_to_cycle(np.zeros((3, 2)), np.zeros((4, 3)))
+    with pytest.raises(ParameterError):
+        distance_to_cycle(np.zeros((3, 2)), np.zeros((0, 2)))
+
+
+# ------------------------------------------------------------------ phase agreement
+def test_circular_distance():
+    np.testing.assert_allclose(circular_distance([0.05, 0.5, 0.3], [0.95, 0.0, 2.3]), [0.1, 0.5, 0.0], atol=1e-12)
+
+
+def _warped(phase):
+    return np.mod(phase + 0.06 * np.sin(2 * np.pi * phase), 1.0)  # monotone warp, max 0.06
+
+
+def test_monotonicity_of_a_warped_phase():
+    phase = np.arange(500) / 97.3  # ~5 periods, unwrapped
+    res = monotonicity(np.mod(_warped(phase) + 0.37, 1.0), phase)
+    assert isinstance(res, PhaseAgreement)
+    assert res.fraction_monotone == 1.0
+    assert res.orientation == 1
+    assert 0.03 < res.max_abs_error_after_alignment < 0.061
+    assert res.mean_abs_error_after_alignment < res.max_abs_error_after_alignment
+    exact = monotonicity(np.mod(phase + 0.37, 1.0), phase)
+    assert exact.max_abs_error_after_alignment < 1e-9
+    assert exact.offset == pytest.approx(0.63, abs=1e-9)
+
+
+def test_monotonicity_handles_reflection():
+    phase = np.arange(500) / 97.3
+    res = monotonicity(np.mod(0.2 - _warped(phase), 1.0), phase)
+    assert res.orientation == -1
+    assert res.fraction_monotone == 1.0
+    assert res.max_abs_error_after_alignment < 0.061
+
+
+def test_monotonicity_is_low_for_random_theta():
+    rng = np.random.default_rng(0)
+    phase = np.arange(500) / 97.3
+    res = monotonicity(rng.random(500), phase)
+    assert res.fraction_monotone < 0.65
+    assert res.max_abs_error_after_alignment > 0.4
+    assert res.mean_abs_error_after_alignment > 0.15
+
+
+def test_monotonicity_counts_backward_steps():
+    phase = np.arange(100) / 25.0
+    theta = np.mod(phase, 1.0)
+    theta[[10, 40, 70]] -= 0.05  # three glitches: the step into each goes back
+    res = monotonicity(theta, phase)
+    assert res.fraction_monotone == pytest.approx(1 - 3 / 99)
+
+
+def test_monotonicity_bad_input():
+    with pytest.raises(ParameterError):
+        monotonicity(np.zeros(5), np.zeros(4))
+    with pytest.raises(ParameterError):
+        monotonicity(np.zeros(1), np.zeros(1))
+    with pytest.raises(ParameterError):
+        monotonicity(np.array([0.1, np.nan]), np.zeros(2))
