@@ -1,0 +1,303 @@
+"""Motion file input/output: ``load``/``save``/``convert`` dispatching on the file suffix.
+
+Supported formats: ``.amc`` (Acclaim motion, with its ``.asf`` skeleton), ``.bvh``
+(Biovision Hierarchy), ``.npz`` (NumPy archive of a whole motion and skeleton) and
+``.csv`` (a ``joint.dof`` table).  The per-format readers and writers are re-exported
+here; the ASF/AMC ones are imported on first use.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError, ParseError
+from ..motion import DEFAULT_FPS, Motion
+from ..skeleton import Skeleton
+from .bvh import read_bvh, write_bvh
+from .tabular import read_csv, read_npz, write_csv, write_npz
+
+__all__ = [
+    "load",
+    "save",
+    "convert",
+    "SUPPORTED_FORMATS",
+    "default_asf_path",
+    "read_bvh",
+    "write_bvh",
+    "read_npz",
+    "write_npz",
+    "read_csv",
+    "write_csv",
+    "read_asf",
+    "write_asf",
+    "read_amc",
+    "write_amc",
+]
+
+#: Suffix -> description, in the order error messages list them.
+SUPPORTED_FORMATS = {
+    ".amc": "Acclaim AMC motion (skeleton from an .asf)",
+    ".bvh": "Biovision Hierarchy",
+    ".npz": "NumPy archive written by cyclecoord",
+    ".csv": "CSV table with a joint.dof header",
+}
+_LAZY = {"read_asf", "write_asf", "read_amc", "write_amc"}
+
+
+def __getattr__(name: str) -> Any:
+    """Import the ASF/AMC functions on first access (PEP 562)."""
+    if name in _LAZY:
+        from . import asfamc
+
+        return getattr(asfamc, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _formats() -> str:
+    return ", ".join(SUPPORTED_FORMATS)
+
+
+def _suffix(path: Path) -> str:
+    suffix = path.suffix.lower()
+    if suffix not in SUPPORTED_FORMATS:
+        shown = f"suffix {path.suffix!r}" if path.suffix else "no suffix"
+        raise ParseError(
+            f"unknown motion format ({shown}); supported formats: {_formats()}", str(path)
+        )
+    return suffix
+
+
+def _check_fps(fps: float | None) -> float | None:
+    if fps is None:
+        return None
+    try:
+        value = float(fps)
+    except (TypeError, ValueError):
+        raise ParameterError(f"fps must be a positive number, got {fps!r}") from None
+    if not (value > 0 and value != float("inf")):
+        raise ParameterError(f"fps must be a positive number, got {fps!r}")
+    return value
+
+
+def load(
+    path: str | os.PathLike[str],
+    skeleton: Skeleton | str | os.PathLike[str] | None = None,
+    fps: float | None = None,
+) -> Motion:
+    """Read a motion file of any supported format, chosen by its suffix.
+
+    Parameters
+    ----------
+    path : path-like
+        ``.amc``, ``.bvh``, ``.npz`` or ``.csv`` (case-insensitive suffix).
+    skeleton : Skeleton or path, optional
+        For AMC: the skeleton or ``.asf`` path (passed to
+        :func:`~cyclecoord.io.asfamc.read_amc`).  For NPZ/CSV: attached to (or replacing
+        the stored skeleton of) the motion.  Not allowed for BVH, which carries its own.
+    fps : float, optional
+        Overrides the file's frame rate (AMC files store none: 120 by default).
+
+    Returns
+    -------
+    Motion
+
+    Raises
+    ------
+    ParseError
+        Missing file, unknown suffix (the message lists the supported formats) or a
+        malformed file.
+    ParameterError
+        Bad ``fps`` or a ``skeleton`` given for a BVH file.
+    """
+    p = Path(path)
+    suffix = _suffix(p)
+    if not p.exists():
+        raise ParseError(f"no such file (supported formats: {_formats()})", str(p))
+    if p.is_dir():
+        raise ParseError(f"is a directory, expected a motion file ({_formats()})", str(p))
+    rate = _check_fps(fps)
+    if suffix == ".amc":
+        from .asfamc import read_amc
+
+        return read_amc(p, skeleton=skeleton, fps=DEFAULT_FPS if rate is None else rate)
+    if suffix == ".bvh":
+        if skeleton is not None:
+            raise ParameterError(
+                f"{p}: a BVH file carries its own skeleton; do not pass skeleton="
+            )
+        motion = read_bvh(p)
+        return motion if rate is None else replace(motion, fps=rate)
+    if suffix == ".npz":
+        return read_npz(p, skeleton=skeleton, fps=rate)
+    return read_csv(p, fps=rate, skeleton=skeleton)
+
+
+def default_asf_path(amc_path: str | os.PathLike[str]) -> Path:
+    """Where :func:`save` puts the skeleton of an AMC by default.
+
+    ``<subject>.asf`` beside the AMC, the subject being the stem up to its first ``_``
+    (``69_01.amc`` -> ``69.asf``, ``out.amc`` -> ``out.asf``): the name
+    :func:`~cyclecoord.io.asfamc.read_amc` looks for when no skeleton is given.
+    """
+    p = Path(amc_path)
+    subject = p.stem.split("_", 1)[0] or p.stem
+    return p.with_name(subject + ".asf")
+
+
+def _same_skeleton(a: Skeleton, b: Skeleton, tol: float = 1e-9) -> bool:
+    """Same joints, hierarchy, dofs, orders, offsets, axes and end sites."""
+    if len(a.joints) != len(b.joints) or abs(a.length_unit - b.length_unit) > tol:
+        return False
+    for ja, jb in zip(a.joints, b.joints):
+        if (ja.name, ja.parent, ja.dofs, ja.rotation_order) != (
+            jb.name,
+            jb.parent,
+            jb.dofs,
+            jb.rotation_order,
+        ):
+            return False
+        if not (np.allclose(ja.offset, jb.offset, rtol=0, atol=tol)
+                and np.allclose(ja.axis, jb.axis, rtol=0, atol=tol)):
+            return False
+        if (ja.end_site is None) != (jb.end_site is None):
+            return False
+        if ja.end_site is not None and not np.allclose(ja.end_site, jb.end_site, rtol=0, atol=tol):
+            return False
+    return True
+
+
+def _can_reuse_asf(asf: Path, skeleton: Skeleton) -> bool:
+    """Whether the existing ``asf`` already describes ``skeleton`` (so need not be written)."""
+    from .asfamc import read_asf, write_asf
+
+    try:
+        if _same_skeleton(read_asf(asf), skeleton):
+            return True
+    except ParseError:
+        pass
+    with tempfile.TemporaryDirectory() as tmp:
+        fresh = Path(tmp) / asf.name
+        write_asf(skeleton, fresh)
+        try:
+            return fresh.read_bytes() == asf.read_bytes()
+        except OSError:
+            return False
+
+
+def _check_kwargs(suffix: str, kwargs: dict, allowed: tuple[str, ...]) -> None:
+    unknown = sorted(set(kwargs) - set(allowed))
+    if unknown:
+        ok = ", ".join(allowed) if allowed else "none"
+        raise ParameterError(
+            f"unknown option(s) {unknown} for saving {suffix}; allowed: {ok}"
+        )
+
+
+def save(motion: Motion, path: str | os.PathLike[str], **kwargs: Any) -> None:
+    """Write a motion in the format given by the suffix of ``path``.
+
+    Parameters
+    ----------
+    motion : Motion
+        The motion to write.
+    path : path-like
+        ``.amc``, ``.bvh``, ``.npz`` or ``.csv``.
+    **kwargs
+        Per format:
+
+        * ``.amc``: ``asf_path`` (where the skeleton goes, always written; default
+          :func:`default_asf_path`, e.g. ``out.amc`` -> ``out.asf``,
+          ``69_01.amc`` -> ``69.asf``) and ``write_skeleton`` (default True; False
+          writes the AMC alone).  The ASF is written only when the motion has a
+          skeleton.  An existing file at the default place is never overwritten: if it
+          already describes the motion's skeleton it is reused, otherwise
+          :class:`ParameterError` asks for ``asf_path``.
+        * ``.bvh``: ``rotation_order`` (see :func:`~cyclecoord.io.bvh.write_bvh`).
+        * ``.npz``, ``.csv``: none.
+
+    Raises
+    ------
+    ParseError
+        Unknown suffix (the message lists the supported formats).
+    ParameterError
+        Unknown options, or a motion the format cannot hold (e.g. BVH without a
+        skeleton).
+    """
+    p = Path(path)
+    suffix = _suffix(p)
+    if suffix == ".amc":
+        _check_kwargs(suffix, kwargs, ("asf_path", "write_skeleton"))
+        from .asfamc import write_amc
+
+        asf = kwargs.get("asf_path")
+        if motion.skeleton is None or not kwargs.get("write_skeleton", True):
+            if asf is not None and motion.skeleton is None:
+                raise ParameterError("asf_path given but the motion has no skeleton")
+            write_amc(motion, p)
+            return
+        if asf is not None:
+            asf = Path(asf)
+            if asf.resolve() == p.resolve():
+                raise ParameterError(f"asf_path {asf} is the AMC output itself")
+            write_amc(motion, p, skeleton_path=asf)
+            return
+        asf = default_asf_path(p)
+        if asf.exists() and _can_reuse_asf(asf, motion.skeleton):
+            # an equivalent skeleton is already there (e.g. the one the motion was
+            # read with): leave it untouched and write only the AMC
+            write_amc(motion, p)
+            return
+        if asf.exists():
+            raise ParameterError(
+                f"{asf} already exists and holds a different skeleton; pass asf_path= "
+                "to choose where this motion's skeleton goes (the existing file may "
+                "belong to other AMC files and is not overwritten)"
+            )
+        write_amc(motion, p, skeleton_path=asf)
+    elif suffix == ".bvh":
+        _check_kwargs(suffix, kwargs, ("rotation_order",))
+        write_bvh(motion, p, **kwargs)
+    elif suffix == ".npz":
+        _check_kwargs(suffix, kwargs, ())
+        write_npz(motion, p)
+    else:
+        _check_kwargs(suffix, kwargs, ())
+        write_csv(motion, p)
+
+
+def convert(
+    src: str | os.PathLike[str],
+    dst: str | os.PathLike[str],
+    skeleton: Skeleton | str | os.PathLike[str] | None = None,
+    fps: float | None = None,
+    **kwargs: Any,
+) -> Motion:
+    """Load ``src`` and save it as ``dst`` (formats from the suffixes).
+
+    Parameters
+    ----------
+    src, dst : path-like
+        Input and output files; they must differ (inputs are never modified).
+    skeleton, fps
+        As for :func:`load`.
+    **kwargs
+        As for :func:`save`.
+
+    Returns
+    -------
+    Motion
+        The motion as loaded from ``src``.
+    """
+    s, d = Path(src), Path(dst)
+    _suffix(d)  # fail on an unknown output format before reading anything
+    if s.exists() and d.exists() and s.resolve() == d.resolve():
+        raise ParameterError(f"convert would overwrite its input {s}")
+    motion = load(s, skeleton=skeleton, fps=fps)
+    save(motion, d, **kwargs)
+    return motion

@@ -1,0 +1,630 @@
+"""Read and write Biovision Hierarchy (BVH) motion files.
+
+A BVH file has a ``HIERARCHY`` section (nested ``ROOT``/``JOINT`` blocks with ``OFFSET``
+and ``CHANNELS``, leaves closed by ``End Site`` blocks) and a ``MOTION`` section
+(``Frames:``, ``Frame Time:`` and one line of channel values per frame).
+
+Conventions (see :mod:`cyclecoord.skeleton`): a joint's rotation channels compose in the
+order they are listed, so ``Zrotation Xrotation Yrotation`` gives the intrinsic order
+``"ZXY"``; position channels replace the matching components of the joint's offset; joint
+axes are the identity.  Channel names map to dofs as ``Xposition -> tx`` ...
+``Zrotation -> rz``.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ParameterError, ParseError
+from ..motion import Motion
+from ..skeleton import Joint, Skeleton, rotation_order_from_dofs
+from ._atomic import atomic_write
+
+__all__ = ["read_bvh", "write_bvh", "BVH_CHANNEL_NAMES"]
+
+#: BVH channel name (lower case) -> cyclecoord dof name.
+BVH_CHANNEL_NAMES = {
+    "xposition": "tx",
+    "yposition": "ty",
+    "zposition": "tz",
+    "xrotation": "rx",
+    "yrotation": "ry",
+    "zrotation": "rz",
+}
+_DOF_TO_BVH = {
+    "tx": "Xposition",
+    "ty": "Yposition",
+    "tz": "Zposition",
+    "rx": "Xrotation",
+    "ry": "Yrotation",
+    "rz": "Zrotation",
+}
+_CHANNEL_LIST = "Xposition Yposition Zposition Xrotation Yrotation Zrotation"
+# tokens that end a CHANNELS list (lower case)
+_STRUCTURE_WORDS = {"offset", "channels", "joint", "end", "{", "}", "root", "hierarchy"}
+_FRAMES_RE = re.compile(r"^frames\s*:\s*(.*)$", re.IGNORECASE)
+_FRAME_TIME_RE = re.compile(r"^frame\s+time\s*:\s*(.*)$", re.IGNORECASE)
+_AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
+
+
+# ----------------------------------------------------------------------------- reading
+@dataclass
+class _JointBuild:
+    """Mutable joint record while the hierarchy is being parsed."""
+
+    name: str
+    parent: int
+    line: int
+    offset: np.ndarray | None = None
+    dofs: tuple[str, ...] | None = None
+    end_site: np.ndarray | None = None
+    children: list[int] = field(default_factory=list)
+
+
+class _HierarchyParser:
+    """Parse the HIERARCHY token stream into joints (iterative: no recursion limit)."""
+
+    def __init__(self, tokens: list[tuple[str, int]], path: str, end_line: int) -> None:
+        self.tokens = tokens
+        self.path = path
+        self.end_line = end_line  # line of MOTION (or last line): where "ran out" errors point
+        self.pos = 0
+        self.joints: list[_JointBuild] = []
+
+    # -- token helpers
+    def error(self, message: str, line: int | None) -> ParseError:
+        return ParseError(message, self.path, line)
+
+    def peek(self) -> tuple[str, int] | None:
+        return self.tokens[self.pos] if self.pos < len(self.tokens) else None
+
+    def next(self, expected: str) -> tuple[str, int]:
+        tok = self.peek()
+        if tok is None:
+            raise self.error(f"hierarchy ended early: expected {expected}", self.end_line)
+        self.pos += 1
+        return tok
+
+    def number(self, what: str, line_hint: int) -> float:
+        tok, line = self.next(what)
+        try:
+            value = float(tok)
+        except ValueError:
+            raise self.error(f"expected {what}, found {tok!r}", line) from None
+        if not np.isfinite(value):
+            raise self.error(f"expected {what}, found non-finite value {tok!r}", line)
+        return value
+
+    def vector(self, keyword: str, line: int) -> np.ndarray:
+        return np.array(
+            [self.number(f"3 numbers after {keyword}", line) for _ in range(3)], dtype=float
+        )
+
+    # -- grammar
+    def open_joint(self, keyword: str, line: int, parent: int) -> int:
+        """After ROOT/JOINT: read the name and the opening brace, register the joint."""
+        name_parts = []
+        while True:
+            tok = self.peek()
+            if tok is None or tok[1] != line or tok[0] == "{":
+                break
+            name_parts.append(tok[0])
+            self.pos += 1
+        if not name_parts:
+            raise self.error(f"expected a joint name after {keyword}", line)
+        name = " ".join(name_parts)
+        if any(j.name == name for j in self.joints):
+            raise self.error(f"joint name {name!r} is used twice", line)
+        tok, tline = self.next(f"'{{' opening joint {name!r}")
+        if tok != "{":
+            raise self.error(f"expected '{{' after {keyword} {name}, found {tok!r}", tline)
+        self.joints.append(_JointBuild(name=name, parent=parent, line=line))
+        index = len(self.joints) - 1
+        if parent >= 0:
+            self.joints[parent].children.append(index)
+        return index
+
+    def channels(self, joint: _JointBuild, line: int) -> tuple[str, ...]:
+        tok, cline = self.next("the number of channels after CHANNELS")
+        try:
+            count = int(tok)
+        except ValueError:
+            raise self.error(
+                f"expected the number of channels after CHANNELS, found {tok!r}", cline
+            ) from None
+        if count < 0:
+            raise self.error(f"CHANNELS count must be >= 0, found {count}", cline)
+        names: list[tuple[str, int]] = []
+        while True:
+            nxt = self.peek()
+            if nxt is None or nxt[0].lower() in _STRUCTURE_WORDS:
+                break
+            if nxt[0].lower() not in BVH_CHANNEL_NAMES:
+                raise self.error(
+                    f"unknown channel name {nxt[0]!r} in joint {joint.name!r}; "
+                    f"expected one of {_CHANNEL_LIST}",
+                    nxt[1],
+                )
+            names.append(nxt)
+            self.pos += 1
+        if len(names) != count:
+            listed = " ".join(n for n, _ in names) or "none"
+            raise self.error(
+                f"CHANNELS declares {count} channels for joint {joint.name!r} but lists "
+                f"{len(names)} ({listed})",
+                line,
+            )
+        dofs = tuple(BVH_CHANNEL_NAMES[n.lower()] for n, _ in names)
+        for (n, nline), d in zip(names, dofs):
+            if dofs.count(d) > 1:
+                raise self.error(f"channel {n} listed twice in joint {joint.name!r}", nline)
+        return dofs
+
+    def end_site(self, joint: _JointBuild, line: int) -> np.ndarray:
+        tok, tline = self.next("'Site' after 'End'")
+        if tok.lower() != "site":
+            raise self.error(f"expected 'End Site', found 'End {tok}'", tline)
+        tok, tline = self.next("'{' opening End Site")
+        if tok != "{":
+            raise self.error(f"expected '{{' after End Site, found {tok!r}", tline)
+        tok, tline = self.next("OFFSET in End Site")
+        if tok.lower() != "offset":
+            raise self.error(f"expected OFFSET in End Site of {joint.name!r}, found {tok!r}", tline)
+        vec = self.vector("OFFSET", tline)
+        tok, tline = self.next("'}' closing End Site")
+        if tok != "}":
+            raise self.error(
+                f"expected '}}' closing End Site of {joint.name!r}, found {tok!r}", tline
+            )
+        if joint.end_site is not None:
+            raise self.error(f"joint {joint.name!r} has more than one End Site", line)
+        return vec
+
+    def parse(self) -> list[_JointBuild]:
+        tok, line = self.next("HIERARCHY")
+        if tok.upper() != "HIERARCHY":
+            raise self.error(f"expected HIERARCHY at the start of the file, found {tok!r}", line)
+        tok, line = self.next("ROOT")
+        if tok.upper() != "ROOT":
+            raise self.error(f"expected ROOT after HIERARCHY, found {tok!r}", line)
+        stack = [self.open_joint("ROOT", line, -1)]
+        while stack:
+            current = self.joints[stack[-1]]
+            nxt = self.peek()
+            if nxt is None:
+                raise self.error(
+                    f"unbalanced braces: joint {current.name!r} opened at line "
+                    f"{current.line} is not closed (expected '}}' before MOTION)",
+                    self.end_line,
+                )
+            tok, line = self.next("")
+            word = tok.lower()
+            if word == "offset":
+                if current.offset is not None:
+                    raise self.error(f"joint {current.name!r} has a second OFFSET", line)
+                current.offset = self.vector("OFFSET", line)
+            elif word == "channels":
+                if current.dofs is not None:
+                    raise self.error(f"joint {current.name!r} has a second CHANNELS line", line)
+                current.dofs = self.channels(current, line)
+            elif word == "joint":
+                stack.append(self.open_joint("JOINT", line, stack[-1]))
+            elif word == "end":
+                current.end_site = self.end_site(current, line)
+            elif tok == "}":
+                if current.offset is None:
+                    raise self.error(
+                        f"joint {current.name!r} (line {current.line}) has no OFFSET", line
+                    )
+                stack.pop()
+            elif word == "root":
+                raise self.error(
+                    "a second ROOT inside a joint block; braces are unbalanced", line
+                )
+            else:
+                raise self.error(
+                    f"unexpected {tok!r} in joint {current.name!r}; expected OFFSET, "
+                    "CHANNELS, JOINT, End Site or '}'",
+                    line,
+                )
+        rest = self.peek()
+        if rest is not None:
+            tok, line = rest
+            if tok == "}":
+                raise self.error("unbalanced braces: '}' after the root joint was closed", line)
+            if tok.upper() == "ROOT":
+                raise self.error(
+                    "a second ROOT: only single-rooted hierarchies are supported", line
+                )
+            raise self.error(f"unexpected {tok!r} after the root joint; expected MOTION", line)
+        return self.joints
+
+
+def _read_text(path: Path) -> str:
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise ParseError("no such file", path) from None
+    except IsADirectoryError:
+        raise ParseError("is a directory, expected a BVH file", path) from None
+    except OSError as exc:
+        raise ParseError(f"cannot read file: {exc.strerror or exc}", path) from None
+    return data.decode("utf-8", errors="replace")
+
+
+def _round_fps(fps: float) -> float:
+    """Snap to an integer rate when within 1e-4 relative (0.0083333 s -> 120 fps)."""
+    nearest = round(fps)
+    if nearest > 0 and abs(fps - nearest) <= 1e-4 * fps:
+        return float(nearest)
+    return float(fps)
+
+
+def read_bvh(path: str | os.PathLike[str]) -> Motion:
+    """Read a BVH file.
+
+    Parameters
+    ----------
+    path : path-like
+        The ``.bvh`` file.  CRLF line ends, tabs and extra whitespace are accepted.
+
+    Returns
+    -------
+    Motion
+        Frames of shape ``(T, D)`` with ``D`` the total channel count, channels in file
+        order as ``(joint, dof)``; ``fps = 1 / Frame Time`` (snapped to an integer rate
+        when within 1e-4 relative); a :class:`~cyclecoord.skeleton.Skeleton` with
+        ``source_format="bvh"``, identity axes and per-joint rotation orders taken from
+        the listed rotation channels.
+
+    Raises
+    ------
+    ParseError
+        Naming file and line for anything malformed: empty file, missing HIERARCHY or
+        MOTION, unbalanced braces, unknown channel names, CHANNELS count not matching
+        the names, frame lines with the wrong number of values, ``Frames:`` not matching
+        the frame lines present (too few or too many), non-numbers, non-finite values,
+        ``Frame Time <= 0``.  Frames are counted from 1 in messages.
+    """
+    path = Path(path)
+    spath = str(path)
+    text = _read_text(path)
+    lines = text.splitlines()
+    if not text.strip():
+        raise ParseError("file is empty; expected a BVH file starting with HIERARCHY", spath)
+
+    # ---- split HIERARCHY tokens from the MOTION section
+    tokens: list[tuple[str, int]] = []
+    motion_line: int | None = None  # 0-based index of the MOTION line
+    for i, raw in enumerate(lines):
+        parts = raw.replace("{", " { ").replace("}", " } ").split()
+        if not parts:
+            continue
+        if parts[0].upper() == "MOTION":
+            motion_line = i
+            break
+        tokens.extend((p, i + 1) for p in parts)
+    end_line = motion_line + 1 if motion_line is not None else len(lines)
+    if not tokens:
+        raise ParseError(
+            "expected HIERARCHY at the start of the file, found MOTION", spath, end_line
+        )
+    builds = _HierarchyParser(tokens, spath, end_line).parse()
+    if motion_line is None:
+        raise ParseError(
+            "missing MOTION section after the hierarchy (expected a line 'MOTION')",
+            spath,
+            len(lines),
+        )
+
+    # ---- skeleton
+    joints = []
+    for b in builds:
+        dofs = b.dofs or ()
+        try:
+            joints.append(
+                Joint(
+                    name=b.name,
+                    parent=b.parent,
+                    offset=b.offset,
+                    dofs=dofs,
+                    rotation_order=rotation_order_from_dofs(dofs, reverse=False),
+                    axis=np.eye(3),
+                    end_site=b.end_site,
+                )
+            )
+        except ParameterError as exc:  # defensive: the parser checks these already
+            raise ParseError(str(exc), spath, b.line) from None
+    try:
+        skeleton = Skeleton(joints=tuple(joints), name=path.stem, source_format="bvh")
+    except ParameterError as exc:  # defensive, as above
+        raise ParseError(str(exc), spath, builds[0].line) from None
+    channels = skeleton.channels
+    n_channels = len(channels)
+
+    # ---- MOTION header
+    body = [(i + 1, ln.strip()) for i, ln in enumerate(lines) if i > motion_line and ln.strip()]
+    if not body:
+        raise ParseError(
+            "MOTION section ends early: expected 'Frames: <count>'", spath, motion_line + 1
+        )
+    fline, ftext = body[0]
+    m = _FRAMES_RE.match(ftext)
+    if m is None:
+        raise ParseError(f"expected 'Frames: <count>', found {ftext[:40]!r}", spath, fline)
+    try:
+        n_frames = int(m.group(1).strip())
+    except ValueError:
+        raise ParseError(
+            f"expected a whole number of frames after 'Frames:', found {m.group(1).strip()!r}",
+            spath,
+            fline,
+        ) from None
+    if n_frames < 0:
+        raise ParseError(f"Frames must be >= 0, found {n_frames}", spath, fline)
+    if len(body) < 2:
+        raise ParseError(
+            "MOTION section ends early: expected 'Frame Time: <seconds>'", spath, fline
+        )
+    tline, ttext = body[1]
+    m = _FRAME_TIME_RE.match(ttext)
+    if m is None:
+        raise ParseError(f"expected 'Frame Time: <seconds>', found {ttext[:40]!r}", spath, tline)
+    try:
+        frame_time = float(m.group(1).strip())
+    except ValueError:
+        raise ParseError(
+            f"expected a number after 'Frame Time:', found {m.group(1).strip()!r}", spath, tline
+        ) from None
+    if not np.isfinite(frame_time) or frame_time <= 0 or not np.isfinite(1.0 / frame_time):
+        raise ParseError(
+            f"Frame Time must be a positive number of seconds, found {m.group(1).strip()}",
+            spath,
+            tline,
+        )
+
+    # ---- frame lines
+    frame_lines = body[2:]
+    if len(frame_lines) < n_frames:
+        where = frame_lines[-1][0] if frame_lines else tline
+        raise ParseError(
+            f"'Frames: {n_frames}' declared but only {len(frame_lines)} frame lines found",
+            spath,
+            where,
+        )
+    if len(frame_lines) > n_frames:
+        raise ParseError(
+            f"'Frames: {n_frames}' declared but {len(frame_lines)} frame lines found "
+            f"(line {frame_lines[n_frames][0]} is frame {n_frames + 1})",
+            spath,
+            frame_lines[n_frames][0],
+        )
+    split_lines = []
+    for k, (lno, txt) in enumerate(frame_lines, start=1):
+        vals = txt.split()
+        if len(vals) != n_channels:
+            raise ParseError(
+                f"frame {k} has {len(vals)} values, the hierarchy declares "
+                f"{n_channels} channels",
+                spath,
+                lno,
+            )
+        split_lines.append(vals)
+    flat = [tok for vals in split_lines for tok in vals]
+    try:
+        numbers = list(map(float, flat))
+    except ValueError:
+        for k, ((lno, _), vals) in enumerate(zip(frame_lines, split_lines), start=1):
+            for c, tok in enumerate(vals):
+                try:
+                    float(tok)
+                except ValueError:
+                    j, d = channels[c]
+                    raise ParseError(
+                        f"frame {k}: value {c + 1} ({j} {_DOF_TO_BVH[d]}) is {tok!r}, "
+                        "expected a number",
+                        spath,
+                        lno,
+                    ) from None
+        raise ParseError("frame values are not all numbers", spath)  # pragma: no cover
+    frames = np.asarray(numbers, dtype=float).reshape(n_frames, n_channels)
+    bad = ~np.isfinite(frames)
+    if bad.any():
+        k, c = (int(v) for v in np.argwhere(bad)[0])
+        j, d = channels[c]
+        raise ParseError(
+            f"frame {k + 1}: value {c + 1} ({j} {_DOF_TO_BVH[d]}) is "
+            f"{split_lines[k][c]!r}, expected a finite number",
+            spath,
+            frame_lines[k][0],
+        )
+    return Motion(
+        frames=frames,
+        channels=channels,
+        fps=_round_fps(1.0 / frame_time),
+        skeleton=skeleton,
+        source=spath,
+        metadata={"frame_time": frame_time},
+    )
+
+
+# ----------------------------------------------------------------------------- writing
+def _is_subsequence(short: str, long: str) -> bool:
+    it = iter(long)
+    return all(c in it for c in short)
+
+
+def _complete_order(order: str, preferred: str = "ZXY") -> str:
+    """A three-axis order that lists ``order``'s axes in the same relative order."""
+    if len(order) == 3:
+        return order
+    if _is_subsequence(order, preferred):
+        return preferred
+    return order + "".join(c for c in "XYZ" if c not in order)
+
+
+def _check_order(order: str) -> str:
+    up = str(order).upper()
+    if len(up) != 3 or sorted(up) != ["X", "Y", "Z"]:
+        raise ParameterError(
+            f"rotation_order must be a permutation of XYZ such as 'ZXY', got {order!r}"
+        )
+    return up
+
+
+def _bvh_ready_orders(skeleton: Skeleton, forced: str | None) -> list[str] | None:
+    """Per-joint 3-axis orders if the skeleton can be written as is, else ``None``."""
+    orders = []
+    for j in skeleton.joints:
+        if not np.allclose(j.axis, np.eye(3), rtol=0.0, atol=1e-12):
+            return None
+        if forced is not None:
+            if not _is_subsequence(j.rotation_order, forced):
+                return None
+            orders.append(forced)
+        else:
+            orders.append(_complete_order(j.rotation_order))
+    return orders
+
+
+def _bvh_names(names: list[str]) -> list[str]:
+    """BVH-safe joint names: whitespace and braces become ``_``, clashes get a suffix."""
+    out: list[str] = []
+    used: set[str] = set()
+    for name in names:
+        base = re.sub(r"[\s{}]+", "_", name.strip()) or "joint"
+        safe, k = base, 2
+        while safe in used:
+            safe, k = f"{base}_{k}", k + 1
+        used.add(safe)
+        out.append(safe)
+    return out
+
+
+def _fmt(values) -> str:
+    return " ".join(f"{v:.8f}" for v in values)
+
+
+def write_bvh(
+    motion: Motion,
+    path: str | os.PathLike[str],
+    rotation_order: str | None = None,
+) -> None:
+    """Write a motion as a BVH file.
+
+    The hierarchy is tab-indented; the root gets ``CHANNELS 6 Xposition Yposition
+    Zposition`` plus three rotation channels, every other joint ``CHANNELS 3`` rotation
+    channels (six if it has translation dofs); leaves with an end site get ``End Site``
+    blocks.  Rotation channels a joint lacks are written as 0, position channels it lacks
+    as its offset component, so forward kinematics is unchanged.  Values are written with
+    8 decimals.
+
+    Parameters
+    ----------
+    motion : Motion
+        Must have a skeleton.  Channel columns may be in any order (mapped by
+        ``(joint, dof)``).  A skeleton with non-identity joint axes (ASF conventions), or
+        whose rotation orders do not fit ``rotation_order``, is first converted with
+        :func:`cyclecoord.retarget.to_bvh_convention`.
+    path : path-like
+        Output file, written atomically.
+    rotation_order : str, optional
+        Force one intrinsic order (a permutation of ``"XYZ"``, e.g. ``"ZXY"``) for every
+        joint.  By default a BVH-convention skeleton keeps each joint's own order and
+        other skeletons are converted to ``"ZXY"``.
+
+    Raises
+    ------
+    ParameterError
+        If the motion has no skeleton or ``rotation_order`` is not a permutation of XYZ.
+
+    Notes
+    -----
+    BVH names are single words: whitespace and braces in joint names are written as
+    ``_`` (a numeric suffix keeps names unique), so such joints read back renamed.
+    """
+    if motion.skeleton is None:
+        raise ParameterError("writing BVH needs a skeleton; this motion has none")
+    forced = None if rotation_order is None else _check_order(rotation_order)
+    orders = _bvh_ready_orders(motion.skeleton, forced)
+    if orders is None:
+        from ..retarget import to_bvh_convention
+
+        motion = to_bvh_convention(motion, rotation_order=forced or "ZXY")
+        orders = _bvh_ready_orders(motion.skeleton, forced)
+        assert orders is not None
+    skel = motion.skeleton
+    assert skel is not None
+    safe_names = _bvh_names([j.name for j in skel.joints])
+
+    # ---- output channel layout and values, in depth-first (file) order
+    children: dict[int, list[int]] = {i: [] for i in range(len(skel.joints))}
+    for i, j in enumerate(skel.joints):
+        if j.parent >= 0:
+            children[j.parent].append(i)
+    dfs: list[tuple[int, int]] = []  # (joint index, depth)
+    todo = [(0, 0)]
+    while todo:
+        i, depth = todo.pop()
+        dfs.append((i, depth))
+        todo.extend((c, depth + 1) for c in reversed(children[i]))
+
+    col = {c: k for k, c in enumerate(motion.channels)}
+    T = motion.n_frames
+    out_dofs: dict[int, tuple[str, ...]] = {}
+    columns: list[np.ndarray] = []
+    for i, _ in dfs:
+        j = skel.joints[i]
+        has_t = i == 0 or any(d.startswith("t") for d in j.dofs)
+        dofs = (("tx", "ty", "tz") if has_t else ()) + tuple("r" + a.lower() for a in orders[i])
+        out_dofs[i] = dofs
+        for d in dofs:
+            k = col.get((j.name, d)) if d in j.dofs else None
+            if k is not None:
+                columns.append(motion.frames[:, k])
+            elif d.startswith("t"):
+                columns.append(np.full(T, j.offset[_AXIS_INDEX[d[1]]]))
+            else:
+                columns.append(np.zeros(T))
+    data = np.column_stack(columns) if columns else np.zeros((T, 0))
+
+    # ---- text
+    out: list[str] = ["HIERARCHY"]
+    stack_close: list[int] = []  # depths of open blocks
+
+    def close_to(depth: int) -> None:
+        while stack_close and stack_close[-1] >= depth:
+            d = stack_close.pop()
+            out.append("\t" * d + "}")
+
+    for i, depth in dfs:
+        close_to(depth)
+        j = skel.joints[i]
+        ind = "\t" * depth
+        out.append(f"{ind}{'ROOT' if depth == 0 else 'JOINT'} {safe_names[i]}")
+        out.append(f"{ind}{{")
+        out.append(f"{ind}\tOFFSET {_fmt(j.offset)}")
+        names = " ".join(_DOF_TO_BVH[d] for d in out_dofs[i])
+        out.append(f"{ind}\tCHANNELS {len(out_dofs[i])} {names}")
+        if j.end_site is not None:
+            out.append(f"{ind}\tEnd Site")
+            out.append(f"{ind}\t{{")
+            out.append(f"{ind}\t\tOFFSET {_fmt(j.end_site)}")
+            out.append(f"{ind}\t}}")
+        stack_close.append(depth)
+    close_to(0)
+    out.append("MOTION")
+    out.append(f"Frames: {T}")
+    out.append(f"Frame Time: {1.0 / motion.fps:.10g}")
+    row_fmt = " ".join(["%.8f"] * data.shape[1])
+    with atomic_write(path, "w", newline="\n") as fh:
+        fh.write("\n".join(out))
+        fh.write("\n")
+        for row in data.tolist():
+            fh.write(row_fmt % tuple(row))
+            fh.write("\n")
