@@ -31,9 +31,11 @@ __all__ = [
 DEFAULT_PRIME = 47
 
 #: A bar is "clear" when death/birth (death capped at the threshold) reaches this ...
-CLEAR_RATIO = 2.0
+CLEAR_RATIO = 1.5
 #: ... and its persistence is at least this many times the next-longest H1 bar's.
 CLEAR_GAP = 2.0
+#: Other H1 bars at least this fraction as persistent as the chosen one cap its default scale.
+OTHER_CLASS_FRACTION = 0.2
 
 
 def check_prime(p: int) -> int:
@@ -290,14 +292,16 @@ def select_bar(
     scale_fraction : float, default 0.9
         Otherwise ``scale = birth + scale_fraction * (min(death, threshold) - birth)``: high
         in the bar as the paper recommends, strictly below the death where the cocycle is
-        still valid.
+        still valid.  When another H1 class at least 20% as persistent is born inside that
+        range, the scale is lowered to 95% of the way to its birth, so the coordinate is
+        read on a complex with one dominant hole.
 
     Notes
     -----
     The bar is *clear* when both hold:
 
-    * ``min(death, threshold) / birth >= 2`` — the class lives at least twice as long as
-      it took to appear (bars of sampling noise in Rips filtrations rarely reach 1.5);
+    * ``min(death, threshold) / birth >= 1.5`` — the class lives well beyond the scale
+      at which it appears (bars of sampling noise in Rips filtrations stay closer to 1);
     * its persistence is at least twice that of the next-longest H1 bar (for
       ``class_index > 0``, of the next-longest bar after it).
     """
@@ -316,6 +320,14 @@ def select_bar(
         if not 0.0 < scale_fraction < 1.0:
             raise ParameterError(f"scale fraction must be in (0, 1), got {scale_fraction}")
         s = birth + scale_fraction * (top - birth)
+        # Another substantial class born inside this bar adds a second hole that bends
+        # the harmonic representative: read the cocycle before it appears.
+        others = [
+            float(b) for k, (b, _) in enumerate(barcode.h1)
+            if k != class_index and birth < b < s and pers[k] >= OTHER_CLASS_FRACTION * pers[class_index]
+        ]
+        if others:
+            s = birth + 0.95 * (min(others) - birth)
     else:
         s = float(scale)
         if not (birth <= s < death) or s > barcode.threshold:

@@ -165,6 +165,7 @@ def cmd_extract(args: argparse.Namespace) -> int:
             n_neighbors=args.neighbors,
             weighting=args.weighting,
             sampling=args.sampling,
+            cycle_start=args.cycle_start,
             random_state=args.seed,
         )
     except NoPeriodicMotionError as exc:
@@ -303,7 +304,7 @@ def build_parser() -> argparse.ArgumentParser:
             "Barcode -> most persistent H1 class -> circular coordinate per frame -> periodic "
             "density -> typical cycle (k-nearest-neighbour centroids), resampled to the capture's "
             "frame rate and written as a loopable clip. Exit code 3 when no H1 bar stands clear "
-            "(death/birth >= 2 and at least 2x the next bar's persistence); the report is still written."
+            "(death/birth >= 1.5 and at least 2x the next bar's persistence); the report is still written."
         ),
     )
     e.add_argument("input", metavar="INPUT")
@@ -313,10 +314,14 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--class", dest="class_index", type=int, default=0, metavar="I",
                    help="use the I-th most persistent H1 class (default 0)")
     g.add_argument("--samples", type=_positive_int, default=500, metavar="N", help="phases sampled from the density (500)")
-    g.add_argument("--neighbors", type=_positive_int, default=10, metavar="K", help="frames averaged per phase (10)")
-    g.add_argument("--weighting", choices=("mean", "gaussian"), default="mean", help="centroid weighting (mean)")
+    g.add_argument("--neighbors", type=_positive_int, default=10, metavar="K", help="frames averaged per phase (10; should exceed the number of cycles)")
+    g.add_argument("--weighting", choices=("kernel", "mean", "gaussian"), default="kernel",
+                   help="how frames near a phase are averaged: smooth kernel (default), the paper's "
+                   "k-nearest mean, or k-nearest Gaussian-weighted")
     g.add_argument("--sampling", choices=("quantile", "random"), default="quantile",
                    help="density quantiles (default, smooth) or random draws as in the paper")
+    g.add_argument("--cycle-start", choices=("slowest", "first"), default="slowest",
+                   help="begin the cycle at its slowest pose (default, hides the loop seam) or at the clip's first phase")
     g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (0)")
     o = e.add_argument_group("output")
     o.add_argument("-o", "--output", metavar="OUT", help="write the cycle (.bvh, .amc, .npz or .csv)")

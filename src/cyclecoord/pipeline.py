@@ -23,7 +23,23 @@ from .metrics import distance_to_cycle, jerk_summary, loop_closure
 from .motion import Motion
 from .preprocess import PreparedData, Preprocessor
 
-__all__ = ["extract", "ExtractionResult", "cycle_lengths"]
+__all__ = ["extract", "ExtractionResult", "cycle_lengths", "slowest_frame"]
+
+
+def slowest_frame(frames: np.ndarray, window: int = 5) -> int:
+    """Index of the frame where a closed cycle moves least.
+
+    Step sizes around the loop are smoothed over ``window`` frames (cyclically); the frame
+    between the two smallest smoothed steps is returned.  Starting a loop there hides the
+    seam best, as animators cut loops at a rest pose.
+    """
+    f = np.asarray(frames, dtype=float)
+    steps = np.linalg.norm(np.roll(f, -1, axis=0) - f, axis=1)  # step i: frame i -> i+1
+    around = steps + np.roll(steps, 1)  # motion entering and leaving frame i
+    w = max(1, min(window, len(f)))
+    kernel = np.ones(w) / w
+    smooth = np.convolve(np.concatenate([around[-w:], around, around[:w]]), kernel, mode="same")[w:-w]
+    return int(np.argmin(smooth))
 
 
 def cycle_lengths(unwrapped: np.ndarray) -> np.ndarray:
@@ -170,9 +186,10 @@ def extract(
     scale_fraction: float = 0.9,
     n_samples: int = 500,
     n_neighbors: int = 10,
-    weighting: str = "mean",
+    weighting: str = "kernel",
     sampling: str = "quantile",
     n_components: int = 30,
+    cycle_start: str = "slowest",
     require_clear: bool = True,
     random_state: int | None = 0,
 ) -> ExtractionResult:
@@ -205,11 +222,17 @@ def extract(
         Phases sampled from the periodic density for the centroid curve.
     n_neighbors : int, default 10
         Frames averaged per sampled phase.
-    weighting : {"mean", "gaussian"}
+    weighting : {"kernel", "mean", "gaussian"}
+        How frames near a phase are averaged: a smooth periodic kernel holding about
+        ``n_neighbors`` frames (default), the paper's plain mean of the ``n_neighbors``
+        nearest, or those Gaussian-weighted.
     sampling : {"quantile", "random"}
         Deterministic density quantiles (default, less jitter) or random draws (paper).
     n_components : int, default 30
         Gaussian mixture components of the periodic density.
+    cycle_start : {"slowest", "first"}
+        Where the written cycle begins: at its slowest pose (default; the seam of the
+        loop is least visible there) or at the phase of the clip's first frame.
     require_clear : bool, default True
         Raise :class:`NoPeriodicMotionError` when the chosen bar does not stand clear.
     random_state : int, optional
@@ -229,10 +252,12 @@ def extract(
     """
     if not isinstance(motion, Motion):
         raise ParameterError(f"extract() takes a Motion, got {type(motion).__name__}")
-    if weighting not in ("mean", "gaussian"):
-        raise ParameterError(f"weighting must be 'mean' or 'gaussian', got {weighting!r}")
+    if weighting not in ("kernel", "mean", "gaussian"):
+        raise ParameterError(f"weighting must be 'kernel', 'mean' or 'gaussian', got {weighting!r}")
     if sampling not in ("quantile", "random"):
         raise ParameterError(f"sampling must be 'quantile' or 'random', got {sampling!r}")
+    if cycle_start not in ("slowest", "first"):
+        raise ParameterError(f"cycle_start must be 'slowest' or 'first', got {cycle_start!r}")
     if n_samples < 10:
         raise ParameterError(f"n_samples must be at least 10, got {n_samples}")
     if n_neighbors < 1:
@@ -244,7 +269,7 @@ def extract(
         difference_root=difference_root, prime=prime, max_scale=max_scale, scale=scale,
         class_index=class_index, scale_fraction=scale_fraction, n_samples=n_samples,
         n_neighbors=n_neighbors, weighting=weighting, sampling=sampling, n_components=n_components,
-        random_state=random_state,
+        cycle_start=cycle_start, random_state=random_state,
     )
     if frames is not None:
         a, b = frames
@@ -336,6 +361,16 @@ def extract(
         theta, prepared.poses, period, density=density, n_samples=n_samples, k=k,
         weighting=weighting, sampling=sampling, random_state=random_state,
     )
+    if cycle_start == "slowest":
+        shift = slowest_frame(np.delete(typ.frames, prepared.root_columns, axis=1) if prepared.root_columns.size < typ.frames.shape[1] else typ.frames)
+        if shift:
+            from dataclasses import replace as _replace
+
+            typ = _replace(
+                typ,
+                frames=np.roll(typ.frames, -shift, axis=0),
+                phases=np.roll(typ.phases, -shift),
+            )
     cyc = np.array(typ.frames, dtype=float)
     root = prepared.root_columns
     if root.size:
