@@ -14,17 +14,68 @@ prepares it, :mod:`~cyclecoord.barcode` computes the persistent cohomology barco
 4
 """
 
-from . import datasets
-from .barcode import Barcode, BarSelection, compute_barcode
-from .coordinates import CircularCoordinates
-from .cycle import TypicalCycle, typical_cycle
-from .density import PeriodicDensity
-from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
-from .io import convert, load, save
-from .motion import DEFAULT_FPS, Motion
-from .pipeline import ExtractionResult, extract
-from .preprocess import PreparedData, Preprocessor
-from .skeleton import Joint, JointPositions, Skeleton, forward_kinematics
+from typing import TYPE_CHECKING
+
+# Public names and the module each lives in.  They are imported on first use (PEP 562)
+# so that `import cyclecoord` and `cyclecoord --help` stay fast: scikit-learn, SciPy's
+# statistics and ripser load only when the pipeline runs.
+_LAZY = {
+    "Barcode": "barcode",
+    "BarSelection": "barcode",
+    "compute_barcode": "barcode",
+    "CircularCoordinates": "coordinates",
+    "TypicalCycle": "cycle",
+    "typical_cycle": "cycle",
+    "PeriodicDensity": "density",
+    "CycleCoordError": "errors",
+    "NoPeriodicMotionError": "errors",
+    "ParameterError": "errors",
+    "ParseError": "errors",
+    "convert": "io",
+    "load": "io",
+    "save": "io",
+    "DEFAULT_FPS": "motion",
+    "Motion": "motion",
+    "ExtractionResult": "pipeline",
+    "extract": "pipeline",
+    "PreparedData": "preprocess",
+    "Preprocessor": "preprocess",
+    "Joint": "skeleton",
+    "JointPositions": "skeleton",
+    "Skeleton": "skeleton",
+    "forward_kinematics": "skeleton",
+}
+_SUBMODULES = {"datasets", "io", "plot", "metrics", "pipeline", "barcode", "coordinates", "cycle", "density"}
+
+
+def __getattr__(name: str):
+    import importlib
+
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    if name in _SUBMODULES:
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module 'cyclecoord' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY) | _SUBMODULES)
+
+
+if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
+    from . import datasets
+    from .barcode import Barcode, BarSelection, compute_barcode
+    from .coordinates import CircularCoordinates
+    from .cycle import TypicalCycle, typical_cycle
+    from .density import PeriodicDensity
+    from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
+    from .io import convert, load, save
+    from .motion import DEFAULT_FPS, Motion
+    from .pipeline import ExtractionResult, extract
+    from .preprocess import PreparedData, Preprocessor
+    from .skeleton import Joint, JointPositions, Skeleton, forward_kinematics
 
 __version__ = "0.1.0"
 

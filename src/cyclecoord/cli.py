@@ -83,6 +83,24 @@ def load_input(path: str, skeleton: str | None = None, fps: float | None = None)
     return load(path, skeleton=skeleton, fps=fps)
 
 
+def _check_output(path: str | None, what: str = "output") -> None:
+    """Fail fast, before any computation, on an output we could not write."""
+    if not path:
+        return
+    from .io import SUPPORTED_FORMATS
+
+    out = Path(path)
+    if what == "output" and out.suffix.lower() not in SUPPORTED_FORMATS:
+        raise ParameterError(
+            f"{path}: unknown output format {out.suffix or '(no suffix)'!r}; use one of {', '.join(SUPPORTED_FORMATS)}"
+        )
+    if what == "report" and out.suffix.lower() != ".json":
+        raise ParameterError(f"{path}: the report is JSON; give it a .json name")
+    folder = out.parent if str(out.parent) else Path(".")
+    if not folder.is_dir():
+        raise ParameterError(f"{path}: folder {folder} does not exist")
+
+
 def _write_json(path: str, payload: dict) -> None:
     from .io._atomic import atomic_write
 
@@ -146,6 +164,8 @@ def cmd_extract(args: argparse.Namespace) -> int:
     from .io import save
     from .pipeline import extract
 
+    _check_output(args.output)
+    _check_output(args.report, "report")
     motion = load_input(args.input, args.skeleton, args.fps)
     report_payload = None
     code = EXIT_OK
@@ -262,6 +282,9 @@ def cmd_barcode(args: argparse.Namespace) -> int:
 def cmd_convert(args: argparse.Namespace) -> int:
     from .io import save
 
+    _check_output(args.output)
+    if Path(args.output).resolve() == Path(args.input).resolve():
+        raise ParameterError(f"{args.output}: refusing to overwrite the input file")
     motion = load_input(args.input, args.skeleton, args.fps)
     if args.frames is not None:
         a, b = args.frames

@@ -314,11 +314,15 @@ def extract(
         raise ParameterError(f"class index {class_index} out of range: the barcode has {len(barcode.h1)} H1 bars")
     pre_sel = select_bar(barcode, class_index, scale, scale_fraction)
     if require_clear and not pre_sel.clear:
+        why = []
+        if pre_sel.ratio < CLEAR_RATIO:
+            why.append(f"death/birth {pre_sel.ratio:.2f} < {CLEAR_RATIO}")
+        if pre_sel.gap < CLEAR_GAP:
+            why.append(f"persistence only {pre_sel.gap:.2f}x the next bar's (< {CLEAR_GAP}x)")
+        ds = "inf" if not np.isfinite(pre_sel.death) else f"{pre_sel.death:.4g}"
         raise fail(
-            "no periodic motion found: the most persistent H1 bar "
-            f"[{pre_sel.birth:.4g}, {pre_sel.death:.4g}) does not stand clear (death/birth {pre_sel.ratio:.2f} "
-            f"< {CLEAR_RATIO} or persistence {pre_sel.gap:.2f}x the next bar's < {CLEAR_GAP}); "
-            "try --max-scale, --pca or --frames"
+            f"no periodic motion found: H1 bar #{class_index} [{pre_sel.birth:.4g}, {ds}) does not stand "
+            f"clear ({'; '.join(why)}); try --max-scale, --pca or --frames"
         )
 
     t0 = time.perf_counter()

@@ -1,0 +1,139 @@
+"""The periodic pipeline end to end: the issue's evidence on synthetic and real captures."""
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.metrics import distance_to_cycle, loop_closure
+from cyclecoord.pipeline import cycle_lengths, slowest_frame
+from cyclecoord.preprocess import Preprocessor
+
+
+def bins_advance(theta, true_phase, n_bins=20):
+    """Monotonicity measure: bin frames by true phase; the circular mean of the coordinate
+    in each bin must advance from bin to bin and go round exactly once (steps in
+    (-0.5, 0.5) summing to 1).  Returns (fraction of bins advancing, total turn)."""
+    b = np.floor(np.mod(true_phase, 1.0) * n_bins).astype(int)
+    means = np.array([np.angle(np.mean(np.exp(2j * np.pi * theta[b == i]))) / (2 * np.pi) for i in range(n_bins)])
+    steps = np.mod(np.diff(np.r_[means, means[0]]) + 0.5, 1.0) - 0.5
+    return float(np.mean(steps > 0)), float(abs(steps.sum()))
+
+
+CASES = [(kind, seed, noise) for kind in ("walk", "jog", "squat", "arm_circles") for seed in (0, 1) for noise in (0.5, 2.0)]
+
+
+@pytest.mark.parametrize("kind,seed,noise", CASES)
+def test_synthetic_phase_cycles_and_cycle_quality(kind, seed, noise):
+    cap = cc.datasets.make_periodic_capture(n_frames=600, period=120.0, noise=noise, kind=kind, random_state=seed)
+    res = cc.extract(cap.motion)
+    # the coordinate is a monotone function of the true phase
+    frac, turn = bins_advance(res.coordinate, cap.phase)
+    assert frac == 1.0 and turn == pytest.approx(1.0)
+    # a 600-frame clip of period 120 holds (600 - 1) / 120 cycles from first to last frame
+    assert res.cycles == pytest.approx(599 / 120, abs=0.1)
+    assert res.period_frames == pytest.approx(120, rel=0.03)
+    # the extracted cycle is closer to the noise-free truth than the noisy frames are
+    clean = Preprocessor().fit(cap.clean).transform(cap.clean).poses
+    joints = np.arange(6, 62)
+    d_cycle = distance_to_cycle(clean[:, joints], res.typical.frames[:, joints]).mean()
+    d_noisy = np.linalg.norm(res.prepared.poses[:, joints] - clean[:, joints], axis=1).mean()
+    assert d_cycle < d_noisy
+    # it loops, and it is not jerkier than the capture
+    assert res.loop_closure <= 1.5
+    assert res.jerk["cycle"] <= 2 * res.jerk["original"]
+    assert res.cycle.n_frames == round(res.period_frames)
+
+
+def test_cycle_travels_like_the_original():
+    cap = cc.datasets.make_periodic_capture(n_frames=600, period=120.0, noise=0.5, random_state=0)
+    res = cc.extract(cap.motion)
+    tz = cap.motion.channel_index("root", "tz")
+    per_cycle = (cap.motion.frames[-1, tz] - cap.motion.frames[0, tz]) / res.cycles
+    cyc = res.cycle.frames[:, tz]
+    # one loop of P frames plus the step back to frame 0 of the next loop covers per_cycle
+    steps = np.diff(cyc)
+    loop = steps.sum() + np.median(steps)
+    assert loop == pytest.approx(per_cycle, rel=0.05)
+    assert res.cycle.skeleton is cap.motion.skeleton
+    assert res.cycle.channels == cap.motion.channels
+
+
+def test_report_has_the_documented_fields():
+    res = cc.extract(cc.datasets.example_capture().motion)
+    rep = res.to_report()
+    for key in ("frames", "dims", "barcode", "selected", "coordinate", "cycles", "period_frames",
+                "cycle_frames", "jerk", "loop_closure", "timings"):
+        assert key in rep
+    assert set(rep["barcode"]) == {"h0", "h1"}
+    assert len(rep["coordinate"]) == res.motion.n_frames
+    assert rep["selected"]["birth"] < rep["selected"]["scale"]
+    assert set(rep["jerk"]) == {"original", "cycle"}
+    assert rep["barcode"]["h0"][-1][1] is None  # the infinite H0 bar
+
+
+def test_deterministic_for_a_seed():
+    m = cc.datasets.example_capture().motion
+    a = cc.extract(m, sampling="random", random_state=3)
+    b = cc.extract(m, sampling="random", random_state=3)
+    np.testing.assert_array_equal(a.cycle.frames, b.cycle.frames)
+    np.testing.assert_array_equal(a.coordinate, b.coordinate)
+
+
+@pytest.mark.parametrize("make", [cc.datasets.make_static_capture, cc.datasets.make_random_walk_capture])
+def test_nothing_periodic_is_refused(make):
+    with pytest.raises(cc.NoPeriodicMotionError, match="no periodic motion") as info:
+        cc.extract(make(random_state=0).motion)
+    assert info.value.result is not None and info.value.result.barcode is not None
+
+
+def test_bad_arguments():
+    m = cc.datasets.example_capture().motion
+    with pytest.raises(cc.ParameterError, match="prime"):
+        cc.extract(m, prime=12)
+    with pytest.raises(cc.ParameterError, match="frame range"):
+        cc.extract(m, frames=(400, 2000))
+    with pytest.raises(cc.ParameterError, match="weighting"):
+        cc.extract(m, weighting="median")
+    with pytest.raises(cc.ParameterError, match="outside"):
+        cc.extract(m, scale=0.01)
+
+
+def test_cycle_lengths_and_slowest_frame():
+    u = np.linspace(0, 3.5, 351)  # 100 frames per cycle
+    np.testing.assert_allclose(cycle_lengths(u), [100, 100, 100])
+    t = np.linspace(0, 1, 50, endpoint=False)
+    speed = 1 + 0.9 * np.cos(2 * np.pi * (t - 0.3))  # slowest near t = 0.8
+    ang = 2 * np.pi * np.cumsum(speed) / speed.sum()
+    loop = np.column_stack([np.cos(ang), np.sin(ang)])
+    assert abs(slowest_frame(loop) - 40) <= 2
+    assert loop_closure(np.roll(loop, -slowest_frame(loop), axis=0)) < 1.0
+
+
+# ------------------------------------------------------------------ real capture (paper Fig. 7)
+def autocorrelation_period(frames, lo=60, hi=250):
+    """Independent period estimate: first autocorrelation peak of the joint angles."""
+    x = frames[:, 6:] - frames[:, 6:].mean(axis=0)
+    n = len(x)
+    ac = np.array([np.sum(x[: n - k] * x[k:]) / (n - k) for k in range(hi)])
+    return lo + int(np.argmax(ac[lo:hi]))
+
+
+def test_69_01_walk_matches_the_paper(walk_69_01):
+    res = cc.extract(walk_69_01, frames=(200, 450), max_scale=50)
+    assert res.selection.index == 0 and res.selection.clear
+    assert res.selection.birth == pytest.approx(9.95, abs=0.3)  # paper Fig. 7
+    assert res.selection.birth < res.selection.scale < 50
+    assert 1.5 < res.cycles < 2.0  # a little under two strides
+    ref = autocorrelation_period(walk_69_01.frames)
+    assert 125 < ref < 155  # about 139 frames
+    assert res.period_frames == pytest.approx(ref, rel=0.10)
+    assert res.loop_closure <= 1.5
+    assert 0.5 <= res.jerk["cycle"] / res.jerk["original"] <= 2.0
+    assert res.estimator.cocycle_check_.ok
+
+
+def test_69_01_default_threshold_agrees(walk_69_01):
+    a = cc.extract(walk_69_01, frames=(200, 450), max_scale=50)
+    b = cc.extract(walk_69_01, frames=(200, 450))
+    assert b.selection.birth == pytest.approx(a.selection.birth)
+    assert b.period_frames == pytest.approx(a.period_frames, rel=0.05)
