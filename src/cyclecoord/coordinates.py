@@ -21,8 +21,18 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import lsqr
 from scipy.spatial import cKDTree
 
-from .barcode import DEFAULT_PRIME, Barcode, BarSelection, compute_barcode, select_bar, temporal_distance_matrix
+from .barcode import (
+    DEFAULT_PRIME,
+    Barcode,
+    BarSelection,
+    check_prime,
+    compute_barcode,
+    default_max_scale,
+    select_bar,
+    temporal_distance_matrix,
+)
 from .errors import ParameterError
+from .landmarks import DEFAULT_MEMORY_LIMIT, choose_landmarks
 
 __all__ = [
     "CircularCoordinates",
@@ -32,6 +42,7 @@ __all__ = [
     "check_cocycle",
     "harmonic_coordinate",
     "orient_with_time",
+    "extend_coordinate",
     "unwrap",
     "RETRY_PRIMES",
 ]
@@ -145,7 +156,9 @@ def check_cocycle(edges: np.ndarray, z: np.ndarray, n: int) -> CocycleCheck:
     return CocycleCheck(n_triangles=int(len(np.unique(key))), n_violations=int(nbad))
 
 
-def harmonic_coordinate(edges: np.ndarray, z: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+def harmonic_coordinate(
+    edges: np.ndarray, z: np.ndarray, n: int, weights: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Solve ``argmin_w ||z + δw||₂`` and return the circle map ``-w mod 1``.
 
     Parameters
@@ -156,6 +169,10 @@ def harmonic_coordinate(edges: np.ndarray, z: np.ndarray, n: int) -> tuple[np.nd
         Real (lifted) cocycle values.
     n : int
         Number of vertices.
+    weights : ndarray, shape (E,), optional
+        Edge weights of a weighted least-squares problem ``argmin_w Σ_e weights_e (z + δw)_e²``
+        (used with landmarks: the product of the two landmarks' cell sizes, so that the
+        landmark problem approximates the one on every point).
 
     Returns
     -------
@@ -169,18 +186,98 @@ def harmonic_coordinate(edges: np.ndarray, z: np.ndarray, n: int) -> tuple[np.nd
     cols = edges.ravel()
     vals = np.tile([-1.0, 1.0], e)
     delta = sp.csr_matrix((vals, (rows, cols)), shape=(e, n))
-    w = lsqr(delta, -z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
+    if weights is None:
+        w = lsqr(delta, -z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
+    else:
+        sw = np.sqrt(np.asarray(weights, dtype=float))
+        w = lsqr(sp.diags(sw) @ delta, -sw * z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
     harmonic = z + delta @ w
     theta = np.mod(-w, 1.0)
     return theta, harmonic
 
 
-def orient_with_time(theta: np.ndarray) -> np.ndarray:
-    """Flip the coordinate if it runs backwards in frame order, and put frame 0 at 0."""
+def orient_with_time(theta: np.ndarray, return_transform: bool = False):
+    """Flip the coordinate if it runs backwards in frame order, and put frame 0 at 0.
+
+    With ``return_transform`` also returns ``(sign, offset)`` such that the result is
+    ``(sign * theta - offset) mod 1``, to apply the same change to other points.
+    """
     steps = np.mod(np.diff(theta) + 0.5, 1.0) - 0.5
-    if steps.sum() < 0:
-        theta = np.mod(-theta, 1.0)
-    return np.mod(theta - theta[0], 1.0)
+    sign = -1.0 if steps.sum() < 0 else 1.0
+    t = np.mod(sign * theta, 1.0)
+    offset = float(t[0])
+    out = np.mod(t - offset, 1.0)
+    return (out, sign, offset) if return_transform else out
+
+
+def extend_coordinate(
+    points: np.ndarray,
+    centers: np.ndarray,
+    center_theta: np.ndarray,
+    edges: np.ndarray,
+    harmonic: np.ndarray,
+    radius: float,
+    max_neighbors: int = 48,
+    chunk: int = 20_000,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Circular coordinate of arbitrary points from a solution on ``centers``.
+
+    A partition of unity over the balls of ``radius`` around the centers (weights
+    ``(radius - d)²``, normalised) blends the harmonic cocycle: a point ``x`` whose
+    nearest center is ``j`` gets ``θ_j + Σ_k φ_k(x) Δ(j → k)``, where ``Δ(j → k)`` is the
+    coordinate's increment along the edge ``j -> k`` of the complex at scale
+    ``2 * radius`` (every pair of centers whose balls both hold ``x`` is such an edge).
+    This is the sparse circular-coordinate construction of Perea (2020); for a center
+    itself it returns (nearly) its own value.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, K)
+    centers : ndarray, shape (L, K)
+    center_theta : ndarray, shape (L,)
+        Raw (unoriented) coordinate ``-w mod 1`` of the centers.
+    edges, harmonic : ndarray
+        Sorted edges ``(i, j)``, ``i < j``, between centers and the harmonic cocycle on them.
+    radius : float
+        Ball radius, half the scale of the complex.
+
+    Returns
+    -------
+    theta : ndarray, shape (N,)
+        Raw coordinate in [0, 1).
+    covered : ndarray of bool, shape (N,)
+        Whether the point lay inside at least one ball (others take the nearest center's
+        value).
+    """
+    x = np.asarray(points, dtype=float)
+    L = len(centers)
+    tree = cKDTree(centers)
+    k = int(min(L, max_neighbors))
+    theta = np.empty(len(x))
+    covered = np.empty(len(x), dtype=bool)
+    for a in range(0, len(x), chunk):
+        q = x[a : a + chunk]
+        d, idx = tree.query(q, k=k, distance_upper_bound=radius)
+        d = np.asarray(d).reshape(len(q), k)
+        idx = np.asarray(idx).reshape(len(q), k)
+        valid = np.isfinite(d)
+        phi = np.where(valid, (radius - np.where(valid, d, radius)) ** 2, 0.0)
+        tot = phi.sum(axis=1)
+        cov = tot > 0
+        nearest = np.where(valid[:, 0], idx[:, 0], 0)
+        out = np.empty(len(q))
+        if cov.any():
+            jj = np.repeat(nearest[cov][:, None], k, axis=1)
+            kk = np.where(valid[cov], idx[cov], jj)  # padded slots point at j itself: zero increment
+            inc = -_lookup(edges, harmonic, L, jj.ravel(), kk.ravel()).reshape(jj.shape)
+            w = phi[cov] / tot[cov][:, None]
+            out[cov] = center_theta[nearest[cov]] + (w * inc).sum(axis=1)
+        if (~cov).any():
+            _, nn = tree.query(q[~cov], k=1)
+            out[~cov] = center_theta[np.asarray(nn).ravel()]
+        theta[a : a + chunk] = np.mod(out, 1.0)
+        covered[a : a + chunk] = cov
+    return theta, covered
 
 
 def unwrap(theta: np.ndarray) -> np.ndarray:
@@ -194,7 +291,8 @@ class CircularCoordinates:
 
     scikit-learn style estimator: parameters in ``__init__``; :meth:`fit` computes the
     barcode, chooses a class and a scale, and solves for the coordinate; learned state
-    lives in attributes ending in ``_``.
+    lives in attributes ending in ``_``.  :meth:`transform` gives the coordinate of
+    points the model never saw; :meth:`save` / :meth:`load` keep a fitted model.
 
     Parameters
     ----------
@@ -210,24 +308,38 @@ class CircularCoordinates:
         Where in the bar the default scale sits (0 = birth, 1 = death).
     temporal : bool, default False
         Use the time-aware metric where consecutive frames are at distance 0.
-    n_landmarks : int, optional
-        Greedy landmark subsample for the barcode (every point by default).
+    landmarks : "auto", int or None, default "auto"
+        Build the filtration on greedy max-min landmarks and extend the coordinate to
+        every point (see :func:`cyclecoord.landmarks.choose_landmarks`).  ``None`` uses
+        every point.
+    memory_limit : float, default 2 GiB
+        Budget for one filtration; above it landmarks are used (fewer if needed).
 
     Attributes
     ----------
     barcode_ : Barcode
+        On the landmarks when they are used.
     selection_ : BarSelection
     prime_ : int
         The prime finally used (another is tried if the lift fails the cocycle check).
+    landmarks_ : ndarray of int or None
+        Indices of the landmark points (``None``: every point).
+    landmark_reason_ : str
+        Why that many points were used (memory guard decisions are stated here).
+    complex_estimate_ : ComplexEstimate
+        Size estimate of the filtration that was built.
+    covering_radius_ : float
+        Largest distance from a point to its nearest landmark (0 without landmarks).
     edges_ : ndarray, shape (E, 2)
-        Rips edges at the chosen scale.
+        Rips edges at the chosen scale between the centers (landmarks or all points).
     cocycle_ : ndarray, shape (E,)
         Integer-lifted cocycle on ``edges_``.
     harmonic_cocycle_ : ndarray, shape (E,)
         Its harmonic (least-squares) representative.
     cocycle_check_ : CocycleCheck
     coordinates_ : ndarray, shape (T,)
-        Circular coordinate of the training points, in [0, 1).
+        Circular coordinate of the training points, in [0, 1), increasing with their
+        order, 0 at the first point.
     n_components_ : int
         Connected components of the graph at the chosen scale (1 is expected).
     """
@@ -240,7 +352,8 @@ class CircularCoordinates:
         prime: int = DEFAULT_PRIME,
         scale_fraction: float = 0.9,
         temporal: bool = False,
-        n_landmarks: int | None = None,
+        landmarks: int | str | None = "auto",
+        memory_limit: float = DEFAULT_MEMORY_LIMIT,
     ) -> None:
         self.max_scale = max_scale
         self.scale = scale
@@ -248,7 +361,8 @@ class CircularCoordinates:
         self.prime = prime
         self.scale_fraction = scale_fraction
         self.temporal = temporal
-        self.n_landmarks = n_landmarks
+        self.landmarks = landmarks
+        self.memory_limit = memory_limit
 
     # ------------------------------------------------------------------
     def _validate(self, X) -> np.ndarray:
@@ -261,19 +375,44 @@ class CircularCoordinates:
             raise ParameterError("points contain NaN or infinite values")
         return x
 
-    def fit_barcode(self, X) -> Barcode:
-        """Compute (only) the barcode; sets ``barcode_`` and returns it."""
-        x = self._validate(X)
-        self._dist_ = temporal_distance_matrix(x) if self.temporal else None
-        src = self._dist_ if self.temporal else x
-        self.barcode_ = compute_barcode(
+    def _barcode(self, prime: int) -> Barcode:
+        src = self._dist_ if self.temporal else self.points_
+        return compute_barcode(
             src,
-            max_scale=self.max_scale,
-            prime=self.prime,
+            max_scale=self.threshold_,
+            prime=prime,
             distance_matrix=self.temporal,
-            n_landmarks=self.n_landmarks,
+            n_landmarks=self.n_landmarks_,
         )
+
+    def fit_barcode(self, X) -> Barcode:
+        """Compute (only) the barcode; sets ``barcode_`` and returns it.
+
+        Chooses the threshold and the number of points first (memory guard).
+        """
+        x = self._validate(X)
         self.points_ = x
+        if self.temporal:
+            need = 8.0 * len(x) ** 2
+            if need > self.memory_limit:
+                raise ParameterError(
+                    f"the temporal metric needs a full {len(x)} x {len(x)} distance matrix "
+                    f"({need / 1e9:.1f} GB, over the {self.memory_limit / 1e9:.1f} GB limit); "
+                    "drop --temporal or analyse fewer frames"
+                )
+            self._dist_ = temporal_distance_matrix(x)
+        else:
+            self._dist_ = None
+        self.threshold_ = float(
+            self.max_scale if self.max_scale is not None else default_max_scale(x, self._dist_)
+        )
+        n, est, reason = choose_landmarks(x, self.threshold_, self.landmarks, self.memory_limit)
+        self.n_landmarks_ = n
+        self.complex_estimate_ = est
+        self.landmark_reason_ = reason
+        self.barcode_ = self._barcode(check_prime(self.prime))
+        self.landmarks_ = self.barcode_.point_indices
+        self.covering_radius_ = float(self.barcode_.extras.get("covering_radius", 0.0))
         return self.barcode_
 
     def fit(self, X, y=None) -> "CircularCoordinates":
@@ -287,6 +426,27 @@ class CircularCoordinates:
         self.fit_barcode(X)
         return self.fit_coordinate()
 
+    def _centers(self) -> tuple[np.ndarray, np.ndarray | None]:
+        """Points the complex is built on, and (for the temporal metric) their distances."""
+        if self.landmarks_ is None:
+            return self.points_, self._dist_
+        idx = self.landmarks_
+        dist = self._dist_[np.ix_(idx, idx)] if self._dist_ is not None else None
+        return self.points_[idx], dist
+
+    def _cocycle_on_centers(self, cocycle: np.ndarray) -> np.ndarray:
+        """Cocycle rows with point indices mapped to center positions, oriented ``i < j``."""
+        if self.landmarks_ is None:
+            return cocycle
+        inv = np.full(len(self.points_), -1, dtype=np.int64)
+        inv[self.landmarks_] = np.arange(len(self.landmarks_))
+        c = cocycle.copy()
+        c[:, 0], c[:, 1] = inv[cocycle[:, 0]], inv[cocycle[:, 1]]
+        swap = c[:, 0] > c[:, 1]
+        c[swap, 0], c[swap, 1] = c[swap, 1], c[swap, 0].copy()
+        c[swap, 2] = -c[swap, 2]
+        return c
+
     def fit_coordinate(self) -> "CircularCoordinates":
         """Second half of :meth:`fit`: select the class and solve for the coordinate,
         reusing the barcode from :meth:`fit_barcode` (so a caller can inspect the
@@ -294,10 +454,29 @@ class CircularCoordinates:
         if not hasattr(self, "barcode_"):
             raise ParameterError("call fit_barcode() before fit_coordinate()")
         barcode = self.barcode_
-        x = self.points_
         selection = select_bar(barcode, self.class_index, self.scale, self.scale_fraction)
-        n = len(x)
-        edges = rips_edges(x, selection.scale, self._dist_)
+        notes = []
+        scale = selection.scale
+        if self.landmarks_ is not None and scale < 2.0 * self.covering_radius_ * 1.02:
+            # the landmark balls (radius scale/2) must cover every point
+            wanted = 2.0 * self.covering_radius_ * 1.02
+            top = min(selection.death, barcode.threshold)
+            if wanted < top:
+                scale = wanted
+                notes.append(
+                    f"scale raised to {scale:.4g} so the landmark balls cover every frame "
+                    f"(covering radius {self.covering_radius_:.4g})"
+                )
+            else:
+                notes.append(
+                    f"the landmark covering radius {self.covering_radius_:.4g} exceeds half the bar's "
+                    "extent: frames far from every landmark take their nearest landmark's coordinate; "
+                    "use more landmarks"
+                )
+        selection = BarSelection(**{**selection.__dict__, "scale": float(scale)})
+        centers, cdist = self._centers()
+        n = len(centers)
+        edges = rips_edges(centers, selection.scale, cdist)
         # Lift and check; when the lift is not an integer cocycle, retry with other primes.
         tried = []
         best = None
@@ -306,24 +485,18 @@ class CircularCoordinates:
             if k == 0:
                 bc, sel = barcode, selection
             else:
-                bc = compute_barcode(
-                    self._dist_ if self.temporal else x,
-                    max_scale=barcode.threshold,
-                    prime=p,
-                    distance_matrix=self.temporal,
-                    n_landmarks=self.n_landmarks,
-                )
-                # the same class: nearest bar in (birth, capped death)
+                bc = self._barcode(p)
                 if len(bc.h1) == 0:
                     continue
+                # the same class: nearest bar in (birth, capped death)
                 cap = np.minimum(bc.h1[:, 1], bc.threshold)
                 ref = (selection.birth, min(selection.death, barcode.threshold))
                 idx = int(np.argmin(np.abs(bc.h1[:, 0] - ref[0]) + np.abs(cap - ref[1])))
-                try:
-                    sel = select_bar(bc, idx, selection.scale if selection.scale < bc.h1[idx, 1] else None, self.scale_fraction)
-                except ParameterError:
+                b, d = bc.h1[idx]
+                if not b <= selection.scale < d:
                     continue
-            cocycle = bc.cocycles[sel.index]
+                sel = BarSelection(**{**selection.__dict__, "index": idx, "birth": float(b), "death": float(d)})
+            cocycle = self._cocycle_on_centers(bc.cocycles[sel.index])
             z, outside = _edge_values(edges, cocycle, lift_cocycle(cocycle, p).astype(float), n)
             check = check_cocycle(edges, z, n)
             check = CocycleCheck(check.n_triangles, check.n_violations, outside)
@@ -340,10 +513,28 @@ class CircularCoordinates:
                 RuntimeWarning,
                 stacklevel=2,
             )
+        for note in notes:
+            warnings.warn(note, RuntimeWarning, stacklevel=2)
         ncomp, _ = connected_components(
             sp.csr_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n)), directed=False
         )
-        theta, harmonic = harmonic_coordinate(edges, z, n)
+        if self.landmarks_ is None:
+            weights = None
+        else:
+            # each landmark stands for the frames nearest to it
+            _, owner = cKDTree(centers).query(self.points_, k=1)
+            mass = np.bincount(np.asarray(owner).ravel(), minlength=n).astype(float)
+            mass = np.maximum(mass, 1.0)
+            weights = mass[edges[:, 0]] * mass[edges[:, 1]]
+        center_theta, harmonic = harmonic_coordinate(edges, z, n, weights)
+        if self.landmarks_ is None:
+            raw = center_theta
+            covered = np.ones(n, dtype=bool)
+        else:
+            raw, covered = extend_coordinate(
+                self.points_, centers, center_theta, edges, harmonic, selection.scale / 2.0
+            )
+        theta, sign, offset = orient_with_time(raw, return_transform=True)
         self.barcode_ = bc
         self.selection_ = sel
         self.prime_ = p
@@ -353,39 +544,68 @@ class CircularCoordinates:
         self.harmonic_cocycle_ = harmonic
         self.cocycle_check_ = check
         self.n_components_ = int(ncomp)
-        self.coordinates_ = orient_with_time(theta)
-        # remember orientation/rotation relative to the raw solution, for transform()
-        self._tree_ = cKDTree(x) if not self.temporal else None
+        self.coordinates_ = theta
+        self.covered_ = covered
+        self.centers_ = centers
+        self.center_theta_ = center_theta
+        self.radius_ = selection.scale / 2.0
+        self.orientation_ = (sign, offset)
         return self
 
-    def transform(self, X) -> np.ndarray:
-        """Circular coordinate of points.
-
-        The training points get their fitted coordinate.  Other points get the
-        circular mean of the coordinates of the training points within the chosen
-        scale, weighted by ``1 - d/scale`` (or of their 5 nearest training points when
-        none is that close): a partition-of-unity extension of the fitted map.
-        """
-        if not hasattr(self, "coordinates_"):
+    def _check_fitted(self) -> None:
+        if not hasattr(self, "center_theta_"):
             raise ParameterError("this CircularCoordinates is not fitted yet; call fit() first")
+
+    def transform(self, X) -> np.ndarray:
+        """Circular coordinate of points, in the fitted model's orientation.
+
+        The training points get their fitted coordinate; other points are placed by the
+        partition-of-unity extension (:func:`extend_coordinate`) over the balls of radius
+        ``scale / 2`` around the centers (landmarks, or all training points).
+        """
+        self._check_fitted()
         x = self._validate(X)
-        if x.shape == self.points_.shape and np.array_equal(x, self.points_):
+        if hasattr(self, "points_") and x.shape == self.points_.shape and np.array_equal(x, self.points_):
             return self.coordinates_.copy()
-        if x.shape[1] != self.points_.shape[1]:
-            raise ParameterError(f"points have {x.shape[1]} dimensions, the model was fitted on {self.points_.shape[1]}")
-        tree = self._tree_ if self._tree_ is not None else cKDTree(self.points_)
-        k = min(32, len(self.points_))
-        d, idx = tree.query(x, k=k)
-        d = np.atleast_2d(d)
-        idx = np.atleast_2d(idx)
-        s = self.selection_.scale
-        w = np.clip(1.0 - d / s, 0.0, None)
-        none = w.sum(axis=1) == 0
-        w[none, :5] = 1.0 / (1e-12 + d[none, :5])
-        ang = 2 * np.pi * self.coordinates_[idx]
-        c = (w * np.cos(ang)).sum(axis=1)
-        si = (w * np.sin(ang)).sum(axis=1)
-        return np.mod(np.arctan2(si, c) / (2 * np.pi), 1.0)
+        if x.shape[1] != self.centers_.shape[1]:
+            raise ParameterError(
+                f"points have {x.shape[1]} dimensions, the model was fitted on {self.centers_.shape[1]}"
+            )
+        raw, _ = extend_coordinate(x, self.centers_, self.center_theta_, self.edges_, self.harmonic_cocycle_, self.radius_)
+        sign, offset = self.orientation_
+        return np.mod(sign * raw - offset, 1.0)
 
     def fit_transform(self, X, y=None) -> np.ndarray:
         return self.fit(X).coordinates_.copy()
+
+    # ------------------------------------------------------------------ persistence
+    _SAVED = ("centers_", "center_theta_", "edges_", "harmonic_cocycle_")
+
+    def to_arrays(self) -> dict:
+        """The fitted state needed by :meth:`transform`, as plain arrays."""
+        self._check_fitted()
+        out = {k.rstrip("_"): getattr(self, k) for k in self._SAVED}
+        out["radius"] = np.array(self.radius_)
+        out["orientation"] = np.array(self.orientation_, dtype=float)
+        out["selection"] = np.array(
+            [self.selection_.index, self.selection_.birth, self.selection_.death, self.selection_.scale]
+        )
+        out["prime"] = np.array(self.prime_)
+        return out
+
+    @classmethod
+    def from_arrays(cls, arrays: dict) -> "CircularCoordinates":
+        """Rebuild a fitted model from :meth:`to_arrays` output (transform only)."""
+        est = cls()
+        try:
+            for k in cls._SAVED:
+                setattr(est, k, np.asarray(arrays[k.rstrip("_")]))
+            est.radius_ = float(arrays["radius"])
+            sign, offset = (float(v) for v in arrays["orientation"])
+            est.orientation_ = (sign, offset)
+            idx, b, d, s = (float(v) for v in arrays["selection"])
+            est.prime_ = int(arrays["prime"])
+        except KeyError as exc:
+            raise ParameterError(f"model data lacks {exc.args[0]!r}") from None
+        est.selection_ = BarSelection(int(idx), b, d, s, True, float("nan"), float("nan"))
+        return est
