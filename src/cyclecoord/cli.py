@@ -96,6 +96,8 @@ def _check_output(path: str | None, what: str = "output") -> None:
         )
     if what == "report" and out.suffix.lower() != ".json":
         raise ParameterError(f"{path}: the report is JSON; give it a .json name")
+    if what == "model" and out.suffix.lower() != ".npz":
+        raise ParameterError(f"{path}: a model is saved as .npz; give it a .npz name")
     folder = out.parent if str(out.parent) else Path(".")
     if not folder.is_dir():
         raise ParameterError(f"{path}: folder {folder} does not exist")
@@ -131,6 +133,37 @@ def _clean(obj):
     return obj
 
 
+def _landmarks(text: str) -> int | str | None:
+    t = text.strip().lower()
+    if t in ("auto",):
+        return "auto"
+    if t in ("none", "all", "full"):
+        return None
+    try:
+        v = int(t)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, 'auto' or 'none', got {text!r}") from None
+    if v < 10:
+        raise argparse.ArgumentTypeError(f"need at least 10 landmarks, got {v}")
+    return v
+
+
+def _bytes(text: str) -> float:
+    """Parse sizes such as 2G, 500M, 1.5GB or a plain number of bytes."""
+    t = text.strip().upper().rstrip("B")
+    mult = {"K": 1024, "M": 1024**2, "G": 1024**3, "T": 1024**4}
+    try:
+        if t and t[-1] in mult:
+            v = float(t[:-1]) * mult[t[-1]]
+        else:
+            v = float(t)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a size such as 2G or 500M, got {text!r}") from None
+    if not np.isfinite(v) or v <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive size, got {text!r}")
+    return v
+
+
 def _add_selection_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("what to analyse and how")
     g.add_argument("--skeleton", metavar="ASF", help="ASF skeleton for an AMC input (default: found beside the AMC)")
@@ -144,6 +177,15 @@ def _add_selection_options(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--max-scale", type=_positive_float, metavar="E",
         help="Rips threshold in the analysed space's units (default: half the point cloud's diameter)",
+    )
+    g.add_argument(
+        "--landmarks", type=_landmarks, default="auto", metavar="N|auto|none",
+        help="build the filtration on N greedy landmarks and extend the coordinate to every frame "
+        "(auto: every frame up to 1000 frames, 500 landmarks beyond; none: every frame)",
+    )
+    g.add_argument(
+        "--memory-limit", type=_bytes, default=None, metavar="SIZE",
+        help="memory budget for the filtration, e.g. 2G (default); above it landmarks are used",
     )
 
 
@@ -166,7 +208,13 @@ def cmd_extract(args: argparse.Namespace) -> int:
 
     _check_output(args.output)
     _check_output(args.report, "report")
+    if args.save_model:
+        _check_output(args.save_model, "model")
+    if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
+        raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
     motion = load_input(args.input, args.skeleton, args.fps)
+    if args.apply:
+        return _apply_model(args, motion)
     report_payload = None
     code = EXIT_OK
     try:
@@ -186,6 +234,8 @@ def cmd_extract(args: argparse.Namespace) -> int:
             weighting=args.weighting,
             sampling=args.sampling,
             cycle_start=args.cycle_start,
+            landmarks=args.landmarks,
+            memory_limit=args.memory_limit,
             random_state=args.seed,
         )
     except NoPeriodicMotionError as exc:
@@ -206,6 +256,8 @@ def cmd_extract(args: argparse.Namespace) -> int:
                 "timings": partial.timings,
                 "warnings": partial.warnings,
             }
+            if args.plot:
+                _save_plots(partial, args.plot)
         code = EXIT_NO_PERIODIC
     else:
         m = res.motion
@@ -239,9 +291,21 @@ def cmd_extract(args: argparse.Namespace) -> int:
         )
         for w in res.warnings:
             print(f"warning: {w}")
+        lm = res.estimator.landmarks_
+        if lm is not None:
+            fb = res.selection.full_birth
+            print(
+                f"landmarks: {len(lm)} of {m.n_frames} frames (covering radius {res.estimator.covering_radius_:.3g})"
+                + (f"; birth on every frame {fb:.4g}" if fb is not None else "")
+            )
         if args.output:
             save(res.cycle, args.output)
             print(f"wrote {args.output}")
+        if args.save_model:
+            res.model.save(args.save_model)
+            print(f"wrote {args.save_model}")
+        if args.plot:
+            _save_plots(res, args.plot)
         report_payload = res.to_report()
         t = res.timings
         print("time: " + ", ".join(f"{k} {v:.3f}s" for k, v in t.items()))
@@ -251,10 +315,76 @@ def cmd_extract(args: argparse.Namespace) -> int:
     return code
 
 
+def _apply_model(args: argparse.Namespace, motion) -> int:
+    """``extract --apply MODEL``: phase of every frame from a saved model, no refit."""
+    from .model import PhaseModel
+
+    model = PhaseModel.load(args.apply)
+    if args.frames is not None:
+        a, b = args.frames
+        n = motion.n_frames
+        a = 0 if a is None else a
+        b = n if b is None else b
+        if not 0 <= a < b <= n:
+            raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames")
+        motion = motion[a:b]
+    info = model.summary(motion)
+    print(
+        f"{motion.source or args.input}: {motion.n_frames} frames phased with {args.apply}: "
+        f"{info['cycles']:.2f} cycles, period {info['period_frames']:.1f} frames "
+        f"(model's own period {model.period_frames:.1f})"
+    )
+    if args.report:
+        payload = {
+            "source": motion.source,
+            "model": str(args.apply),
+            "frames": [motion.start_frame, motion.start_frame + motion.n_frames],
+            "n_frames": motion.n_frames,
+            "coordinate": [float(v) for v in info["coordinate"]],
+            "cycles": info["cycles"],
+            "period_frames": info["period_frames"],
+            "model_period_frames": model.period_frames,
+        }
+        _write_json(args.report, _clean(payload))
+        print(f"wrote {args.report}")
+    return EXIT_OK
+
+
+def _save_plots(result, folder: str) -> None:
+    """``extract --plot DIR``: the standard figures (only the barcode when nothing was found)."""
+    from .plot import save_figures
+
+    for path in save_figures(result, folder):
+        print(f"wrote {path}")
+
+
+def cmd_render(args: argparse.Namespace) -> int:
+    from .plot import render
+
+    out = Path(args.output)
+    if out.suffix.lower() not in (".gif", ".mp4"):
+        raise ParameterError(f"{args.output}: render writes .gif or .mp4 animations, got {out.suffix or '(no suffix)'!r}")
+    folder = out.parent if str(out.parent) else Path(".")
+    if not folder.is_dir():
+        raise ParameterError(f"{args.output}: folder {folder} does not exist")
+    motion = load_input(args.input, args.skeleton, args.fps)
+    if args.frames is not None:
+        a, b = args.frames
+        n = motion.n_frames
+        a = 0 if a is None else a
+        b = n if b is None else b
+        if not 0 <= a < b <= n:
+            raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames (0-based, half-open)")
+        motion = motion[a:b]
+    other = load_input(args.side_by_side, None, args.fps) if args.side_by_side else None
+    path = render(motion, out, other=other, view=args.view, step=args.step, follow=args.follow)
+    what = f"{motion.n_frames} frames" + (f" beside {other.n_frames} frames of {args.side_by_side}" if other else "")
+    print(f"wrote {path} ({what}, {args.view} view)")
+    return EXIT_OK
+
+
 def cmd_barcode(args: argparse.Namespace) -> int:
-    from .barcode import compute_barcode
     from .preprocess import Preprocessor
-    from .barcode import temporal_distance_matrix
 
     motion = load_input(args.input, args.skeleton, args.fps)
     if args.frames is not None:
@@ -267,12 +397,16 @@ def cmd_barcode(args: argparse.Namespace) -> int:
         motion = motion[a:b]
     prep = Preprocessor(difference_root=not args.no_root_diff, normalize=args.normalize, pca=args.pca)
     pts = prep.fit_transform(motion).points
-    if args.temporal:
-        bc = compute_barcode(temporal_distance_matrix(pts), args.max_scale, args.prime, distance_matrix=True)
-    else:
-        bc = compute_barcode(pts, args.max_scale, args.prime)
+    from .coordinates import CircularCoordinates
+
+    est = CircularCoordinates(
+        max_scale=args.max_scale, prime=args.prime, temporal=args.temporal, landmarks=args.landmarks,
+        **({} if args.memory_limit is None else {"memory_limit": args.memory_limit}),
+    )
+    bc = est.fit_barcode(pts)
     if args.json:
-        payload = {"threshold": bc.threshold, "prime": bc.prime, "n_points": bc.n_points, **bc.to_dict()}
+        payload = {"threshold": bc.threshold, "prime": bc.prime, "n_points": bc.n_points,
+                   "landmarks": est.landmark_reason_, **bc.to_dict()}
         print(json.dumps(_clean(payload)))
     else:
         print(_summary_barcode(bc))
@@ -312,6 +446,8 @@ def build_parser() -> argparse.ArgumentParser:
             "  cyclecoord extract 69_01.amc --frames 200:450 --max-scale 50 -o cycle.bvh\n"
             "  cyclecoord barcode 69_01.amc --frames 200:450 --json\n"
             "  cyclecoord convert 69_01.amc -o 69_01.bvh\n"
+            "  cyclecoord extract 69_01.amc --frames 200:450 --max-scale 50 -o cycle.bvh --plot figures\n"
+            "  cyclecoord render 69_01.amc --frames 200:450 -o walk.gif --side-by-side cycle.bvh\n"
             "exit codes: 0 ok, 1 error, 2 usage, 3 no periodic motion found"
         ),
     )
@@ -349,6 +485,12 @@ def build_parser() -> argparse.ArgumentParser:
     o = e.add_argument_group("output")
     o.add_argument("-o", "--output", metavar="OUT", help="write the cycle (.bvh, .amc, .npz or .csv)")
     o.add_argument("--report", metavar="R.json", help="write a JSON report (barcode, coordinate, figures, timings)")
+    o.add_argument("--plot", metavar="DIR",
+                   help="write figures into DIR (created if missing): barcode, pca, density, coordinate, channels (.png)")
+    o.add_argument("--save-model", metavar="M.npz",
+                   help="save the fitted phase model (preparation + coordinate) to phase new frames later")
+    o.add_argument("--apply", metavar="M.npz",
+                   help="do not fit: give every frame of INPUT its phase from a saved model (with --report)")
     e.set_defaults(func=cmd_extract)
 
     b = sub.add_parser("barcode", help="print the H0/H1 barcode of a capture",
@@ -366,6 +508,27 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--fps", type=_positive_float, metavar="F", help="frame rate to record in the output")
     c.add_argument("--frames", type=_frame_range, metavar="A:B", help="only these frames")
     c.set_defaults(func=cmd_convert)
+
+    r = sub.add_parser(
+        "render", help="animate a capture as a stick figure (.gif, or .mp4 with ffmpeg)",
+        description=(
+            "Draw the skeleton of every STEP-th frame (forward kinematics, y up, with the floor) and "
+            "write a GIF, or an MP4 when ffmpeg is installed. Plays in real time. With --side-by-side "
+            "a second capture (e.g. an extracted cycle) is drawn next to it; the shorter one loops."
+        ),
+    )
+    r.add_argument("input", metavar="INPUT")
+    r.add_argument("-o", "--output", required=True, metavar="OUT", help="animation file, .gif or .mp4")
+    r.add_argument("--skeleton", metavar="ASF", help="ASF skeleton for an AMC input (default: found beside the AMC)")
+    r.add_argument("--frames", type=_frame_range, metavar="A:B", help="only these frames of INPUT (0-based, half-open)")
+    r.add_argument("--fps", type=_positive_float, metavar="F", help="frame rate of the capture (AMC files carry none; default 120)")
+    r.add_argument("--side-by-side", metavar="OTHER", help="a second capture to draw beside INPUT (e.g. the cycle from extract -o)")
+    r.add_argument("--step", type=_positive_int, metavar="K", help="draw every K-th frame (default: about 30 frames per second)")
+    r.add_argument("--view", choices=("side", "front", "3d"), default="side",
+                   help="side: across the direction of travel (default); front: along it; 3d: perspective")
+    r.add_argument("--follow", action=argparse.BooleanOptionalAction, default=None,
+                   help="keep the figure centred and move the floor (default: only when it travels far)")
+    r.set_defaults(func=cmd_render)
     return p
 
 
@@ -389,6 +552,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("cyclecoord: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # output piped into `head` and the like
+        import os
+
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_OK
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -28,6 +28,7 @@ from .barcode import (
     check_prime,
     compute_barcode,
     default_max_scale,
+    refine_birth,
     select_bar,
     temporal_distance_matrix,
 )
@@ -535,6 +536,8 @@ class CircularCoordinates:
                 self.points_, centers, center_theta, edges, harmonic, selection.scale / 2.0
             )
         theta, sign, offset = orient_with_time(raw, return_transform=True)
+        if self.landmarks_ is not None and not self.temporal:
+            sel = BarSelection(**{**sel.__dict__, "full_birth": refine_birth(self.points_, sel.birth, p)})
         self.barcode_ = bc
         self.selection_ = sel
         self.prime_ = p

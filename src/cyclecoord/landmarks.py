@@ -28,7 +28,7 @@ __all__ = [
 #: With ``landmarks="auto"`` captures up to this many frames use every frame ...
 AUTO_FULL_LIMIT = 1000
 #: ... and longer ones this many greedy landmarks (fewer if the memory guard says so).
-AUTO_LANDMARKS = 1000
+AUTO_LANDMARKS = 500
 #: Default memory budget for one filtration, in bytes (a laptop-friendly 2 GiB).
 DEFAULT_MEMORY_LIMIT = 2 * 1024**3
 

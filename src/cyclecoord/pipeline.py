@@ -128,6 +128,14 @@ class ExtractionResult:
     parameters: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     estimator: CircularCoordinates | None = None
+    preprocessor: Preprocessor | None = None
+
+    @property
+    def model(self):
+        """The fitted :class:`~cyclecoord.model.PhaseModel` (phase of new frames, save/load)."""
+        from .model import PhaseModel
+
+        return PhaseModel.from_result(self)
 
     def to_report(self) -> dict[str, Any]:
         """JSON-ready summary (see the CLI's ``--report``)."""
@@ -152,6 +160,7 @@ class ExtractionResult:
             "jerk": self.jerk,
             "loop_closure": float(self.loop_closure),
             "distance_to_cycle": self.distance,
+            "landmarks": _landmark_report(self.estimator),
             "cocycle_check": {
                 "triangles": int(self.estimator.cocycle_check_.n_triangles) if self.estimator else None,
                 "violations": int(self.estimator.cocycle_check_.n_violations) if self.estimator else None,
@@ -160,6 +169,19 @@ class ExtractionResult:
             "timings": {k: round(float(v), 6) for k, v in self.timings.items()},
             "warnings": list(self.warnings),
         }
+
+
+def _landmark_report(est: CircularCoordinates | None) -> dict | None:
+    if est is None or not hasattr(est, "landmark_reason_"):
+        return None
+    lm = getattr(est, "landmarks_", None)
+    return {
+        "n_landmarks": None if lm is None else int(len(lm)),
+        "reason": est.landmark_reason_,
+        "covering_radius": float(getattr(est, "covering_radius_", 0.0)),
+        "complex_estimate": est.complex_estimate_.to_dict(),
+        "frames_outside_landmark_balls": int(np.sum(~est.covered_)) if hasattr(est, "covered_") else None,
+    }
 
 
 def _root_displacement(motion: Motion, root_cols: np.ndarray, cycles: float) -> np.ndarray:
@@ -190,6 +212,8 @@ def extract(
     sampling: str = "quantile",
     n_components: int = 30,
     cycle_start: str = "slowest",
+    landmarks: int | str | None = "auto",
+    memory_limit: float | None = None,
     require_clear: bool = True,
     random_state: int | None = 0,
 ) -> ExtractionResult:
@@ -233,6 +257,12 @@ def extract(
     cycle_start : {"slowest", "first"}
         Where the written cycle begins: at its slowest pose (default; the seam of the
         loop is least visible there) or at the phase of the clip's first frame.
+    landmarks : "auto", int or None
+        Build the filtration on greedy max-min landmarks (``"auto"``: every frame up to
+        1,000 frames, 500 landmarks beyond) and extend the coordinate to every frame;
+        ``None`` uses every frame.
+    memory_limit : float, optional
+        Byte budget for the filtration (default 2 GiB); above it landmarks are used.
     require_clear : bool, default True
         Raise :class:`NoPeriodicMotionError` when the chosen bar does not stand clear.
     random_state : int, optional
@@ -269,7 +299,7 @@ def extract(
         difference_root=difference_root, prime=prime, max_scale=max_scale, scale=scale,
         class_index=class_index, scale_fraction=scale_fraction, n_samples=n_samples,
         n_neighbors=n_neighbors, weighting=weighting, sampling=sampling, n_components=n_components,
-        cycle_start=cycle_start, random_state=random_state,
+        cycle_start=cycle_start, landmarks=landmarks, memory_limit=memory_limit, random_state=random_state,
     )
     if frames is not None:
         a, b = frames
@@ -291,11 +321,14 @@ def extract(
 
     est = CircularCoordinates(
         max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
-        scale_fraction=scale_fraction, temporal=temporal,
+        scale_fraction=scale_fraction, temporal=temporal, landmarks=landmarks,
+        **({} if memory_limit is None else {"memory_limit": memory_limit}),
     )
     t0 = time.perf_counter()
     barcode = est.fit_barcode(prepared.points)
     timings["barcode"] = time.perf_counter() - t0
+    if est.landmarks_ is not None:
+        notes.append(f"barcode on {len(est.landmarks_)} landmarks: {est.landmark_reason_}")
 
     from .barcode import select_bar
 
@@ -304,7 +337,7 @@ def extract(
             motion=motion, prepared=prepared, barcode=barcode, selection=None, coordinate=None,
             unwrapped=None, cycles=float("nan"), period_frames=float("nan"), cycle_frames=np.zeros(0),
             density=None, typical=None, cycle=None, jerk={}, loop_closure=float("nan"), distance={},
-            timings=timings, parameters=params, warnings=notes, estimator=est,
+            timings=timings, parameters=params, warnings=notes, estimator=est, preprocessor=prep,
         )
         return NoPeriodicMotionError(msg, result=partial)
 
@@ -407,5 +440,5 @@ def extract(
         motion=motion, prepared=prepared, barcode=barcode, selection=sel, coordinate=theta,
         unwrapped=u, cycles=cycles, period_frames=float(period), cycle_frames=lengths, density=density,
         typical=typ, cycle=cycle_motion, jerk=jerk, loop_closure=closure, distance=distance,
-        timings=timings, parameters=params, warnings=notes, estimator=est,
+        timings=timings, parameters=params, warnings=notes, estimator=est, preprocessor=prep,
     )

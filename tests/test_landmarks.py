@@ -1,0 +1,146 @@
+"""Landmarks, the memory guard, coordinates of new frames and saved phase models."""
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.cli import main
+from cyclecoord.coordinates import CircularCoordinates
+from cyclecoord.landmarks import AUTO_FULL_LIMIT, AUTO_LANDMARKS, choose_landmarks, estimate_complex
+from cyclecoord.model import PhaseModel
+from cyclecoord.preprocess import Preprocessor
+
+
+def median_circular_difference(a, b):
+    """Median |a - b| on the circle after the best rotation and reflection of ``a``."""
+    best = np.inf
+    for sign in (1, -1):
+        d = np.mod(sign * a - b, 1.0)
+        shift = np.angle(np.mean(np.exp(2j * np.pi * d))) / (2 * np.pi)
+        best = min(best, float(np.median(np.abs(np.mod(d - shift + 0.5, 1.0) - 0.5))))
+    return best
+
+
+@pytest.fixture(scope="module")
+def synthetic_2000():
+    cap = cc.datasets.make_periodic_capture(n_frames=2000, noise=0.5, random_state=0)
+    return Preprocessor().fit_transform(cap.motion).points
+
+
+def test_estimate_matches_the_real_edge_count():
+    x = np.random.default_rng(0).standard_normal((800, 4))
+    est = estimate_complex(x, 1.5)
+    from scipy.spatial.distance import pdist
+
+    real = int(np.sum(pdist(x) <= 1.5))
+    assert est.edges == pytest.approx(real, rel=0.1)
+    assert est.triangles > 0 and est.bytes > 8 * 800 * 800
+
+
+def test_choice_of_landmarks():
+    small = np.random.default_rng(0).standard_normal((AUTO_FULL_LIMIT, 3))
+    big = np.random.default_rng(0).standard_normal((AUTO_FULL_LIMIT + 1, 3))
+    assert choose_landmarks(small, 1.0)[0] is None
+    assert choose_landmarks(big, 1.0)[0] == AUTO_LANDMARKS
+    assert choose_landmarks(big, 1.0, landmarks=None)[0] is None
+    assert choose_landmarks(big, 1.0, landmarks=300)[0] == 300
+    with pytest.raises(cc.ParameterError):
+        choose_landmarks(big, 1.0, landmarks="many")
+
+
+def test_memory_guard_switches_before_building(monkeypatch, synthetic_2000):
+    import ripser
+
+    calls = []
+    real = ripser.ripser
+
+    def spy(*args, **kwargs):
+        calls.append(kwargs)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(ripser, "ripser", spy)
+    est = CircularCoordinates(landmarks=None, memory_limit=5e6)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est.fit_barcode(synthetic_2000)
+    assert "memory guard" in est.landmark_reason_
+    assert est.landmarks_ is not None and len(est.landmarks_) < 2000
+    assert est.complex_estimate_.bytes <= 5e6
+    assert calls and all(c.get("n_perm") for c in calls)  # the full complex was never asked for
+
+
+def test_landmarks_match_full_on_69_01(walk_69_01):
+    x = Preprocessor().fit_transform(walk_69_01[200:450]).points
+    full = CircularCoordinates(max_scale=50, landmarks=None).fit(x)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        lm = CircularCoordinates(max_scale=50, landmarks=150).fit(x)
+    assert lm.landmarks_ is not None and len(lm.landmarks_) == 150
+    assert lm.selection_.full_birth == pytest.approx(full.selection_.birth, rel=0.05)
+    assert median_circular_difference(lm.coordinates_, full.coordinates_) < 0.01
+
+
+def test_landmarks_match_full_on_2000_synthetic_frames(synthetic_2000):
+    full = CircularCoordinates(landmarks=None).fit(synthetic_2000)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        lm = CircularCoordinates(landmarks="auto").fit(synthetic_2000)
+    assert len(lm.landmarks_) == AUTO_LANDMARKS
+    assert lm.covering_radius_ > 0 and lm.covered_.all()
+    assert lm.selection_.full_birth == pytest.approx(full.selection_.birth, rel=0.05)
+    assert median_circular_difference(lm.coordinates_, full.coordinates_) < 0.01
+
+
+@pytest.mark.parametrize("n_frames", [600, 2400])
+def test_transform_of_held_back_frames(n_frames):
+    cap = cc.datasets.make_periodic_capture(n_frames=n_frames, noise=0.5, random_state=2)
+    m = cap.motion
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        full = cc.extract(m)
+        part = cc.extract(m[np.arange(0, n_frames, 2)])
+    phase = part.model.phase(m[np.arange(1, n_frames, 2)])
+    assert median_circular_difference(phase, full.coordinate[1::2]) < 0.02
+
+
+def test_model_round_trip(tmp_path):
+    m = cc.datasets.example_capture().motion
+    res = cc.extract(m)
+    path = tmp_path / "walk.npz"
+    res.model.save(path)
+    back = PhaseModel.load(path)
+    other = cc.datasets.make_periodic_capture(n_frames=300, random_state=9).motion
+    np.testing.assert_allclose(back.phase(other), res.model.phase(other), atol=1e-12)
+    # the saved model re-derives training frames by the extension: the same phases, circularly
+    d = np.abs(np.mod(back.phase(m) - res.coordinate + 0.5, 1.0) - 0.5)
+    assert np.median(d) < 0.01 and d.max() < 0.05
+    assert back.period_frames == pytest.approx(res.period_frames)
+
+
+def test_model_errors(tmp_path):
+    bad = tmp_path / "bad.npz"
+    bad.write_bytes(b"not a zip")
+    with pytest.raises(cc.ParseError, match="bad.npz"):
+        PhaseModel.load(bad)
+    res = cc.extract(cc.datasets.example_capture().motion)
+    few = res.motion.select(res.motion.channels[:20])
+    with pytest.raises(cc.ParameterError, match="lacks"):
+        res.model.phase(few)
+
+
+def test_cli_save_and_apply(tmp_path, capsys):
+    model, rep = tmp_path / "m.npz", tmp_path / "phase.json"
+    take = tmp_path / "take.npz"
+    cc.save(cc.datasets.make_periodic_capture(n_frames=600, random_state=4).motion, take)
+    assert main(["extract", "example", "--save-model", str(model)]) == 0
+    assert main(["extract", str(take), "--apply", str(model), "--report", str(rep)]) == 0
+    r = json.loads(rep.read_text())
+    assert len(r["coordinate"]) == 600
+    assert r["cycles"] == pytest.approx(599 / 120, abs=0.25)
+    capsys.readouterr()
+    assert main(["extract", "example", "--landmarks", "200", "--memory-limit", "1G", "--report", str(rep)]) == 0
+    r = json.loads(rep.read_text())
+    assert r["landmarks"]["n_landmarks"] == 200 and r["selected"]["full_birth"] is not None
