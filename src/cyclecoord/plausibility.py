@@ -1,0 +1,648 @@
+"""Plausibility checks for synthesised motion: limbs passing through each other, joint ranges.
+
+The paper warns (§4.5, §7) that blending cycles may produce "impossible motions with
+self-intersecting skeleta" and that such frames "could be detected using forward
+kinematics".  :func:`self_intersections` does that: every bone is a segment from a joint
+to its child (a capsule of zero radius), and frames where two bones that do not touch
+in the skeleton come closer than a clearance threshold are flagged.
+:func:`joint_range_violations` flags joint angles outside the range the inputs showed.
+:func:`check_plausibility` runs both against the input motions and reports only what is
+*new*: real captures have near-contacts of their own (hands brushing the hips), which a
+blend of them may repeat without being implausible.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any, Sequence
+
+import numpy as np
+
+from .errors import CycleCoordError, ParameterError
+from .motion import Motion
+
+__all__ = [
+    "Bones",
+    "bones",
+    "segment_distances",
+    "SelfIntersections",
+    "self_intersections",
+    "JointRangeViolation",
+    "joint_range_violations",
+    "PlausibilityReport",
+    "check_plausibility",
+    "ImplausibleMotionError",
+    "DEFAULT_CLEARANCE",
+]
+
+#: Default clearance between bone centre lines, as a fraction of the skeleton's total
+#: bone length (about 10 cm on a CMU skeleton, whose bones add up to about 90 units of
+#: 5.6 cm).
+DEFAULT_CLEARANCE = 0.02
+#: A contact is new when the output goes this fraction of the threshold closer than
+#: the inputs' own closest approach.
+_NEW_TOLERANCE = 0.1
+#: Frames x bone pairs per chunk in the distance computation.
+_CHUNK = 400_000
+
+
+class ImplausibleMotionError(CycleCoordError):
+    """Raised (by the CLI's ``--strict``) when a motion fails its plausibility checks."""
+
+
+# ---------------------------------------------------------------------------- bones
+@dataclass(frozen=True)
+class Bones:
+    """The bones of a skeleton as segments between forward-kinematics points.
+
+    Attributes
+    ----------
+    names : list of str
+        One per bone: the joint whose bone it is (ASF naming: bone ``lfemur`` runs from
+        the hip to the knee), ``"parent>child"`` where a joint has several bones.
+    start, end : ndarray of int, shape (B,)
+        Point indices (into :attr:`JointPositions.positions`) of each bone's ends.
+    pairs : ndarray of int, shape (Q, 2)
+        Bone pairs that are checked: bones sharing no joint (after merging joints that
+        coincide at rest), i.e. neither parent and child nor siblings at one joint.
+    rest_distance : ndarray, shape (Q,)
+        Distance of each pair in the rest pose (all channels 0).
+    second_neighbours : ndarray of bool, shape (Q,)
+        Pairs joined through one other bone (a bone touching both).
+    """
+
+    names: list
+    start: np.ndarray
+    end: np.ndarray
+    pairs: np.ndarray
+    rest_distance: np.ndarray
+    second_neighbours: np.ndarray
+
+    def pair_names(self) -> list[tuple[str, str]]:
+        return [(self.names[i], self.names[j]) for i, j in self.pairs]
+
+
+def bones(motion: Motion) -> Bones:
+    """Segments and checkable pairs of a motion's skeleton.
+
+    Points that coincide in the rest pose (zero-length offsets such as CMU's
+    ``lhipjoint`` at the root, or siblings starting at one place such as CMU's
+    ``lowerneck`` and clavicles at the end of ``thorax``) are one node; every
+    pair of distinct nodes joined by a parent link is a bone; two bones are adjacent
+    when they share a node.
+
+    Raises
+    ------
+    ParameterError
+        If the motion has no skeleton or fewer than two bones.
+    """
+    if motion.skeleton is None:
+        raise ParameterError("plausibility checks need a skeleton (forward kinematics); this motion has none")
+    skel = motion.skeleton
+    rest = Motion(np.zeros((1, 0)), (), skeleton=skel).positions()
+    pos = rest.positions[0]
+    parents = rest.parents
+    n = pos.shape[0]
+    scale = max(skel.total_length(), 1e-12)
+    node = np.arange(n)
+
+    def find(i: int) -> int:
+        while node[i] != i:
+            node[i] = node[node[i]]
+            i = node[i]
+        return i
+
+    tol = 1e-6 * scale
+    for i in range(n):  # zero-length links: child and parent are one point
+        p = parents[i]
+        if p >= 0 and np.linalg.norm(pos[i] - pos[p]) <= tol:
+            node[find(i)] = find(p)
+    for i in range(n):  # siblings starting at one place (CMU's neck and clavicles)
+        for k in range(i + 1, n):
+            if (
+                parents[i] >= 0 and parents[k] >= 0 and find(int(parents[i])) == find(int(parents[k]))
+                and np.linalg.norm(pos[i] - pos[k]) <= tol
+            ):
+                node[find(k)] = find(i)
+    roots = np.array([find(i) for i in range(n)])
+    keys: list[tuple[int, int]] = []
+    links: list[tuple[int, int]] = []
+    for i in range(n):
+        p = parents[i]
+        if p < 0 or roots[i] == roots[p]:
+            continue
+        key = (int(roots[p]), int(roots[i]))
+        if key in keys:
+            continue
+        keys.append(key)
+        links.append((int(p), int(i)))
+    per_parent = np.bincount([p for p, _ in links], minlength=n)
+    point_names = rest.names
+    names = [
+        point_names[p] if per_parent[p] == 1 else f"{point_names[p]}>{point_names[i].split('/')[0]}"
+        for p, i in links
+    ]
+    start = [p for p, _ in links]
+    end = [i for _, i in links]
+    if len(names) < 2:
+        raise ParameterError("the skeleton has fewer than two bones; nothing can collide")
+    s = np.array(start)
+    e = np.array(end)
+    ns, ne = roots[s], roots[e]
+    ii, jj = np.triu_indices(len(names), k=1)
+    share = (ns[ii] == ns[jj]) | (ns[ii] == ne[jj]) | (ne[ii] == ns[jj]) | (ne[ii] == ne[jj])
+    pairs = np.column_stack([ii[~share], jj[~share]])
+    # bones one bone apart (a bone touches both): fingers and thumb, neck and clavicles
+    nb = len(names)
+    adj = np.zeros((nb, nb), dtype=bool)
+    adj[ii[share], jj[share]] = True
+    adj = adj | adj.T
+    near = (adj.astype(int) @ adj.astype(int)) > 0
+    second = near[pairs[:, 0], pairs[:, 1]]
+    rest_d = segment_distances(pos[None, s[pairs[:, 0]]], pos[None, e[pairs[:, 0]]],
+                               pos[None, s[pairs[:, 1]]], pos[None, e[pairs[:, 1]]])[0]
+    return Bones(names=names, start=s, end=e, pairs=pairs, rest_distance=rest_d, second_neighbours=second)
+
+
+def segment_distances(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
+    """Closest distance between segments ``p0-p1`` and ``q0-q1``, elementwise.
+
+    Parameters
+    ----------
+    p0, p1, q0, q1 : ndarray, shape (..., 3)
+        Segment end points (broadcast together).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Distances.  The closest points are found by minimising over the first
+        segment's parameter with the second's clamped, then re-clamping the first (the
+        exact solution for segments); degenerate (zero-length) segments work as points.
+    """
+    u = p1 - p0
+    v = q1 - q0
+    w = p0 - q0
+    a = np.einsum("...i,...i->...", u, u)
+    b = np.einsum("...i,...i->...", u, v)
+    c = np.einsum("...i,...i->...", v, v)
+    d = np.einsum("...i,...i->...", u, w)
+    e = np.einsum("...i,...i->...", v, w)
+    denom = a * c - b * b
+    tiny = 1e-12 * np.maximum(a * c, 1e-300)
+    safe_a = np.where(a > 0, a, 1.0)
+    safe_c = np.where(c > 0, c, 1.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # closest point of the first line to the second, clamped (any s if parallel)
+        s = np.where(denom > tiny, (b * e - c * d) / np.where(denom > tiny, denom, 1.0), 0.0)
+        s = np.clip(s, 0.0, 1.0)
+        # the second segment's point closest to it, clamped; then the first's again
+        t = (b * s + e) / safe_c
+        s_low = np.clip(-d / safe_a, 0.0, 1.0)
+        s_high = np.clip((b - d) / safe_a, 0.0, 1.0)
+    s = np.where(t < 0.0, s_low, np.where(t > 1.0, s_high, s))
+    t = np.clip(t, 0.0, 1.0)
+    # degenerate segments: a point against a segment (or a point)
+    point_q = c <= 0
+    s = np.where(point_q, s_low, s)
+    t = np.where(point_q, 0.0, t)
+    point_p = a <= 0
+    s = np.where(point_p, 0.0, s)
+    t = np.where(point_p, np.clip(e / safe_c, 0.0, 1.0), t)
+    diff = w + s[..., None] * u - t[..., None] * v
+    return np.sqrt(np.einsum("...i,...i->...", diff, diff))
+
+
+def _pair_distances(motion: Motion, bn: Bones) -> np.ndarray:
+    """Distances ``(T, Q)`` of every checked bone pair in every frame."""
+    pos = motion.positions().positions  # (T, P, 3)
+    T = pos.shape[0]
+    Q = bn.pairs.shape[0]
+    out = np.empty((T, Q))
+    a, b = bn.pairs[:, 0], bn.pairs[:, 1]
+    sa, ea, sb, eb = bn.start[a], bn.end[a], bn.start[b], bn.end[b]
+    step = max(1, _CHUNK // max(Q, 1))
+    for lo in range(0, T, step):
+        p = pos[lo : lo + step]
+        out[lo : lo + step] = segment_distances(p[:, sa], p[:, ea], p[:, sb], p[:, eb])
+    return out
+
+
+# ---------------------------------------------------------------- intersections
+@dataclass
+class SelfIntersections:
+    """Bone pairs closer than the clearance, per frame.
+
+    Attributes
+    ----------
+    threshold : float
+        Clearance in skeleton length units.
+    bones : Bones
+    min_distance : ndarray, shape (Q,)
+        Closest approach of each checked pair over the motion.
+    flagged : ndarray of bool, shape (T, Q)
+        Pair closer than ``threshold`` in that frame (pairs ignored because they are
+        within the threshold at rest are never flagged).
+    ignored : ndarray of bool, shape (Q,)
+        Pairs one bone apart and already closer than the threshold in the rest pose
+        (e.g. thumb and fingers), which are not checked.
+    distances : ndarray, shape (T, Q)
+        Distance of every checked pair in every frame, length units.
+    start_frame : int
+        The motion's first frame number, for reports.
+    """
+
+    threshold: float
+    bones: Bones
+    min_distance: np.ndarray
+    flagged: np.ndarray
+    ignored: np.ndarray
+    distances: np.ndarray
+    start_frame: int = 0
+
+    @property
+    def frames(self) -> np.ndarray:
+        """0-based indices of frames with at least one flagged pair."""
+        return np.flatnonzero(self.flagged.any(axis=1))
+
+    def contacts(self) -> list[dict[str, Any]]:
+        """One entry per flagged pair: names, frame count, first frame, closest distance."""
+        out = []
+        names = self.bones.pair_names()
+        for q in np.flatnonzero(self.flagged.any(axis=0)):
+            fr = np.flatnonzero(self.flagged[:, q])
+            out.append({
+                "bones": list(names[q]),
+                "frames": int(fr.size),
+                "first_frame": int(fr[0] + self.start_frame),
+                "min_distance": float(self.min_distance[q]),
+            })
+        return out
+
+
+def self_intersections(
+    motion: Motion,
+    threshold: float | None = None,
+    *,
+    ignore_rest_contacts: bool = True,
+) -> SelfIntersections:
+    """Frames where two bones that share no joint come closer than a clearance.
+
+    Each bone is the segment from a joint to its child (from forward kinematics); the
+    distance between two bones is the closest distance between their segments,
+    computed for all frames and pairs at once.  A skeleton has no flesh, so the
+    threshold is a clearance between bone centre lines: below it, limbs of ordinary
+    thickness interpenetrate.
+
+    Parameters
+    ----------
+    motion : Motion
+        With a skeleton.
+    threshold : float, optional
+        Clearance in skeleton length units; default :data:`DEFAULT_CLEARANCE` (2 %) of
+        the skeleton's total bone length.
+    ignore_rest_contacts : bool, default True
+        Do not flag pairs that are one bone apart (a third bone touches both) and
+        already closer than the threshold in the rest pose: short bones side by side
+        such as fingers and thumb, or the upper neck and the clavicles.  Pairs further
+        apart in the skeleton (a hand and a thigh) are always checked, even if they
+        touch at rest.
+
+    Returns
+    -------
+    SelfIntersections
+    """
+    if not isinstance(motion, Motion):
+        raise ParameterError(f"expected a Motion, got {type(motion).__name__}")
+    bn = bones(motion)
+    if threshold is None:
+        threshold = DEFAULT_CLEARANCE * motion.skeleton.total_length()  # type: ignore[union-attr]
+    if not np.isfinite(threshold) or threshold <= 0:
+        raise ParameterError(f"threshold must be a positive length, got {threshold!r}")
+    dist = _pair_distances(motion, bn)
+    if ignore_rest_contacts:
+        ignored = (bn.rest_distance < threshold) & bn.second_neighbours
+    else:
+        ignored = np.zeros(bn.pairs.shape[0], dtype=bool)
+    flagged = (dist < threshold) & ~ignored[None, :]
+    return SelfIntersections(
+        threshold=float(threshold), bones=bn, min_distance=dist.min(axis=0) if dist.size else np.zeros(0),
+        flagged=flagged, ignored=ignored, distances=dist, start_frame=int(motion.start_frame),
+    )
+
+
+# ---------------------------------------------------------------- joint ranges
+@dataclass(frozen=True)
+class JointRangeViolation:
+    """A joint angle channel leaving the range the reference motions showed.
+
+    Attributes
+    ----------
+    channel : (str, str)
+        ``(joint, dof)``.
+    frames : int
+        Number of frames outside the allowed range.
+    first_frame : int
+        First such frame (the motion's numbering).
+    low, high : float
+        Allowed range, degrees (reference min - margin, max + margin).
+    worst : float
+        Value furthest outside, degrees.
+    excess : float
+        How far outside, degrees.
+    """
+
+    channel: tuple
+    frames: int
+    first_frame: int
+    low: float
+    high: float
+    worst: float
+    excess: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "channel": ".".join(self.channel),
+            "frames": self.frames,
+            "first_frame": self.first_frame,
+            "allowed": [self.low, self.high],
+            "worst": self.worst,
+            "excess_deg": self.excess,
+        }
+
+
+def _joint_angle_columns(motion: Motion) -> list[int]:
+    root = set(motion.root_channels())
+    return [i for i, (_, d) in enumerate(motion.channels) if d in ("rx", "ry", "rz") and i not in root]
+
+
+def joint_range_violations(
+    motion: Motion,
+    reference_motions: Sequence[Motion],
+    margin_deg: float = 5.0,
+) -> list[JointRangeViolation]:
+    """Joint angles outside ``[min - margin, max + margin]`` of the reference motions.
+
+    Only joint rotation channels are checked (not the root's position or orientation).
+    Angles are compared modulo 360: each value is taken on the turn nearest the
+    middle of the reference range.
+
+    Parameters
+    ----------
+    motion : Motion
+    reference_motions : sequence of Motion
+        Motions that define what is normal (e.g. the inputs of a blend); channels they
+        lack are not checked.  References of a skeleton with the same joints in other
+        conventions (ASF against BVH) are re-expressed in ``motion``'s first.
+    margin_deg : float, default 5
+        Tolerance in degrees.
+
+    Returns
+    -------
+    list of JointRangeViolation
+        Worst excess first.
+    """
+    if not isinstance(motion, Motion):
+        raise ParameterError(f"expected a Motion, got {type(motion).__name__}")
+    refs = list(reference_motions)
+    if not refs or not all(isinstance(r, Motion) for r in refs):
+        raise ParameterError("joint_range_violations needs at least one reference Motion")
+    if not np.isfinite(margin_deg) or margin_deg < 0:
+        raise ParameterError(f"margin_deg must be a non-negative number, got {margin_deg!r}")
+    refs = [_in_convention_of(r, motion) for r in refs]
+    out: list[JointRangeViolation] = []
+    for c in _joint_angle_columns(motion):
+        ch = motion.channels[c]
+        vals = []
+        for r in refs:
+            if ch in r.channels:
+                vals.append(np.unwrap(r.frames[:, r.channel_index(*ch)], period=360.0))
+        if not vals:
+            continue
+        # bring every reference onto one turn (nearest the first's mean), then the range
+        centre0 = float(np.mean(vals[0]))
+        vals = [v - 360.0 * np.round((np.mean(v) - centre0) / 360.0) for v in vals]
+        lo = float(min(v.min() for v in vals)) - margin_deg
+        hi = float(max(v.max() for v in vals)) + margin_deg
+        mid = 0.5 * (lo + hi)
+        x = motion.frames[:, c]
+        x = x - 360.0 * np.round((x - mid) / 360.0)
+        excess = np.maximum(lo - x, x - hi)
+        bad = np.flatnonzero(excess > 0)
+        if bad.size:
+            k = bad[np.argmax(excess[bad])]
+            out.append(JointRangeViolation(
+                channel=ch, frames=int(bad.size), first_frame=int(bad[0] + motion.start_frame),
+                low=lo, high=hi, worst=float(x[k]), excess=float(excess[k]),
+            ))
+    out.sort(key=lambda v: -v.excess)
+    return out
+
+
+# -------------------------------------------------------------------- the report
+@dataclass
+class PlausibilityReport:
+    """Self-intersections and joint ranges of a motion, relative to reference motions.
+
+    Attributes
+    ----------
+    n_frames : int
+    threshold : float
+        Clearance between bone centre lines, skeleton length units.
+    margin_deg : float
+    contacts : list of dict
+        Bone pairs closer than the threshold: ``bones``, ``frames``, ``first_frame``,
+        ``min_distance``, ``reference_min_distance`` (closest the references came) and
+        ``new`` (the motion comes clearly closer than any reference did).
+    new_contact_frames : list of int
+        Frames with at least one new contact.
+    joint_range : list of JointRangeViolation
+    notes : list of str
+        Plain-language explanation of the findings.
+    """
+
+    n_frames: int
+    threshold: float
+    margin_deg: float
+    contacts: list = field(default_factory=list)
+    new_contact_frames: list = field(default_factory=list)
+    joint_range: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+
+    @property
+    def clean(self) -> bool:
+        """No new contact and no joint outside its range."""
+        return not self.new_contact_frames and not self.joint_range
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "clean": self.clean,
+            "n_frames": self.n_frames,
+            "threshold": self.threshold,
+            "margin_deg": self.margin_deg,
+            "contacts": self.contacts,
+            "new_contact_frames": [int(f) for f in self.new_contact_frames],
+            "joint_range_violations": [v.to_dict() for v in self.joint_range],
+            "notes": list(self.notes),
+        }
+
+    def summary(self) -> str:
+        """One or a few lines for the terminal."""
+        if self.clean:
+            head = "plausibility: clean"
+        else:
+            parts = []
+            if self.new_contact_frames:
+                parts.append(f"new limb contacts in {len(self.new_contact_frames)} frames")
+            if self.joint_range:
+                parts.append(f"{len(self.joint_range)} joint angles outside the inputs' range")
+            head = "plausibility: " + "; ".join(parts)
+        return "\n".join([head] + [f"  {n}" for n in self.notes])
+
+
+def _in_convention_of(reference: Motion, motion: Motion) -> Motion:
+    """The reference written with ``motion``'s channels when the skeletons share joints.
+
+    A blend of an AMC capture with a BVH cycle is written in one convention; comparing
+    joint angles needs the references in the same one.
+    """
+    from .interpolate import in_conventions_of
+
+    return in_conventions_of(reference, motion)
+
+
+def _reference_views(reference: Motion, motion: Motion) -> list[Motion]:
+    """The reference on its own skeleton and, when compatible, played on ``motion``'s.
+
+    A blend is posed on one skeleton; an input from a performer with other proportions
+    (narrower hips for the same legs) brings limbs closer on that skeleton than on its
+    own.  Playing the reference's channels on the output's skeleton (root translation
+    scaled by the ratio of sizes) shows what the input itself does there.
+    """
+    reference = _in_convention_of(reference, motion)
+    views = [reference]
+    skel, rskel = motion.skeleton, reference.skeleton
+    if skel is None or rskel is None or skel is rskel:
+        return views
+    same = [j.name for j in skel.joints] == [j.name for j in rskel.joints] and all(
+        a.dofs == b.dofs for a, b in zip(skel.joints, rskel.joints)
+    )
+    if not same:
+        return views
+    frames = np.array(reference.frames, dtype=float)
+    rsize = rskel.total_length()
+    if rsize > 0:
+        root = skel.joints[0].name
+        cols = [i for i, (j, d) in enumerate(reference.channels) if j == root and d in ("tx", "ty", "tz")]
+        frames[:, cols] *= skel.total_length() / rsize
+    views.append(replace(reference, frames=frames, skeleton=skel))
+    return views
+
+
+def check_plausibility(
+    motion: Motion,
+    references: Sequence[Motion] = (),
+    threshold: float | None = None,
+    margin_deg: float = 5.0,
+) -> PlausibilityReport:
+    """Self-intersections and joint ranges of ``motion`` compared with ``references``.
+
+    A bone pair closer than the threshold is *new* when no reference has it that close:
+    its distance is below the references' own closest approach of the same pair (by
+    bone names) minus 10 % of the threshold.  Each reference is measured on its own
+    skeleton (distances scaled to ``motion``'s size) and, when the skeletons have the
+    same joints, also played on ``motion``'s skeleton: a performer's pose on another
+    performer's proportions can bring limbs closer by itself, which is not the
+    blend's doing.  Pairs a reference also brings within the
+    threshold are listed but explained, not counted against the motion.  Without
+    references every contact is new and joint ranges are not checked.
+
+    Parameters
+    ----------
+    motion : Motion
+        With a skeleton.
+    references : sequence of Motion
+        The inputs (e.g. the cycles blended); each with a skeleton of the same joint
+        names.
+    threshold : float, optional
+        Clearance (default 2 % of ``motion``'s total bone length); the references are
+        checked with the same clearance scaled by their skeleton's size.
+    margin_deg : float, default 5
+
+    Returns
+    -------
+    PlausibilityReport
+    """
+    inter = self_intersections(motion, threshold)
+    thr = inter.threshold
+    size = motion.skeleton.total_length()  # type: ignore[union-attr]
+    names = inter.bones.pair_names()
+    ref_min: dict[tuple[str, str], float] = {}
+    for r in references:
+        if r.skeleton is None:
+            continue
+        for view in _reference_views(r, motion):
+            rb = bones(view)
+            rsize = view.skeleton.total_length()  # type: ignore[union-attr]
+            rd = _pair_distances(view, rb).min(axis=0) * (size / rsize if rsize > 0 else 1.0)
+            for key, d in zip(rb.pair_names(), rd):
+                ref_min[key] = min(ref_min.get(key, np.inf), float(d))
+    contacts = []
+    new_mask = np.zeros(inter.flagged.shape[0], dtype=bool)
+    notes: list[str] = []
+    explained = 0
+    for q in np.flatnonzero(inter.flagged.any(axis=0)):
+        key = names[q]
+        rmin = ref_min.get(key, ref_min.get((key[1], key[0]), np.inf))
+        frames = np.flatnonzero(inter.flagged[:, q])
+        if references:
+            limit = min(thr, rmin) - _NEW_TOLERANCE * thr
+            new_frames = np.flatnonzero(inter.distances[:, q] < limit)
+        else:
+            new_frames = frames
+        is_new = bool(new_frames.size)
+        if is_new:
+            new_mask[new_frames] = True
+        else:
+            explained += 1
+        contacts.append({
+            "bones": list(key),
+            "frames": int(frames.size),
+            "first_frame": int(frames[0] + motion.start_frame),
+            "min_distance": float(inter.min_distance[q]),
+            "reference_min_distance": None if not np.isfinite(rmin) else float(rmin),
+            "new": bool(is_new),
+        })
+    if inter.ignored.any():
+        notes.append(
+            f"{int(inter.ignored.sum())} pairs of neighbouring bones are within the clearance {thr:.3g} "
+            "already at rest (e.g. fingers and thumb) and are not checked"
+        )
+    if explained:
+        notes.append(
+            f"{explained} bone pairs come within the clearance {thr:.3g}, but the inputs come as close "
+            "(their own near-contacts, not new)"
+        )
+    n_new = sum(1 for c in contacts if c["new"])
+    if n_new:
+        worst = min((c for c in contacts if c["new"]), key=lambda c: c["min_distance"])
+        notes.append(
+            f"{n_new} bone pairs come closer than the inputs ever do, e.g. {worst['bones'][0]} and "
+            f"{worst['bones'][1]} at {worst['min_distance']:.3g} (clearance {thr:.3g}, inputs' closest "
+            f"{worst['reference_min_distance'] if worst['reference_min_distance'] is not None else 'n/a'})"
+        )
+    violations: list[JointRangeViolation] = []
+    if references:
+        violations = joint_range_violations(motion, references, margin_deg)
+        if violations:
+            v = violations[0]
+            notes.append(
+                f"{len(violations)} joint angles leave the inputs' range (+-{margin_deg:g} deg), worst "
+                f"{'.'.join(v.channel)} at {v.worst:.1f} (allowed {v.low:.1f} to {v.high:.1f})"
+            )
+    if not contacts and not violations:
+        notes.append(f"no bones closer than {thr:.3g} and every joint angle within the inputs' range")
+    return PlausibilityReport(
+        n_frames=motion.n_frames, threshold=thr, margin_deg=float(margin_deg), contacts=contacts,
+        new_contact_frames=[int(f + motion.start_frame) for f in np.flatnonzero(new_mask)],
+        joint_range=violations, notes=notes,
+    )

@@ -1,0 +1,341 @@
+"""Alignment, blending and transitions between cycles (cyclecoord.interpolate)."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.errors import ParameterError
+from cyclecoord.interpolate import (
+    STEP_LIMIT,
+    CycleCurve,
+    align,
+    as_cycle,
+    blend,
+    cycle_summary,
+    estimate_period,
+    mean_heading,
+    prepare_cycle,
+    root_drift,
+    rotate_heading,
+    transition,
+)
+from cyclecoord.metrics import jerk_summary
+
+
+# ------------------------------------------------------------------ synthetic cycles
+def make_cycle(kind="walk", period=120, seed=0, noise=0.0):
+    """One exact loop of a synthetic capture and its true per-loop root change.
+
+    With a constant phase speed frame ``t`` is at phase ``t / period``; rendering one
+    frame more than a loop gives the next loop's first frame, hence the displacement.
+    """
+    cap = cc.datasets.make_periodic_capture(
+        kind=kind, n_frames=period + 1, period=period, noise=noise, speed_variation=0.0, random_state=seed
+    )
+    m = cap.motion
+    disp = m.frames[period] - m.frames[0]
+    return m[:period], disp
+
+
+def rolled(cycle, k, disp):
+    """The same loop started ``k`` frames later (the wrapped frames travel one loop on)."""
+    f = np.asarray(cycle.frames)
+    return cycle.with_frames(np.vstack([f[k:], f[:k] + disp]))
+
+
+def played_backwards(cycle):
+    return cycle.with_frames(np.asarray(cycle.frames)[::-1])
+
+
+def pose_columns(m):
+    root = set(m.root_channels())
+    return [i for i in range(m.n_channels) if i not in root]
+
+
+@pytest.fixture(scope="module")
+def walk():
+    return make_cycle("walk", 120, seed=0)
+
+
+@pytest.fixture(scope="module")
+def jog():
+    return make_cycle("jog", 80, seed=3)
+
+
+# ------------------------------------------------------------------ curves
+def test_curve_passes_through_frames_and_resamples_losslessly(walk):
+    cycle, _ = walk
+    curve = CycleCurve.from_motion(cycle)
+    assert np.abs(curve.sample(120) - cycle.frames).max() < 1e-9
+    assert np.abs(curve(np.arange(120) / 120) - cycle.frames).max() < 1e-9
+    # P -> N -> P, for N above P (odd and even): the frames come back
+    for n in (121, 256, 301):
+        up = cycle.with_frames(curve.sample(n))
+        back = CycleCurve.from_motion(up, displacement=curve.drift[list(cycle.root_channels())]).sample(120)
+        assert np.abs(back - cycle.frames).max() < 1e-8, n
+    # one loop later the root has travelled the drift
+    assert np.allclose(curve(1.0)[0] - curve(0.0)[0], curve.drift)
+
+
+def test_root_drift_recovers_the_travel_per_loop(walk, jog):
+    for cycle, disp in (walk, jog):
+        root = cycle.root_channels()
+        est = root_drift(cycle)
+        assert est == pytest.approx(disp[root], abs=1e-5)
+        assert est[2] > 10  # travels along +z, one stride per loop
+        # a known displacement is used as given
+        known = replace(cycle, metadata={"root_displacement": [0, 0, 5, 0, 0, 0]})
+        assert list(root_drift(known)) == [0, 0, 5, 0, 0, 0]
+        prep = prepare_cycle(cycle)
+        assert prep[:, root].sum(axis=0) == pytest.approx(est)
+
+
+def test_align_finds_whole_fractional_and_reversed_shifts(walk):
+    cycle, disp = walk
+    al = align(cycle, rolled(cycle, 37, disp))
+    assert not al.reversed
+    assert al.shift == pytest.approx((120 - 37) / 120, abs=1e-9)
+    assert al.shift_frames == pytest.approx(-37, abs=1e-6)
+    assert al.cost < 1e-6 < al.cost_unaligned
+    # a fraction of a frame: b(θ) = a(θ - 0.1234) is matched by shifting b by +0.1234
+    curve = CycleCurve.from_motion(cycle)
+    frac = cycle.with_frames(curve.shifted(-0.1234).sample(120))
+    al = align(cycle, frac)
+    assert al.shift == pytest.approx(0.1234, abs=1e-9)
+    # played backwards: found as reversed with zero cost, unless reversal is not allowed
+    back = played_backwards(cycle)
+    al = align(cycle, back)
+    assert al.reversed and al.cost < 1e-6
+    forward_only = align(cycle, back, allow_reverse=False)
+    assert not forward_only.reversed and forward_only.cost > 1.0
+    # cycles of different lengths are compared on the phase circle
+    long = cycle.with_frames(curve.sample(203))
+    al = align(cycle, long)
+    assert al.cost < 1e-6 and min(al.shift, 1 - al.shift) < 1e-9
+
+
+def test_blend_with_itself_and_shifted_copies_returns_the_cycle(walk):
+    cycle, disp = walk
+    same = blend([cycle, cycle], [0.5, 0.5])
+    assert same.n_frames == 120
+    assert np.abs(same.frames - cycle.frames).max() < 1e-6
+    shifted = blend([cycle, rolled(cycle, 45, disp)], [0.3, 0.7])
+    assert np.abs(shifted.frames - cycle.frames).max() < 1e-6
+    three = blend(
+        [cycle, rolled(cycle, 7, disp), played_backwards(rolled(cycle, 90, disp))],
+        [0.2, 0.3, 0.5],
+        allow_reverse=True,
+    )
+    assert np.abs(three.frames - cycle.frames).max() < 1e-6
+    assert three.metadata["blend"]["alignments"][2]["reversed"] is True
+    assert three.metadata["root_displacement"] == pytest.approx(disp[cycle.root_channels()], abs=1e-5)
+
+
+@pytest.mark.parametrize(
+    "weights, message",
+    [
+        ([0.5, 0.6], "sum to 1"),
+        ([1.2, -0.2], "non-negative"),
+        ([1.0], "one weight per cycle"),
+        ([0.5, float("nan")], "finite"),
+        (["a", "b"], "numbers"),
+    ],
+)
+def test_bad_weights_are_refused(walk, weights, message):
+    cycle, _ = walk
+    with pytest.raises(ParameterError, match=message):
+        blend([cycle, cycle], weights)
+
+
+def test_bad_inputs_are_refused(walk):
+    cycle, _ = walk
+    with pytest.raises(ParameterError, match="non-empty"):
+        blend([], [])
+    with pytest.raises(ParameterError, match="same channels"):
+        blend([cycle, cycle.select(cycle.channels[:-1])], [0.5, 0.5])
+    with pytest.raises(ParameterError, match="at least 4"):
+        blend([cycle, cycle[:3]], [0.5, 0.5])
+    with pytest.raises(ParameterError, match="exactly one"):
+        transition(cycle, cycle)
+    with pytest.raises(ParameterError, match="exactly one"):
+        transition(cycle, cycle, frames=10, cycles=1)
+    with pytest.raises(ParameterError, match="frames must be"):
+        transition(cycle, cycle, frames=1)
+    # channels in another order are matched by name
+    order = list(reversed(cycle.channels))
+    same = blend([cycle, cycle.select(order)], [0.5, 0.5])
+    assert np.abs(same.frames - cycle.frames).max() < 1e-6
+
+
+def test_angles_near_180_do_not_average_to_zero(walk):
+    cycle, _ = walk
+    c = cycle.channel_index("lhumerus", "ry")
+    f = np.array(cycle.frames)
+    f[:, c] = (f[:, c] + 180.0 + 180.0) % 360.0 - 180.0  # now crosses +-180 inside the file
+    wrapped = cycle.with_frames(f)
+    g = f.copy()
+    g[:, c] -= 360.0  # the same rotations written one turn lower
+    lower = cycle.with_frames(g)
+    out = blend([wrapped, lower], [0.5, 0.5])
+    diff = (out.frames[:, c] - f[:, c] + 180.0) % 360.0 - 180.0
+    assert np.abs(diff).max() < 1e-6
+    assert np.abs(np.diff(out.frames[:, c])).max() < 20  # continuous, no jump through 0
+
+
+def test_blend_faces_the_reference_and_keeps_its_speed(walk):
+    cycle, disp = walk
+    assert mean_heading(cycle) == pytest.approx(0.0, abs=5.0)  # the synthetic walker faces +z
+    turned = rotate_heading(cycle, 120.0)
+    assert mean_heading(turned) == pytest.approx(mean_heading(cycle) + 120.0, abs=1e-6)
+    # same bodies, positions turned: forward kinematics agrees after turning back
+    back = rotate_heading(turned, -120.0)
+    assert np.abs(back.positions().positions - cycle.positions().positions).max() < 1e-9
+    out = blend([cycle, turned], [0.5, 0.5])
+    # without turning, the velocities of the two would partly cancel
+    assert out.metadata["root_displacement"][2] == pytest.approx(disp[2], rel=1e-6)
+    assert np.abs(out.frames - cycle.frames).max() < 1e-6
+    naive = blend([cycle, turned], [0.5, 0.5], align_heading=False)
+    assert naive.metadata["root_displacement"][2] < 0.5 * disp[2]
+
+
+def test_walk_jog_blends_move_period_and_stay_smooth(walk, jog):
+    (w, w_disp), (j, j_disp) = walk, jog
+    inputs = [cycle_summary(w), cycle_summary(j)]
+    jerks = [jerk_summary(m.frames[:, pose_columns(m)], m.fps, cyclic=True) for m in (w, j)]
+    lengths = []
+    for wt in (0.0, 0.25, 0.5, 0.75, 1.0):
+        out = blend([w, j], [1 - wt, wt])
+        s = cycle_summary(out)
+        lengths.append(out.n_frames)
+        assert out.n_frames == round((1 - wt) * 120 + wt * 80)
+        assert s["loop_closure"] <= 1.5
+        pj = jerk_summary(out.frames[:, pose_columns(out)], out.fps, cyclic=True)
+        assert min(jerks) / 2 <= pj <= 2 * max(jerks)
+        assert min(i["jerk"] for i in inputs) / 2 <= s["jerk"] <= 2 * max(i["jerk"] for i in inputs)
+        # travel per loop is the weighted mean of the strides
+        assert out.metadata["root_displacement"][2] == pytest.approx((1 - wt) * w_disp[2] + wt * j_disp[2], rel=1e-4)
+        if wt == 0.0:
+            assert np.abs(out.frames - w.frames).max() < 1e-6
+        if wt == 1.0:
+            al = out.metadata["blend"]["alignments"][1]
+            expect = CycleCurve.from_motion(j).shifted(al["shift"]).sample(80)
+            cols = pose_columns(j)
+            assert np.abs(out.frames[:, cols] - expect[:, cols]).max() < 1e-6
+    assert lengths == sorted(lengths, reverse=True) and lengths[0] > lengths[-1]
+
+
+def test_transition_is_continuous_and_exports_to_bvh(walk, jog, tmp_path):
+    (w, _), (j, _) = walk, jog
+    clip = transition(w, j, cycles=2)
+    info = clip.metadata["transition"]
+    start, stop = info["ramp"]
+    assert start == 120 and stop == 120 + info["ramp_frames"]
+    assert clip.n_frames == stop + 80
+    assert info["ramp_cycles"] == pytest.approx(2.0, abs=0.02)
+    # starts with the walk's own frames, ends with weight 1
+    assert np.abs(clip.frames[:120] - w.frames).max() < 1e-6
+    weight = np.array(info["weight"])
+    assert weight[0] == 0 and weight[-1] == 1 and np.all(np.diff(weight) >= 0)
+    # phase advances at the walk's rate at first and the jog's at the end
+    ph = np.diff(info["phase"])
+    assert ph[0] == pytest.approx(1 / 120) and ph[-1] == pytest.approx(1 / 80)
+    cont = info["continuity"]
+    assert cont["max_ratio"] <= STEP_LIMIT
+    # the ramp has no step larger than the larger of the two cycles' steps (x1.5)
+    steps_w = np.linalg.norm(np.diff(prepare_cycle(w), axis=0), axis=1).max()
+    steps_j = np.linalg.norm(np.diff(prepare_cycle(j), axis=0), axis=1).max()
+    assert cont["max_step"] <= STEP_LIMIT * max(steps_w, steps_j)
+    # a ramp far too short is reported with a longer suggestion
+    quick = transition(w, j, frames=3, lead_in=0, lead_out=0)
+    qc = quick.metadata["transition"]["continuity"]
+    assert qc["max_ratio"] > STEP_LIMIT and qc["suggested_ramp_frames"] > 3
+    # BVH round trip
+    path = tmp_path / "walk_to_jog.bvh"
+    cc.save(clip, path)
+    back = cc.load(path)
+    assert back.n_frames == clip.n_frames and back.fps == pytest.approx(clip.fps)
+    assert np.abs(back.positions().positions - clip.positions().positions).max() < 1e-6
+
+
+def test_transition_by_frames_and_without_leads(walk, jog):
+    (w, _), (j, _) = walk, jog
+    clip = transition(w, j, frames=150, lead_in=0, lead_out=0)
+    assert clip.n_frames == 150
+    info = clip.metadata["transition"]
+    assert info["weight"][0] == 0 and info["weight"][-1] == 1
+    assert info["continuity"]["max_ratio"] <= STEP_LIMIT
+    # the ground position keeps advancing (never jumps back between the two cycles)
+    tz = clip.frames[:, clip.channel_index("root", "tz")]
+    assert np.all(np.diff(tz) > 0)
+
+
+def test_as_cycle_rule(walk, tmp_path):
+    cycle, _ = walk
+    src = as_cycle(cycle)
+    assert not src.extracted and src.cycle is cycle and "taken as a cycle" in src.reason
+    cap = cc.datasets.make_periodic_capture(n_frames=400, period=100, noise=0.3, random_state=1).motion
+    assert estimate_period(cap) == pytest.approx(100, rel=0.1)
+    assert estimate_period(cycle) is None
+    src = as_cycle(cap)
+    assert src.extracted and "repeats every" in src.reason
+    assert src.cycle.n_frames == pytest.approx(100, rel=0.1)
+    assert as_cycle(cap, mode="cycle").cycle is cap
+    # what extract writes is recognised by its metadata after an NPZ round trip
+    path = tmp_path / "cycle.npz"
+    cc.save(src.cycle, path)
+    again = as_cycle(cc.load(path))
+    assert not again.extracted and "metadata" in again.reason
+    # a still capture "loops" (its seam is one more noisy step) but does not move
+    still = cc.datasets.make_static_capture(random_state=0).motion
+    with pytest.raises(cc.NoPeriodicMotionError):
+        as_cycle(still)
+    with pytest.raises(ParameterError, match="mode"):
+        as_cycle(cycle, mode="maybe")
+    with pytest.raises(ParameterError, match="frame range"):
+        as_cycle(cap, frames=(300, 500))
+
+
+# --------------------------------------------------------------- real captures
+@pytest.fixture(scope="module")
+def cmu_cycles(cmu_dir):
+    walk = as_cycle(cc.load(cmu_dir / "69" / "69_01.amc"), frames=(200, 450), max_scale=50)
+    # 143_01: the paper's window and threshold; the cocycle read at 40 (inside the bar
+    # [25, 50)) follows the strides (period ~45 frames, as the hip angles show)
+    jog = as_cycle(cc.load(cmu_dir / "143" / "143_01.amc"), frames=(0, 96), max_scale=50, scale=40)
+    assert walk.extracted and jog.extracted
+    return walk.cycle, jog.cycle
+
+
+def test_cmu_walk_and_jog_blends(cmu_cycles):
+    from cyclecoord.plausibility import check_plausibility
+
+    w, j = cmu_cycles
+    assert 130 <= w.n_frames <= 160 and 38 <= j.n_frames <= 55
+    jerks = [jerk_summary(m.frames[:, pose_columns(m)], m.fps, cyclic=True) for m in (w, j)]
+    periods = []
+    for wt in (0.0, 0.25, 0.5, 0.75, 1.0):
+        out = blend([w, j], [1 - wt, wt])
+        periods.append(out.n_frames)
+        s = cycle_summary(out)
+        assert s["loop_closure"] <= 1.5
+        pj = jerk_summary(out.frames[:, pose_columns(out)], out.fps, cyclic=True)
+        assert min(jerks) / 2 <= pj <= 2 * max(jerks)
+        report = check_plausibility(out, [w, j])
+        assert report.notes
+        if not report.clean:  # it explains itself: which bones, how close, against what
+            new = [c for c in report.contacts if c["new"]]
+            assert new and all(c["reference_min_distance"] is not None for c in new)
+            assert any(new[0]["bones"][0] in n for n in report.notes) or report.joint_range
+    assert all(a > b for a, b in zip(periods, periods[1:]))
+
+
+def test_cmu_walk_to_jog_transition(cmu_cycles, tmp_path):
+    w, j = cmu_cycles
+    clip = transition(w, j, cycles=2)
+    assert clip.metadata["transition"]["continuity"]["max_ratio"] <= STEP_LIMIT
+    path = tmp_path / "t.bvh"
+    cc.save(clip, path)
+    back = cc.load(path)
+    assert np.abs(back.positions().positions - clip.positions().positions).max() < 1e-6

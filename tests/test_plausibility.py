@@ -1,0 +1,155 @@
+"""Self-intersection and joint-range checks (cyclecoord.plausibility)."""
+
+import json
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.errors import ParameterError
+from cyclecoord.plausibility import (
+    DEFAULT_CLEARANCE,
+    bones,
+    check_plausibility,
+    joint_range_violations,
+    segment_distances,
+    self_intersections,
+)
+
+# a left-arm pose whose forearm crosses the chest (found by forward kinematics)
+ARM_THROUGH_TORSO = {("lhumerus", "rx"): -30.0, ("lhumerus", "ry"): 45.0, ("lhumerus", "rz"): -45.0,
+                     ("lradius", "rx"): 120.0}
+LEFT_ARM = {"lhumerus", "lradius", "lwrist", "lhand", "lfingers", "lthumb"}
+TORSO = {"lowerback", "upperback", "thorax", "lowerneck", "rclavicle", "rhumerus", "rradius"}
+
+
+@pytest.fixture(scope="module")
+def walk():
+    cap = cc.datasets.make_periodic_capture(kind="walk", n_frames=120, period=120, noise=0.0,
+                                            speed_variation=0.0, random_state=0)
+    return cap.motion
+
+
+def arm_through_torso(walk, first=40, last=80):
+    """The walk with the left arm driven smoothly into the chest and out again."""
+    f = np.array(walk.frames)
+    t = np.arange(walk.n_frames)
+    ramp = np.clip(np.minimum(t - first + 20, last + 20 - t) / 20.0, 0.0, 1.0)  # 1 on [first, last]
+    for (joint, dof), value in ARM_THROUGH_TORSO.items():
+        c = walk.channel_index(joint, dof)
+        f[:, c] = (1 - ramp) * f[:, c] + ramp * value
+    return walk.with_frames(f)
+
+
+def test_bones_follow_the_asf_bones_and_skip_touching_pairs(walk):
+    bn = bones(walk)
+    assert len(bn.names) == 30
+    for name in ("lfemur", "ltibia", "thorax", "lhumerus", "lradius", "head", "lthumb"):
+        assert name in bn.names
+    pairs = {frozenset(p) for p in bn.pair_names()}
+    # parent/child and siblings at one joint are never compared
+    for p in [("lfemur", "ltibia"), ("lhumerus", "lradius"), ("lhipjoint", "lowerback"),
+              ("lhipjoint", "rhipjoint"), ("thorax", "lclavicle"), ("lowerneck", "rclavicle")]:
+        assert frozenset(p) not in pairs, p
+    for p in [("lfemur", "rfemur"), ("ltibia", "rtibia"), ("lradius", "upperback"), ("lhand", "lfemur")]:
+        assert frozenset(p) in pairs, p
+
+
+def test_segment_distances_match_brute_force():
+    rng = np.random.default_rng(0)
+    p0, p1, q0, q1 = rng.normal(size=(4, 300, 3))
+    p1[:20] = p0[:20]  # points
+    q1[20:40] = q0[20:40] + 0.0
+    # parallel copies moved by a unit vector square to them: distance exactly 1
+    u = p1[40:60] - p0[40:60]
+    side = np.cross(u, rng.normal(size=(20, 3)))
+    side /= np.linalg.norm(side, axis=1, keepdims=True)
+    q0[40:60], q1[40:60] = p0[40:60] + side, p1[40:60] + side
+    d = segment_distances(p0, p1, q0, q1)
+    s = np.linspace(0, 1, 401)[:, None]
+    brute = np.empty(d.shape)
+    for i in range(d.size):  # nearest pair of 401 points along each segment
+        a = p0[i] + s * (p1[i] - p0[i])
+        b = q0[i] + s * (q1[i] - q0[i])
+        brute[i] = np.sqrt(((a[:, None, :] - b[None, :, :]) ** 2).sum(-1).min())
+    assert np.all(d <= brute + 1e-12)
+    assert np.abs(d - brute).max() < 2e-2
+    assert d[40:60] == pytest.approx(np.ones(20))
+    # crossing segments touch
+    assert segment_distances(np.array([-1.0, 0, 0]), np.array([1.0, 0, 0]),
+                             np.array([0, -1.0, 0]), np.array([0, 1.0, 0])) == pytest.approx(0.0)
+
+
+def test_normal_walk_is_clean(walk):
+    found = self_intersections(walk)
+    assert found.threshold == pytest.approx(DEFAULT_CLEARANCE * walk.skeleton.total_length())
+    assert found.frames.size == 0 and found.contacts() == []
+    report = check_plausibility(walk, [walk])
+    assert report.clean and "no bones closer" in report.summary()
+
+
+def test_arm_through_the_torso_is_flagged(walk):
+    bad = arm_through_torso(walk)
+    found = self_intersections(bad)
+    frames = found.frames
+    assert frames.size >= 30
+    assert frames.min() >= 20 and frames.max() <= 100  # only while the arm is in
+    assert set(range(45, 76)) <= set(frames.tolist())
+    crossing = [c for c in found.contacts()
+                if (set(c["bones"]) & LEFT_ARM) and (set(c["bones"]) & TORSO)]
+    assert crossing and min(c["min_distance"] for c in crossing) < 0.2
+    report = check_plausibility(bad, [walk])
+    assert not report.clean
+    assert set(range(45, 76)) <= set(report.new_contact_frames)
+    assert any(v.channel == ("lradius", "rx") for v in report.joint_range)
+    assert "closer than the inputs ever do" in report.summary()
+    payload = json.loads(json.dumps(report.to_dict()))
+    assert payload["clean"] is False and payload["joint_range_violations"]
+
+
+def test_contacts_the_inputs_share_are_explained_not_new(walk):
+    bad = arm_through_torso(walk)
+    report = check_plausibility(bad, [walk, bad])
+    assert report.new_contact_frames == [] and not report.joint_range
+    assert report.clean
+    assert any("the inputs come as close" in n for n in report.notes)
+    # a tighter or looser clearance changes what is flagged
+    assert self_intersections(bad, threshold=0.01).frames.size < self_intersections(bad).frames.size
+
+
+def test_joint_range(walk):
+    assert joint_range_violations(walk, [walk]) == []
+    c = walk.channel_index("ltibia", "rx")
+    f = np.array(walk.frames)
+    f[:, c] += 360.0  # the same rotations one turn up: not a violation
+    assert joint_range_violations(walk.with_frames(f), [walk]) == []
+    g = np.array(walk.frames)
+    top = g[:, c].max()
+    g[10, c] = top + 12.0
+    found = joint_range_violations(walk.with_frames(g), [walk], margin_deg=5.0)
+    assert len(found) == 1
+    v = found[0]
+    assert v.channel == ("ltibia", "rx") and v.frames == 1 and v.first_frame == 10
+    assert v.excess == pytest.approx(7.0) and v.high == pytest.approx(top + 5.0)
+    assert joint_range_violations(walk.with_frames(g), [walk], margin_deg=15.0) == []
+
+
+def test_bad_arguments(walk):
+    with pytest.raises(ParameterError, match="skeleton"):
+        self_intersections(cc.Motion(walk.frames, walk.channels))
+    with pytest.raises(ParameterError, match="threshold"):
+        self_intersections(walk, threshold=-1.0)
+    with pytest.raises(ParameterError, match="reference"):
+        joint_range_violations(walk, [])
+    with pytest.raises(ParameterError, match="margin"):
+        joint_range_violations(walk, [walk], margin_deg=float("nan"))
+
+
+def test_real_walk_near_contacts_explain_themselves(walk_69_01):
+    clip = walk_69_01[200:450]
+    found = self_intersections(clip)
+    # legs passing each other come within 2 % of the skeleton size in a real walk
+    assert any({"ltibia", "rtibia"} == set(c["bones"]) for c in found.contacts())
+    report = check_plausibility(clip, [clip])
+    assert report.clean
+    assert any("the inputs come as close" in n for n in report.notes)
