@@ -44,8 +44,18 @@ _LAZY = {
     "JointPositions": "skeleton",
     "Skeleton": "skeleton",
     "forward_kinematics": "skeleton",
+    "PhaseModel": "model",
+    "detect": "detect",
+    "DetectionResult": "detect",
+    "blend": "interpolate",
+    "transition": "interpolate",
+    "align": "interpolate",
+    "run_batch": "batch",
 }
-_SUBMODULES = {"datasets", "io", "plot", "metrics", "pipeline", "barcode", "coordinates", "cycle", "density"}
+_SUBMODULES = {
+    "datasets", "io", "plot", "metrics", "pipeline", "barcode", "coordinates", "cycle", "density",
+    "detect", "interpolate", "plausibility", "batch", "model", "landmarks", "preprocess",
+}
 
 
 def __getattr__(name: str):

@@ -376,7 +376,7 @@ def cmd_render(args: argparse.Namespace) -> int:
         if not 0 <= a < b <= n:
             raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames (0-based, half-open)")
         motion = motion[a:b]
-    other = load_input(args.side_by_side, None, args.fps) if args.side_by_side else None
+    other = load_input(args.side_by_side, None, None) if args.side_by_side else None
     path = render(motion, out, other=other, view=args.view, step=args.step, follow=args.follow)
     what = f"{motion.n_frames} frames" + (f" beside {other.n_frames} frames of {args.side_by_side}" if other else "")
     print(f"wrote {path} ({what}, {args.view} view)")
@@ -430,6 +430,200 @@ def cmd_convert(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _auto_or_positive(text: str) -> float | None:
+    """A positive number, or ``auto`` for the default (per-input options of blend/transition)."""
+    if text.strip().lower() == "auto":
+        return None
+    return _positive_float(text)
+
+
+def _weights(text: str) -> list[float]:
+    """Parse ``0.3,0.7`` into numbers (their range is checked by the blend)."""
+    try:
+        return [float(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected comma-separated numbers such as 0.3,0.7, got {text!r}") from None
+
+
+def _per_input(values: list | None, n: int, option: str) -> list:
+    """An option given once (for every input) or once per input, in input order."""
+    if not values:
+        return [None] * n
+    if len(values) == 1:
+        return list(values) * n
+    if len(values) != n:
+        raise ParameterError(f"{option} given {len(values)} times for {n} inputs; give it once or once per input")
+    return list(values)
+
+
+def _load_cycles(args: argparse.Namespace) -> list:
+    """Every input as a cycle (captures are extracted first), with why."""
+    from .interpolate import as_cycle
+
+    n = len(args.inputs)
+    windows = _per_input(args.window, n, "--window")
+    fpss = _per_input(args.fps, n, "--fps")
+    scales = _per_input(args.max_scale, n, "--max-scale")
+    cocycle_scales = _per_input(args.scale, n, "--scale")
+    mode = "cycle" if args.as_cycle else "extract" if args.extract else "auto"
+    out = []
+    for path, window, fps, max_scale, scale in zip(args.inputs, windows, fpss, scales, cocycle_scales):
+        motion = load_input(path, None, fps)
+        options = {"random_state": args.seed}
+        if max_scale is not None:
+            options["max_scale"] = max_scale
+        if scale is not None:
+            options["scale"] = scale
+        try:
+            src = as_cycle(motion, mode=mode, frames=window, **options)
+        except NoPeriodicMotionError as exc:
+            raise NoPeriodicMotionError(f"{path}: {exc}", result=exc.result) from None
+        c = src.cycle
+        print(f"{path}: cycle of {c.n_frames} frames ({c.n_frames / c.fps:.3f} s at {c.fps:g} fps); {src.reason}")
+        out.append(src)
+    return out
+
+
+def _check_outputs(args: argparse.Namespace) -> None:
+    """Fail fast on outputs we could not write or that would overwrite an input."""
+    _check_output(args.output)
+    _check_output(args.report, "report")
+    for out in (args.output, args.report):
+        if out is None:
+            continue
+        for src in args.inputs:
+            if Path(src).exists() and Path(out).resolve() == Path(src).resolve():
+                raise ParameterError(f"{out}: refusing to overwrite an input file")
+
+
+def _finish(args: argparse.Namespace, motion, payload: dict, report, what: str, problem: str | None = None) -> int:
+    """Print the plausibility verdict, honour --strict, write the motion and the report."""
+    from .io import save
+    from .plausibility import ImplausibleMotionError
+
+    print(report.summary())
+    payload["plausibility"] = report.to_dict()
+    refused = args.strict and (not report.clean or problem is not None)
+    payload["written"] = None if refused or not args.output else args.output
+    if args.report:
+        _write_json(args.report, _clean(payload))
+        print(f"wrote {args.report}")
+    if refused:
+        why = problem if report.clean and problem else "fails the plausibility checks"
+        raise ImplausibleMotionError(
+            f"the {what} {why} and --strict is set; nothing written"
+            + (f" (see {args.report})" if args.report else "")
+        )
+    if args.output:
+        save(motion, args.output)
+        print(f"wrote {args.output}")
+    return EXIT_OK
+
+
+def cmd_blend(args: argparse.Namespace) -> int:
+    from .interpolate import blend, cycle_summary
+    from .plausibility import check_plausibility
+
+    _check_outputs(args)
+    try:
+        sources = _load_cycles(args)
+    except NoPeriodicMotionError as exc:
+        print(f"cyclecoord: {exc}", file=sys.stderr)
+        return EXIT_NO_PERIODIC
+    n = len(sources)
+    weights = args.weights if args.weights is not None else [1.0 / n] * n
+    cycles = [s.cycle for s in sources]
+    out = blend(cycles, weights, allow_reverse=args.allow_reverse, align_heading=not args.no_heading, up=args.up)
+    info = out.metadata["blend"]
+    for i, al in enumerate(info["alignments"][1:], start=1):
+        rev = ", reversed" if al["reversed"] else ""
+        print(
+            f"aligned {args.inputs[i]} to {args.inputs[0]}: shift {al['shift_frames']:.2f} frames{rev}, "
+            f"rms pose difference {al['cost']:.3g} (unaligned {al['cost_unaligned']:.3g})"
+        )
+    summaries = [cycle_summary(c) for c in cycles]
+    s = cycle_summary(out)
+    print(
+        f"blend {', '.join(f'{w:g}' for w in info['weights'])}: {out.n_frames} frames ({s['seconds']:.3f} s; inputs "
+        + ", ".join(f"{v['frames']}" for v in summaries)
+        + f"), loop closure {s['loop_closure']:.2f}, jerk {s['jerk']:.4g} (inputs "
+        + ", ".join(f"{v['jerk']:.4g}" for v in summaries) + ")"
+    )
+    for note in info["notes"]:
+        print(f"note: {note}")
+    report = check_plausibility(out, cycles, margin_deg=args.margin)
+    payload = {
+        "inputs": [dict(src.to_dict(), path=p, summary=sm) for src, p, sm in zip(sources, args.inputs, summaries)],
+        "weights": info["weights"],
+        "output": dict(s, path=args.output),
+        "root_displacement": out.metadata["root_displacement"],
+        "blend": info,
+    }
+    return _finish(args, out, payload, report, "blend")
+
+
+def cmd_transition(args: argparse.Namespace) -> int:
+    from .interpolate import transition
+    from .plausibility import check_plausibility
+
+    _check_outputs(args)
+    try:
+        sources = _load_cycles(args)
+    except NoPeriodicMotionError as exc:
+        print(f"cyclecoord: {exc}", file=sys.stderr)
+        return EXIT_NO_PERIODIC
+    a, b = (s.cycle for s in sources)
+    clip = transition(
+        a, b, frames=args.frames, cycles=args.cycles, lead_in=args.lead_in, lead_out=args.lead_out,
+        allow_reverse=args.allow_reverse, align_heading=not args.no_heading, up=args.up,
+    )
+    info = clip.metadata["transition"]
+    al = info["alignment"]
+    cont = info["continuity"]
+    print(
+        f"aligned {args.inputs[1]} to {args.inputs[0]}: shift {al['shift_frames']:.2f} frames"
+        + (", reversed" if al["reversed"] else "")
+    )
+    print(
+        f"transition: {clip.n_frames} frames ({info['lead_in_frames']} of A, ramp {info['ramp_frames']} frames = "
+        f"{info['ramp_cycles']:.2f} cycles, {info['lead_out_frames']} of B); largest step {cont['max_ratio']:.2f}x "
+        f"the typical step at its phase (limit {cont['limit']:g})"
+    )
+    for note in info["notes"]:
+        print(f"note: {note}")
+    report = check_plausibility(clip, [a, b], margin_deg=args.margin)
+    meta = {k: v for k, v in info.items() if k not in ("weight", "phase")}
+    payload = {
+        "inputs": [dict(src.to_dict(), path=p) for src, p in zip(sources, args.inputs)],
+        "output": {"path": args.output, "frames": clip.n_frames, "fps": clip.fps},
+        "transition": meta,
+        "weight": info["weight"],
+        "phase": info["phase"],
+    }
+    problem = None
+    if cont["max_ratio"] > cont["limit"]:
+        problem = f"has a step {cont['max_ratio']:.2f}x the typical step (limit {cont['limit']:g})"
+    return _finish(args, clip, payload, report, "transition", problem)
+
+
+def cmd_batch(args: argparse.Namespace) -> int:
+    from .batch import DEFAULT_PATTERNS, run_batch
+
+    options = dict(
+        pca=args.pca, normalize=args.normalize, temporal=args.temporal, prime=args.prime,
+        max_scale=args.max_scale, landmarks=args.landmarks, random_state=args.seed,
+        **({} if args.memory_limit is None else {"memory_limit": args.memory_limit}),
+    )
+    summary = run_batch(
+        args.folder, args.output, jobs=args.jobs, scheduler=args.scheduler,
+        pattern=args.pattern or DEFAULT_PATTERNS, force=args.force, extract_options=options,
+        write_cycles=None if args.cycles == "none" else args.cycles, fps=args.fps,
+        progress=not args.no_progress,
+    )
+    print(summary.describe())
+    return EXIT_ERROR if summary.n_error or not summary.rows else EXIT_OK
+
+
 # ------------------------------------------------------------------ parser
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
@@ -448,6 +642,10 @@ def build_parser() -> argparse.ArgumentParser:
             "  cyclecoord convert 69_01.amc -o 69_01.bvh\n"
             "  cyclecoord extract 69_01.amc --frames 200:450 --max-scale 50 -o cycle.bvh --plot figures\n"
             "  cyclecoord render 69_01.amc --frames 200:450 -o walk.gif --side-by-side cycle.bvh\n"
+            "  cyclecoord blend 69_01.amc 143_01.amc --window 200:450 --window 0:96 --max-scale 50 \\\n"
+            "      --scale auto --scale 40 --weights 0.5,0.5 -o walk_jog.bvh --report blend.json\n"
+            "  cyclecoord transition walk_cycle.bvh jog_cycle.bvh --cycles 2 -o walk_to_jog.bvh\n"
+            "  cyclecoord batch captures/ -o results/ --jobs 4\n"
             "exit codes: 0 ok, 1 error, 2 usage, 3 no periodic motion found"
         ),
     )
@@ -529,6 +727,119 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--follow", action=argparse.BooleanOptionalAction, default=None,
                    help="keep the figure centred and move the floor (default: only when it travels far)")
     r.set_defaults(func=cmd_render)
+
+    def cycle_inputs(q: argparse.ArgumentParser) -> None:
+        g = q.add_argument_group(
+            "inputs",
+            "An input is taken as one cycle when it was written by extract or blend (NPZ metadata), or when "
+            "it loops (last-to-first step <= 1.5x its median step), does not repeat within its length "
+            "(at most ~1.5 periods by autocorrelation) and moves (some pose >= 3 median steps from the mean "
+            "pose); anything else is a capture and its typical cycle is "
+            "extracted first (facing heading 0, to keep the root's Euler angles away from gimbal lock). "
+            "Options given once apply to every input; given once per input, they apply in input order "
+            "('auto' or ':' keeps an input's default).",
+        )
+        how = g.add_mutually_exclusive_group()
+        how.add_argument("--as-cycle", action="store_true", help="take every input as a cycle as it is")
+        how.add_argument("--extract", action="store_true", help="extract the typical cycle of every input")
+        g.add_argument("--window", type=_frame_range, action="append", metavar="A:B",
+                       help="0-based half-open frame window of an input (like extract's --frames)")
+        g.add_argument("--fps", type=_auto_or_positive, action="append", metavar="F",
+                       help="frame rate of an input (AMC files carry none; default 120)")
+        g.add_argument("--max-scale", type=_auto_or_positive, action="append", metavar="E",
+                       help="Rips threshold for extracting an input ('auto': extract's default)")
+        g.add_argument("--scale", type=_auto_or_positive, action="append", metavar="E",
+                       help="scale to read an input's cocycle at ('auto': extract's default)")
+        g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed for extraction (0)")
+        m = q.add_argument_group("matching and checks")
+        m.add_argument("--allow-reverse", action="store_true",
+                       help="let a cycle play backwards when that matches the first better")
+        m.add_argument("--no-heading", action="store_true",
+                       help="do not turn the cycles to the first one's heading before blending")
+        m.add_argument("--up", choices=("x", "y", "z"), default="y", help="vertical axis (default y)")
+        m.add_argument("--margin", type=float, default=5.0, metavar="DEG",
+                       help="joint-range tolerance beyond the inputs' range, degrees (5)")
+        m.add_argument("--strict", action="store_true",
+                       help="refuse to write an output that fails the plausibility checks (exit 1)")
+        o = q.add_argument_group("output")
+        o.add_argument("-o", "--output", metavar="OUT", help="write the result (.bvh, .amc, .npz or .csv)")
+        o.add_argument("--report", metavar="R.json",
+                       help="write a JSON report (inputs, alignment, figures, plausibility)")
+
+    bl = sub.add_parser(
+        "blend",
+        help="blend two or more cycles by weights into a new loopable cycle",
+        description=(
+            "Convex combination y(θ) = Σ w_i x_i(θ) of periodic cycles (paper §4.5). The first input is the "
+            "reference: the others are scaled to its skeleton, turned to its heading and aligned to its phase "
+            "(circular search over shifts); the blend lasts Σ w_i T_i and travels the weighted mean stride. "
+            "Limbs passing through each other and joint angles outside the inputs' range are reported."
+        ),
+    )
+    bl.add_argument("inputs", nargs="+", metavar="INPUT", help="two or more cycles or captures")
+    bl.add_argument("--weights", type=_weights, metavar="W1,W2,...",
+                    help="one non-negative weight per input, summing to 1 (default: equal)")
+    cycle_inputs(bl)
+    bl.set_defaults(func=cmd_blend)
+
+    tr = sub.add_parser(
+        "transition",
+        help="a clip that turns one cycle into another without a hitch",
+        description=(
+            "Cycles of A, then a ramp over which the weight of B rises smoothly from 0 to 1 while the phase "
+            "keeps advancing and the cadence slides from A's to B's (the paper's homotopy), then cycles of B. "
+            "The continuity check compares every step with the typical step of A and B at the same phase."
+        ),
+    )
+    tr.add_argument("inputs", nargs=2, metavar="INPUT", help="cycle (or capture) A, then B")
+    length = tr.add_mutually_exclusive_group(required=True)
+    length.add_argument("--frames", type=_positive_int, metavar="N", help="length of the ramp in frames")
+    length.add_argument("--cycles", type=_positive_float, metavar="C", help="length of the ramp in cycles")
+    tr.add_argument("--lead-in", type=int, default=1, metavar="K", help="whole cycles of A before the ramp (1)")
+    tr.add_argument("--lead-out", type=int, default=1, metavar="K", help="whole cycles of B after the ramp (1)")
+    cycle_inputs(tr)
+    tr.set_defaults(func=cmd_transition)
+
+    ba = sub.add_parser(
+        "batch",
+        help="run extract on every capture in a folder, locally or on a Dask cluster",
+        description=(
+            "Run extract on every capture under DIR (recursively; .amc, .bvh, .npz, .csv by default). "
+            "OUTDIR mirrors DIR's tree: NAME.report.json and NAME.cycle.bvh per capture, and summary.csv "
+            "with one row per capture (status ok / no_periodic / error and the key figures). A failing "
+            "capture is recorded and the batch goes on. A re-run skips captures whose report matches the "
+            "input's size, modification time and the options (errors are retried); --force recomputes. "
+            "OUTDIR must lie outside DIR. Exit code 1 when any capture failed or none was found."
+        ),
+    )
+    ba.add_argument("folder", metavar="DIR", help="folder of captures")
+    ba.add_argument("-o", "--output", required=True, metavar="OUTDIR", help="output folder (created if missing)")
+    w = ba.add_argument_group("where it runs")
+    w.add_argument("-j", "--jobs", type=int, default=1, metavar="N",
+                   help="worker processes (default 1: in this process; 0: one per CPU core)")
+    w.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on a Dask distributed cluster, e.g. tcp://host:8786 (needs cyclecoord[dask]; "
+                   "the workers must see DIR and OUTDIR at the same paths)")
+    w.add_argument("--force", action="store_true", help="recompute captures whose report is up to date")
+    w.add_argument("--pattern", action="append", metavar="GLOB",
+                   help="file-name glob, case-insensitive; repeat for several (default: *.amc *.bvh *.npz *.csv)")
+    w.add_argument("--cycles", choices=("bvh", "npz", "none"), default="bvh",
+                   help="format of the cycle written per capture (default bvh; none: reports only)")
+    w.add_argument("--no-progress", action="store_true", help="no progress bar")
+    g = ba.add_argument_group("what to analyse and how (the same for every capture)")
+    g.add_argument("--fps", type=_positive_float, metavar="F", help="frame rate (AMC files carry none; default 120)")
+    g.add_argument("--pca", type=_positive_int, metavar="K", help="project poses onto K principal components first")
+    g.add_argument("--normalize", action="store_true", help="scale each channel by its standard deviation")
+    g.add_argument("--temporal", action="store_true", help="time-aware metric: consecutive frames at distance 0")
+    g.add_argument("--prime", type=int, default=47, metavar="P", help="coefficient field Z/P, a prime > 11 (default 47)")
+    g.add_argument("--max-scale", type=_positive_float, metavar="E",
+                   help="Rips threshold in the analysed space's units (default: half the point cloud's diameter)")
+    g.add_argument("--landmarks", type=_landmarks, default="auto", metavar="N|auto|none",
+                   help="filtration on N greedy landmarks (auto: every frame up to 1000 frames, 500 beyond)")
+    g.add_argument("--memory-limit", type=_bytes, default=None, metavar="SIZE",
+                   help="memory budget per capture for the filtration, e.g. 2G; above it landmarks are used")
+    g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (0)")
+    ba.set_defaults(func=cmd_batch)
     return p
 
 
