@@ -315,6 +315,8 @@ class CircularCoordinates:
         every point.
     memory_limit : float, default 2 GiB
         Budget for one filtration; above it landmarks are used (fewer if needed).
+    refine_birth : bool, default True
+        With landmarks, also compute the class's birth on every point when cheap.
 
     Attributes
     ----------
@@ -355,6 +357,7 @@ class CircularCoordinates:
         temporal: bool = False,
         landmarks: int | str | None = "auto",
         memory_limit: float = DEFAULT_MEMORY_LIMIT,
+        refine_birth: bool = True,
     ) -> None:
         self.max_scale = max_scale
         self.scale = scale
@@ -364,6 +367,7 @@ class CircularCoordinates:
         self.temporal = temporal
         self.landmarks = landmarks
         self.memory_limit = memory_limit
+        self.refine_birth = refine_birth
 
     # ------------------------------------------------------------------
     def _validate(self, X) -> np.ndarray:
@@ -536,7 +540,7 @@ class CircularCoordinates:
                 self.points_, centers, center_theta, edges, harmonic, selection.scale / 2.0
             )
         theta, sign, offset = orient_with_time(raw, return_transform=True)
-        if self.landmarks_ is not None and not self.temporal:
+        if self.landmarks_ is not None and not self.temporal and self.refine_birth:
             sel = BarSelection(**{**sel.__dict__, "full_birth": refine_birth(self.points_, sel.birth, p)})
         self.barcode_ = bc
         self.selection_ = sel

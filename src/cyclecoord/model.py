@@ -110,6 +110,8 @@ class PhaseModel:
             "difference_root": bool(p.difference_root),
             "normalize": bool(p.normalize),
             "pca": p.pca,
+            "root": getattr(p, "root_mode_", "euler"),
+            "delay": p.delay,
             "n_channels": int(p.n_channels_),
         }
         arrays["header"] = np.array(json.dumps(header))
@@ -135,11 +137,13 @@ class PhaseModel:
         if header.get("version") != _VERSION:
             raise ParseError(f"model file version {header.get('version')} is not supported", path)
         pre = Preprocessor(
-            difference_root=header["difference_root"], normalize=header["normalize"], pca=header["pca"]
+            difference_root=header["difference_root"], normalize=header["normalize"], pca=header["pca"],
+            delay=header.get("delay"), root=header.get("root", "euler"),
         )
         try:
             pre.root_columns_ = arrays["pre_root_columns"].astype(int)
             pre._rot_mask_ = arrays["pre_rot_mask"].astype(bool)
+            pre.root_mode_ = header.get("root", "euler")
             pre.mean_ = arrays["pre_mean"]
             pre.scale_ = arrays["pre_scale"]
             comp = arrays["pre_components"]

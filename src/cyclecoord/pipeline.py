@@ -16,7 +16,7 @@ import numpy as np
 
 from .barcode import DEFAULT_PRIME, CLEAR_GAP, CLEAR_RATIO, Barcode, BarSelection
 from .coordinates import CircularCoordinates, unwrap
-from .cycle import TypicalCycle, integrate_root, typical_cycle
+from .cycle import TypicalCycle, typical_cycle
 from .density import PeriodicDensity
 from .errors import NoPeriodicMotionError, ParameterError
 from .metrics import distance_to_cycle, jerk_summary, loop_closure
@@ -184,15 +184,6 @@ def _landmark_report(est: CircularCoordinates | None) -> dict | None:
     }
 
 
-def _root_displacement(motion: Motion, root_cols: np.ndarray, cycles: float) -> np.ndarray:
-    """Mean root change per cycle (rotations summed as wrapped differences)."""
-    f = motion.frames[:, root_cols]
-    d = np.diff(f, axis=0)
-    rot = np.array([motion.channels[c][1].startswith("r") for c in root_cols], dtype=bool)
-    d[:, rot] = (d[:, rot] + 180.0) % 360.0 - 180.0
-    return d.sum(axis=0) / cycles
-
-
 def extract(
     motion: Motion,
     frames: tuple[int | None, int | None] | None = None,
@@ -201,6 +192,7 @@ def extract(
     normalize: bool = False,
     temporal: bool = False,
     difference_root: bool = True,
+    root: str = "body",
     prime: int = DEFAULT_PRIME,
     max_scale: float | None = None,
     scale: float | None = None,
@@ -232,7 +224,10 @@ def extract(
     temporal : bool
         Use the time-aware metric (consecutive frames at distance 0).
     difference_root : bool, default True
-        Replace root translation/orientation by first differences.
+        Replace root translation/orientation by per-frame changes.
+    root : {"body", "euler"}, default "body"
+        Root changes as rotation vectors and steps in the root's own frame (gimbal-free,
+        heading-invariant; needs the skeleton) or as Euler-channel differences (paper).
     prime : int, default 47
         Coefficient field Z/p, a prime greater than 11.
     max_scale : float, optional
@@ -296,7 +291,7 @@ def extract(
     notes: list[str] = []
     params = dict(
         frames=None if frames is None else list(frames), pca=pca, normalize=normalize, temporal=temporal,
-        difference_root=difference_root, prime=prime, max_scale=max_scale, scale=scale,
+        difference_root=difference_root, root=root, prime=prime, max_scale=max_scale, scale=scale,
         class_index=class_index, scale_fraction=scale_fraction, n_samples=n_samples,
         n_neighbors=n_neighbors, weighting=weighting, sampling=sampling, n_components=n_components,
         cycle_start=cycle_start, landmarks=landmarks, memory_limit=memory_limit, random_state=random_state,
@@ -315,7 +310,7 @@ def extract(
         )
 
     t0 = time.perf_counter()
-    prep = Preprocessor(difference_root=difference_root, normalize=normalize, pca=pca)
+    prep = Preprocessor(difference_root=difference_root, normalize=normalize, pca=pca, root=root)
     prepared = prep.fit_transform(motion)
     timings["prepare"] = time.perf_counter() - t0
 
@@ -411,8 +406,9 @@ def extract(
     cyc = np.array(typ.frames, dtype=float)
     root = prepared.root_columns
     if root.size:
-        disp = _root_displacement(motion, root, cycles)
-        cyc[:, root] = integrate_root(typ.frames[:, root], motion.frames[0, root], disp)
+        # loop the cycle so it travels and turns, per frame, as the capture did on average
+        mean_delta = prepared.poses[:-1, root].mean(axis=0)
+        cyc[:, root] = prep.integrate_root(typ.frames[:, root], motion.frames[0, root], mean_delta, motion)
     cycle_motion = motion.with_frames(
         cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}",
         metadata={"period_frames": period, "cycles_in_source": cycles},

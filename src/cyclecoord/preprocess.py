@@ -2,9 +2,18 @@
 
 A walk's root translation grows without bound and its heading may turn, which turns the
 closed loop of a periodic motion into a spiral.  Following the paper (§4.1) the root's
-translation and orientation channels are replaced by their first differences (per-frame
-velocities), which are periodic again.  Optional per-channel scaling by standard deviation
-(§6.4) and a PCA projection (§5.1) follow.
+translation and orientation are replaced by per-frame changes, which are periodic again.
+
+Two forms of the change are offered.  ``root="body"`` (default when the skeleton is
+known): the rotation from one frame's root orientation to the next as a rotation vector
+(degrees), and the translation step expressed in the root's own frame.  Both are free of
+gimbal lock and do not depend on which way the actor faces.  ``root="euler"``: plain
+differences of the Euler channels (wrapped to ±180°), as in the paper; used when there
+is no skeleton.  Euler differences break down where the root's middle angle nears ±90°
+(CMU 143_01 faces that way: two channels jump by up to 86° between frames).
+
+Optional per-channel scaling by standard deviation (§6.4), a PCA projection (§5.1) and a
+delay embedding follow.  :meth:`Preprocessor.integrate_root` inverts the differencing.
 """
 
 from __future__ import annotations
@@ -12,6 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from .errors import ParameterError
 from .motion import Motion
@@ -71,18 +81,80 @@ def difference_root(frames: np.ndarray, root_columns: np.ndarray, rotation_mask:
     return out
 
 
+_AX = {"x": 0, "y": 1, "z": 2}
+
+
+def _root_layout(motion: Motion, cols: np.ndarray):
+    """For body-frame differencing: the root joint and, per root column, its role.
+
+    Returns ``None`` unless the root has exactly the three translation and three
+    rotation dofs and a skeleton describes its rotation convention.
+    """
+    sk = motion.skeleton
+    if sk is None or cols.size != 6:
+        return None
+    root = sk.joints[0]
+    dofs = [motion.channels[c][1] for c in cols]
+    if sorted(dofs) != sorted(["tx", "ty", "tz", "rx", "ry", "rz"]) or len(root.rotation_order) != 3:
+        return None
+    return root, dofs
+
+
+def _root_rotations(frames: np.ndarray, cols: np.ndarray, root, dofs) -> np.ndarray:
+    vals = np.column_stack([frames[:, cols[dofs.index("r" + a.lower())]] for a in root.rotation_order])
+    local = Rotation.from_euler(root.rotation_order, vals, degrees=True).as_matrix()
+    return root.axis @ local @ root.axis.T
+
+
+def body_frame_differences(frames: np.ndarray, cols: np.ndarray, root, dofs) -> np.ndarray:
+    """Root changes per frame in the root's own frame, one row per frame.
+
+    Columns follow ``cols``: the translation dofs get ``R_tᵀ (p_{t+1} - p_t)`` and the
+    rotation dofs the rotation vector (degrees) of ``R_tᵀ R_{t+1}``; the last row repeats
+    the previous one.
+    """
+    R = _root_rotations(frames, cols, root, dofs)
+    p = np.column_stack([frames[:, cols[dofs.index(t)]] for t in ("tx", "ty", "tz")])
+    dp = np.einsum("tji,tj->ti", R[:-1], np.diff(p, axis=0))
+    rel = np.einsum("tji,tjk->tik", R[:-1], R[1:])
+    w = Rotation.from_matrix(rel).as_rotvec(degrees=True)
+    out = np.empty((len(frames), 6))
+    for k, d in enumerate(dofs):
+        src = dp if d.startswith("t") else w
+        out[:-1, k] = src[:, _AX[d[1]]]
+    out[-1] = out[-2]
+    return out
+
+
+def _start_frame(start: np.ndarray, cols: np.ndarray, motion: Motion) -> np.ndarray:
+    """A one-frame array holding ``start`` in the root columns (for the rotation helper)."""
+    f = np.zeros((1, motion.n_channels))
+    f[0, cols] = start
+    return f
+
+
 class Preprocessor:
     """Turn a :class:`~cyclecoord.motion.Motion` into the point cloud that is analysed.
 
     Parameters
     ----------
     difference_root : bool, default True
-        Replace the root's translation and rotation channels by first differences.
+        Replace the root's translation and rotation channels by per-frame changes.
+    root : {"body", "euler"}, default "body"
+        How the root changes are expressed (see the module notes): rotation vectors and
+        translation steps in the root's frame (needs a skeleton; otherwise falls back to
+        Euler), or plain Euler-channel differences as in the paper.
     normalize : bool, default False
         Divide every channel (after differencing) by its standard deviation, so each
         channel weighs the same in the distance (constant channels are left unscaled).
     pca : int or None, default None
         Project onto the first ``pca`` principal components.
+    delay : int or None, default None
+        Delay embedding: each point becomes ``[p(t), p(t - delay)]`` (frames before the
+        first repeat it).  A motion that goes out and back along the same path (a squat,
+        a jumping jack) is a segment in pose space, not a loop; paired with its past it
+        becomes a loop (Takens; paper §4.2).  The typical cycle is still averaged from
+        the poses themselves.
 
     Attributes
     ----------
@@ -97,10 +169,19 @@ class Preprocessor:
     explained_variance_ratio_ : ndarray, shape (K,) or None
     """
 
-    def __init__(self, difference_root: bool = True, normalize: bool = False, pca: int | None = None) -> None:
+    def __init__(
+        self,
+        difference_root: bool = True,
+        normalize: bool = False,
+        pca: int | None = None,
+        delay: int | None = None,
+        root: str = "body",
+    ) -> None:
+        self.root = root
         self.difference_root = difference_root
         self.normalize = normalize
         self.pca = pca
+        self.delay = delay
 
     # ------------------------------------------------------------------
     def _poses(self, motion: Motion) -> np.ndarray:
@@ -112,6 +193,16 @@ class Preprocessor:
             )
         if not self.difference_root:
             return np.array(frames, dtype=float)
+        if self.root_mode_ == "body":
+            layout = _root_layout(motion, self.root_columns_)
+            if layout is None:
+                raise ParameterError(
+                    "body-frame root differencing needs the capture's skeleton with a 6-dof root; "
+                    "use root='euler'"
+                )
+            out = np.array(frames, dtype=float)
+            out[:, self.root_columns_] = body_frame_differences(frames, self.root_columns_, *layout)
+            return out
         return difference_root(frames, self.root_columns_, self._rot_mask_)
 
     def fit(self, motion: Motion) -> "Preprocessor":
@@ -123,6 +214,9 @@ class Preprocessor:
         cols = np.asarray(motion.root_channels() if self.difference_root else [], dtype=int)
         self.root_columns_ = cols
         self._rot_mask_ = np.array([motion.channels[c][1].startswith("r") for c in cols], dtype=bool)
+        if self.root not in ("body", "euler"):
+            raise ParameterError(f"root must be 'body' or 'euler', got {self.root!r}")
+        self.root_mode_ = "body" if (self.root == "body" and _root_layout(motion, cols) is not None) else "euler"
         poses = self._poses(motion)
         self.mean_ = poses.mean(axis=0)
         if self.normalize:
@@ -144,6 +238,8 @@ class Preprocessor:
             self.components_ = vt[:k]
             var = s**2
             self.explained_variance_ratio_ = var[:k] / var.sum() if var.sum() > 0 else np.zeros(k)
+        if self.delay is not None and (int(self.delay) != self.delay or self.delay < 0):
+            raise ParameterError(f"delay must be a whole number of frames >= 0, got {self.delay}")
         self.n_channels_ = motion.n_channels
         return self
 
@@ -162,7 +258,70 @@ class Preprocessor:
             points = poses / self.scale_
         else:
             points = poses
+        if self.delay:
+            k = int(self.delay)
+            past = np.concatenate([np.repeat(points[:1], min(k, len(points)), axis=0), points[:-k]])[: len(points)]
+            points = np.hstack([points, past])
         return PreparedData(points=np.ascontiguousarray(points), poses=poses, root_columns=self.root_columns_)
 
     def fit_transform(self, motion: Motion) -> PreparedData:
         return self.fit(motion).transform(motion)
+
+    def integrate_root(
+        self, deltas: np.ndarray, start: np.ndarray, mean_delta: np.ndarray | None, motion: Motion
+    ) -> np.ndarray:
+        """Turn per-frame root changes of a loop back into root channel values.
+
+        Parameters
+        ----------
+        deltas : ndarray, shape (P, R)
+            Root changes in this preprocessor's form (columns as ``root_columns_``).
+        start : ndarray, shape (R,)
+            Root channel values of the first frame.
+        mean_delta : ndarray, shape (R,), optional
+            The mean change per frame the loop should have (the source capture's), so
+            that looping the result travels and turns like the original; the deltas are
+            shifted by a constant to reach it.
+        motion : Motion
+            Gives the root's rotation convention (skeleton).
+
+        Returns
+        -------
+        ndarray, shape (P, R)
+            Absolute root values; rotation channels continuous in time (no ±180 jumps).
+        """
+        d = np.array(deltas, dtype=float)
+        if mean_delta is not None:
+            d += np.asarray(mean_delta, dtype=float) - d.mean(axis=0)
+        cols = self.root_columns_
+        if self.root_mode_ != "body":
+            out = np.empty_like(d)
+            out[0] = start
+            out[1:] = start + np.cumsum(d[:-1], axis=0)
+            return out
+        root, dofs = _root_layout(motion, cols)
+        R0 = _root_rotations(_start_frame(start, cols, motion), cols, root, dofs)[0]
+        t_idx = [dofs.index(t) for t in ("tx", "ty", "tz")]
+        r_idx = [dofs.index("r" + a) for a in "xyz"]
+        steps = Rotation.from_rotvec(d[:, r_idx], degrees=True).as_matrix()
+        P = len(d)
+        R = np.empty((P, 3, 3))
+        pos = np.empty((P, 3))
+        R[0] = R0
+        pos[0] = np.asarray(start, dtype=float)[t_idx]
+        for k in range(1, P):
+            R[k] = R[k - 1] @ steps[k - 1]
+            pos[k] = pos[k - 1] + R[k - 1] @ d[k - 1, t_idx]
+        local = np.einsum("ji,tjk,kl->til", root.axis, R, root.axis)
+        ang = Rotation.from_matrix(local).as_euler(root.rotation_order, degrees=True)
+        ang = np.degrees(np.unwrap(np.radians(ang), axis=0))
+        out = np.empty((P, len(cols)))
+        for k, a in enumerate(root.rotation_order.lower()):
+            out[:, dofs.index("r" + a)] = ang[:, k]
+        for k, t in enumerate(("tx", "ty", "tz")):
+            out[:, dofs.index(t)] = pos[:, k]
+        # keep the first frame's Euler angles exactly as given (same rotation, same numbers)
+        first = np.asarray(start, dtype=float)
+        shift = np.round((first[r_idx] - out[0, r_idx]) / 360.0) * 360.0
+        out[:, r_idx] += shift
+        return out
