@@ -1,0 +1,79 @@
+"""The motion object and forward kinematics."""
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import cyclecoord as cc
+from cyclecoord.skeleton import Joint, Skeleton, _rotation_matrices, forward_kinematics
+
+
+def two_joint():
+    return Skeleton((
+        Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
+        Joint("arm", 0, [0, 1, 0], ("rx", "rz"), "ZX", end_site=[1, 0, 0]),
+    ))
+
+
+@pytest.mark.parametrize("order", ["ZXY", "ZYX", "XYZ", "YXZ", "X", "ZY"])
+def test_rotation_matrices_match_scipy_intrinsic(order):
+    v = np.random.default_rng(1).uniform(-180, 180, (200, len(order)))
+    np.testing.assert_allclose(
+        _rotation_matrices(v, order), Rotation.from_euler(order, v, degrees=True).as_matrix(), atol=1e-12
+    )
+
+
+def test_forward_kinematics_by_hand():
+    sk = two_joint()
+    m = cc.Motion(np.array([[1, 2, 3, 0, 0, 90, 0, 0], [0, 0, 0, 0, 0, 0, 90, 0]]), sk.channels, skeleton=sk)
+    p = forward_kinematics(m)
+    assert p.names == ["root", "arm", "arm/end"]
+    np.testing.assert_allclose(p.positions[0], [[1, 2, 3], [0, 2, 3], [0, 3, 3]], atol=1e-12)
+    np.testing.assert_allclose(p.positions[1], [[0, 0, 0], [0, 1, 0], [1, 1, 0]], atol=1e-12)
+    np.testing.assert_allclose(p["arm/end"], p.positions[:, 2])
+
+
+def test_slicing_keeps_everything_else():
+    cap = cc.datasets.example_capture()
+    m = cap.motion
+    part = m[200:450]
+    assert part.n_frames == 250 and part.start_frame == 200
+    assert part.channels == m.channels and part.skeleton is m.skeleton and part.fps == m.fps
+    np.testing.assert_array_equal(part.frames, m.frames[200:450])
+    assert m[::2].fps == m.fps / 2
+    assert m[5].n_frames == 1 and m[-1].start_frame == m.n_frames - 1
+    with pytest.raises(IndexError):
+        m[10_000]
+
+
+def test_select_and_concatenate():
+    m = cc.datasets.example_capture().motion
+    arm = m.select(["rhumerus", "root.tz"])
+    assert arm.channels == (("rhumerus", "rx"), ("rhumerus", "ry"), ("rhumerus", "rz"), ("root", "tz"))
+    both = cc.Motion.concatenate([m[:100], m[100:]])
+    np.testing.assert_array_equal(both.frames, m.frames)
+    with pytest.raises(cc.ParameterError, match="channels"):
+        cc.Motion.concatenate([m, arm])
+    with pytest.raises(KeyError):
+        m.select(["nosuchjoint"])
+
+
+def test_inputs_are_not_frozen_or_modified():
+    f = np.zeros((5, 8))
+    m = cc.Motion(f, two_joint().channels)
+    assert f.flags.writeable
+    f[0, 0] = 7.0
+    assert m.frames[0, 0] == 0.0  # the motion owns a copy
+    with pytest.raises(ValueError):
+        m.frames[0, 0] = 1.0  # and it is read-only
+
+
+def test_bad_motions():
+    with pytest.raises(cc.ParameterError, match="channel names"):
+        cc.Motion(np.zeros((3, 4)), [("a", "rx")])
+    with pytest.raises(cc.ParameterError, match="duplicate"):
+        cc.Motion(np.zeros((3, 2)), [("a", "rx"), ("a", "rx")])
+    with pytest.raises(cc.ParameterError, match="fps"):
+        cc.Motion(np.zeros((3, 1)), [("a", "rx")], fps=0)
+    with pytest.raises(cc.ParameterError, match="skeleton"):
+        cc.Motion(np.zeros((3, 1)), [("a", "rx")]).positions()
