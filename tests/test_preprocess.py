@@ -61,3 +61,29 @@ def test_bad_settings():
     f[3, 7] = np.nan
     with pytest.raises(ParameterError, match="frame 3"):
         Preprocessor().fit(make(f))
+
+
+def test_delay_embedding_turns_an_out_and_back_motion_into_a_loop():
+    t = np.arange(400)
+    f = np.zeros((400, 8))
+    f[:, 6] = 30 * np.sin(2 * np.pi * t / 100)  # a joint swinging out and back: a segment
+    f[:, 7] = 0.5 * f[:, 6]
+    plain = Preprocessor().fit_transform(make(f)).points
+    emb = Preprocessor(delay=25).fit_transform(make(f)).points
+    assert emb.shape == (400, 16)
+    np.testing.assert_array_equal(emb[25:, 8:], plain[:-25])
+    np.testing.assert_array_equal(emb[:25, 8:], np.repeat(plain[:1], 25, axis=0))
+    from cyclecoord.barcode import select_bar
+    from cyclecoord.coordinates import CircularCoordinates, unwrap
+
+    # the segment has no loop; with its past (a quarter period back) it is an ellipse
+    flat = CircularCoordinates().fit_barcode(plain)
+    assert flat.h1.size == 0 or not select_bar(flat, 0).clear
+    est = CircularCoordinates().fit(emb)
+    u = unwrap(est.coordinates_)
+    # frames before the first delay have no real past: count from there
+    assert est.selection_.clear and u[-1] - u[25] == pytest.approx(374 / 100, abs=0.05)
+    two = Preprocessor(delay=[10, 25]).fit_transform(make(f)).points
+    assert two.shape == (400, 24)
+    with pytest.raises(ParameterError):
+        Preprocessor(delay=2.5).fit(make(f))

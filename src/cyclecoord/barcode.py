@@ -33,8 +33,11 @@ DEFAULT_PRIME = 47
 
 #: A bar is "clear" when death/birth (death capped at the threshold) reaches this ...
 CLEAR_RATIO = 1.5
-#: ... and its persistence is at least this many times the next-longest H1 bar's.
+#: ... and its persistence is at least this many times the next-longest H1 bar's ...
 CLEAR_GAP = 2.0
+#: ... and at least this fraction of the threshold (bars between repeated frames are born
+#: at 0, so their death/birth is infinite however short they are).
+CLEAR_MIN_FRACTION = 0.05
 
 
 def check_prime(p: int) -> int:
@@ -321,7 +324,9 @@ def select_bar(
     * ``min(death, threshold) / birth >= 1.5`` — the class lives well beyond the scale
       at which it appears (bars of sampling noise in Rips filtrations stay closer to 1);
     * its persistence is at least twice that of the next-longest H1 bar (for
-      ``class_index > 0``, of the next-longest bar after it).
+      ``class_index > 0``, of the next-longest bar after it);
+    * its persistence is at least 5% of the threshold (repeated frames make bars born at
+      0 whose ratio is infinite however short they are).
     """
     n = len(barcode.h1)
     if n == 0:
@@ -350,7 +355,9 @@ def select_bar(
         birth=birth,
         death=death,
         scale=float(s),
-        clear=bool(ratio >= CLEAR_RATIO and gap >= CLEAR_GAP),
+        clear=bool(
+            ratio >= CLEAR_RATIO and gap >= CLEAR_GAP and pers[class_index] >= CLEAR_MIN_FRACTION * barcode.threshold
+        ),
         ratio=ratio,
         gap=gap,
     )

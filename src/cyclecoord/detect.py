@@ -274,7 +274,7 @@ def detect(
     difference_root: bool = True,
     prime: int = DEFAULT_PRIME,
     max_scale: float | None = None,
-    delay: float | None = 0.25,
+    delay: float | tuple | None = 0.25,
     landmarks: int | str | None = "auto",
     memory_limit: float | None = None,
     n_classes: int | None = None,
@@ -296,10 +296,13 @@ def detect(
         0-based half-open frame range to analyse.
     pca, normalize, temporal, difference_root, prime, max_scale, landmarks, memory_limit
         As for :func:`cyclecoord.extract`.
-    delay : float or None, default 0.25
-        Delay embedding in seconds (each pose paired with the pose this long before), so
-        that out-and-back movements (squats, jumping jacks, knee raises) form loops;
-        ``None`` or 0 analyses the poses alone, as the paper did.
+    delay : float, sequence of float, or None, default 0.25
+        Delay embedding in seconds (each pose joined by the poses this long before), so
+        that out-and-back movements (squats, jumping jacks, knee raises) form loops.
+        ``None`` or 0 analyses the poses alone, as the paper did.  A delay of half a
+        motion's period folds that motion's loop flat; several delays can be given.
+        Measured: 0.25 s keeps synthetic boundaries within 30 frames; 0.5 s finds more of
+        CMU 13_29's slow exercises (42% against 28% of frames) but blurs boundaries.
     n_classes : int, optional
         Use exactly the ``n_classes`` most persistent H1 classes (still validated by
         excitation for the segments).
@@ -362,7 +365,8 @@ def detect(
     notes: list[str] = []
 
     t0 = time.perf_counter()
-    lag = int(round(delay * motion.fps)) if delay else None
+    lag = [int(round(d * motion.fps)) for d in np.atleast_1d(delay) if d] if delay is not None else None
+    lag = lag or None
     prepared = Preprocessor(difference_root=difference_root, normalize=normalize, pca=pca, delay=lag).fit_transform(motion)
     timings["prepare"] = time.perf_counter() - t0
 

@@ -111,7 +111,7 @@ class PhaseModel:
             "normalize": bool(p.normalize),
             "pca": p.pca,
             "root": getattr(p, "root_mode_", "euler"),
-            "delay": p.delay,
+            "delay": None if p.delay is None else np.atleast_1d(p.delay).astype(int).tolist(),
             "n_channels": int(p.n_channels_),
         }
         arrays["header"] = np.array(json.dumps(header))

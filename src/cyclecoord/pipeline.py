@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from .barcode import DEFAULT_PRIME, CLEAR_GAP, CLEAR_RATIO, Barcode, BarSelection
+from .barcode import CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, DEFAULT_PRIME, Barcode, BarSelection
 from .coordinates import CircularCoordinates, unwrap
 from .cycle import TypicalCycle, typical_cycle
 from .density import PeriodicDensity
@@ -150,7 +150,7 @@ class ExtractionResult:
             "prime": int(self.barcode.prime),
             "barcode": self.barcode.to_dict(),
             "selected": self.selection.to_dict(),
-            "clear_criterion": {"min_ratio": CLEAR_RATIO, "min_gap": CLEAR_GAP},
+            "clear_criterion": {"min_ratio": CLEAR_RATIO, "min_gap": CLEAR_GAP, "min_fraction_of_threshold": CLEAR_MIN_FRACTION},
             "coordinate": [float(v) for v in self.coordinate],
             "cycles": float(self.cycles),
             "period_frames": float(self.period_frames),
@@ -347,6 +347,8 @@ def extract(
             why.append(f"death/birth {pre_sel.ratio:.2f} < {CLEAR_RATIO}")
         if pre_sel.gap < CLEAR_GAP:
             why.append(f"persistence only {pre_sel.gap:.2f}x the next bar's (< {CLEAR_GAP}x)")
+        if not why:
+            why.append(f"persistence under {CLEAR_MIN_FRACTION:.0%} of the threshold {barcode.threshold:.4g}")
         ds = "inf" if not np.isfinite(pre_sel.death) else f"{pre_sel.death:.4g}"
         raise fail(
             f"no periodic motion found: H1 bar #{class_index} [{pre_sel.birth:.4g}, {ds}) does not stand "

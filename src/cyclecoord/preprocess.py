@@ -126,6 +126,18 @@ def body_frame_differences(frames: np.ndarray, cols: np.ndarray, root, dofs) -> 
     return out
 
 
+def _delays(delay) -> list[int]:
+    """Delays in frames from an int or a sequence of ints (validated)."""
+    values = list(delay) if np.ndim(delay) else [delay]
+    out = []
+    for v in values:
+        if int(v) != v or v < 0:
+            raise ParameterError(f"delays must be whole numbers of frames >= 0, got {delay}")
+        if int(v) > 0:
+            out.append(int(v))
+    return out
+
+
 def _start_frame(start: np.ndarray, cols: np.ndarray, motion: Motion) -> np.ndarray:
     """A one-frame array holding ``start`` in the root columns (for the rotation helper)."""
     f = np.zeros((1, motion.n_channels))
@@ -149,9 +161,9 @@ class Preprocessor:
         channel weighs the same in the distance (constant channels are left unscaled).
     pca : int or None, default None
         Project onto the first ``pca`` principal components.
-    delay : int or None, default None
-        Delay embedding: each point becomes ``[p(t), p(t - delay)]`` (frames before the
-        first repeat it).  A motion that goes out and back along the same path (a squat,
+    delay : int, sequence of int, or None, default None
+        Delay embedding: each point becomes ``[p(t), p(t - d1), p(t - d2), ...]`` for the
+        given delays in frames (frames before the first repeat it).  A motion that goes out and back along the same path (a squat,
         a jumping jack) is a segment in pose space, not a loop; paired with its past it
         becomes a loop (Takens; paper §4.2).  The typical cycle is still averaged from
         the poses themselves.
@@ -238,8 +250,8 @@ class Preprocessor:
             self.components_ = vt[:k]
             var = s**2
             self.explained_variance_ratio_ = var[:k] / var.sum() if var.sum() > 0 else np.zeros(k)
-        if self.delay is not None and (int(self.delay) != self.delay or self.delay < 0):
-            raise ParameterError(f"delay must be a whole number of frames >= 0, got {self.delay}")
+        if self.delay is not None:
+            _delays(self.delay)  # validates
         self.n_channels_ = motion.n_channels
         return self
 
@@ -259,9 +271,11 @@ class Preprocessor:
         else:
             points = poses
         if self.delay:
-            k = int(self.delay)
-            past = np.concatenate([np.repeat(points[:1], min(k, len(points)), axis=0), points[:-k]])[: len(points)]
-            points = np.hstack([points, past])
+            parts = [points]
+            for k in _delays(self.delay):
+                k = min(k, len(points))
+                parts.append(np.concatenate([np.repeat(points[:1], k, axis=0), points[: len(points) - k]]))
+            points = np.hstack(parts)
         return PreparedData(points=np.ascontiguousarray(points), poses=poses, root_columns=self.root_columns_)
 
     def fit_transform(self, motion: Motion) -> PreparedData:
