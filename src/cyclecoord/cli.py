@@ -320,14 +320,7 @@ def _apply_model(args: argparse.Namespace, motion) -> int:
     from .model import PhaseModel
 
     model = PhaseModel.load(args.apply)
-    if args.frames is not None:
-        a, b = args.frames
-        n = motion.n_frames
-        a = 0 if a is None else a
-        b = n if b is None else b
-        if not 0 <= a < b <= n:
-            raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames")
-        motion = motion[a:b]
+    motion = motion.window(args.frames)
     info = model.summary(motion)
     print(
         f"{motion.source or args.input}: {motion.n_frames} frames phased with {args.apply}: "
@@ -452,14 +445,7 @@ def cmd_render(args: argparse.Namespace) -> int:
     if not folder.is_dir():
         raise ParameterError(f"{args.output}: folder {folder} does not exist")
     motion = load_input(args.input, args.skeleton, args.fps)
-    if args.frames is not None:
-        a, b = args.frames
-        n = motion.n_frames
-        a = 0 if a is None else a
-        b = n if b is None else b
-        if not 0 <= a < b <= n:
-            raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames (0-based, half-open)")
-        motion = motion[a:b]
+    motion = motion.window(args.frames)
     other = load_input(args.side_by_side, None, None) if args.side_by_side else None
     path = render(motion, out, other=other, view=args.view, step=args.step, follow=args.follow)
     what = f"{motion.n_frames} frames" + (f" beside {other.n_frames} frames of {args.side_by_side}" if other else "")
@@ -471,14 +457,7 @@ def cmd_barcode(args: argparse.Namespace) -> int:
     from .preprocess import Preprocessor
 
     motion = load_input(args.input, args.skeleton, args.fps)
-    if args.frames is not None:
-        a, b = args.frames
-        n = motion.n_frames
-        a = 0 if a is None else a
-        b = n if b is None else b
-        if not 0 <= a < b <= n:
-            raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames")
-        motion = motion[a:b]
+    motion = motion.window(args.frames)
     prep = Preprocessor(difference_root=not args.no_root_diff, normalize=args.normalize, pca=args.pca)
     pts = prep.fit_transform(motion).points
     from .coordinates import CircularCoordinates
@@ -504,9 +483,7 @@ def cmd_convert(args: argparse.Namespace) -> int:
     if Path(args.output).resolve() == Path(args.input).resolve():
         raise ParameterError(f"{args.output}: refusing to overwrite the input file")
     motion = load_input(args.input, args.skeleton, args.fps)
-    if args.frames is not None:
-        a, b = args.frames
-        motion = motion[slice(a, b)]
+    motion = motion.window(args.frames)
     if Path(args.output).resolve() == Path(args.input).resolve():
         raise ParameterError(f"{args.output}: refusing to overwrite the input file")
     save(motion, args.output)

@@ -350,14 +350,7 @@ def detect(
         scale_fraction=scale_fraction, window=window, max_period=max_period,
         min_consistency=min_consistency, min_cycles=min_cycles, merge_overlap=merge_overlap,
     )
-    if frames is not None:
-        a, b = frames
-        n = motion.n_frames
-        a = 0 if a is None else int(a)
-        b = n if b is None else int(b)
-        if not (0 <= a < b <= n):
-            raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames (0-based, half-open)")
-        motion = motion[a:b]
+    motion = motion.window(frames)
     T = motion.n_frames
     if T < 20:
         raise ParameterError(f"{T} frames are too few to look for periodic motion")

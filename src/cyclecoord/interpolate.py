@@ -1196,16 +1196,10 @@ def as_cycle(
     if not isinstance(motion, Motion):
         raise ParameterError(f"expected a Motion, got {type(motion).__name__}")
     if frames is not None:
-        a, b = frames
-        n = motion.n_frames
-        a = 0 if a is None else int(a)
-        b = n if b is None else int(b)
-        if not 0 <= a < b <= n:
-            raise ParameterError(f"frame range {a}:{b} is not inside the input's {n} frames (0-based, half-open)")
-        if (a, b) == (0, n):
+        windowed = motion.window(frames)
+        if windowed is motion:
             frames = None  # the whole input: no window
-        else:
-            motion = motion[a:b]
+        motion = windowed
     motion = _check_motion(motion, "the input")
     closure = _input_closure(motion)
     period = estimate_period(motion)

@@ -137,6 +137,19 @@ class Motion:
         first = int(idx[0]) if idx.size else 0
         return replace(self, frames=sub, start_frame=self.start_frame + first)
 
+    def window(self, frames: tuple[int | None, int | None] | None) -> "Motion":
+        """Frames ``start:stop`` (0-based, half-open; ``None`` ends mean the capture's ends),
+        checked to lie inside the capture; ``None`` returns the motion itself."""
+        if frames is None:
+            return self
+        a, b = frames
+        n = self.n_frames
+        a = 0 if a is None else int(a)
+        b = n if b is None else int(b)
+        if not 0 <= a < b <= n:
+            raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames (0-based, half-open)")
+        return self if (a, b) == (0, n) else self[a:b]
+
     def select(self, channels: Iterable[Channel | str]) -> "Motion":
         """Keep only some channels (``(joint, dof)`` pairs, ``"joint.dof"`` or a joint
         name for all its channels), in the order given."""

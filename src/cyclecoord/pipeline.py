@@ -296,14 +296,7 @@ def extract(
         n_neighbors=n_neighbors, weighting=weighting, sampling=sampling, n_components=n_components,
         cycle_start=cycle_start, landmarks=landmarks, memory_limit=memory_limit, random_state=random_state,
     )
-    if frames is not None:
-        a, b = frames
-        n = motion.n_frames
-        a = 0 if a is None else int(a)
-        b = n if b is None else int(b)
-        if not (0 <= a < b <= n):
-            raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames (0-based, half-open)")
-        motion = motion[a:b]
+    motion = motion.window(frames)
     if motion.n_frames < 2 * n_neighbors or motion.n_frames < 10:
         raise ParameterError(
             f"{motion.n_frames} frames are too few to find a cycle (need at least {max(10, 2 * n_neighbors)})"

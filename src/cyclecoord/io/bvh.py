@@ -23,6 +23,7 @@ import numpy as np
 from ..errors import ParameterError, ParseError
 from ..motion import Motion
 from ..skeleton import Joint, Skeleton, rotation_order_from_dofs
+from ..retarget import _check_order
 from ._atomic import atomic_write
 
 __all__ = ["read_bvh", "write_bvh", "BVH_CHANNEL_NAMES"]
@@ -466,15 +467,6 @@ def _complete_order(order: str, preferred: str = "ZXY") -> str:
     if _is_subsequence(order, preferred):
         return preferred
     return order + "".join(c for c in "XYZ" if c not in order)
-
-
-def _check_order(order: str) -> str:
-    up = str(order).upper()
-    if len(up) != 3 or sorted(up) != ["X", "Y", "Z"]:
-        raise ParameterError(
-            f"rotation_order must be a permutation of XYZ such as 'ZXY', got {order!r}"
-        )
-    return up
 
 
 def _bvh_ready_orders(skeleton: Skeleton, forced: str | None) -> list[str] | None:
