@@ -453,10 +453,10 @@ def detect(
             strength[c.motion] = np.maximum(strength[c.motion], s)
         best = np.argmax(strength, axis=0)
         labels = np.where(strength.max(axis=0) > 0, best, -1)
-        # drop label runs shorter than the smoothing window
+        # drop flicker: label runs shorter than half the smoothing window
         for mid in range(n_motions):
             for a, b in _runs(labels == mid):
-                if b - a < w:
+                if b - a < w // 2:
                     labels[a:b] = -1
 
     # segments: runs of each label, described by the motion's lead (most persistent) class
