@@ -9,8 +9,8 @@ Sections (each can be chosen with ``--parts``):
 * **synthetic** -- :func:`cyclecoord.datasets.make_motion_chain` with three different
   periodic motions and known boundaries, for several kind triples and seeds.  Printed
   per case: frame accuracy after the best one-to-one matching of detected motions to
-  true ones (:func:`cyclecoord.detect.best_match_accuracy`), the largest boundary error
-  (:func:`cyclecoord.detect.boundary_errors`), the motions found and the seconds; then
+  true ones (:func:`cyclecoord.detection.best_match_accuracy`), the largest boundary error
+  (:func:`cyclecoord.detection.boundary_errors`), the motions found and the seconds; then
   the mean and minimum.  Targets: accuracy >= 90 %, boundaries within 30 frames.
 * **13_29** -- CMU 13_29 (six exercises) against ``../shared/data/labels/13_29.csv``:
   accuracy after matching (target >= 80 %), the matching, per activity the fraction of
@@ -53,7 +53,7 @@ if str(_HERE) not in sys.path:  # the sibling benchmark module, also when import
 import bench_extract as bx  # noqa: E402  (table printing, JSON conversion, git state)
 
 import cyclecoord as cc  # noqa: E402
-from cyclecoord.detect import DetectionResult, best_match_accuracy, boundary_errors, detect  # noqa: E402
+from cyclecoord.detection import DetectionResult, best_match_accuracy, boundary_errors, detect  # noqa: E402
 from cyclecoord.errors import NoPeriodicMotionError, ParameterError, ParseError  # noqa: E402
 from cyclecoord.io._atomic import atomic_write  # noqa: E402
 
@@ -252,7 +252,7 @@ def class_coverage(result: DetectionResult, spans: Sequence[tuple[int, int, str]
 def unlabelled_motions(result: DetectionResult, spans: Sequence[tuple[int, int, str]]) -> list[str]:
     """Notes on kept classes whose motion ended up labelling no frame at all.
 
-    :func:`cyclecoord.detect.detect` drops label runs shorter than its smoothing window
+    :func:`cyclecoord.detection.detect` drops label runs shorter than its smoothing window
     (``window`` seconds, odd number of frames), so a motion excited for less than that
     is found as a class but labels nothing.
     """
@@ -349,7 +349,7 @@ def run_chain(
     dict
         ``kinds``, ``seed``, ``n_frames``, ``accuracy`` (after best matching),
         ``matching`` ``{motion id: kind}``, ``boundary_errors`` (frames, both ways; see
-        :func:`cyclecoord.detect.boundary_errors`), ``max_boundary_error``,
+        :func:`cyclecoord.detection.boundary_errors`), ``max_boundary_error``,
         ``n_motions``, ``kinds_found`` (number of true kinds matched to a motion),
         ``periods`` (true, per kind) and ``segment_periods`` (detected, per segment with
         its matched kind), ``accuracy_ok``, ``boundaries_ok``, plus ``seconds``,

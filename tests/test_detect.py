@@ -7,7 +7,7 @@ import pytest
 
 import cyclecoord as cc
 from cyclecoord.cli import main
-from cyclecoord.detect import Segment, best_match_accuracy, boundary_errors, detect, excitation
+from cyclecoord.detection import Segment, best_match_accuracy, boundary_errors, detect, excitation
 
 
 @pytest.fixture(scope="module", params=[(("walk", "jumping_jack", "arm_circles"), 0), (("walk", "jog", "squat"), 1), (("squat", "arm_circles", "jog"), 2)])

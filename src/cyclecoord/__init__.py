@@ -45,8 +45,8 @@ _LAZY = {
     "Skeleton": "skeleton",
     "forward_kinematics": "skeleton",
     "PhaseModel": "model",
-    "detect": "detect",
-    "DetectionResult": "detect",
+    "detect": "detection",
+    "DetectionResult": "detection",
     "blend": "interpolate",
     "transition": "interpolate",
     "align": "interpolate",
@@ -54,7 +54,7 @@ _LAZY = {
 }
 _SUBMODULES = {
     "datasets", "io", "plot", "metrics", "pipeline", "barcode", "coordinates", "cycle", "density",
-    "detect", "interpolate", "plausibility", "batch", "model", "landmarks", "preprocess",
+    "detection", "interpolate", "plausibility", "batch", "model", "landmarks", "preprocess",
 }
 
 

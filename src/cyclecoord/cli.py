@@ -353,7 +353,7 @@ def _save_plots(result, folder: str) -> None:
 
 def cmd_detect(args: argparse.Namespace) -> int:
     """``cyclecoord detect``: several periodic motions, their segments and per-frame labels."""
-    from .detect import detect
+    from .detection import detect
     from .io import save
     from .pipeline import extract
 
@@ -396,7 +396,10 @@ def cmd_detect(args: argparse.Namespace) -> int:
             segs = [s for s in res.segments if s.motion == mid]
             best = max(segs, key=lambda s: s.stop - s.start)
             try:
-                ex = extract(m, frames=(best.start, best.stop), require_clear=False)
+                ex = extract(
+                    m, frames=(best.start, best.stop), require_clear=False,
+                    delay=args.delay if args.delay > 0 else None, landmarks=args.landmarks,
+                )
             except CycleCoordError as exc:
                 print(f"motion {mid}: no cycle ({exc})")
                 continue

@@ -23,7 +23,10 @@ from .metrics import distance_to_cycle, jerk_summary, loop_closure
 from .motion import Motion
 from .preprocess import PreparedData, Preprocessor
 
-__all__ = ["extract", "ExtractionResult", "cycle_lengths", "slowest_frame"]
+__all__ = ["extract", "ExtractionResult", "cycle_lengths", "slowest_frame", "MIN_CYCLES"]
+
+#: A clip whose coordinate goes round fewer times than this holds no measurable period.
+MIN_CYCLES = 0.75
 
 
 def slowest_frame(frames: np.ndarray, window: int = 5) -> int:
@@ -191,6 +194,7 @@ def extract(
     pca: int | None = None,
     normalize: bool = False,
     temporal: bool = False,
+    delay: float | None = None,
     difference_root: bool = True,
     root: str = "body",
     prime: int = DEFAULT_PRIME,
@@ -223,6 +227,9 @@ def extract(
         Scale each channel by its standard deviation first.
     temporal : bool
         Use the time-aware metric (consecutive frames at distance 0).
+    delay : float, optional
+        Delay embedding in seconds for the filtration (out-and-back motions such as
+        squats then form loops); the cycle is still averaged from the poses.
     difference_root : bool, default True
         Replace root translation/orientation by per-frame changes.
     root : {"body", "euler"}, default "body"
@@ -291,7 +298,7 @@ def extract(
     notes: list[str] = []
     params = dict(
         frames=None if frames is None else list(frames), pca=pca, normalize=normalize, temporal=temporal,
-        difference_root=difference_root, root=root, prime=prime, max_scale=max_scale, scale=scale,
+        delay=delay, difference_root=difference_root, root=root, prime=prime, max_scale=max_scale, scale=scale,
         class_index=class_index, scale_fraction=scale_fraction, n_samples=n_samples,
         n_neighbors=n_neighbors, weighting=weighting, sampling=sampling, n_components=n_components,
         cycle_start=cycle_start, landmarks=landmarks, memory_limit=memory_limit, random_state=random_state,
@@ -303,7 +310,8 @@ def extract(
         )
 
     t0 = time.perf_counter()
-    prep = Preprocessor(difference_root=difference_root, normalize=normalize, pca=pca, root=root)
+    lag = int(round(delay * motion.fps)) if delay else None
+    prep = Preprocessor(difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=lag)
     prepared = prep.fit_transform(motion)
     timings["prepare"] = time.perf_counter() - t0
 
@@ -371,10 +379,13 @@ def extract(
     theta = est.coordinates_
     u = unwrap(theta)
     cycles = float(u[-1] - u[0])
-    if cycles <= 0.5:
-        notes.append(f"the coordinate covers only {cycles:.2f} cycles over the clip; the period estimate is unreliable")
-    if cycles <= 0:
-        raise fail("no periodic motion found: the circular coordinate does not advance along the clip")
+    if cycles < MIN_CYCLES:
+        raise fail(
+            f"no periodic motion found: the circular coordinate covers only {cycles:.2f} cycles over the "
+            f"clip (at least {MIN_CYCLES} are needed to measure a period)"
+        )
+    if cycles < 1.5:
+        notes.append(f"the coordinate covers only {cycles:.2f} cycles over the clip; the period estimate is rough")
     period = (motion.n_frames - 1) / cycles
     lengths = cycle_lengths(u)
 

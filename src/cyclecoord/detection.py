@@ -306,9 +306,9 @@ def detect(
     n_classes : int, optional
         Use exactly the ``n_classes`` most persistent H1 classes (still validated by
         excitation for the segments).
-    max_classes : int, default 20
+    max_classes : int, default 30
         At most this many candidate classes.
-    min_persistence : float, default 0.25
+    min_persistence : float, default 0.1
         Candidates need at least this fraction of the longest bar's persistence.
     scale_fraction : float, default 0.9
         Each class is read this far up its own bar.
