@@ -72,6 +72,34 @@ def test_memory_guard_switches_before_building(monkeypatch, synthetic_2000):
     assert calls and all(c.get("n_perm") for c in calls)  # the full complex was never asked for
 
 
+def test_refine_birth_refuses_a_dense_complex_from_a_sample(monkeypatch):
+    """A complex far over ``max_edges`` is refused before any exact pair count.
+
+    Counting every pair within the scale costs as much as the pairs (quadratic when the
+    complex is dense); the sampled estimate decides first.
+    """
+    import scipy.spatial
+
+    from cyclecoord.barcode import refine_birth
+
+    def no_tree(*args, **kwargs):
+        raise AssertionError("the exact count ran for a complex the sample already refused")
+
+    monkeypatch.setattr(scipy.spatial, "cKDTree", no_tree)
+    x = np.random.default_rng(0).standard_normal((3000, 3))  # scale 1.0 links ~10% of pairs
+    assert refine_birth(x, 1.0, max_edges=10_000) is None
+
+
+def test_refine_birth_finds_the_full_birth_of_a_circle():
+    from cyclecoord.barcode import refine_birth
+
+    t = np.linspace(0, 1, 400, endpoint=False)
+    x = np.c_[np.cos(2 * np.pi * t), np.sin(2 * np.pi * t)]
+    step = 2 * np.sin(np.pi / 400)  # neighbour distance: the full Rips loop is born there
+    # a landmark birth larger than the full one: the class is still alive at 1.05x it
+    assert refine_birth(x, 0.2) == pytest.approx(step, rel=1e-6)
+
+
 def test_landmarks_match_full_on_69_01(walk_69_01):
     x = Preprocessor().fit_transform(walk_69_01[200:450]).points
     full = CircularCoordinates(max_scale=50, landmarks=None).fit(x)

@@ -387,8 +387,15 @@ def refine_birth(
     t = float(landmark_birth) * margin
     from scipy.spatial import cKDTree
 
+    # Random pairs first: counting every pair within t costs as much as the pairs
+    # themselves (quadratic for a dense complex; 25 s at 64k frames), so a complex that
+    # is clearly too big is refused from a sample before anything is counted.
+    from .landmarks import estimate_complex
+
+    if estimate_complex(x, t, n_samples=20_000).edges > 2 * max_edges:
+        return None
     tree = cKDTree(x)
-    # count first: query_pairs materialises every pair
+    # then count exactly: query_pairs materialises every pair
     if tree.count_neighbors(tree, t) - len(x) > 2 * max_edges:
         return None
     pairs = tree.query_pairs(t, output_type="ndarray")
