@@ -420,6 +420,36 @@ class CircularCoordinates:
         self.covering_radius_ = float(self.barcode_.extras.get("covering_radius", 0.0))
         return self.barcode_
 
+    def use_barcode(self, X, barcode: Barcode) -> "CircularCoordinates":
+        """Adopt a barcode already computed on every point of ``X`` (Euclidean metric).
+
+        Skips the threshold choice and the memory guard of :meth:`fit_barcode`; meant for
+        many small point clouds (the windows of :func:`cyclecoord.detect`) whose barcode
+        the caller has computed and screened itself.  Call :meth:`fit_coordinate` next.
+
+        Parameters
+        ----------
+        X : array-like, shape (T, K)
+            The points the barcode was computed on, in frame order.
+        barcode : Barcode
+            Full (landmark-free) barcode of ``X``.
+        """
+        x = self._validate(X)
+        if barcode.point_indices is not None or barcode.n_points != len(x):
+            raise ParameterError("use_barcode() needs a barcode on every point of X (no landmarks)")
+        if self.temporal:
+            raise ParameterError("use_barcode() works with the Euclidean metric only")
+        self.points_ = x
+        self._dist_ = None
+        self.threshold_ = float(barcode.threshold)
+        self.n_landmarks_ = None
+        self.complex_estimate_ = None
+        self.landmark_reason_ = "every frame (barcode supplied)"
+        self.barcode_ = barcode
+        self.landmarks_ = None
+        self.covering_radius_ = 0.0
+        return self
+
     def fit(self, X, y=None) -> "CircularCoordinates":
         """Barcode, class and scale selection, cocycle check and the coordinate.
 

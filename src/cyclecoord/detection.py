@@ -32,8 +32,8 @@ from typing import Any
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
-from .barcode import CLEAR_RATIO, DEFAULT_PRIME, Barcode
-from .coordinates import CircularCoordinates
+from .barcode import CLEAR_RATIO, DEFAULT_PRIME, Barcode, compute_barcode, select_bar
+from .coordinates import CircularCoordinates, unwrap
 from .errors import NoPeriodicMotionError, ParameterError
 from .motion import Motion
 from .preprocess import Preprocessor
@@ -43,6 +43,11 @@ __all__ = [
     "DetectionResult",
     "DetectedClass",
     "Segment",
+    "WindowInfo",
+    "METHODS",
+    "window_table",
+    "binned_cycle",
+    "cycle_distance",
     "excitation",
     "best_match_accuracy",
     "boundary_errors",
@@ -139,7 +144,14 @@ class DetectionResult:
         Motion id per frame, ``-1`` where nothing periodic happens.
     n_motions : int
     timings : dict
+        Seconds per stage: ``prepare``, ``barcode``, ``coordinates`` (global classes),
+        ``windows`` (windowed stage, when run), ``segments`` (grouping and labelling),
+        ``total``.
     warnings : list of str
+    windows : list of WindowInfo
+        Every window of the windowed stage (empty with ``method="global"``).
+    method : str
+        The method that ran (``"auto"``, ``"global"`` or ``"windows"``).
     """
 
     motion: Motion
@@ -152,6 +164,8 @@ class DetectionResult:
     parameters: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     estimator: CircularCoordinates | None = None
+    windows: list = field(default_factory=list)
+    method: str = "global"
 
     def to_report(self) -> dict[str, Any]:
         bc = self.barcode.to_dict()
@@ -166,8 +180,10 @@ class DetectionResult:
             "barcode": bc,
             "chosen_classes": [{"index": k, "motion": v} for k, v in sorted(chosen.items())],
             "classes": [c.to_dict() for c in self.classes],
+            "method": self.method,
             "n_motions": self.n_motions,
             "segments": [s.to_dict() for s in self.segments],
+            "windows": [w.to_dict() for w in self.windows],
             "labels": [int(v) for v in self.labels],
             "timings": {k: round(float(v), 6) for k, v in self.timings.items()},
             "warnings": list(self.warnings),
@@ -264,6 +280,432 @@ def best_match_accuracy(predicted: np.ndarray, truth: np.ndarray) -> tuple[float
     return float(conf[rows, cols].sum() / t.size), match
 
 
+# ------------------------------------------------------------------ windowed stage
+#: Detection methods of :func:`detect`.
+METHODS = ("auto", "global", "windows")
+
+#: Phase bins of a window's typical cycle (its phase-invariant descriptor).
+CYCLE_BINS = 16
+
+#: Labelling cost of "nothing periodic" per frame, in units of a cycle's own typical
+#: distance to the frames that made it: a frame more than this many times farther from
+#: every motion's cycle than those frames are is left unlabelled.
+NONE_COST = 2.0
+
+
+@dataclass
+class WindowInfo:
+    """One time window of the windowed stage and what its barcode showed.
+
+    Attributes
+    ----------
+    start, stop : int
+        Half-open frame range (0-based, in the analysed frames).
+    step : int
+        Every ``step``-th frame of the range went into the window's filtration.
+    birth, death : float
+        The window's most persistent H1 bar (``death`` is ``inf`` when alive at the
+        window's threshold); NaN when the window has no H1 bar.
+    threshold : float
+        The window's filtration threshold (half its diameter), analysed-space units.
+    scale : float
+        Scale the cocycle was read at (NaN when no coordinate was computed).
+    clear : bool
+        Whether the bar stands clear (:func:`cyclecoord.barcode.select_bar`).
+    cycles : float
+        Unwrapped turns of its circular coordinate from the first frame to the last.
+    steadiness : float
+        Fraction of coordinate steps going the way of the net advance, in [0, 1].
+    period_frames : float
+        Window frames per completed cycle (``(stop - start) / cycles``).
+    looping : bool
+        Clear bar, at least ``window_cycles`` cycles and ``window_steadiness``.
+    motion : int
+        Motion id the window ended up in, ``-1`` otherwise.
+    cycle : ndarray, shape (CYCLE_BINS, D) or None
+        Mean pose (root channels left out) per phase bin of the coordinate: the window's
+        typical cycle, compared between windows up to rotation and reflection.
+    """
+
+    start: int
+    stop: int
+    step: int
+    birth: float
+    death: float
+    threshold: float
+    scale: float = float("nan")
+    clear: bool = False
+    cycles: float = 0.0
+    steadiness: float = 0.0
+    period_frames: float = float("nan")
+    looping: bool = False
+    motion: int = -1
+    cycle: np.ndarray | None = field(default=None, repr=False)
+
+    def to_dict(self) -> dict:
+        def num(v: float) -> float | None:
+            return float(v) if np.isfinite(v) else None
+
+        return {
+            "start": int(self.start), "stop": int(self.stop), "step": int(self.step),
+            "birth": num(self.birth), "death": num(self.death), "threshold": num(self.threshold),
+            "scale": num(self.scale), "clear": bool(self.clear), "cycles": float(self.cycles),
+            "steadiness": float(self.steadiness), "period_frames": num(self.period_frames),
+            "looping": bool(self.looping), "motion": int(self.motion),
+        }
+
+
+def binned_cycle(theta: np.ndarray, poses: np.ndarray, bins: int = CYCLE_BINS) -> np.ndarray:
+    """Mean pose per phase bin of a circular coordinate (a small typical cycle).
+
+    Parameters
+    ----------
+    theta : ndarray, shape (N,)
+        Circular coordinate in cycles (used modulo 1).
+    poses : ndarray, shape (N, D)
+        The frames' poses.
+    bins : int, default 16
+        Phase bins.
+
+    Returns
+    -------
+    ndarray, shape (bins, D)
+        Empty bins are interpolated linearly (around the circle) from their neighbours.
+    """
+    x = np.asarray(poses, dtype=float)
+    b = np.minimum((np.mod(np.asarray(theta, dtype=float), 1.0) * bins).astype(int), bins - 1)
+    count = np.bincount(b, minlength=bins)
+    sums = np.zeros((bins, x.shape[1]))
+    np.add.at(sums, b, x)
+    have = np.flatnonzero(count > 0)
+    out = np.zeros_like(sums)
+    out[have] = sums[have] / count[have, None]
+    for k in np.flatnonzero(count == 0):
+        if have.size == 0:
+            break
+        nxt = have[np.argmin((have - k) % bins)]
+        prv = have[np.argmin((k - have) % bins)]
+        dn, dp = (nxt - k) % bins, (k - prv) % bins
+        out[k] = out[prv] if dn + dp == 0 else (out[prv] * dn + out[nxt] * dp) / (dn + dp)
+    return out
+
+
+def cycle_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """RMS pose distance between two binned cycles after the best rotation and reflection.
+
+    Every circular shift of ``b`` and of ``b`` reversed is tried (``2 * bins`` cases), so
+    the result does not depend on where either coordinate put its zero or which way it
+    runs.
+
+    Parameters
+    ----------
+    a, b : ndarray, shape (bins, D)
+
+    Returns
+    -------
+    float
+        In the poses' units (degrees for joint angles).
+    """
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    n = len(a)
+    shifts = np.arange(n)
+    idx = (np.arange(n)[None, :] - shifts[:, None]) % n  # (shift, bin)
+    best = np.inf
+    for bb in (b, b[::-1]):
+        d = np.sqrt(np.mean(np.sum((a[None] - bb[idx]) ** 2, axis=2), axis=1))
+        best = min(best, float(d.min()))
+    return best
+
+
+def _amplitude(cycle: np.ndarray) -> float:
+    """RMS distance of a binned cycle's poses from their mean."""
+    return float(np.sqrt(np.mean(np.sum((cycle - cycle.mean(axis=0)) ** 2, axis=1))))
+
+
+def _fit_window(points: np.ndarray, prime: int, scale_fraction: float) -> tuple[dict, np.ndarray | None]:
+    """Barcode of one window and, when its longest bar stands clear, the coordinate."""
+    bc = compute_barcode(points, prime=prime)
+    info: dict[str, Any] = {"threshold": bc.threshold, "birth": float("nan"), "death": float("nan")}
+    if len(bc.h1) == 0:
+        return info, None
+    sel = select_bar(bc, 0, scale_fraction=scale_fraction)
+    info.update(birth=sel.birth, death=sel.death, clear=sel.clear)
+    if not sel.clear:
+        return info, None
+    est = CircularCoordinates(prime=prime, scale_fraction=scale_fraction, landmarks=None, refine_birth=False)
+    est.use_barcode(points, bc)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est.fit_coordinate()
+    u = unwrap(est.coordinates_)
+    net = float(u[-1] - u[0])
+    steps = np.diff(u)
+    info.update(
+        scale=est.selection_.scale, cycles=abs(net),
+        steadiness=float(np.mean(np.sign(steps) == np.sign(net))) if net and steps.size else 0.0,
+    )
+    return info, est.coordinates_
+
+
+def window_table(
+    points: np.ndarray,
+    poses: np.ndarray,
+    fps: float,
+    lengths: tuple = (2.0, 4.0, 6.0),
+    stride: float = 0.5,
+    max_points: int = 100,
+    prime: int = DEFAULT_PRIME,
+    scale_fraction: float = 0.9,
+    min_cycles: float = 0.9,
+    min_steadiness: float = 0.5,
+    progress: bool = True,
+) -> list[WindowInfo]:
+    """Sliding windows over prepared points: local barcode, coordinate and typical cycle.
+
+    Parameters
+    ----------
+    points : ndarray, shape (T, K)
+        The analysed points (after the delay embedding).
+    poses : ndarray, shape (T, D)
+        Poses the typical cycles are averaged from (root channels left out).
+    fps : float
+        Frames per second.
+    lengths : sequence of float, default (2, 4, 6)
+        Window lengths in seconds (longer than the capture: skipped).
+    stride : float, default 0.5
+        Seconds between window starts, at least; a window of length ``L`` is stepped by
+        ``max(stride, L / 8)``.  The last window ends at the last frame.
+    max_points : int, default 100
+        At most this many frames per window (every ``ceil(L / max_points)``-th frame).
+    prime, scale_fraction
+        As for :class:`~cyclecoord.coordinates.CircularCoordinates`.
+    min_cycles : float, default 0.9
+        A window loops when its coordinate completes at least this many turns ...
+    min_steadiness : float, default 0.5
+        ... with at least this fraction of its steps going one way, on a clear bar.
+    progress : bool, default True
+        Show a tqdm bar on stderr (only once the windows take more than 2 s).
+
+    Returns
+    -------
+    list of WindowInfo
+        Every window, by length then start; ``cycle`` is set for looping windows.
+    """
+    from tqdm import tqdm
+
+    T = len(points)
+    plan = []
+    for length in lengths:
+        n = int(round(float(length) * fps))
+        if n < 10 or n > T:
+            continue
+        hop = max(1, int(round(max(stride, float(length) / 8.0) * fps)))
+        starts = list(range(0, T - n + 1, hop))
+        if starts[-1] != T - n:
+            starts.append(T - n)
+        step = max(1, int(np.ceil(n / max_points)))
+        plan.extend((a, a + n, step) for a in starts)
+    out: list[WindowInfo] = []
+    with tqdm(total=len(plan), desc="detect windows", unit="window", disable=not progress or not plan,
+              delay=2.0, leave=False) as bar:
+        for a, b, step in plan:
+            idx = np.arange(a, b, step)
+            info, theta = _fit_window(points[idx], prime, scale_fraction)
+            w = WindowInfo(start=a, stop=b, step=step, **info)
+            if w.cycles > 0:
+                w.period_frames = (b - a) / w.cycles
+            if theta is not None and w.cycles >= min_cycles and w.steadiness >= min_steadiness:
+                w.looping = True
+                w.cycle = binned_cycle(theta, poses[idx])
+            out.append(w)
+            bar.update(1)
+    return out
+
+
+def _cluster_windows(windows: list[WindowInfo], similarity: float) -> list[list[WindowInfo]]:
+    """Group looping windows whose typical cycles are alike (average linkage).
+
+    The distance between two windows is :func:`cycle_distance` over the geometric mean of
+    their cycles' amplitudes (RMS spread of the binned poses round their mean), so the
+    cut ``similarity`` is relative to the size of the motions compared.
+    """
+    from scipy.cluster.hierarchy import fcluster, linkage
+    from scipy.spatial.distance import squareform
+
+    loops = [w for w in windows if w.looping]
+    if len(loops) < 2:
+        return [loops] if loops else []
+    amp = np.array([max(_amplitude(w.cycle), 1e-9) for w in loops])
+    n = len(loops)
+    d = np.zeros((n, n))
+    for i in range(n):
+        for j in range(i + 1, n):
+            d[i, j] = d[j, i] = cycle_distance(loops[i].cycle, loops[j].cycle) / np.sqrt(amp[i] * amp[j])
+    groups = fcluster(linkage(squareform(d, checks=False), "average"), similarity, "distance")
+    return [[w for w, g in zip(loops, groups) if g == k] for k in np.unique(groups)]
+
+
+def _viterbi(cost: np.ndarray, switch: float) -> np.ndarray:
+    """Cheapest state path through per-frame costs, paying ``switch`` per change of state."""
+    T, K = cost.shape
+    acc = cost[0].copy()
+    back = np.zeros((T, K), dtype=np.int32)
+    states = np.arange(K)
+    for t in range(1, T):
+        best = int(np.argmin(acc))
+        move = acc[best] + switch
+        stay = acc <= move
+        back[t] = np.where(stay, states, best)
+        acc = np.where(stay, acc, move) + cost[t]
+    path = np.empty(T, dtype=int)
+    path[-1] = int(np.argmin(acc))
+    for t in range(T - 1, 0, -1):
+        path[t - 1] = back[t, path[t]]
+    return path
+
+
+@dataclass
+class _Candidate:
+    """A motion before labelling: its cycles, where it may label frames, its sources."""
+
+    cycles: list
+    scales: list
+    allowed: np.ndarray
+    classes: list = field(default_factory=list)
+    windows: list = field(default_factory=list)
+
+
+def _candidate_cost(c: _Candidate, poses: np.ndarray) -> np.ndarray:
+    from .metrics import distance_to_cycle
+
+    cost = np.min([distance_to_cycle(poses, cyc) / s for cyc, s in zip(c.cycles, c.scales)], axis=0)
+    return np.where(c.allowed, cost, np.inf)
+
+
+def _dilate(mask: np.ndarray, margin: int) -> np.ndarray:
+    if margin <= 0 or not mask.any():
+        return mask.copy()
+    from scipy.ndimage import binary_dilation
+
+    return binary_dilation(mask, iterations=int(margin))
+
+
+def _typical_distance(poses: np.ndarray, cycle: np.ndarray) -> float:
+    """Median distance of the frames a cycle was made from to that cycle (its scale)."""
+    from .metrics import distance_to_cycle
+
+    return max(float(np.median(distance_to_cycle(poses, cycle))), 1e-9)
+
+
+def _windowed_motions(
+    windows: list[WindowInfo],
+    kept: list[DetectedClass],
+    global_labels: np.ndarray,
+    n_global: int,
+    poses: np.ndarray,
+    window: int,
+    min_cycles: float,
+    similarity: float,
+    merge_overlap: float,
+) -> tuple[np.ndarray, list[Segment], int]:
+    """Steps 6-8 of the module notes: motions from windows (and global classes), labels, segments.
+
+    ``n_global`` global motions (their classes in ``kept``) come first; with
+    ``n_global == 0`` only windows are used.  Sets ``motion`` on windows and classes.
+    """
+    T = len(poses)
+    cands: list[_Candidate] = []
+    for mid in range(n_global):
+        members = [c for c in kept if c.motion == mid]
+        mask = np.zeros(T, dtype=bool)
+        cycles, scales = [], []
+        for c in members:
+            mask |= c.mask
+            fr = np.flatnonzero(c.mask)
+            cyc = binned_cycle(c.coordinate[fr], poses[fr])
+            cycles.append(cyc)
+            scales.append(_typical_distance(poses[fr], cyc))
+        cands.append(_Candidate(cycles, scales, mask, classes=members))
+    excited = [c.allowed.copy() for c in cands]  # the global motions' own frames
+    for group in _cluster_windows(windows, similarity):
+        if max(w.cycles for w in group) < min_cycles:
+            continue  # loops, but never min_cycles turns in one window
+        cover = np.zeros(T, dtype=bool)
+        for w in group:
+            cover[w.start : w.stop] = True
+        cycles = [w.cycle for w in group]
+        scales = [_typical_distance(poses[w.start : w.stop : w.step], w.cycle) for w in group]
+        target, best = None, 0.0
+        for k in range(n_global):
+            inter = np.sum(cover & excited[k])
+            share = inter / max(1, min(cover.sum(), excited[k].sum()))
+            if share > merge_overlap and share > best:
+                target, best = k, share
+        if target is None:
+            cands.append(_Candidate(cycles, scales, cover, windows=list(group)))
+        else:
+            c = cands[target]
+            c.cycles += cycles
+            c.scales += scales
+            c.allowed = c.allowed | cover
+            c.windows += list(group)
+
+    labels = np.full(T, -1, dtype=int)
+    K = len(cands)
+    if K == 0:
+        return labels, [], 0
+    cost = np.full((T, K + 1), NONE_COST)
+    for k, c in enumerate(cands):
+        c.allowed = _dilate(c.allowed, window)
+        cost[:, k] = _candidate_cost(c, poses)
+    path = _viterbi(cost, switch=window / 2.0)
+    labels = np.where(path == K, -1, path)
+    if n_global:
+        labels = np.where(global_labels >= 0, global_labels, labels)
+    for k in range(K):
+        for a, b in _runs(labels == k):
+            if b - a < window // 2:
+                labels[a:b] = -1
+
+    # number motions by first labelled frame (global motions that label nothing go last)
+    with_frames = sorted((int(np.flatnonzero(labels == k)[0]), k) for k in range(K) if np.any(labels == k))
+    rest = [(int(np.flatnonzero(cands[k].classes[0].mask)[0]), k) for k in range(n_global) if not np.any(labels == k)]
+    order = [k for _, k in with_frames] + [k for _, k in sorted(rest)]
+    new_id = {k: i for i, k in enumerate(order)}
+    labels = np.array([new_id.get(int(v), -1) for v in labels], dtype=int)
+    for k, c in enumerate(cands):
+        mid = new_id.get(k, -1)
+        for cl in c.classes:
+            cl.motion = mid
+        for w in c.windows:
+            w.motion = mid
+
+    segments: list[Segment] = []
+    for k in order:
+        c, mid = cands[k], new_id[k]
+        lead = min(c.classes, key=lambda cl: cl.index) if c.classes else None
+        for a, b in _runs(labels == mid):
+            if lead is not None and (not c.windows or np.mean(lead.mask[a:b]) >= 0.5):
+                cyc = abs(float(np.sum(np.mod(np.diff(lead.coordinate[a:b]) + 0.5, 1.0) - 0.5)))
+                period = (b - a - 1) / cyc if cyc > 0 else float("nan")
+                classes = (lead.index,) + tuple(cl.index for cl in c.classes if cl is not lead)
+                birth, death, scale = lead.birth, lead.death, lead.scale
+            else:
+                inside = [w for w in c.windows if w.stop > a and w.start < b] or c.windows
+                multi = [w for w in inside if w.cycles >= min_cycles] or inside
+                period = float(np.median([w.period_frames for w in multi]))
+                cyc = (b - a) / period
+                classes = tuple(cl.index for cl in sorted(c.classes, key=lambda cl: cl.index))
+                birth = float(np.median([w.birth for w in inside]))
+                death = float(np.median([w.death for w in inside]))
+                scale = float(np.median([w.scale for w in inside]))
+            segments.append(Segment(start=int(a), stop=int(b), motion=mid, classes=classes, birth=birth,
+                                    death=death, scale=scale, cycles=cyc, period_frames=period))
+    segments.sort(key=lambda sg: sg.start)
+    return labels, segments, len(order)
+
+
 def detect(
     motion: Motion,
     frames: tuple[int | None, int | None] | None = None,
@@ -286,6 +728,14 @@ def detect(
     min_consistency: float = 0.4,
     min_cycles: float = 1.5,
     merge_overlap: float = 0.5,
+    method: str = "auto",
+    window_lengths: tuple = (2.0, 4.0, 6.0),
+    window_stride: float = 0.5,
+    window_points: int = 100,
+    window_cycles: float = 0.9,
+    window_steadiness: float = 0.5,
+    similarity: float = 1.5,
+    progress: bool = True,
 ) -> DetectionResult:
     """Find the periodic motions in a capture and the frames where each happens.
 
@@ -323,7 +773,34 @@ def detect(
         An excited stretch must complete this many cycles.
     merge_overlap : float, default 0.5
         Classes whose excited frames overlap by more than this fraction of the smaller
-        region are one motion.
+        region are one motion (and, with ``method="auto"``, a group of windows joins the
+        global motion whose excited frames hold more than this fraction of its frames).
+    method : {"auto", "global", "windows"}, default "auto"
+        ``"global"``: the classes of the one barcode on the whole capture (steps 1-5
+        above, the paper's method).  ``"windows"``: the windowed stage alone (steps
+        6-8).  ``"auto"``: both; windowed motions that excite a global motion's frames
+        join it, the others are added, and the global labels are kept where the global
+        stage labelled a frame.  See the module notes for the measured reasons.
+    window_lengths : sequence of float, default (2, 4, 6)
+        Window lengths in seconds.  A window must hold about a cycle of a motion to see
+        its loop, so the longest should exceed the slowest period looked for.
+    window_stride : float, default 0.5
+        Smallest step between window starts, seconds (a window of length ``L`` steps by
+        ``max(window_stride, L / 8)``).
+    window_points : int, default 100
+        At most this many frames per window go into its filtration (evenly spaced).
+    window_cycles : float, default 0.9
+        A window *loops* when its clear bar's coordinate completes this many turns ...
+    window_steadiness : float, default 0.5
+        ... with at least this fraction of its steps going the same way.  A group of
+        looping windows becomes a motion only when one of its windows completes
+        ``min_cycles`` turns.
+    similarity : float, default 1.5
+        Looping windows whose typical cycles differ by less than this (RMS pose distance
+        after the best rotation and reflection, over the geometric mean of the two
+        cycles' amplitudes; average linkage) are one motion.
+    progress : bool, default True
+        tqdm bar on stderr over the windows, shown only when they take over 2 s.
 
     Returns
     -------
@@ -343,12 +820,30 @@ def detect(
         raise ParameterError("min_consistency and merge_overlap must be in (0, 1], min_persistence in [0, 1]")
     if n_classes is not None and n_classes < 1:
         raise ParameterError(f"n_classes must be at least 1, got {n_classes}")
+    if method not in METHODS:
+        raise ParameterError(f"method must be one of {list(METHODS)}, got {method!r}")
+    try:
+        window_lengths = tuple(float(v) for v in np.atleast_1d(window_lengths))
+    except (TypeError, ValueError):
+        raise ParameterError(f"window_lengths must be numbers of seconds, got {window_lengths!r}") from None
+    if not window_lengths or not all(np.isfinite(v) and v > 0 for v in window_lengths):
+        raise ParameterError(f"window_lengths must be positive numbers of seconds, got {window_lengths}")
+    for name, val in (("window_stride", window_stride), ("window_cycles", window_cycles), ("similarity", similarity)):
+        if not np.isfinite(val) or val <= 0:
+            raise ParameterError(f"{name} must be a positive number, got {val}")
+    if not 0 <= window_steadiness <= 1:
+        raise ParameterError(f"window_steadiness must be in [0, 1], got {window_steadiness}")
+    if int(window_points) != window_points or window_points < 10:
+        raise ParameterError(f"window_points must be a whole number >= 10, got {window_points}")
     params = dict(
         frames=None if frames is None else list(frames), pca=pca, normalize=normalize, temporal=temporal,
         difference_root=difference_root, prime=prime, max_scale=max_scale, landmarks=landmarks,
         delay=delay, n_classes=n_classes, max_classes=max_classes, min_persistence=min_persistence,
         scale_fraction=scale_fraction, window=window, max_period=max_period,
         min_consistency=min_consistency, min_cycles=min_cycles, merge_overlap=merge_overlap,
+        method=method, window_lengths=list(window_lengths), window_stride=window_stride,
+        window_points=int(window_points), window_cycles=window_cycles, window_steadiness=window_steadiness,
+        similarity=similarity,
     )
     motion = motion.window(frames)
     T = motion.n_frames
@@ -393,7 +888,7 @@ def detect(
     v_min = 1.0 / (max_period * fps)
     classes: list[DetectedClass] = []
     t0 = time.perf_counter()
-    for i in cand:
+    for i in cand if method != "windows" else ():
         est.class_index = i
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -476,15 +971,40 @@ def detect(
             )
     segments.sort(key=lambda s: s.start)
     timings["segments"] = time.perf_counter() - t0
+
+    # 6-8. windowed stage
+    windows: list[WindowInfo] = []
+    if method != "global":
+        keep_cols = np.setdiff1d(np.arange(prepared.poses.shape[1]), prepared.root_columns)
+        poses = prepared.poses[:, keep_cols] if keep_cols.size else prepared.poses
+        t0 = time.perf_counter()
+        windows = window_table(
+            prepared.points, poses, fps, window_lengths, window_stride, int(window_points), prime,
+            scale_fraction, window_cycles, window_steadiness, progress,
+        )
+        timings["windows"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        n_global = n_motions if method == "auto" else 0
+        if method == "windows":
+            for c in kept:
+                c.motion = -1
+        labels, segments, n_motions = _windowed_motions(
+            windows, kept if n_global else [], labels, n_global, poses, w, min_cycles, similarity, merge_overlap,
+        )
+        timings["segments"] += time.perf_counter() - t0
     timings["total"] = sum(timings.values())
     result = DetectionResult(
         motion=motion, barcode=barcode, classes=classes, segments=segments, labels=labels,
         n_motions=n_motions, timings=timings, parameters=params, warnings=notes, estimator=est,
+        windows=windows, method=method,
     )
     if not segments:
+        looping = sum(wi.looping for wi in windows)
+        local = (f"; {len(windows)} window(s), {looping} looping, no group of them completes {min_cycles:g} "
+                 "cycles in a window" if method != "global" else "")
         raise NoPeriodicMotionError(
             f"no periodic motion found: {len(cand)} candidate H1 class(es), none completes "
-            f"{min_cycles:g} steady cycles anywhere in the capture",
+            f"{min_cycles:g} steady cycles anywhere in the capture" + local,
             result=result,
         )
     return result
