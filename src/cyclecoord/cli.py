@@ -282,7 +282,7 @@ def cmd_extract(args: argparse.Namespace) -> int:
         )
         ratio = res.jerk["cycle"] / res.jerk["original"] if res.jerk["original"] > 0 else float("nan")
         print(
-            f"cycle: {res.cycle.n_frames} frames, loop closure {res.loop_closure:.2f} (1 = seamless), "
+            f"cycle: {res.cycle.n_frames} frames, loop closure {res.loop_closure:.2f} (seam step / median step; up to 1.5 loops cleanly), "
             f"jerk {res.jerk['cycle']:.4g} vs original {res.jerk['original']:.4g} (ratio {ratio:.2f})"
         )
         print(

@@ -438,7 +438,7 @@ def cycle_summary(motion: Motion) -> dict[str, float]:
     -------
     dict
         ``frames``, ``seconds``, ``loop_closure`` (last-to-first step over the median
-        step, 1 = seamless; see :func:`cyclecoord.metrics.loop_closure`), ``jerk``
+        step; up to about 1.5 loops cleanly; see :func:`cyclecoord.metrics.loop_closure`), ``jerk``
         (mean jerk norm, looping, channel units / s³) and ``median_step``.
     """
     prep = prepare_cycle(motion)
