@@ -11,6 +11,32 @@ from typing import IO, Iterator
 __all__ = ["atomic_write"]
 
 
+def _umask() -> int:
+    """The process's file-creation mask, read without changing it where possible."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)  # elsewhere: the usual set-and-restore
+    os.umask(mask)
+    return mask
+
+
+def _final_mode(target: Path) -> int:
+    """Permissions for the new file: those of the file it replaces, else what ``open`` gives.
+
+    :func:`tempfile.mkstemp` creates files readable by their owner alone (0600); an output
+    should be readable like any file the user's tools write (0666 less the umask).
+    """
+    try:
+        return target.stat().st_mode & 0o7777
+    except OSError:
+        return 0o666 & ~_umask()
+
+
 @contextmanager
 def atomic_write(path: str | os.PathLike[str], mode: str = "w", **kwargs) -> Iterator[IO]:
     """Open a temporary file next to ``path``; on success move it over ``path``.
@@ -39,6 +65,7 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w", **kwargs) -> Ite
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
+        os.chmod(tmp, _final_mode(target))
         os.replace(tmp, target)
     except BaseException:
         try:
