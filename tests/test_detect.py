@@ -85,3 +85,114 @@ def test_cli_detect(tmp_path, capsys):
     capsys.readouterr()
     assert main(["detect", str(src), "--report", str(rep)]) == 3
     assert json.loads(rep.read_text())["segments"] == []
+
+
+# ------------------------------------------------------------------ windowed stage
+def _quiet_last_motion(kinds, seed, fraction, segment_frames=500):
+    """A chain whose last motion is performed at ``fraction`` of its amplitude (and the
+    transition into it): its loop is small beside the others, so the global barcode's
+    candidates (>= 10% of the longest bar) leave it out."""
+    cap = cc.datasets.make_motion_chain(kinds=kinds, segment_frames=segment_frames, random_state=seed)
+    m = cap.motion
+    f = m.frames.copy()
+    a, b, _ = cap.boundaries[-1]
+    cols = [i for i, (joint, _) in enumerate(m.channels) if joint != "root"]
+    mu = f[a:b, cols].mean(axis=0)
+    f[a - 40 :, cols] = mu + fraction * (f[a - 40 :, cols] - mu)
+    return cap, cc.Motion(f, m.channels, fps=m.fps, skeleton=m.skeleton)
+
+
+def test_windows_find_a_small_motion_the_global_barcode_misses():
+    cap, m = _quiet_last_motion(("squat", "jog"), 0, 0.2)
+    old = detect(m, method="global", progress=False)
+    acc_old, _ = best_match_accuracy(old.labels, cap.labels)
+    assert old.n_motions == 1 and acc_old < 0.6  # the paper's method sees only the squat
+    for method in ("auto", "windows"):
+        res = detect(m, method=method, progress=False)
+        acc, match = best_match_accuracy(res.labels, cap.labels)
+        assert res.n_motions == 2 and sorted(match.values()) == [0, 1], method
+        assert acc >= 0.9, method
+        assert max(boundary_errors(res.segments, cap.boundaries, m.n_frames)) <= 30, method
+        jog = [s for s in res.segments if match.get(s.motion) == 1]
+        assert jog and all(s.period_frames == pytest.approx(80, rel=0.25) for s in jog)
+        assert any(w.looping and w.motion >= 0 for w in res.windows)
+
+
+def test_windowed_report_and_parameters(chain):
+    cap, res = chain
+    assert res.method == "auto" and res.windows
+    rep = json.loads(json.dumps(res.to_report()))  # JSON-serialisable as it is
+    assert rep["method"] == "auto" and len(rep["windows"]) == len(res.windows)
+    w = rep["windows"][0]
+    assert set(w) >= {"start", "stop", "step", "birth", "death", "clear", "cycles", "steadiness", "looping", "motion"}
+    assert set(res.timings) >= {"prepare", "barcode", "coordinates", "windows", "segments", "total"}
+    motions = {wi.motion for wi in res.windows if wi.looping} - {-1}
+    assert motions <= set(range(res.n_motions))
+    with pytest.raises(cc.ParameterError):
+        detect(cap.motion, method="nonsense")
+    with pytest.raises(cc.ParameterError):
+        detect(cap.motion, window_lengths=(0.0,))
+
+
+def test_cycle_distance_ignores_rotation_and_reflection():
+    from cyclecoord.detection import binned_cycle, cycle_distance
+
+    t = np.linspace(0, 1, 200, endpoint=False)
+    poses = np.column_stack([np.cos(2 * np.pi * t), np.sin(2 * np.pi * t), 0.3 * np.cos(4 * np.pi * t)]) * 20
+    a = binned_cycle(t, poses)
+    b = binned_cycle(np.mod(-t + 0.37, 1.0), poses)  # other zero, other direction
+    assert cycle_distance(a, b) < 0.1 * cycle_distance(a, a + 10.0)
+    assert cycle_distance(a, a + 10.0) == pytest.approx(10.0 * np.sqrt(3), rel=1e-9)
+    # empty bins are filled from their neighbours
+    half = binned_cycle(t[t < 0.5], poses[t < 0.5])
+    assert np.all(np.isfinite(half)) and half.shape == (16, 3)
+
+
+def test_window_table_loops_only_where_periodic():
+    from cyclecoord.detection import window_table
+    from cyclecoord.preprocess import Preprocessor
+
+    periodic = cc.datasets.make_periodic_capture(n_frames=720, period=100, random_state=0).motion
+    still = cc.datasets.make_random_walk_capture(n_frames=720, random_state=0).motion
+    found = []
+    for m in (periodic, still):
+        prep = Preprocessor(delay=30).fit_transform(m)
+        wins = window_table(prep.points, prep.poses, m.fps, lengths=(2.0, 4.0), progress=False)
+        assert all(w.stop - w.start in (240, 480) and (w.stop - w.start) / w.step <= 100 for w in wins)
+        assert wins[-1].stop == m.n_frames
+        found.append([w for w in wins if w.looping])
+    loops, none = found
+    assert none == []
+    assert len(loops) >= 10
+    for w in loops:  # 2.4 or 4.8 cycles of a 100-frame period
+        assert w.period_frames == pytest.approx(100, rel=0.25)
+
+
+def test_cli_detect_method(tmp_path):
+    rep = tmp_path / "d.json"
+    assert main(["detect", "example:chain", "--method", "windows", "--no-progress", "--report", str(rep)]) == 0
+    r = json.loads(rep.read_text())
+    # windows alone merge this chain's jumping jacks and arm circles (auto keeps them apart)
+    assert r["method"] == "windows" and r["n_motions"] >= 2 and r["windows"]
+    assert all(s["classes"] == [] for s in r["segments"])
+
+
+def test_13_29_windows_find_the_slow_exercises(cmu_dir):
+    """CMU 13_29 (six exercises) against the labels in ../shared/data/labels."""
+    import csv
+
+    path = cmu_dir.parent / "labels" / "13_29.csv"
+    if not path.is_file():
+        pytest.skip(f"labels not found at {path}")
+    m = cc.load(cmu_dir / "13" / "13_29.amc")
+    with open(path, newline="") as fh:
+        spans = [(int(r["start_frame"]), int(r["stop_frame"]), r["activity"]) for r in csv.DictReader(fh)]
+    truth = np.full(m.n_frames, -1)
+    for k, (a, b, _) in enumerate(spans):
+        truth[a:b] = k
+    old, _ = best_match_accuracy(detect(m, method="global", progress=False).labels, truth)
+    res = detect(m, progress=False)
+    acc, match = best_match_accuracy(res.labels, truth)
+    assert acc >= 0.70 and acc > old + 0.3
+    names = {spans[t][2] for t in match.values()}
+    assert {"JumpJack", "Twist", "KneeRaise", "Squat"} <= names

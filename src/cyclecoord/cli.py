@@ -369,7 +369,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
             motion, frames=args.frames, pca=args.pca, normalize=args.normalize, temporal=args.temporal,
             difference_root=not args.no_root_diff, prime=args.prime, max_scale=args.max_scale,
             landmarks=args.landmarks, memory_limit=args.memory_limit, n_classes=args.classes,
-            delay=args.delay if args.delay > 0 else None,
+            delay=args.delay if args.delay > 0 else None, method=args.method, progress=not args.no_progress,
         )
     except NoPeriodicMotionError as exc:
         print(f"cyclecoord: {exc}", file=sys.stderr)
@@ -381,7 +381,10 @@ def cmd_detect(args: argparse.Namespace) -> int:
     )
     print(_summary_barcode(res.barcode))
     kept = [c for c in res.classes if c.motion >= 0]
-    print(f"{len(res.classes)} candidate H1 classes, {len(kept)} excited: {res.n_motions} motion(s)")
+    print(f"method {res.method}: {len(res.classes)} candidate H1 classes, {len(kept)} excited", end="")
+    if res.windows:
+        print(f"; {len(res.windows)} windows, {sum(w.looping for w in res.windows)} looping", end="")
+    print(f": {res.n_motions} motion(s)")
     for sg in res.segments:
         print(
             f"  motion {sg.motion}: frames {m.start_frame + sg.start}-{m.start_frame + sg.stop} "
@@ -777,8 +780,11 @@ def build_parser() -> argparse.ArgumentParser:
             "Reads several long H1 bars as several periodic motions (paper sec. 4.6): every candidate "
             "class (death/birth >= 1.5 and at least 10%% of the longest bar's persistence, at most 30) gets "
             "a circular coordinate at its own scale; a class counts where its coordinate advances steadily "
-            "for at least 1.5 cycles; classes exciting the same frames are one motion. Prints segments and "
-            "writes per-frame labels (-1: nothing periodic) in the report. Exit code 3 when nothing is found."
+            "for at least 1.5 cycles; classes exciting the same frames are one motion. The windowed stage "
+            "(--method windows or auto, the default) also reads the barcodes of sliding 2, 4 and 6 s windows, "
+            "groups windows with alike typical cycles into motions and labels each frame with the motion "
+            "whose cycle is nearest. Prints segments and writes per-frame labels (-1: nothing periodic) in "
+            "the report. Exit code 3 when nothing is found."
         ),
     )
     d.add_argument("input", metavar="INPUT")
@@ -786,7 +792,11 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--classes", type=_positive_int, metavar="N", help="use exactly the N most persistent H1 classes")
     d.add_argument("--delay", type=float, default=0.25, metavar="S",
                    help="delay embedding in seconds so out-and-back motions form loops (0.25; 0 = off, as the paper)")
-    d.add_argument("--report", metavar="R.json", help="JSON: segments, labels per frame, classes, barcode")
+    d.add_argument("--method", choices=("auto", "global", "windows"), default="auto",
+                   help="global: long bars of the one barcode (the paper); windows: sliding-window barcodes; "
+                   "auto (default): both, windowed motions that excite a global motion's frames join it")
+    d.add_argument("--no-progress", action="store_true", help="no progress bar over the windows")
+    d.add_argument("--report", metavar="R.json", help="JSON: segments, labels per frame, classes, windows, barcode")
     d.add_argument("--extract", metavar="OUTDIR", help="write a typical cycle (BVH) for each detected motion")
     d.add_argument("--plot", metavar="DIR", help="write the barcode and the coordinates with segments shaded")
     d.set_defaults(func=cmd_detect)
