@@ -7,21 +7,23 @@ Run from a checkout::
 Sections (each can be chosen with ``--parts``):
 
 * **synthetic** -- :func:`cyclecoord.datasets.make_motion_chain` with three different
-  periodic motions and known boundaries, for several kind triples and seeds.  Printed
-  per case: frame accuracy after the best one-to-one matching of detected motions to
+  periodic motions and known boundaries, for several kind triples and seeds, with every
+  method of ``detect`` (``auto``, the default, then ``global`` and ``windows``; the
+  summary of each is printed side by side).  Printed per case (default method): frame accuracy after the best one-to-one matching of detected motions to
   true ones (:func:`cyclecoord.detection.best_match_accuracy`), the largest boundary error
   (:func:`cyclecoord.detection.boundary_errors`), the motions found and the seconds; then
   the mean and minimum.  Targets: accuracy >= 90 %, boundaries within 30 frames.
 * **13_29** -- CMU 13_29 (six exercises) against ``../shared/data/labels/13_29.csv``:
   accuracy after matching (target >= 80 %), the matching, per activity the fraction of
   its frames given its matched motion, the segments, and a small table over settings
-  (delay, landmarks).
+  (method, delay, landmarks).
 * **01_09** -- CMU 01_09 (playground) against the annotation printed in Fig. 10 of
   Vejdemo-Johansson et al. (2014): per activity, the fraction of its frames covered by
   any detected motion, and by which.
 * **concat** -- the paper's concatenation experiment (walk, jog, hop) rebuilt from the
   captures at hand: 69_01 [200:450] (walk), 143_01 [0:96] (jog) and 13_29 [0:456]
-  (jumping jacks, in place of the paper's hop 143_05, which we do not have).
+  (jumping jacks, in place of the paper's hop 143_05, which we do not have); every
+  method side by side.
 * **timing** -- ``cc.load`` + ``detect`` on 13_29 (4,592 frames) end to end, per stage,
   against the 30 s target (PASS/FAIL printed, never asserted).
 
@@ -103,8 +105,13 @@ CONCAT_PARTS: tuple[tuple[str, str, str, int, int, str], ...] = (
     ("jumping jacks", "13", "13_29", 0, 456, "real jumping jacks, in place of the paper's hop (143_05, not available)"),
 )
 
+#: Detection methods compared side by side (the default, ``"auto"``, is the main run).
+METHODS: tuple[str, ...] = ("auto", "global", "windows")
+
 #: Settings of the 13_29 sensitivity table (``detect`` keyword arguments).
 SENSITIVITY: tuple[dict, ...] = (
+    {"method": "global"},
+    {"method": "windows"},
     {"delay": 0.0},
     {"delay": 0.25},
     {"delay": 0.5},
@@ -142,6 +149,7 @@ def run_detect(motion: cc.Motion, **kwargs: Any) -> tuple[DetectionResult, float
     note : str or None
         The :class:`NoPeriodicMotionError` message when nothing was found.
     """
+    kwargs.setdefault("progress", False)
     t0 = time.perf_counter()
     try:
         result = detect(motion, **kwargs)
@@ -388,38 +396,57 @@ def synthetic_section(
     seeds: Sequence[int] = SEEDS,
     segment_frames: int = SEGMENT_FRAMES,
     progress: bool = True,
+    methods: Sequence[str] = METHODS,
 ) -> dict:
-    """:func:`run_chain` for every triple and seed, with the mean/min summary."""
-    cases = []
-    bar = _bar(len(triples) * len(seeds), "synthetic chains", progress)
-    try:
-        for kinds in triples:
-            for seed in seeds:
-                if bar is not None:
-                    bar.set_postfix_str(f"{'/'.join(kinds)} seed {seed}")
-                cases.append(run_chain(kinds, seed, segment_frames))
-                if bar is not None:
-                    bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
+    """:func:`run_chain` for every triple and seed, with the mean/min summary.
+
+    ``cases`` and ``summary`` are for ``detect``'s defaults; ``by_method`` holds the
+    summary of every method in ``methods`` (the default's included) run on the same chains.
+    """
+    by_method: dict[str, dict] = {}
+    default_cases: list[dict] = []
+    for method in methods:
+        cases = []
+        bar = _bar(len(triples) * len(seeds), f"synthetic chains ({method})", progress)
+        try:
+            for kinds in triples:
+                for seed in seeds:
+                    if bar is not None:
+                        bar.set_postfix_str(f"{'/'.join(kinds)} seed {seed}")
+                    cases.append(run_chain(kinds, seed, segment_frames, method=method))
+                    if bar is not None:
+                        bar.update(1)
+        finally:
+            if bar is not None:
+                bar.close()
+        by_method[method] = _chain_summary(cases)
+        if method == "auto":
+            default_cases = cases
+    if not default_cases:
+        default_cases = [run_chain(k, sd, segment_frames) for k in triples for sd in seeds]
+    return {
+        "segment_frames": int(segment_frames),
+        "cases": default_cases,
+        "summary": _chain_summary(default_cases),
+        "by_method": by_method,
+    }
+
+
+def _chain_summary(cases: Sequence[dict]) -> dict:
+    """Mean/min accuracy, boundary errors, targets met and seconds over chain cases."""
     accs = [c["accuracy"] for c in cases]
     errs = [c["max_boundary_error"] for c in cases]
     return {
-        "segment_frames": int(segment_frames),
-        "cases": cases,
-        "summary": {
-            "n_cases": len(cases),
-            "mean_accuracy": float(np.mean(accs)) if accs else float("nan"),
-            "min_accuracy": float(np.min(accs)) if accs else float("nan"),
-            "mean_max_boundary_error": float(np.mean(errs)) if errs else float("nan"),
-            "worst_boundary_error": int(max(errs)) if errs else None,
-            "accuracy_ok": sum(c["accuracy_ok"] for c in cases),
-            "boundaries_ok": sum(c["boundaries_ok"] for c in cases),
-            "both_ok": sum(c["accuracy_ok"] and c["boundaries_ok"] for c in cases),
-            "three_motions": sum(c["n_motions"] == 3 for c in cases),
-            "mean_seconds": float(np.mean([c["seconds"] for c in cases])) if cases else float("nan"),
-        },
+        "n_cases": len(cases),
+        "mean_accuracy": float(np.mean(accs)) if accs else float("nan"),
+        "min_accuracy": float(np.min(accs)) if accs else float("nan"),
+        "mean_max_boundary_error": float(np.mean(errs)) if errs else float("nan"),
+        "worst_boundary_error": int(max(errs)) if errs else None,
+        "accuracy_ok": sum(c["accuracy_ok"] for c in cases),
+        "boundaries_ok": sum(c["boundaries_ok"] for c in cases),
+        "both_ok": sum(c["accuracy_ok"] and c["boundaries_ok"] for c in cases),
+        "three_motions": sum(c["n_motions"] == 3 for c in cases),
+        "mean_seconds": float(np.mean([c["seconds"] for c in cases])) if cases else float("nan"),
     }
 
 
@@ -483,11 +510,12 @@ def section_13_29(
 
 def _is_default(kwargs: dict) -> bool:
     """Whether ``detect(**kwargs)`` is the same call as ``detect()`` with its defaults."""
-    defaults = {"delay": 0.25, "landmarks": "auto"}
+    defaults = {"delay": 0.25, "landmarks": "auto", "method": "auto"}
     return all(k in defaults and defaults[k] == v for k, v in kwargs.items())
 
 
-def section_01_09(data_dir: Path = DATA_DIR, settings: Sequence[dict] = ({}, {"delay": 0.0}, {"delay": 0.5}),
+def section_01_09(data_dir: Path = DATA_DIR, settings: Sequence[dict] = ({}, {"method": "global"}, {"method": "windows"},
+                                                                         {"delay": 0.0}, {"delay": 0.5}),
                   progress: bool = True) -> dict:
     """01_09 against the paper's Fig. 10 annotation, for each of ``settings``."""
     try:
@@ -563,6 +591,17 @@ def section_concat(data_dir: Path = DATA_DIR) -> dict:
     out["parts_found"] = [a for a, v in out["activities"].items() if v["matched_fraction"] >= 0.5]
     out["class_coverage"] = class_coverage(result, spans)
     out["unlabelled_motions"] = unlabelled_motions(result, spans)
+    out["methods"] = {}
+    for method in METHODS:
+        r, sec, n = (result, seconds, note) if method == "auto" else run_detect(motion, method=method)
+        sc = activity_scores(r.labels, truth, names)
+        errs = boundary_errors(r.segments, spans, motion.n_frames) if r.segments else []
+        out["methods"][method] = {
+            "accuracy": sc["accuracy"], "n_motions": int(r.n_motions), "seconds": sec, "nothing_found": n,
+            "parts_found": [a for a, v in sc["activities"].items() if v["matched_fraction"] >= 0.5],
+            "matched_fractions": {a: v["matched_fraction"] for a, v in sc["activities"].items()},
+            "boundary_errors": [int(e) for e in errs],
+        }
     return out
 
 
@@ -645,7 +684,8 @@ def run_benchmark(
     report: dict[str, Any] = {"machine": machine_info(), "quick": bool(quick), "parts": list(parts),
                               "data_dir": str(data_dir), "skipped": []}
     steps: list[tuple[str, Callable[[], dict]]] = [
-        ("synthetic", lambda: synthetic_section(triples, seeds, segment_frames, progress)),
+        ("synthetic", lambda: synthetic_section(triples, seeds, segment_frames, progress,
+                                                ("auto",) if quick else METHODS)),
         ("13_29", lambda: section_13_29(data_dir, () if quick else SENSITIVITY, progress)),
         ("01_09", lambda: section_01_09(data_dir, progress=progress)),
         ("concat", lambda: section_concat(data_dir)),
@@ -749,6 +789,14 @@ def format_report(report: dict) -> str:
         )
         lines.append("  accuracy = frame accuracy after the best one-to-one matching of motions to kinds; "
                      "boundary errors both ways (true->nearest detected, detected->nearest true)")
+        if syn.get("by_method"):
+            lines.append("  methods side by side on the same chains:")
+            lines.append(_table(
+                ["method", "mean accuracy", "min accuracy", "worst bnd err", "both targets", "3 motions", "s/chain"],
+                [[m + (" (default)" if m == "auto" else ""), _pct(v["mean_accuracy"]), _pct(v["min_accuracy"]),
+                  str(v["worst_boundary_error"]), f"{v['both_ok']}/{v['n_cases']}",
+                  f"{v['three_motions']}/{v['n_cases']}", _f(v["mean_seconds"], "{:.2f}")]
+                 for m, v in syn["by_method"].items()]))
         lines.append("")
 
     r = report.get("13_29")
@@ -808,6 +856,13 @@ def format_report(report: dict) -> str:
         lines.extend(_class_lines(r["classes"], r.get("class_coverage"), r.get("unlabelled_motions", ())))
         if r["nothing_found"]:
             lines.append(f"  nothing found: {r['nothing_found']}")
+        if r.get("methods"):
+            lines.append("  methods side by side:")
+            lines.append(_table(
+                ["method", "accuracy", "motions", "parts found (>= 50%)", "share of each part", "boundary errors", "seconds"],
+                [[m, _pct(v["accuracy"]), str(v["n_motions"]), ", ".join(v["parts_found"]) or "none",
+                  ", ".join(f"{a} {_pct(f)}" for a, f in v["matched_fractions"].items()),
+                  str(v["boundary_errors"] or "-"), _f(v["seconds"], "{:.1f}")] for m, v in r["methods"].items()]))
         lines.append("")
 
     r = report.get("timing")

@@ -388,7 +388,7 @@ def test_detect_bench_small_chain(detect_smoke):
         assert seg["period_frames"] == pytest.approx(case["periods"][seg["kind"]], rel=0.25)
     for act in case["activities"].values():
         assert act["matched_fraction"] <= act["covered_fraction"] <= 1.0
-    assert set(case["timings"]) == {"prepare", "barcode", "coordinates", "segments", "total"}
+    assert set(case["timings"]) == {"prepare", "barcode", "coordinates", "windows", "segments", "total"}
     s = syn["summary"]
     assert s["n_cases"] == 1 and s["min_accuracy"] == s["mean_accuracy"] == case["accuracy"]
     assert s["worst_boundary_error"] == case["max_boundary_error"] and s["both_ok"] == 1
