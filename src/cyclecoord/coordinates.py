@@ -21,6 +21,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import lsqr
 from scipy.spatial import cKDTree
 
+from ._blas import one_blas_thread
 from .barcode import (
     DEFAULT_PRIME,
     Barcode,
@@ -390,6 +391,7 @@ class CircularCoordinates:
             n_landmarks=self.n_landmarks_,
         )
 
+    @one_blas_thread
     def fit_barcode(self, X) -> Barcode:
         """Compute (only) the barcode; sets ``barcode_`` and returns it.
 
@@ -482,6 +484,7 @@ class CircularCoordinates:
         c[swap, 2] = -c[swap, 2]
         return c
 
+    @one_blas_thread
     def fit_coordinate(self) -> "CircularCoordinates":
         """Second half of :meth:`fit`: select the class and solve for the coordinate,
         reusing the barcode from :meth:`fit_barcode` (so a caller can inspect the

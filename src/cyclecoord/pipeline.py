@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ._blas import one_blas_thread
 from .barcode import CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, DEFAULT_PRIME, Barcode, BarSelection
 from .coordinates import CircularCoordinates, unwrap
 from .cycle import TypicalCycle, typical_cycle
@@ -187,6 +188,7 @@ def _landmark_report(est: CircularCoordinates | None) -> dict | None:
     }
 
 
+@one_blas_thread
 def extract(
     motion: Motion,
     frames: tuple[int | None, int | None] | None = None,
