@@ -193,6 +193,6 @@ def test_13_29_windows_find_the_slow_exercises(cmu_dir):
     old, _ = best_match_accuracy(detect(m, method="global", progress=False).labels, truth)
     res = detect(m, progress=False)
     acc, match = best_match_accuracy(res.labels, truth)
-    assert acc >= 0.70 and acc > old + 0.3
+    assert acc >= 0.80 and acc > old + 0.3  # the target; global alone gets 28%
     names = {spans[t][2] for t in match.values()}
-    assert {"JumpJack", "Twist", "KneeRaise", "Squat"} <= names
+    assert {"JumpJack", "Twist", "ArmCircle", "ToeTouchOneHand", "KneeRaise", "Squat"} <= names

@@ -36,8 +36,11 @@ correctly.  A **windowed stage** looks locally:
 7. **Motions from windows**: looping windows are grouped by average linkage on
    :func:`cycle_distance` (best rotation and reflection) relative to the cycles'
    amplitudes, cut at ``similarity``; non-adjacent windows of the same motion fall into
-   the same group.  A group is a motion only when one of its windows completes
-   ``min_cycles`` turns.
+   the same group.  A group is a motion when one of its windows completes
+   ``min_cycles`` turns, or when at least three of its windows together cover
+   ``min_cycles`` of their median period (a slow motion performed for under two of its
+   cycles, which no single window holds one and a half times: 13_29's alternating toe
+   touches take about 4.3 s a cycle and are performed for 6.5 s).
 8. **Labels**: every frame within ``window`` seconds of a motion's windows may take that
    motion; the cost of a frame is its :func:`~cyclecoord.metrics.distance_to_cycle` to the
    motion's nearest window cycle, over that cycle's typical distance to its own frames,
@@ -67,6 +70,7 @@ from typing import Any
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
+from ._blas import one_blas_thread
 from .barcode import CLEAR_RATIO, DEFAULT_PRIME, Barcode, compute_barcode, select_bar
 from .coordinates import CircularCoordinates, unwrap
 from .errors import NoPeriodicMotionError, ParameterError
@@ -664,11 +668,12 @@ def _windowed_motions(
         cands.append(_Candidate(cycles, scales, mask, classes=members))
     excited = [c.allowed.copy() for c in cands]  # the global motions' own frames
     for group in _cluster_windows(windows, similarity):
-        if max(w.cycles for w in group) < min_cycles:
-            continue  # loops, but never min_cycles turns in one window
         cover = np.zeros(T, dtype=bool)
         for w in group:
             cover[w.start : w.stop] = True
+        span = cover.sum() / float(np.median([w.period_frames for w in group]))
+        if max(w.cycles for w in group) < min_cycles and (len(group) < 3 or span < min_cycles):
+            continue  # loops, but neither one window nor the group's frames hold min_cycles turns
         cycles = [w.cycle for w in group]
         scales = [_typical_distance(poses[w.start : w.stop : w.step], w.cycle) for w in group]
         target, best = None, 0.0
@@ -741,6 +746,7 @@ def _windowed_motions(
     return labels, segments, len(order)
 
 
+@one_blas_thread
 def detect(
     motion: Motion,
     frames: tuple[int | None, int | None] | None = None,
@@ -828,8 +834,9 @@ def detect(
         A window *loops* when its clear bar's coordinate completes this many turns ...
     window_steadiness : float, default 0.5
         ... with at least this fraction of its steps going the same way.  A group of
-        looping windows becomes a motion only when one of its windows completes
-        ``min_cycles`` turns.
+        looping windows becomes a motion when one of its windows completes
+        ``min_cycles`` turns, or when three or more of them cover ``min_cycles`` of
+        their median period.
     similarity : float, default 1.5
         Looping windows whose typical cycles differ by less than this (RMS pose distance
         after the best rotation and reflection, over the geometric mean of the two
@@ -1035,8 +1042,8 @@ def detect(
     )
     if not segments:
         looping = sum(wi.looping for wi in windows)
-        local = (f"; {len(windows)} window(s), {looping} looping, no group of them completes {min_cycles:g} "
-                 "cycles in a window" if method != "global" else "")
+        local = (f"; {len(windows)} window(s), {looping} looping, no group of them holds {min_cycles:g} "
+                 "cycles" if method != "global" else "")
         raise NoPeriodicMotionError(
             f"no periodic motion found: {len(cand)} candidate H1 class(es), none completes "
             f"{min_cycles:g} steady cycles anywhere in the capture" + local,
