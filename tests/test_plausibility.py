@@ -1,6 +1,7 @@
 """Self-intersection and joint-range checks (cyclecoord.plausibility)."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -103,6 +104,9 @@ def test_arm_through_the_torso_is_flagged(walk):
     assert set(range(45, 76)) <= set(report.new_contact_frames)
     assert any(v.channel == ("lradius", "rx") for v in report.joint_range)
     assert "closer than the inputs ever do" in report.summary()
+    # every distance in the note is printed to three significant figures
+    note = next(n for n in report.notes if "closer than the inputs ever do" in n)
+    assert re.fullmatch(r".* at [0-9.e-]+ \(clearance [0-9.e-]+, inputs' closest ([0-9.]{1,5}|n/a)\)", note), note
     payload = json.loads(json.dumps(report.to_dict()))
     assert payload["clean"] is False and payload["joint_range_violations"]
 

@@ -625,10 +625,11 @@ def check_plausibility(
     n_new = sum(1 for c in contacts if c["new"])
     if n_new:
         worst = min((c for c in contacts if c["new"]), key=lambda c: c["min_distance"])
+        ref = worst["reference_min_distance"]
         notes.append(
             f"{n_new} bone pairs come closer than the inputs ever do, e.g. {worst['bones'][0]} and "
             f"{worst['bones'][1]} at {worst['min_distance']:.3g} (clearance {thr:.3g}, inputs' closest "
-            f"{worst['reference_min_distance'] if worst['reference_min_distance'] is not None else 'n/a'})"
+            f"{'n/a' if ref is None else f'{ref:.3g}'})"
         )
     violations: list[JointRangeViolation] = []
     if references:
