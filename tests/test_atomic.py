@@ -5,7 +5,7 @@ import stat
 
 import pytest
 
-from cyclecoord.io._atomic import atomic_write
+from cyclecoord.io._atomic import atomic_path, atomic_write
 
 
 @pytest.mark.skipif(os.name != "posix", reason="POSIX permissions")
@@ -48,3 +48,18 @@ def test_missing_folder_is_named(tmp_path):
     with pytest.raises(FileNotFoundError, match="does not exist"):
         with atomic_write(tmp_path / "nope" / "out.txt") as fh:
             fh.write("x")
+
+
+def test_atomic_path_for_writers_that_want_a_name(tmp_path):
+    target = tmp_path / "anim.gif"
+    with atomic_path(target, suffix=".tmp.gif") as tmp:
+        assert tmp.parent == tmp_path and tmp.name.endswith(".tmp.gif") and not target.exists()
+        tmp.write_bytes(b"GIF89a")
+    assert target.read_bytes() == b"GIF89a"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["anim.gif"]
+    with pytest.raises(RuntimeError):
+        with atomic_path(target) as tmp:
+            tmp.write_bytes(b"partial")
+            raise RuntimeError("encoder died")
+    assert target.read_bytes() == b"GIF89a"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["anim.gif"]

@@ -317,6 +317,10 @@ def test_render_gif_frames_and_motion(capture, tmp_path):
     with Image.open(out) as im:
         assert abs(im.info["duration"] - 1000 / 30) <= 4  # real time: 120 fps / 4
     assert os.listdir(tmp_path) == ["walk.gif"]
+    if os.name == "posix":  # readable like any file the user writes, not mkstemp's 0600
+        mask = os.umask(0)
+        os.umask(mask)
+        assert (out.stat().st_mode & 0o777) == 0o666 & ~mask
 
 
 def test_render_side_by_side_loops_the_shorter(result, tmp_path):

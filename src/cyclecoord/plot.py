@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping, Sequence
@@ -1066,29 +1065,22 @@ def render(
         writer = anim.PillowWriter(fps=play_fps)
     else:
         writer = anim.FFMpegWriter(fps=play_fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=f".tmp{suffix}", dir=folder)
-    os.close(fd)
     import matplotlib as mpl
 
-    try:
-        with mpl.rc_context({"savefig.bbox": None}):  # a 'tight' bbox would change the frame size
-            writer.setup(fig, tmp, dpi)
-            try:
-                for i in range(len(times)):
-                    draw_frame(i)
-                    writer.grab_frame()
-            except BaseException:
-                with contextlib.suppress(Exception):  # stop the encoder; the partial file is removed below
-                    writer.finish()
-                raise
-            writer.finish()
-        os.replace(tmp, out)
-    except BaseException:
+    from .io._atomic import atomic_path
+
+    with atomic_path(out, suffix=f".tmp{suffix}") as tmp, mpl.rc_context({"savefig.bbox": None}):
+        # (a 'tight' bbox would change the frame size)
+        writer.setup(fig, str(tmp), dpi)
         try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
+            for i in range(len(times)):
+                draw_frame(i)
+                writer.grab_frame()
+        except BaseException:
+            with contextlib.suppress(Exception):  # stop the encoder; atomic_path removes the partial file
+                writer.finish()
+            raise
+        writer.finish()
     return out
 
 
