@@ -305,3 +305,24 @@ def test_cli_exit_codes_and_summary(tmp_path, capsys):
     code = main(["batch", str(bad), "-o", str(bad / "inside")])
     assert code == 1 and "inside" in capsys.readouterr().err
     assert not (bad / "inside").exists()
+
+
+def test_a_changed_skeleton_makes_an_amc_report_stale(tmp_path):
+    src = tmp_path / "in"
+    src.mkdir()
+    cc.save(_capture("walk", 5), src / "07_01.amc")  # writes 07.asf beside it
+    assert (src / "07.asf").is_file()
+    out = tmp_path / "out"
+    assert run_batch(src, out, progress=False).processed == ["07_01.amc"]
+    block = _strict_json(out / "07_01.report.json")["batch"]
+    assert block["skeleton"][0] == str((src / "07.asf").resolve())
+    assert run_batch(src, out, progress=False).processed == []  # nothing changed
+    st = (src / "07.asf").stat()
+    os.utime(src / "07.asf", ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
+    assert run_batch(src, out, progress=False).processed == ["07_01.amc"]
+    assert run_batch(src, out, progress=False).processed == []
+    # the skeleton gone: the capture is retried and fails with a message naming the problem
+    (src / "07.asf").unlink()
+    gone = run_batch(src, out, progress=False)
+    assert gone.processed == ["07_01.amc"] and gone.row("07_01.amc")["status"] == "error"
+    assert "no skeleton found" in gone.row("07_01.amc")["message"]

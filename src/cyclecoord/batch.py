@@ -17,8 +17,9 @@ Every capture ends with one of three statuses: ``ok``, ``no_periodic`` (the barc
 no clear circle; the report holds the barcode) or ``error`` (unreadable file, bad option,
 out of memory, a crashed worker, ...; the report holds the message).  A failure never
 stops the batch.  A re-run skips every capture whose report says ``ok`` or
-``no_periodic`` for the same input size, modification time and options; errors are
-retried.  ``summary.csv`` is rebuilt from the reports of all captures every time, so it
+``no_periodic`` for the same input size, modification time and options (and, for an
+``.amc``, the same size and modification time of the ``.asf`` it is read with); errors
+are retried.  ``summary.csv`` is rebuilt from the reports of all captures every time, so it
 is complete after a resumed run.
 
 Outputs are never written inside the input folder: the output folder may not be the
@@ -46,7 +47,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
-from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError
+from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
 from .io._atomic import atomic_write
 
 __all__ = [
@@ -96,6 +97,7 @@ class _Task:
     fps: float | None
     cycle_format: str | None
     options_hash: str
+    skeleton: list | None = None  # [path, size, mtime_ns] of the .asf an .amc is read with
 
     @property
     def report(self) -> Path:
@@ -318,6 +320,7 @@ def _batch_block(task: _Task, status: str, message: str, **extra: Any) -> dict[s
         "options": task.options,
         "fps": task.fps,
         "options_hash": task.options_hash,
+        "skeleton": task.skeleton,
         "status": status,
         "message": message,
         "cycle_file": None,
@@ -467,6 +470,24 @@ def _row(report: dict) -> dict[str, Any]:
     return row
 
 
+def _skeleton_signature(path: Path) -> list | None:
+    """``[path, size, mtime_ns]`` of the .asf an .amc capture is read with, else None.
+
+    An AMC holds only angles; the skeleton beside it (found as :func:`cyclecoord.load`
+    finds it) shapes the result too, so a changed .asf must make the report stale.
+    """
+    if path.suffix.lower() != ".amc":
+        return None
+    from .io.asfamc import find_skeleton
+
+    try:
+        asf = find_skeleton(path)
+        st = asf.stat()
+    except (ParseError, OSError):
+        return None  # the run fails and says why; a failed report is never reused
+    return [str(asf), int(st.st_size), int(st.st_mtime_ns)]
+
+
 def _up_to_date(task: _Task) -> dict[str, Any] | None:
     """The summary row from ``task``'s existing report, if it still holds; else None."""
     try:
@@ -474,9 +495,8 @@ def _up_to_date(task: _Task) -> dict[str, Any] | None:
         b = report["batch"]
         if b.get("status") not in ("ok", "no_periodic"):
             return None
-        if (b.get("file"), b.get("input_size"), b.get("input_mtime_ns"), b.get("options_hash")) != (
-            task.file, task.size, task.mtime_ns, task.options_hash,
-        ):
+        if (b.get("file"), b.get("input_size"), b.get("input_mtime_ns"), b.get("options_hash"),
+                b.get("skeleton")) != (task.file, task.size, task.mtime_ns, task.options_hash, task.skeleton):
             return None
         if b["status"] == "ok" and task.cycle_format is not None:
             cyc = b.get("cycle_file")
@@ -721,7 +741,7 @@ def run_batch(
         tasks.append(_Task(
             file=f, input=str(src / f), base=str(base), out_dir=str(out), size=int(st.st_size),
             mtime_ns=int(st.st_mtime_ns), options=options, fps=fps, cycle_format=write_cycles,
-            options_hash=opt_hash,
+            options_hash=opt_hash, skeleton=_skeleton_signature(src / f),
         ))
 
     out.mkdir(parents=True, exist_ok=True)

@@ -63,7 +63,7 @@ from ..motion import Motion
 from ..skeleton import DOF_NAMES, Joint, Skeleton, rotation_order_from_dofs
 from ._atomic import atomic_write
 
-__all__ = ["read_asf", "write_asf", "read_amc", "write_amc"]
+__all__ = ["read_asf", "write_asf", "read_amc", "write_amc", "find_skeleton"]
 
 PathLike = str | os.PathLike
 
@@ -821,7 +821,16 @@ def write_asf(skeleton: Skeleton, path: PathLike) -> None:
 
 
 # --------------------------------------------------------------------------- AMC read
-def _find_skeleton(amc_path: Path) -> Path:
+def find_skeleton(amc_path: Path) -> Path:
+    """The .asf that :func:`read_amc` uses for ``amc_path`` when no skeleton is given.
+
+    The only .asf in the AMC's folder, else ``<subject>.asf`` for ``<subject>_<trial>.amc``.
+
+    Raises
+    ------
+    ParseError
+        When neither rule finds exactly one file (the message says what was looked for).
+    """
     folder = amc_path.parent
     try:
         asfs = sorted(
@@ -852,7 +861,7 @@ def _resolve_skeleton(
     if isinstance(skeleton, Skeleton):
         return skeleton, None
     if skeleton is None:
-        asf = _find_skeleton(amc_path)
+        asf = find_skeleton(amc_path)
     elif isinstance(skeleton, (str, os.PathLike)):
         asf = Path(skeleton)
     else:
