@@ -7,7 +7,14 @@ import pytest
 
 import cyclecoord as cc
 from cyclecoord.cli import main
-from cyclecoord.detection import Segment, best_match_accuracy, boundary_errors, detect, excitation
+from cyclecoord.detection import (
+    Segment,
+    autocorrelation_period,
+    best_match_accuracy,
+    boundary_errors,
+    detect,
+    excitation,
+)
 
 
 @pytest.fixture(scope="module", params=[(("walk", "jumping_jack", "arm_circles"), 0), (("walk", "jog", "squat"), 1), (("squat", "arm_circles", "jog"), 2)])
@@ -196,3 +203,25 @@ def test_13_29_windows_find_the_slow_exercises(cmu_dir):
     assert acc >= 0.80 and acc > old + 0.3  # the target; global alone gets 28%
     names = {spans[t][2] for t in match.values()}
     assert {"JumpJack", "Twist", "ArmCircle", "ToeTouchOneHand", "KneeRaise", "Squat"} <= names
+    # each segment's period against the autocorrelation of its exercise's labelled frames
+    # (ArmCircle's labelled frames show no clear repetition to compare with)
+    truth_period = {"JumpJack": 134, "Twist": 424, "ToeTouchOneHand": 496, "KneeRaise": 335, "Squat": 375}
+    for s in res.segments:
+        name = spans[match[s.motion]][2]
+        if name in truth_period:
+            assert s.period_frames == pytest.approx(truth_period[name], rel=0.2), (name, s)
+
+
+def test_autocorrelation_period_refines_a_window_length_guess():
+    t = np.arange(700)
+    rng = np.random.default_rng(0)
+    poses = np.c_[np.sin(2 * np.pi * t / 480), np.cos(2 * np.pi * t / 480), 0.5 * np.sin(4 * np.pi * t / 480)]
+    poses = poses + 0.05 * rng.standard_normal(poses.shape)
+    # a 700-frame stretch holds 1.46 cycles of 480 frames; windows turning once would say ~700
+    assert autocorrelation_period(poses, 700.0) == pytest.approx(480, abs=5)
+    assert autocorrelation_period(poses, 480.0) == pytest.approx(480, abs=5)
+    # noise has no repetition: the guess stands; so does a guess the stretch cannot test
+    noise = rng.standard_normal((700, 3))
+    assert autocorrelation_period(noise, 300.0) == 300.0
+    assert autocorrelation_period(poses[:50], 480.0) == 480.0
+    assert autocorrelation_period(poses, float("nan")) != autocorrelation_period(poses, float("nan"))

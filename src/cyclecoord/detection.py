@@ -47,7 +47,8 @@ correctly.  A **windowed stage** looks locally:
    and :data:`NONE_COST` for "nothing periodic".  The cheapest labelling that pays half
    a ``window`` of frames per change (Viterbi) gives the labels; runs shorter than half
    a window are dropped.  A windowed segment's period is the median of its windows'
-   ``frames / cycles`` (those completing ``min_cycles`` when there are any).
+   ``frames / cycles`` (those completing ``min_cycles`` when there are any), refined by
+   the segment's own autocorrelation (:func:`autocorrelation_period`).
 
 ``method="auto"`` (the default) runs both: a group of windows whose frames overlap a
 global motion's excited frames by more than ``merge_overlap`` of the smaller region
@@ -87,6 +88,7 @@ __all__ = [
     "window_table",
     "binned_cycle",
     "cycle_distance",
+    "autocorrelation_period",
     "excitation",
     "best_match_accuracy",
     "boundary_errors",
@@ -637,6 +639,51 @@ def _typical_distance(poses: np.ndarray, cycle: np.ndarray) -> float:
     return max(float(np.median(distance_to_cycle(poses, cycle))), 1e-9)
 
 
+def autocorrelation_period(poses: np.ndarray, guess: float, min_correlation: float = 0.3) -> float:
+    """Refine a period estimate by the autocorrelation of a stretch of poses.
+
+    The poses (mean removed) are correlated with themselves shifted by every lag in
+    ``[guess / 2, min(1.5 guess, 0.8 T)]``; the lag of the highest correlation is the
+    period when it is an interior maximum of at least ``min_correlation``.  A windowed
+    segment's first estimate is the median of its windows' ``frames / turns``, which is
+    the window's length when the windows turn about once (a slow motion performed for
+    under two cycles); the stretch's own repetition fixes that.
+
+    Parameters
+    ----------
+    poses : ndarray, shape (T, D)
+        The frames of one segment.
+    guess : float
+        First estimate of the period, in frames.
+    min_correlation : float, default 0.3
+        Smallest normalised correlation accepted.
+
+    Returns
+    -------
+    float
+        The refined period in frames, or ``guess`` when no lag qualifies.
+    """
+    x = np.asarray(poses, dtype=float)
+    T = x.shape[0]
+    if not np.isfinite(guess) or guess <= 0:
+        return float(guess)
+    lo = max(2, int(np.floor(0.5 * guess)))
+    hi = min(int(np.ceil(1.5 * guess)), int(0.8 * T))
+    if hi - lo < 2:
+        return float(guess)
+    x = x - x.mean(axis=0)
+    lags = np.arange(lo - 1, hi + 2)
+    corr = np.empty(lags.size)
+    for i, lag in enumerate(lags):
+        a, b = x[: T - lag], x[lag:]
+        den = np.sqrt(np.sum(a * a) * np.sum(b * b))
+        corr[i] = np.sum(a * b) / den if den > 0 else -np.inf
+    j = int(np.argmax(corr[1:-1])) + 1
+    if corr[j] < min_correlation or corr[j] < corr[j - 1] or corr[j] < corr[j + 1]:
+        return float(guess)
+    return float(lags[j])
+
+
 def _windowed_motions(
     windows: list[WindowInfo],
     kept: list[DetectedClass],
@@ -734,7 +781,7 @@ def _windowed_motions(
             else:
                 inside = [w for w in c.windows if w.stop > a and w.start < b] or c.windows
                 multi = [w for w in inside if w.cycles >= min_cycles] or inside
-                period = float(np.median([w.period_frames for w in multi]))
+                period = autocorrelation_period(poses[a:b], float(np.median([w.period_frames for w in multi])))
                 cyc = (b - a) / period
                 classes = tuple(cl.index for cl in sorted(c.classes, key=lambda cl: cl.index))
                 birth = float(np.median([w.birth for w in inside]))
