@@ -12,6 +12,7 @@ from cyclecoord.cycle import (
     kernel_centroids,
     knn_centroids,
     resample_cyclic,
+    select_bandwidth,
     typical_cycle,
 )
 from cyclecoord.density import PeriodicDensity
@@ -278,3 +279,91 @@ def test_kernel_centroids_validate():
         kernel_centroids(np.zeros(5), np.zeros((4, 2)), np.zeros(3))
     with pytest.raises(ParameterError):
         kernel_centroids(np.zeros(5), np.zeros((5, 2)), np.zeros(3), k=6)
+
+
+# ------------------------------------------------------------ bandwidth selection
+def noisy_sine(noise, cycles=8, per=100, seed=0):
+    rng = np.random.default_rng(seed)
+    theta = np.mod(np.arange(cycles * per) / per, 1.0)
+    truth = np.stack([np.sin(2 * np.pi * theta), np.cos(4 * np.pi * theta)], axis=1)
+    return theta, truth + noise * rng.standard_normal(truth.shape), per
+
+
+def test_select_bandwidth_smooths_a_noisy_sine():
+    theta, poses, per = noisy_sine(0.5)
+    sel = select_bandwidth(theta, poses, per)
+    narrow = sel.candidates[0]
+    assert narrow <= 0.5 < sel.bandwidth <= per / 8
+    assert sel.cv_error.shape == sel.candidates.shape == sel.cv_se.shape
+    assert sel.cv_error[sel.index] == sel.cv_error.min()
+    q = np.arange(200) / 200
+    truth = np.stack([np.sin(2 * np.pi * q), np.cos(4 * np.pi * q)], axis=1)
+    err = lambda w: np.sqrt(np.mean((kernel_centroids(theta, poses, q, bandwidth=w / per) - truth) ** 2))
+    assert err(sel.bandwidth) < 0.5 * err(narrow)
+    # the one-standard-error rule never picks a narrower width
+    assert select_bandwidth(theta, poses, per, rule="1se").bandwidth >= sel.bandwidth
+
+
+def test_select_bandwidth_keeps_a_clean_curve_sharp():
+    theta, poses, per = noisy_sine(0.0)
+    poses = np.sin(2 * np.pi * 5 * theta)[:, None]  # five bumps a period, no noise
+    sel = select_bandwidth(theta, poses, per)
+    assert sel.bandwidth <= sel.candidates[1]
+
+
+def test_select_bandwidth_exclude_and_query():
+    theta, poses, per = noisy_sine(0.3, cycles=3)
+    a = select_bandwidth(theta, poses, per, exclude=2, max_validation=50)
+    assert a.exclude == 2 and a.n_validation == 50
+    # predicting every frame far from its own phase makes every width bad
+    b = select_bandwidth(theta, poses, per, query=np.mod(theta + 0.5, 1.0))
+    assert b.cv_error.min() > 5 * select_bandwidth(theta, poses, per).cv_error.min()
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"rule": "median"},
+        {"exclude": -1},
+        {"candidates": [0.0, 1.0]},
+        {"candidates": []},
+        {"period_frames": 0.0},
+        {"max_width": -3.0},
+        {"query": np.zeros(5)},
+    ],
+)
+def test_select_bandwidth_bad_parameters(kwargs):
+    theta, poses, per = noisy_sine(0.3, cycles=2)
+    args = {"period_frames": per, **kwargs}
+    with pytest.raises(ParameterError):
+        select_bandwidth(theta, poses, **args)
+
+
+@pytest.mark.parametrize("bandwidth", [0.0, -1.0, float("nan"), float("inf"), "wide", True])
+def test_bad_bandwidths_are_refused(noisy_motion, bandwidth):
+    theta, poses, _ = noisy_motion
+    with pytest.raises(ParameterError):
+        typical_cycle(theta, poses, PERIOD, bandwidth=bandwidth)
+    if not isinstance(bandwidth, str):
+        with pytest.raises(ParameterError):
+            kernel_centroids(theta, poses, [0.5], bandwidth=bandwidth)
+
+
+def test_numeric_bandwidth_needs_the_kernel(noisy_motion):
+    theta, poses, _ = noisy_motion
+    with pytest.raises(ParameterError):
+        typical_cycle(theta, poses, PERIOD, weighting="mean", bandwidth=3.0)
+    assert np.isnan(typical_cycle(theta, poses, PERIOD, weighting="mean", bandwidth="auto").bandwidth)
+
+
+def test_typical_cycle_reports_its_bandwidth(noisy_motion):
+    theta, poses, clean = noisy_motion
+    legacy = typical_cycle(theta, poses, PERIOD, random_state=0)
+    assert legacy.bandwidth == pytest.approx(10 / (len(theta) * np.sqrt(2 * np.pi)) * PERIOD)
+    assert legacy.bandwidth_selection is None
+    auto = typical_cycle(theta, poses, PERIOD, bandwidth="auto", random_state=0)
+    assert auto.bandwidth == auto.bandwidth_selection.bandwidth > legacy.bandwidth
+    err = lambda c: np.linalg.norm(c.frames - curve(c.phases), axis=1).mean()
+    assert err(auto) < err(legacy)
+    fixed = typical_cycle(theta, poses, PERIOD, bandwidth=auto.bandwidth, random_state=0)
+    np.testing.assert_allclose(fixed.frames, auto.frames)

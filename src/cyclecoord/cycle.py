@@ -33,6 +33,8 @@ __all__ = [
     "TypicalCycle",
     "knn_centroids",
     "kernel_centroids",
+    "BandwidthSelection",
+    "select_bandwidth",
     "resample_cyclic",
     "integrate_root",
     "typical_cycle",
@@ -60,6 +62,12 @@ def _positive_int(value: object, name: str, minimum: int = 1) -> int:
     if isinstance(value, bool) or not isinstance(value, Integral) or value < minimum:
         raise ParameterError(f"{name} must be an integer >= {minimum}, got {value!r}")
     return int(value)
+
+
+def _positive_float(value: object, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, Real) or not np.isfinite(value) or value <= 0:
+        raise ParameterError(f"{name} must be a positive finite number, got {value!r}")
+    return float(value)
 
 
 def _wrap01(x: np.ndarray) -> np.ndarray:
@@ -176,6 +184,7 @@ def kernel_centroids(
     phases: np.ndarray,
     k: int = 10,
     chunk_elements: int = 4_000_000,
+    bandwidth: float | None = None,
 ) -> np.ndarray:
     """Kernel-weighted average pose at each phase (Nadaraya-Watson on the circle).
 
@@ -191,11 +200,25 @@ def kernel_centroids(
     poses : array_like, shape (T, D)
     phases : array_like, shape (N,)
     k : int, default 10
-        Effective number of frames per average.
+        Effective number of frames per average; sets the width when ``bandwidth`` is
+        None.
+    chunk_elements : int, default 4,000,000
+        Largest weight matrix (phases x frames) built at once.
+    bandwidth : float, optional
+        Kernel width ``σ`` in *phase units* (a fraction of one period, ``0 < σ``);
+        default ``k / (T √(2π))``.  :func:`select_bandwidth` chooses one from the data
+        (it reports frames of the period; divide by the period in frames).
 
     Returns
     -------
     ndarray, shape (N, D)
+        One average pose per phase, in the units of ``poses``.
+
+    Raises
+    ------
+    ParameterError
+        For mismatched shapes, non-finite values, ``k`` outside ``1..T`` or a
+        non-positive bandwidth.
     """
     theta = _wrap01(_finite_array(theta, "theta", 1))
     poses = _finite_array(poses, "poses", 2)
@@ -206,7 +229,10 @@ def kernel_centroids(
     k = _positive_int(k, "k")
     if k > T:
         raise ParameterError(f"k must be between 1 and the number of frames ({T}), got {k}")
-    sigma = k / (T * np.sqrt(2.0 * np.pi))
+    if bandwidth is None:
+        sigma = k / (T * np.sqrt(2.0 * np.pi))
+    else:
+        sigma = _positive_float(bandwidth, "bandwidth")
     out = np.empty((phases.shape[0], poses.shape[1]))
     step = max(1, chunk_elements // max(T, 1))
     for a in range(0, phases.shape[0], step):
@@ -223,6 +249,192 @@ def kernel_centroids(
             tot[empty] = 1.0
         out[a : a + step] = (w / tot) @ poses
     return out
+
+
+@dataclass(frozen=True, eq=False)
+class BandwidthSelection:
+    """Result of :func:`select_bandwidth`.
+
+    Attributes
+    ----------
+    bandwidth : float
+        Chosen kernel width ``σ``, in frames of one period (``σ`` in phase units times
+        the period in frames).
+    candidates : ndarray, shape (G,)
+        Widths tried, in frames of one period, ascending.
+    cv_error : ndarray, shape (G,)
+        Mean leave-out squared prediction error per candidate, in squared pose units
+        (summed over channels, averaged over validation frames).
+    cv_se : ndarray, shape (G,)
+        Standard error of ``cv_error`` over the validation frames.
+    rule : str
+        ``"min"`` or ``"1se"``.
+    exclude : int
+        Frames on each side (in time) left out with the predicted frame.
+    n_validation : int
+        Number of frames whose prediction error was averaged.
+    """
+
+    bandwidth: float
+    candidates: np.ndarray
+    cv_error: np.ndarray
+    cv_se: np.ndarray
+    rule: str
+    exclude: int
+    n_validation: int
+
+    @property
+    def index(self) -> int:
+        """Position of the chosen width in ``candidates``."""
+        return int(np.argmin(np.abs(self.candidates - self.bandwidth)))
+
+
+_RULES = ("min", "1se")
+# what bandwidth="auto" uses (see select_bandwidth)
+_AUTO_RULE = "min"
+_AUTO_EXCLUDE = 0
+
+
+def select_bandwidth(
+    theta: np.ndarray,
+    poses: np.ndarray,
+    period_frames: float,
+    k: int = 10,
+    candidates: np.ndarray | None = None,
+    n_candidates: int = 14,
+    max_width: float | None = None,
+    rule: str = "min",
+    exclude: int = 0,
+    max_validation: int = 2000,
+    chunk_elements: int = 4_000_000,
+    query: np.ndarray | None = None,
+) -> BandwidthSelection:
+    """Kernel width for :func:`kernel_centroids` by leave-out cross-validation.
+
+    Each validation frame ``i`` is predicted by the Nadaraya-Watson average at its own
+    phase ``theta[i]`` over the *other* frames -- frame ``i`` and, with ``exclude > 0``,
+    the frames within ``exclude`` frames of it in time are given weight 0 -- and the
+    squared error ``||poses[i] - prediction||²`` is averaged over the validation frames.
+    Leaving out time neighbours guards against noise that is correlated from frame to
+    frame (it would otherwise reward widths that only copy the neighbours).
+
+    The cost is ``O(n_val · T · (D + 1))`` per candidate, in chunks of at most
+    ``chunk_elements`` weights.
+
+    Parameters
+    ----------
+    theta : array_like, shape (T,)
+        Circular coordinate of every frame (phase units, taken modulo 1), in frame
+        (time) order.
+    poses : array_like, shape (T, D)
+        The frames (any units; the error is summed over channels in these units).
+    period_frames : float
+        Length of one period in frames (> 0); converts widths between frames of the
+        period and phase units.
+    k : int, default 10
+        The default grid starts at :func:`kernel_centroids`' ``k``-based width,
+        ``k / (T √(2π))`` in phase units, or at half a frame if that is narrower.
+    candidates : array_like, optional
+        Widths to try, in frames of one period (positive); overrides the grid.
+    n_candidates : int, default 14
+        Size of the default log-spaced grid.
+    max_width : float, optional
+        Widest width of the default grid, in frames of one period; default
+        ``period_frames / 8``.
+    rule : {"min", "1se"}
+        ``"min"``: the width of least error; ``"1se"``: the widest width whose error is
+        within one standard error of the least.
+    exclude : int, default 0
+        Frames on each side of ``i`` (in time) left out with it; 0 is plain
+        leave-one-out.
+    max_validation : int, default 2000
+        At most this many validation frames, evenly spaced in time.
+    chunk_elements : int, default 4,000,000
+        Largest weight matrix (validation frames x frames) built at once.
+    query : array_like, shape (T,), optional
+        Where frame ``i`` is predicted (phase units); default ``theta[i]``.  A position
+        not computed from frame ``i`` itself (e.g. interpolated from its time
+        neighbours) keeps a coordinate estimated from the noisy poses from favouring
+        narrow widths.
+
+    Returns
+    -------
+    BandwidthSelection
+
+    Raises
+    ------
+    ParameterError
+        For mismatched shapes, non-finite values, non-positive widths or period, an
+        unknown rule, or too few frames left after exclusion.
+    """
+    theta = _wrap01(_finite_array(theta, "theta", 1))
+    poses = _finite_array(poses, "poses", (1, 2))
+    if poses.ndim == 1:
+        poses = poses[:, None]
+    T = theta.shape[0]
+    if poses.shape[0] != T:
+        raise ParameterError(f"theta has {T} values but poses has {poses.shape[0]} rows")
+    period = _positive_float(period_frames, "period_frames")
+    k = _positive_int(k, "k")
+    if k > T:
+        raise ParameterError(f"k must be between 1 and the number of frames ({T}), got {k}")
+    if rule not in _RULES:
+        raise ParameterError(f"rule must be one of {_RULES}, got {rule!r}")
+    exclude = _positive_int(exclude, "exclude", 0)
+    if T < 2 * exclude + 2:
+        raise ParameterError(f"{T} frames are too few to leave out {2 * exclude + 1} at a time")
+    max_validation = _positive_int(max_validation, "max_validation")
+    if query is None:
+        query = theta
+    else:
+        query = _wrap01(_finite_array(query, "query", 1))
+        if query.shape[0] != T:
+            raise ParameterError(f"query has {query.shape[0]} values for {T} frames")
+    if candidates is None:
+        n_candidates = _positive_int(n_candidates, "n_candidates")
+        lo = min(k / (T * np.sqrt(2.0 * np.pi)) * period, 0.5)
+        hi = period / 8.0 if max_width is None else _positive_float(max_width, "max_width")
+        widths = np.geomspace(lo, hi, n_candidates) if hi > lo and n_candidates > 1 else np.array([lo])
+    else:
+        widths = _finite_array(candidates, "candidates", 1)
+        if widths.size == 0 or np.any(widths <= 0):
+            raise ParameterError("candidates must be positive widths in frames of one period")
+        widths = np.unique(widths)
+    sig2 = (widths / period) ** 2  # phase units, squared
+
+    n_val = min(T, max_validation)
+    val = np.unique(np.round(np.linspace(0, T - 1, n_val)).astype(int))
+    n_val = val.size
+    err = np.empty((n_val, widths.size))
+    offsets = np.arange(-exclude, exclude + 1)
+    poses32 = poses.astype(np.float32)
+    step = max(1, chunk_elements // max(T, 1))
+    for a in range(0, n_val, step):
+        rows = val[a : a + step]
+        d = np.mod(query[rows, None] - theta[None, :] + 0.5, 1.0) - 0.5
+        d2 = d * d
+        cols = rows[:, None] + offsets[None, :]
+        ok = (cols >= 0) & (cols < T)
+        r_idx = np.broadcast_to(np.arange(rows.size)[:, None], cols.shape)
+        d2[r_idx[ok], cols[ok]] = np.inf
+        d2 -= d2.min(axis=1, keepdims=True)  # nearest kept frame at weight 1: no underflow
+        d2 = d2.astype(np.float32)  # single precision halves the cost; ample for a choice
+        target = poses[rows]
+        for g, s2 in enumerate(sig2):
+            w = np.exp(d2 * np.float32(-0.5 / s2))
+            pred = (w @ poses32) / w.sum(axis=1, keepdims=True, dtype=float)
+            err[a : a + step, g] = np.sum((target - pred) ** 2, axis=1)
+    mean = err.mean(axis=0)
+    se = err.std(axis=0, ddof=1) / np.sqrt(n_val) if n_val > 1 else np.zeros_like(mean)
+    best = int(np.argmin(mean))
+    if rule == "1se":
+        best = int(np.flatnonzero(mean <= mean[best] + se[best]).max())
+    for arr in (widths, mean, se):
+        arr.flags.writeable = False
+    return BandwidthSelection(
+        bandwidth=float(widths[best]), candidates=widths, cv_error=mean, cv_se=se,
+        rule=rule, exclude=exclude, n_validation=int(n_val),
+    )
 
 
 def resample_cyclic(curve: np.ndarray, n_out: int, times: np.ndarray | None = None) -> np.ndarray:
@@ -339,6 +551,29 @@ def integrate_root(
 
 
 # --------------------------------------------------------------------- typical cycle
+def _heldout_times(theta: np.ndarray, density: PeriodicDensity, exclude: int = 0) -> np.ndarray:
+    """Time (fraction of the period) of each frame interpolated from its time neighbours.
+
+    The coordinate of frame ``i`` is computed from frame ``i``'s own noisy pose, so
+    frames near it in coordinate tend to share its noise; predicting frame ``i`` at the
+    midpoint of frames ``i - exclude - 1`` and ``i + exclude + 1`` (on the unwrapped,
+    density-warped coordinate, which advances about linearly in time) removes that
+    dependence.  The two end frames are extrapolated from their one-sided neighbours.
+    """
+    n = theta.shape[0]
+    lifted = density.cdf(np.unwrap(2.0 * np.pi * _wrap01(theta)) / (2.0 * np.pi))
+    if n < 2 * exclude + 4:
+        return _wrap01(lifted)
+    g = exclude + 1
+    out = lifted.copy()
+    out[g : n - g] = 0.5 * (lifted[: n - 2 * g] + lifted[2 * g :])
+    i = np.arange(g)  # first frames: extrapolate from frames i + g and i + g + 1
+    out[:g] = lifted[i + g] - g * (lifted[i + g + 1] - lifted[i + g])
+    j = np.arange(n - g, n)  # last frames: from frames j - g and j - g - 1
+    out[n - g :] = lifted[j - g] + g * (lifted[j - g] - lifted[j - g - 1])
+    return _wrap01(out)
+
+
 @dataclass(frozen=True, eq=False)
 class TypicalCycle:
     """One typical period of a motion.
@@ -355,12 +590,20 @@ class TypicalCycle:
         Centroid curve at the sampled phases.
     sample_phases : ndarray, shape (N,)
         The sampled phases, sorted ascending, in ``[0, 1)``.
+    bandwidth : float
+        Width ``σ`` of the kernel average, in frames of one period (NaN for the
+        ``"mean"`` and ``"gaussian"`` weightings).
+    bandwidth_selection : BandwidthSelection or None
+        The cross-validation behind ``bandwidth`` when it was chosen with
+        ``bandwidth="auto"``.
     """
 
     frames: np.ndarray
     phases: np.ndarray
     curve: np.ndarray
     sample_phases: np.ndarray
+    bandwidth: float = float("nan")
+    bandwidth_selection: BandwidthSelection | None = None
 
     @property
     def n_frames(self) -> int:
@@ -378,6 +621,7 @@ def typical_cycle(
     weighting: str = "kernel",
     sampling: str = "quantile",
     random_state: None | int | np.random.Generator = None,
+    bandwidth: None | str | float = None,
 ) -> TypicalCycle:
     """Build the typical cycle of a motion from its circular coordinate.
 
@@ -408,6 +652,12 @@ def typical_cycle(
         draws from the density, placed in time by the density's cdf.
     random_state : None, int or numpy Generator
         Seed for the density fit and the random sampling.
+    bandwidth : None, "auto" or float
+        Width ``σ`` of the ``"kernel"`` weighting, in frames of one period.  None:
+        ``k`` frames' worth, ``k / (T √(2π))`` in phase units (a fraction of a frame
+        when the capture holds many cycles); ``"auto"``: chosen by leave-one-out
+        cross-validation (:func:`select_bandwidth`); a positive number: that width.
+        None and ``"auto"`` are ignored by the other weightings.
 
     Returns
     -------
@@ -417,7 +667,9 @@ def typical_cycle(
     ------
     ParameterError
         For bad shapes or values, ``period_frames < 2``, an unfitted density, an unknown
-        sampling or weighting, or ``k`` larger than the number of frames.
+        sampling or weighting, ``k`` larger than the number of frames, or a bandwidth
+        that is not None, ``"auto"`` or a positive number (or a number with a weighting
+        other than ``"kernel"``).
     """
     if isinstance(period_frames, bool) or not isinstance(period_frames, Real) or not np.isfinite(period_frames):
         raise ParameterError(f"period_frames must be a finite number, got {period_frames!r}")
@@ -432,6 +684,12 @@ def typical_cycle(
     theta = _finite_array(theta, "theta", 1)
     if isinstance(k, bool) or not isinstance(k, Integral) or not 1 <= k <= theta.shape[0]:
         raise ParameterError(f"k must be an integer between 1 and the number of frames ({theta.shape[0]}), got {k!r}")
+    if bandwidth is not None and not (isinstance(bandwidth, str) and bandwidth == "auto"):
+        if isinstance(bandwidth, str):
+            raise ParameterError(f"bandwidth must be None, 'auto' or a positive number, got {bandwidth!r}")
+        bandwidth = _positive_float(bandwidth, "bandwidth")
+        if weighting != "kernel":
+            raise ParameterError(f"a numeric bandwidth needs weighting='kernel', got {weighting!r}")
     rng = _as_generator(random_state)
 
     if density is None:
@@ -449,12 +707,34 @@ def typical_cycle(
         times = density.cdf(sample_phases)
     sample_phases = _wrap01(sample_phases)
 
-    if weighting == "kernel":
+    selection = None
+    width = float("nan")
+    if weighting == "kernel" and bandwidth is None:
+        # legacy: k frames' worth of width in the phase
+        width = k / (theta.shape[0] * np.sqrt(2.0 * np.pi)) * float(period_frames)
         curve = kernel_centroids(theta, poses, sample_phases, k=k)
+    elif weighting == "kernel":
+        # the kernel runs in time: frame i sits at time cdf(theta_i) of the period, the
+        # sampled phases at `times`, so a width in frames means the same everywhere on
+        # the cycle however unevenly the coordinate advances
+        tau = _wrap01(density.cdf(_wrap01(theta)))
+        if bandwidth == "auto":
+            selection = select_bandwidth(
+                tau, poses, float(period_frames), k=k, rule=_AUTO_RULE, exclude=_AUTO_EXCLUDE,
+                query=_heldout_times(theta, density, _AUTO_EXCLUDE),
+            )
+            width = selection.bandwidth
+        else:
+            width = bandwidth
+        curve = kernel_centroids(tau, poses, _wrap01(np.asarray(times, dtype=float)), k=k,
+                                 bandwidth=width / float(period_frames))
     else:
         curve = knn_centroids(theta, poses, sample_phases, k=k, weighting=weighting)
     frames = resample_cyclic(curve, n_cycle, times=times)
     phases = _wrap01(density.ppf(np.arange(n_cycle) / n_cycle))
     for arr in (frames, phases, curve, sample_phases):
         arr.flags.writeable = False
-    return TypicalCycle(frames=frames, phases=phases, curve=curve, sample_phases=sample_phases)
+    return TypicalCycle(
+        frames=frames, phases=phases, curve=curve, sample_phases=sample_phases,
+        bandwidth=float(width), bandwidth_selection=selection,
+    )

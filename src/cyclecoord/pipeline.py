@@ -10,6 +10,7 @@ from __future__ import annotations
 import time
 import warnings
 from dataclasses import dataclass, field
+from numbers import Real
 from typing import Any
 
 import numpy as np
@@ -163,6 +164,7 @@ class ExtractionResult:
             "cycle_length": int(self.cycle.n_frames),
             "jerk": self.jerk,
             "loop_closure": float(self.loop_closure),
+            "bandwidth_frames": float(self.typical.bandwidth) if np.isfinite(self.typical.bandwidth) else None,
             "distance_to_cycle": self.distance,
             "landmarks": _landmark_report(self.estimator),
             "cocycle_check": {
@@ -206,6 +208,7 @@ def extract(
     scale_fraction: float = 0.9,
     n_samples: int = 500,
     n_neighbors: int = 10,
+    bandwidth: str | float | None = None,
     weighting: str = "kernel",
     sampling: str = "quantile",
     n_components: int = 30,
@@ -249,7 +252,13 @@ def extract(
     n_samples : int, default 500
         Phases sampled from the periodic density for the centroid curve.
     n_neighbors : int, default 10
-        Frames averaged per sampled phase.
+        Frames averaged per sampled phase (sets the kernel width when ``bandwidth`` is
+        None).
+    bandwidth : None, "auto" or float
+        Width of the kernel average in frames of one period: None for ``n_neighbors``
+        frames' worth, ``"auto"`` for leave-one-out cross-validation, or a positive
+        number (see :func:`~cyclecoord.cycle.typical_cycle`); the width used is
+        ``result.typical.bandwidth``.
     weighting : {"kernel", "mean", "gaussian"}
         How frames near a phase are averaged: a smooth periodic kernel holding about
         ``n_neighbors`` frames (default), the paper's plain mean of the ``n_neighbors``
@@ -296,13 +305,17 @@ def extract(
         raise ParameterError(f"n_samples must be at least 10, got {n_samples}")
     if n_neighbors < 1:
         raise ParameterError(f"n_neighbors must be at least 1, got {n_neighbors}")
+    if not (bandwidth is None or (isinstance(bandwidth, str) and bandwidth == "auto") or (
+        isinstance(bandwidth, Real) and not isinstance(bandwidth, bool) and np.isfinite(bandwidth) and bandwidth > 0
+    )):
+        raise ParameterError(f"bandwidth must be None, 'auto' or a positive number of frames, got {bandwidth!r}")
     timings: dict[str, float] = {}
     notes: list[str] = []
     params = dict(
         frames=None if frames is None else list(frames), pca=pca, normalize=normalize, temporal=temporal,
         delay=delay, difference_root=difference_root, root=root, prime=prime, max_scale=max_scale, scale=scale,
         class_index=class_index, scale_fraction=scale_fraction, n_samples=n_samples,
-        n_neighbors=n_neighbors, weighting=weighting, sampling=sampling, n_components=n_components,
+        n_neighbors=n_neighbors, bandwidth=bandwidth, weighting=weighting, sampling=sampling, n_components=n_components,
         cycle_start=cycle_start, landmarks=landmarks, memory_limit=memory_limit, random_state=random_state,
     )
     motion = motion.window(frames)
@@ -399,7 +412,7 @@ def extract(
     k = min(n_neighbors, motion.n_frames)
     typ = typical_cycle(
         theta, prepared.poses, period, density=density, n_samples=n_samples, k=k,
-        weighting=weighting, sampling=sampling, random_state=random_state,
+        weighting=weighting, sampling=sampling, random_state=random_state, bandwidth=bandwidth,
     )
     if cycle_start == "slowest":
         shift = slowest_frame(np.delete(typ.frames, prepared.root_columns, axis=1) if prepared.root_columns.size < typ.frames.shape[1] else typ.frames)
