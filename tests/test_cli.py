@@ -37,6 +37,22 @@ def test_extract_options_reach_the_pipeline(tmp_path, capsys):
     assert code == 0, err
     r = json.loads(rep.read_text())
     assert r["frames"] == [0, 300] and r["dims"] == 5 and r["threshold"] == 30
+    assert r["bandwidth_frames"] == pytest.approx(8 / (300 * np.sqrt(2 * np.pi)) * r["period_frames"])
+
+
+def test_extract_bandwidth_option(tmp_path, capsys):
+    rep = tmp_path / "r.json"
+    code, out, err = run(capsys, "extract", "example", "--bandwidth", "auto", "--report", rep)
+    assert code == 0, err
+    assert "(cross-validated)" in out
+    chosen = json.loads(rep.read_text())["bandwidth_frames"]
+    assert chosen > 0 and f"kernel width {chosen:.3g} frames" in out
+    code, out, err = run(capsys, "extract", "example", "--bandwidth", "3.5", "--report", rep)
+    assert code == 0 and json.loads(rep.read_text())["bandwidth_frames"] == 3.5
+    with pytest.raises(SystemExit):
+        run(capsys, "extract", "example", "--bandwidth", "wide")
+    code, out, err = run(capsys, "extract", "example", "--bandwidth", "auto", "--weighting", "mean")
+    assert code == 1 and "needs weighting='kernel'" in err and "Traceback" not in err
 
 
 def test_no_periodic_motion_exits_3_and_still_reports(tmp_path, capsys):

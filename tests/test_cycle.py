@@ -349,11 +349,13 @@ def test_bad_bandwidths_are_refused(noisy_motion, bandwidth):
             kernel_centroids(theta, poses, [0.5], bandwidth=bandwidth)
 
 
-def test_numeric_bandwidth_needs_the_kernel(noisy_motion):
+def test_a_bandwidth_needs_the_kernel(noisy_motion):
     theta, poses, _ = noisy_motion
     with pytest.raises(ParameterError):
         typical_cycle(theta, poses, PERIOD, weighting="mean", bandwidth=3.0)
-    assert np.isnan(typical_cycle(theta, poses, PERIOD, weighting="mean", bandwidth="auto").bandwidth)
+    with pytest.raises(ParameterError, match="needs weighting='kernel'"):
+        typical_cycle(theta, poses, PERIOD, weighting="mean", bandwidth="auto")
+    assert np.isnan(typical_cycle(theta, poses, PERIOD, weighting="mean").bandwidth)
 
 
 def test_typical_cycle_reports_its_bandwidth(noisy_motion):

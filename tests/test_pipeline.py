@@ -96,6 +96,11 @@ def test_bad_arguments():
         cc.extract(m, weighting="median")
     with pytest.raises(cc.ParameterError, match="outside"):
         cc.extract(m, scale=0.01)
+    for bad in (-1.0, 0, "wide", float("nan"), True):
+        with pytest.raises(cc.ParameterError, match="bandwidth"):
+            cc.extract(m, bandwidth=bad)
+    with pytest.raises(cc.ParameterError, match="needs weighting='kernel'"):
+        cc.extract(m, bandwidth="auto", weighting="mean")
 
 
 def test_cycle_lengths_and_slowest_frame():

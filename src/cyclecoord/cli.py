@@ -49,6 +49,15 @@ def _positive_int(text: str) -> int:
     return v
 
 
+def _bandwidth(text: str) -> str | float:
+    if text == "auto":
+        return text
+    try:
+        return _positive_float(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected 'auto' or a positive number of frames, got {text!r}") from None
+
+
 def _positive_float(text: str) -> float:
     try:
         v = float(text)
@@ -231,6 +240,7 @@ def cmd_extract(args: argparse.Namespace) -> int:
             class_index=args.class_index,
             n_samples=args.samples,
             n_neighbors=args.neighbors,
+            bandwidth=args.bandwidth,
             weighting=args.weighting,
             sampling=args.sampling,
             cycle_start=args.cycle_start,
@@ -284,6 +294,9 @@ def cmd_extract(args: argparse.Namespace) -> int:
         print(
             f"cycle: {res.cycle.n_frames} frames, loop closure {res.loop_closure:.2f} (seam step / median step; up to 1.5 loops cleanly), "
             f"jerk {res.jerk['cycle']:.4g} vs original {res.jerk['original']:.4g} (ratio {ratio:.2f})"
+            + (f"; kernel width {res.typical.bandwidth:.3g} frames in time"
+               + (" (cross-validated)" if res.typical.bandwidth_selection is not None else "")
+               if args.bandwidth is not None else "")
         )
         print(
             f"frames to cycle: median distance {res.distance['median']:.3g} "
@@ -739,6 +752,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="use the I-th most persistent H1 class (default 0)")
     g.add_argument("--samples", type=_positive_int, default=500, metavar="N", help="phases sampled from the density (500)")
     g.add_argument("--neighbors", type=_positive_int, default=10, metavar="K", help="frames averaged per phase (10; should exceed the number of cycles)")
+    g.add_argument("--bandwidth", type=_bandwidth, default=None, metavar="auto|F",
+                   help="width of the kernel average in frames of one period, run in time rather "
+                   "than phase: 'auto' picks it by leave-one-out cross-validation (smoother cycles "
+                   "from noisy captures; slower on long ones), a number fixes it (default: K frames' worth)")
     g.add_argument("--weighting", choices=("kernel", "mean", "gaussian"), default="kernel",
                    help="how frames near a phase are averaged: smooth kernel (default), the paper's "
                    "k-nearest mean, or k-nearest Gaussian-weighted")

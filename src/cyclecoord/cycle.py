@@ -657,7 +657,7 @@ def typical_cycle(
         ``k`` frames' worth, ``k / (T √(2π))`` in phase units (a fraction of a frame
         when the capture holds many cycles); ``"auto"``: chosen by leave-one-out
         cross-validation (:func:`select_bandwidth`); a positive number: that width.
-        None and ``"auto"`` are ignored by the other weightings.
+        The other weightings take only None.
 
     Returns
     -------
@@ -688,8 +688,8 @@ def typical_cycle(
         if isinstance(bandwidth, str):
             raise ParameterError(f"bandwidth must be None, 'auto' or a positive number, got {bandwidth!r}")
         bandwidth = _positive_float(bandwidth, "bandwidth")
-        if weighting != "kernel":
-            raise ParameterError(f"a numeric bandwidth needs weighting='kernel', got {weighting!r}")
+    if bandwidth is not None and weighting != "kernel":
+        raise ParameterError(f"bandwidth={bandwidth!r} needs weighting='kernel', got {weighting!r}")
     rng = _as_generator(random_state)
 
     if density is None:

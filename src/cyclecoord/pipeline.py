@@ -309,6 +309,8 @@ def extract(
         isinstance(bandwidth, Real) and not isinstance(bandwidth, bool) and np.isfinite(bandwidth) and bandwidth > 0
     )):
         raise ParameterError(f"bandwidth must be None, 'auto' or a positive number of frames, got {bandwidth!r}")
+    if bandwidth is not None and weighting != "kernel":
+        raise ParameterError(f"bandwidth={bandwidth!r} needs weighting='kernel', got {weighting!r}")
     timings: dict[str, float] = {}
     notes: list[str] = []
     params = dict(
