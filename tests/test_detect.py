@@ -7,9 +7,11 @@ import pytest
 
 import cyclecoord as cc
 from cyclecoord.cli import main
+from cyclecoord.metrics import distance_to_cycle
 from cyclecoord.detection import (
     Segment,
     autocorrelation_period,
+    motion_cycles,
     best_match_accuracy,
     boundary_errors,
     detect,
@@ -35,6 +37,30 @@ def test_chain_motions_are_found_and_segmented(chain):
     for sg in res.segments:
         kind = cap.boundaries[match[sg.motion]][2]
         assert sg.period_frames == pytest.approx(periods[kind], rel=0.25)
+
+
+def _closest_cycle(frames, cycles):
+    """Index of the cycle nearest to most of ``frames`` (joint channels only)."""
+    d = np.array([distance_to_cycle(frames[:, 6:], c.cycle.frames[:, 6:]) for c in cycles])
+    return int(np.bincount(np.argmin(d, axis=0), minlength=len(cycles)).argmax())
+
+
+def test_motion_cycles_follow_the_detected_classes(chain):
+    cap, res = chain
+    _, match = best_match_accuracy(res.labels, cap.labels)
+    periods = dict(zip([k for _, _, k in cap.boundaries], cap.motion.metadata["periods"]))
+    cycles = motion_cycles(res)
+    assert [c.motion for c in cycles] == list(range(res.n_motions))
+    for c in cycles:
+        kind = cap.boundaries[match[c.motion]][2]
+        assert c.phase_from.startswith("class")
+        assert c.cycle.n_frames == round(c.period_frames)
+        assert c.period_frames == pytest.approx(periods[kind], rel=0.25)
+        assert c.loop_closure <= 1.5
+        assert c.cycle.channels == cap.motion.channels and c.cycle.fps == cap.motion.fps
+        # the motion's own frames are nearer its cycle than any other motion's cycle
+        a, b, _ = cap.boundaries[match[c.motion]]
+        assert _closest_cycle(cap.motion.frames[a:b], cycles) == c.motion
 
 
 def test_report_and_labels(chain):
@@ -114,7 +140,7 @@ def test_windows_find_a_small_motion_the_global_barcode_misses():
     old = detect(m, method="global", progress=False)
     acc_old, _ = best_match_accuracy(old.labels, cap.labels)
     assert old.n_motions == 1 and acc_old < 0.6  # the paper's method sees only the squat
-    for method in ("auto", "windows"):
+    for method in ("windows", "auto"):  # auto last: its result is used below
         res = detect(m, method=method, progress=False)
         acc, match = best_match_accuracy(res.labels, cap.labels)
         assert res.n_motions == 2 and sorted(match.values()) == [0, 1], method
@@ -123,6 +149,16 @@ def test_windows_find_a_small_motion_the_global_barcode_misses():
         jog = [s for s in res.segments if match.get(s.motion) == 1]
         assert jog and all(s.period_frames == pytest.approx(80, rel=0.25) for s in jog)
         assert any(w.looping and w.motion >= 0 for w in res.windows)
+    # under auto the jog has no global class: its typical cycle takes its phase from time
+    # over the segment's period, and the jog's frames are nearer it than the squat's cycle
+    cycles = motion_cycles(res)
+    jog_id = next(k for k, t in match.items() if t == 1)
+    jog_cycle = next(c for c in cycles if c.motion == jog_id)
+    assert jog_cycle.phase_from == "time"
+    assert jog_cycle.cycle.n_frames == round(jog_cycle.period_frames)
+    assert jog_cycle.period_frames == pytest.approx(80, rel=0.25) and jog_cycle.loop_closure <= 1.5
+    a, b, _ = cap.boundaries[1]
+    assert _closest_cycle(m.frames[a:b], cycles) == jog_id
 
 
 def test_windowed_report_and_parameters(chain):

@@ -406,22 +406,20 @@ def cmd_detect(args: argparse.Namespace) -> int:
     for w in res.warnings:
         print(f"warning: {w}")
     if args.extract and code == EXIT_OK:
+        from .detection import motion_cycles
+
         folder = Path(args.extract)
         folder.mkdir(parents=True, exist_ok=True)
-        for mid in range(res.n_motions):
-            segs = [s for s in res.segments if s.motion == mid]
-            best = max(segs, key=lambda s: s.stop - s.start)
-            try:
-                ex = extract(
-                    m, frames=(best.start, best.stop), require_clear=False,
-                    delay=args.delay if args.delay > 0 else None, landmarks=args.landmarks,
-                )
-            except CycleCoordError as exc:
-                print(f"motion {mid}: no cycle ({exc})")
-                continue
-            out = folder / f"motion{mid}_cycle.bvh"
-            save(ex.cycle, out)
-            print(f"motion {mid}: cycle of {ex.cycle.n_frames} frames from frames {best.start}:{best.stop} -> {out}")
+        for mc in motion_cycles(res):
+            out = folder / f"motion{mc.motion}_cycle.bvh"
+            save(mc.cycle, out)
+            how = (f"phase from H1 {mc.phase_from}'s coordinate on {mc.n_frames_used} excited frames"
+                   if mc.phase_from != "time" else f"phase from time over {mc.n_frames_used} frames")
+            print(
+                f"motion {mc.motion}: cycle of {mc.cycle.n_frames} frames from frames "
+                f"{m.start_frame + mc.start}:{m.start_frame + mc.stop} ({how}), loop closure "
+                f"{mc.loop_closure:.2f} -> {out}"
+            )
     if args.plot:
         from .plot import plot_barcode, plot_coordinate
 

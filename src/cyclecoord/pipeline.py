@@ -25,7 +25,7 @@ from .metrics import distance_to_cycle, jerk_summary, loop_closure
 from .motion import Motion
 from .preprocess import PreparedData, Preprocessor
 
-__all__ = ["extract", "ExtractionResult", "cycle_lengths", "slowest_frame", "MIN_CYCLES"]
+__all__ = ["extract", "ExtractionResult", "loop_cycle", "cycle_lengths", "slowest_frame", "MIN_CYCLES"]
 
 #: A clip whose coordinate goes round fewer times than this holds no measurable period.
 MIN_CYCLES = 0.75
@@ -191,6 +191,71 @@ def _landmark_report(est: CircularCoordinates | None) -> dict | None:
 
 
 @one_blas_thread
+def loop_cycle(
+    typical: TypicalCycle,
+    motion: Motion,
+    prepared: PreparedData,
+    preprocessor: Preprocessor,
+    cycle_start: str = "slowest",
+    rows: np.ndarray | None = None,
+    metadata: dict | None = None,
+) -> tuple[TypicalCycle, Motion]:
+    """Turn a typical cycle in the prepared space into a loopable clip of the capture.
+
+    The cycle is rotated to begin at its slowest pose (``cycle_start="slowest"``, where
+    a loop's seam is least visible), and its root channels, per-frame differences in the
+    prepared space, are integrated so that the clip travels and turns per frame as the
+    capture did on average.
+
+    Parameters
+    ----------
+    typical : TypicalCycle
+        From :func:`~cyclecoord.cycle.typical_cycle` on ``prepared.poses`` (or rows of it).
+    motion : Motion
+        The capture ``prepared`` was made from.
+    prepared : PreparedData
+    preprocessor : Preprocessor
+        The fitted preprocessor that made ``prepared``.
+    cycle_start : {"slowest", "first"}
+    rows : ndarray of int, optional
+        The frames the cycle was averaged from (default all); their root differences
+        give the travel per frame.
+    metadata : dict, optional
+        Stored on the returned clip.
+
+    Returns
+    -------
+    (TypicalCycle, Motion)
+        The cycle (rotated when ``cycle_start="slowest"``) and the clip, with the
+        capture's channels, skeleton and frame rate.
+    """
+    if cycle_start not in ("slowest", "first"):
+        raise ParameterError(f"cycle_start must be 'slowest' or 'first', got {cycle_start!r}")
+    root = prepared.root_columns
+    if cycle_start == "slowest":
+        joints = np.delete(typical.frames, root, axis=1) if root.size < typical.frames.shape[1] else typical.frames
+        shift = slowest_frame(joints)
+        if shift:
+            from dataclasses import replace
+
+            typical = replace(
+                typical,
+                frames=np.roll(typical.frames, -shift, axis=0),
+                phases=np.roll(typical.phases, -shift),
+            )
+    cyc = np.array(typical.frames, dtype=float)
+    if root.size:
+        last = len(prepared.poses) - 1  # the last row repeats the one before (see difference_root)
+        used = np.arange(last) if rows is None else np.asarray(rows, dtype=int)
+        used = used[used < last] if np.any(used < last) else used
+        mean_delta = prepared.poses[used][:, root].mean(axis=0)
+        cyc[:, root] = preprocessor.integrate_root(typical.frames[:, root], motion.frames[int(used.min()), root], mean_delta, motion)
+    clip = motion.with_frames(
+        cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}", metadata=dict(metadata or {}),
+    )
+    return typical, clip
+
+
 def extract(
     motion: Motion,
     frames: tuple[int | None, int | None] | None = None,
@@ -416,24 +481,8 @@ def extract(
         theta, prepared.poses, period, density=density, n_samples=n_samples, k=k,
         weighting=weighting, sampling=sampling, random_state=random_state, bandwidth=bandwidth,
     )
-    if cycle_start == "slowest":
-        shift = slowest_frame(np.delete(typ.frames, prepared.root_columns, axis=1) if prepared.root_columns.size < typ.frames.shape[1] else typ.frames)
-        if shift:
-            from dataclasses import replace as _replace
-
-            typ = _replace(
-                typ,
-                frames=np.roll(typ.frames, -shift, axis=0),
-                phases=np.roll(typ.phases, -shift),
-            )
-    cyc = np.array(typ.frames, dtype=float)
-    root = prepared.root_columns
-    if root.size:
-        # loop the cycle so it travels and turns, per frame, as the capture did on average
-        mean_delta = prepared.poses[:-1, root].mean(axis=0)
-        cyc[:, root] = prep.integrate_root(typ.frames[:, root], motion.frames[0, root], mean_delta, motion)
-    cycle_motion = motion.with_frames(
-        cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}",
+    typ, cycle_motion = loop_cycle(
+        typ, motion, prepared, prep, cycle_start=cycle_start,
         metadata={"period_frames": period, "cycles_in_source": cycles},
     )
     timings["cycle"] = time.perf_counter() - t0
