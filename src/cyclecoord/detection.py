@@ -40,7 +40,7 @@ correctly.  A **windowed stage** looks locally:
    ``min_cycles`` turns, or when at least three of its windows together cover
    ``min_cycles`` of their median period (a slow motion performed for under two of its
    cycles, which no single window holds one and a half times: 13_29's alternating toe
-   touches take about 4.3 s a cycle and are performed for 6.5 s).
+   touches take about 4.1 s a cycle and are performed for 6.5 s).
 8. **Labels**: every frame within ``window`` seconds of a motion's windows may take that
    motion; the cost of a frame is its :func:`~cyclecoord.metrics.distance_to_cycle` to the
    motion's nearest window cycle, over that cycle's typical distance to its own frames,
