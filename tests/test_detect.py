@@ -107,8 +107,12 @@ def test_scoring_helpers():
 
 def test_cli_detect(tmp_path, capsys):
     rep, out = tmp_path / "d.json", tmp_path / "cycles"
-    code = main(["detect", "example:chain", "--report", str(rep), "--extract", str(out)])
+    figs = tmp_path / "figs"
+    code = main(["detect", "example:chain", "--report", str(rep), "--extract", str(out), "--plot", str(figs)])
     assert code == 0
+    for name in ("barcode.png", "coordinates.png", "windows.png"):
+        data = (figs / name).read_bytes()
+        assert data.startswith(b"\x89PNG") and len(data) > 5000, name
     r = json.loads(rep.read_text())
     assert r["n_motions"] == 3 and len(r["labels"]) == r["n_frames"]
     cycles = sorted(out.glob("motion*_cycle.bvh"))

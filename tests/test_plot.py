@@ -298,6 +298,30 @@ def test_save_figures_writes_five_real_pngs(result, tmp_path):
         plot.save_figures(result, tmp_path / "afile")
 
 
+# ------------------------------------------------------------------ windows (detect)
+def test_windows_one_bar_per_window_coloured_by_motion(tmp_path):
+    from cyclecoord.detection import detect
+
+    m = cc.datasets.make_motion_chain(kinds=("walk", "squat"), segment_frames=400, random_state=0).motion
+    res = detect(m, progress=False)
+    fig = plot.plot_windows(res)
+    ax = fig.axes[0]
+    bars = [c for c in ax.collections if c.get_paths()]
+    assert len(bars) == len(res.windows)
+    lengths = sorted({w.stop - w.start for w in res.windows})
+    assert [t.get_text() for t in ax.get_yticklabels()] == [f"{n / m.fps:.3g} s" for n in lengths]
+    for w, bar in zip(res.windows, bars):
+        want = f"C{w.motion % 10}" if w.motion >= 0 else ("0.6" if w.looping else "0.92")
+        assert np.allclose(bar.get_facecolor()[0][:3], to_rgba(want)[:3])
+    assert any(w.motion >= 0 for w in res.windows)
+    fig.savefig(tmp_path / "w.png")
+    _check_image(tmp_path / "w.png")
+    with pytest.raises(ParameterError, match="method='global'"):
+        plot.plot_windows(detect(m, method="global", progress=False))
+    with pytest.raises(ParameterError, match="DetectionResult"):
+        plot.plot_windows(m)
+
+
 # ------------------------------------------------------------------ render
 def test_render_gif_frames_and_motion(capture, tmp_path):
     m = capture.motion[:48]

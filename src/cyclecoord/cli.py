@@ -421,7 +421,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 f"{mc.loop_closure:.2f} -> {out}"
             )
     if args.plot:
-        from .plot import plot_barcode, plot_coordinate
+        from .plot import plot_barcode, plot_coordinate, plot_windows
 
         folder = Path(args.plot)
         folder.mkdir(parents=True, exist_ok=True)
@@ -436,8 +436,11 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 f"class {c.index}": c.coordinate for c in res.classes[:4]
             }
             figs["coordinates.png"] = plot_coordinate(
-                coords, segments=[(s.start, s.stop, f"motion {s.motion}") for s in res.segments]
+                coords, start_frame=m.start_frame,
+                segments=[(m.start_frame + s.start, m.start_frame + s.stop, f"motion {s.motion}") for s in res.segments],
             )
+        if res.windows:
+            figs["windows.png"] = plot_windows(res)
         from .io._atomic import atomic_write
 
         for name, fig in figs.items():
@@ -813,7 +816,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--no-progress", action="store_true", help="no progress bar over the windows")
     d.add_argument("--report", metavar="R.json", help="JSON: segments, labels per frame, classes, windows, barcode")
     d.add_argument("--extract", metavar="OUTDIR", help="write a typical cycle (BVH) for each detected motion")
-    d.add_argument("--plot", metavar="DIR", help="write the barcode and the coordinates with segments shaded")
+    d.add_argument("--plot", metavar="DIR", help="write the barcode (barcode.png), the coordinates with segments shaded (coordinates.png) and the windows coloured by motion (windows.png)")
     d.set_defaults(func=cmd_detect)
 
     r = sub.add_parser(

@@ -39,6 +39,7 @@ __all__ = [
     "plot_density",
     "plot_coordinate",
     "plot_channels",
+    "plot_windows",
     "render",
     "save_figures",
     "FIGURE_NAMES",
@@ -504,6 +505,51 @@ def plot_coordinate(
     ax.set_xlim(start - 0.5, start + longest - 0.5)
     ax.set_xlabel("frame")
     ax.set_title("circular coordinate per frame", fontsize=10, pad=14 if segments else 6)
+    return fig
+
+
+def plot_windows(result: Any, *, ax: "Axes | None" = None, fig: "Figure | None" = None) -> "Figure":
+    """The windowed stage of :func:`cyclecoord.detection.detect`: every window as a bar.
+
+    One row per window length; each window is a bar over its frames, coloured by the
+    motion it joined (the colours of ``plot_coordinate``'s segments, ``motion k`` ->
+    ``Ck``), grey when it loops but joined no motion, pale when its barcode showed no
+    clear loop.
+
+    Parameters
+    ----------
+    result : DetectionResult
+        With windows (``method`` ``"auto"`` or ``"windows"``).
+    ax, fig : optional
+
+    Returns
+    -------
+    Figure
+    """
+    windows = getattr(result, "windows", None)
+    motion = getattr(result, "motion", None)
+    if motion is None or windows is None:
+        raise ParameterError(f"plot_windows() takes a DetectionResult, got {type(result).__name__}")
+    if not windows:
+        raise ParameterError("the detection ran no windows (method='global'); nothing to draw")
+    if ax is None:
+        fig = _new_figure((9.0, 2.6), fig)
+        ax = fig.add_subplot()
+    else:
+        fig = ax.figure
+    lengths = sorted({w.stop - w.start for w in windows})
+    start = motion.start_frame
+    for w in windows:
+        row = lengths.index(w.stop - w.start)
+        colour = f"C{w.motion % 10}" if w.motion >= 0 else ("0.6" if w.looping else "0.92")
+        ax.broken_barh([(start + w.start - 0.5, w.stop - w.start)], (row + 0.15, 0.7), facecolor=colour,
+                       alpha=0.35, edgecolor="none")
+    ax.set_yticks([r + 0.5 for r in range(len(lengths))], [f"{n / motion.fps:.3g} s" for n in lengths])
+    ax.set_ylim(0, len(lengths))
+    ax.set_xlim(start - 0.5, start + motion.n_frames - 0.5)
+    ax.set_xlabel("frame")
+    ax.set_ylabel("window")
+    ax.set_title("windows: coloured by motion, grey = loops but no motion, pale = no clear loop", fontsize=10)
     return fig
 
 
