@@ -149,7 +149,8 @@ def test_bad_theta(theta):
 
 @pytest.mark.parametrize(
     "kwargs",
-    [{"n_components": 0}, {"max_iter": -1}, {"reg_covar": 0.0}, {"reg_covar": float("nan")}, {"n_copies": 2}],
+    [{"n_components": 0}, {"max_iter": -1}, {"reg_covar": 0.0}, {"reg_covar": float("nan")}, {"n_copies": 2},
+     {"max_samples": 1}, {"max_samples": 2.5}, {"max_samples": True}],
 )
 def test_bad_parameters(kwargs):
     with pytest.raises(ParameterError):
@@ -165,3 +166,19 @@ def test_unfitted_and_bad_counts(fitted):
         fitted.sample(-3)
     with pytest.raises(ParameterError):
         fitted.ppf([0.2, np.nan])
+
+
+def test_long_inputs_are_fitted_on_an_even_subsample():
+    theta = draw(60000, seed=3)
+    sub = PeriodicDensity(random_state=0, max_samples=5000).fit(theta)
+    assert sub.n_samples_ == 5000
+    # the same as fitting the evenly spaced values by hand
+    by_hand = PeriodicDensity(random_state=0, max_samples=None).fit(theta[np.round(np.linspace(0, 59999, 5000)).astype(int)])
+    np.testing.assert_allclose(sub.quantiles(200), by_hand.quantiles(200))
+    # and close to the fit on every value, and to the truth
+    full = PeriodicDensity(random_state=0, max_samples=None).fit(theta)
+    assert full.n_samples_ == 60000
+    assert np.max(np.abs(sub.cdf(GRID[::50]) - full.cdf(GRID[::50]))) < 0.01
+    err_sub = np.mean(np.abs(sub.pdf(GRID[::50]) - true_pdf(GRID[::50])))
+    err_full = np.mean(np.abs(full.pdf(GRID[::50]) - true_pdf(GRID[::50])))
+    assert err_sub < 0.08 and err_full < 0.05  # mean |pdf - truth|; the pdf peaks near 3
