@@ -56,7 +56,8 @@ joins it, other groups become motions of their own, and frames the global stage
 labelled keep their global label.  Measured (``benchmarks/bench_detect.py``): on 25
 synthetic chains ``auto`` keeps the global method's accuracy (mean 99.4%, min 97.9%)
 with boundaries within 27 frames, while windows alone merge jumping jacks with arm
-circles in some chains; on 13_29 ``auto`` labels 95% of frames correctly and finds all six exercises (global 28%).
+circles in some chains; on 13_29 ``auto`` labels 95% of frames correctly and finds all
+six exercises (global 28%).
 ``method="global"`` is the paper's method alone, ``method="windows"`` the windowed stage
 alone.
 
@@ -882,6 +883,8 @@ def motion_cycles(
             continue
         seg = max(segs, key=lambda sg: sg.stop - sg.start)
         a, b, period = seg.start, seg.stop, float(seg.period_frames)
+        if not np.isfinite(period) or period < 2:
+            continue
         rows = np.arange(a, b)
         lead = next((cl for cl in result.classes if cl.index == seg.classes[0]), None) if seg.classes else None
         if lead is not None and lead.mask[a:b].sum() >= period:  # at least one full turn
@@ -889,8 +892,6 @@ def motion_cycles(
             theta, source = np.mod(lead.coordinate[rows], 1.0), f"class {lead.index}"
         else:
             theta, source = np.mod((rows - a) / period, 1.0), "time"
-        if not np.isfinite(period) or period < 2:
-            continue
         density = PeriodicDensity(random_state=random_state).fit(theta)
         typ = typical_cycle(
             theta, prepared.poses[rows], period, density=density, n_samples=n_samples,
