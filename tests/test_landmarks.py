@@ -90,6 +90,29 @@ def test_refine_birth_refuses_a_dense_complex_from_a_sample(monkeypatch):
     assert refine_birth(x, 1.0, max_edges=10_000) is None
 
 
+def test_refine_birth_budget_is_the_edge_count(monkeypatch):
+    """Over budget by a clear margin: refused from the sample; within it: counted exactly."""
+    import scipy.spatial
+
+    from cyclecoord.barcode import refine_birth
+
+    x = np.random.default_rng(1).standard_normal((3000, 3))
+    edges = estimate_complex(x, 1.05).edges  # refine_birth looks at 1.05 x the birth
+    real_tree = scipy.spatial.cKDTree
+    built = []
+
+    def counting_tree(*args, **kwargs):
+        built.append(1)
+        return real_tree(*args, **kwargs)
+
+    monkeypatch.setattr(scipy.spatial, "cKDTree", counting_tree)
+    assert refine_birth(x, 1.0, max_edges=int(edges / 1.6)) is None  # 1.6 x over
+    assert built == []
+    # 10 % over: the sample cannot tell, the exact count refuses it
+    assert refine_birth(x, 1.0, max_edges=int(edges / 1.1)) is None
+    assert built == [1]
+
+
 def test_refine_birth_finds_the_full_birth_of_a_circle():
     from cyclecoord.barcode import refine_birth
 
