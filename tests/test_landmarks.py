@@ -9,6 +9,7 @@ import pytest
 import cyclecoord as cc
 from cyclecoord.cli import main
 from cyclecoord.coordinates import CircularCoordinates
+from cyclecoord.errors import ParameterError
 from cyclecoord.landmarks import AUTO_FULL_LIMIT, AUTO_LANDMARKS, choose_landmarks, estimate_complex
 from cyclecoord.model import PhaseModel
 from cyclecoord.preprocess import Preprocessor
@@ -58,7 +59,7 @@ def test_memory_guard_switches_before_building(monkeypatch, synthetic_2000):
     real = ripser.ripser
 
     def spy(*args, **kwargs):
-        calls.append(kwargs)
+        calls.append(len(args[0]))  # points handed to ripser
         return real(*args, **kwargs)
 
     monkeypatch.setattr(ripser, "ripser", spy)
@@ -69,7 +70,7 @@ def test_memory_guard_switches_before_building(monkeypatch, synthetic_2000):
     assert "memory guard" in est.landmark_reason_
     assert est.landmarks_ is not None and len(est.landmarks_) < 2000
     assert est.complex_estimate_.bytes <= 5e6
-    assert calls and all(c.get("n_perm") for c in calls)  # the full complex was never asked for
+    assert calls and all(n == len(est.landmarks_) for n in calls)  # the full complex was never asked for
 
 
 def test_refine_birth_refuses_a_dense_complex_from_a_sample(monkeypatch):
@@ -195,3 +196,29 @@ def test_cli_save_and_apply(tmp_path, capsys):
     assert main(["extract", "example", "--landmarks", "200", "--memory-limit", "1G", "--report", str(rep)]) == 0
     r = json.loads(rep.read_text())
     assert r["landmarks"]["n_landmarks"] == 200 and r["selected"]["full_birth"] is not None
+
+
+@pytest.mark.parametrize("shape", [(3000, 8), (1500, 3)])
+def test_greedy_landmarks_make_ripsers_choice(shape):
+    import ripser
+    from scipy.spatial.distance import pdist, squareform
+
+    from cyclecoord.landmarks import greedy_landmarks
+
+    x = np.random.default_rng(shape[1]).standard_normal(shape)
+    res = ripser.ripser(x, maxdim=0, thresh=1e-3, n_perm=150)
+    idx, radius = greedy_landmarks(x, 150)
+    np.testing.assert_array_equal(idx, res["idx_perm"])
+    assert radius == pytest.approx(res["r_cover"], rel=1e-12)
+    # the same choice from a distance matrix
+    idx_d, radius_d = greedy_landmarks(squareform(pdist(x)), 150, distance_matrix=True)
+    np.testing.assert_array_equal(idx_d, idx)
+    assert radius_d == pytest.approx(radius, rel=1e-12)
+    # every point is within the covering radius of a landmark, and one is exactly at it
+    nearest = np.min(np.linalg.norm(x[:, None, :] - x[idx][None, :, :], axis=2), axis=1)
+    assert nearest.max() == pytest.approx(radius, rel=1e-12)
+    full, r0 = greedy_landmarks(x[:20], 20)
+    assert sorted(full) == list(range(20)) and r0 == 0.0
+    for bad in (0, len(x) + 1, 2.5, True):
+        with pytest.raises(ParameterError):
+            greedy_landmarks(x, bad)
