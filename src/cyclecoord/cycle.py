@@ -710,7 +710,7 @@ def typical_cycle(
     selection = None
     width = float("nan")
     if weighting == "kernel" and bandwidth is None:
-        # legacy: k frames' worth of width in the phase
+        # the default: k frames' worth of width in the phase
         width = k / (theta.shape[0] * np.sqrt(2.0 * np.pi)) * float(period_frames)
         curve = kernel_centroids(theta, poses, sample_phases, k=k)
     elif weighting == "kernel":
