@@ -646,6 +646,25 @@ def _typical_distance(poses: np.ndarray, cycle: np.ndarray) -> float:
     return max(float(np.median(distance_to_cycle(poses, cycle))), 1e-9)
 
 
+def _class_period(coordinate: np.ndarray, mask: np.ndarray, a: int, b: int) -> tuple[float, float]:
+    """Turns of a class's coordinate over frames ``a:b`` and the period they give.
+
+    The period is counted on the frames where the class is excited (``mask``), frames
+    per turn over those stretches, so that a segment running past its motion (into a
+    transition where the coordinate stands still) does not lengthen it; with fewer than
+    0.75 turns there, the whole segment's frames per turn.
+    """
+    def turns(lo: int, hi: int) -> float:
+        return abs(float(np.sum(np.mod(np.diff(coordinate[lo:hi]) + 0.5, 1.0) - 0.5)))
+
+    cyc = turns(a, b)
+    runs = [(a + lo, a + hi) for lo, hi in _runs(mask[a:b]) if hi - lo > 1]
+    excited = sum(turns(lo, hi) for lo, hi in runs)
+    if excited >= 0.75:
+        return cyc, sum(hi - lo - 1 for lo, hi in runs) / excited
+    return cyc, (b - a - 1) / cyc if cyc > 0 else float("nan")
+
+
 def autocorrelation_period(poses: np.ndarray, guess: float, min_correlation: float = 0.3) -> float:
     """Refine a period estimate by the autocorrelation of a stretch of poses.
 
@@ -781,8 +800,7 @@ def _windowed_motions(
         lead = min(c.classes, key=lambda cl: cl.index) if c.classes else None
         for a, b in _runs(labels == mid):
             if lead is not None and (not c.windows or np.mean(lead.mask[a:b]) >= 0.5):
-                cyc = abs(float(np.sum(np.mod(np.diff(lead.coordinate[a:b]) + 0.5, 1.0) - 0.5)))
-                period = (b - a - 1) / cyc if cyc > 0 else float("nan")
+                cyc, period = _class_period(lead.coordinate, lead.mask, a, b)
                 classes = (lead.index,) + tuple(cl.index for cl in c.classes if cl is not lead)
                 birth, death, scale = lead.birth, lead.death, lead.scale
             else:
@@ -1164,13 +1182,13 @@ def detect(
         members = [c for c in kept if c.motion == mid]
         lead = min(members, key=lambda c: c.index)
         for a, b in _runs(labels == mid):
-            cyc = abs(float(np.sum(np.mod(np.diff(lead.coordinate[a:b]) + 0.5, 1.0) - 0.5)))
+            cyc, period = _class_period(lead.coordinate, lead.mask, a, b)
             segments.append(
                 Segment(
                     start=int(a), stop=int(b), motion=mid,
                     classes=(lead.index,) + tuple(c.index for c in members if c is not lead),
                     birth=lead.birth, death=lead.death, scale=lead.scale, cycles=cyc,
-                    period_frames=(b - a - 1) / cyc if cyc > 0 else float("nan"),
+                    period_frames=period,
                 )
             )
     segments.sort(key=lambda s: s.start)
