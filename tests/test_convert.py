@@ -10,7 +10,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from cyclecoord.errors import ParameterError, ParseError
-from cyclecoord.io import convert, default_asf_path, load, read_bvh, save
+from cyclecoord.io import convert, default_asf_path, load, save
 from cyclecoord.motion import Motion
 from cyclecoord.retarget import continuous_euler, to_bvh_convention
 from cyclecoord.skeleton import Joint, Skeleton, forward_kinematics

@@ -366,9 +366,8 @@ def _save_plots(result, folder: str) -> None:
 
 def cmd_detect(args: argparse.Namespace) -> int:
     """``cyclecoord detect``: several periodic motions, their segments and per-frame labels."""
-    from .detection import detect
+    from .detection import detect, motion_cycles
     from .io import save
-    from .pipeline import extract
 
     _check_output(args.report, "report")
     if args.extract and Path(args.extract).exists() and not Path(args.extract).is_dir():
@@ -406,8 +405,6 @@ def cmd_detect(args: argparse.Namespace) -> int:
     for w in res.warnings:
         print(f"warning: {w}")
     if args.extract and code == EXIT_OK:
-        from .detection import motion_cycles
-
         folder = Path(args.extract)
         folder.mkdir(parents=True, exist_ok=True)
         for mc in motion_cycles(res):
