@@ -611,6 +611,24 @@ class TypicalCycle:
         return int(self.frames.shape[0])
 
 
+def check_bandwidth(bandwidth: object, weighting: str = "kernel") -> None | str | float:
+    """Validate a ``bandwidth`` argument (see :func:`typical_cycle`); return it normalised.
+
+    Raises
+    ------
+    ParameterError
+        Unless it is None, ``"auto"`` or a positive finite number, or when it is not None
+        and ``weighting`` is not ``"kernel"``.
+    """
+    if bandwidth is not None and not (isinstance(bandwidth, str) and bandwidth == "auto"):
+        if isinstance(bandwidth, str):
+            raise ParameterError(f"bandwidth must be None, 'auto' or a positive number of frames, got {bandwidth!r}")
+        bandwidth = _positive_float(bandwidth, "bandwidth")
+    if bandwidth is not None and weighting != "kernel":
+        raise ParameterError(f"bandwidth={bandwidth!r} needs weighting='kernel', got {weighting!r}")
+    return bandwidth
+
+
 def typical_cycle(
     theta: np.ndarray,
     poses: np.ndarray,
@@ -684,12 +702,7 @@ def typical_cycle(
     theta = _finite_array(theta, "theta", 1)
     if isinstance(k, bool) or not isinstance(k, Integral) or not 1 <= k <= theta.shape[0]:
         raise ParameterError(f"k must be an integer between 1 and the number of frames ({theta.shape[0]}), got {k!r}")
-    if bandwidth is not None and not (isinstance(bandwidth, str) and bandwidth == "auto"):
-        if isinstance(bandwidth, str):
-            raise ParameterError(f"bandwidth must be None, 'auto' or a positive number, got {bandwidth!r}")
-        bandwidth = _positive_float(bandwidth, "bandwidth")
-    if bandwidth is not None and weighting != "kernel":
-        raise ParameterError(f"bandwidth={bandwidth!r} needs weighting='kernel', got {weighting!r}")
+    bandwidth = check_bandwidth(bandwidth, weighting)
     rng = _as_generator(random_state)
 
     if density is None:

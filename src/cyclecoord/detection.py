@@ -655,7 +655,8 @@ def _class_period(coordinate: np.ndarray, mask: np.ndarray, a: int, b: int) -> t
     0.75 turns there, the whole segment's frames per turn.
     """
     def turns(lo: int, hi: int) -> float:
-        return abs(float(np.sum(np.mod(np.diff(coordinate[lo:hi]) + 0.5, 1.0) - 0.5)))
+        u = unwrap(coordinate[lo:hi])
+        return abs(float(u[-1] - u[0]))
 
     cyc = turns(a, b)
     runs = [(a + lo, a + hi) for lo, hi in _runs(mask[a:b]) if hi - lo > 1]

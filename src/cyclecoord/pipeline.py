@@ -10,7 +10,6 @@ from __future__ import annotations
 import time
 import warnings
 from dataclasses import dataclass, field
-from numbers import Real
 from typing import Any
 
 import numpy as np
@@ -18,7 +17,7 @@ import numpy as np
 from ._blas import one_blas_thread
 from .barcode import CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, DEFAULT_PRIME, Barcode, BarSelection
 from .coordinates import CircularCoordinates, unwrap
-from .cycle import TypicalCycle, typical_cycle
+from .cycle import TypicalCycle, check_bandwidth, typical_cycle
 from .density import PeriodicDensity
 from .errors import NoPeriodicMotionError, ParameterError
 from .metrics import distance_to_cycle, jerk_summary, loop_closure
@@ -370,12 +369,7 @@ def extract(
         raise ParameterError(f"n_samples must be at least 10, got {n_samples}")
     if n_neighbors < 1:
         raise ParameterError(f"n_neighbors must be at least 1, got {n_neighbors}")
-    if not (bandwidth is None or (isinstance(bandwidth, str) and bandwidth == "auto") or (
-        isinstance(bandwidth, Real) and not isinstance(bandwidth, bool) and np.isfinite(bandwidth) and bandwidth > 0
-    )):
-        raise ParameterError(f"bandwidth must be None, 'auto' or a positive number of frames, got {bandwidth!r}")
-    if bandwidth is not None and weighting != "kernel":
-        raise ParameterError(f"bandwidth={bandwidth!r} needs weighting='kernel', got {weighting!r}")
+    bandwidth = check_bandwidth(bandwidth, weighting)  # before any work is done
     timings: dict[str, float] = {}
     notes: list[str] = []
     params = dict(
