@@ -10,8 +10,8 @@ Sections (each can be chosen with ``--parts``):
   periodic motions and known boundaries, for several kind triples and seeds, with every
   method of ``detect`` (``auto``, the default, then ``global`` and ``windows``; the
   summary of each is printed side by side).  Printed per case (default method): frame accuracy after the best one-to-one matching of detected motions to
-  true ones (:func:`cyclecoord.detection.best_match_accuracy`), the largest boundary error
-  (:func:`cyclecoord.detection.boundary_errors`), the motions found and the seconds; then
+  true ones (:func:`cyclecoord.periodic.detection.best_match_accuracy`), the largest boundary error
+  (:func:`cyclecoord.periodic.detection.boundary_errors`), the motions found and the seconds; then
   the mean and minimum.  Targets: accuracy >= 90 %, boundaries within 30 frames.
 * **13_29** -- CMU 13_29 (six exercises) against ``../shared/data/labels/13_29.csv``:
   accuracy after matching (target >= 80 %), the matching, per activity the fraction of
@@ -55,7 +55,7 @@ if str(_HERE) not in sys.path:  # the sibling benchmark module, also when import
 import bench_extract as bx  # noqa: E402  (table printing, JSON conversion, git state)
 
 import cyclecoord as cc  # noqa: E402
-from cyclecoord.detection import DetectionResult, best_match_accuracy, boundary_errors, detect  # noqa: E402
+from cyclecoord.periodic.detection import DetectionResult, best_match_accuracy, boundary_errors, detect  # noqa: E402
 from cyclecoord.errors import NoPeriodicMotionError, ParameterError, ParseError  # noqa: E402
 from cyclecoord.io._atomic import atomic_write  # noqa: E402
 
@@ -260,7 +260,7 @@ def class_coverage(result: DetectionResult, spans: Sequence[tuple[int, int, str]
 def unlabelled_motions(result: DetectionResult, spans: Sequence[tuple[int, int, str]]) -> list[str]:
     """Notes on kept classes whose motion ended up labelling no frame at all.
 
-    :func:`cyclecoord.detection.detect` drops label runs shorter than its smoothing window
+    :func:`cyclecoord.periodic.detection.detect` drops label runs shorter than its smoothing window
     (``window`` seconds, odd number of frames), so a motion excited for less than that
     is found as a class but labels nothing.
     """
@@ -357,7 +357,7 @@ def run_chain(
     dict
         ``kinds``, ``seed``, ``n_frames``, ``accuracy`` (after best matching),
         ``matching`` ``{motion id: kind}``, ``boundary_errors`` (frames, both ways; see
-        :func:`cyclecoord.detection.boundary_errors`), ``max_boundary_error``,
+        :func:`cyclecoord.periodic.detection.boundary_errors`), ``max_boundary_error``,
         ``n_motions``, ``kinds_found`` (number of true kinds matched to a motion),
         ``periods`` (true, per kind) and ``segment_periods`` (detected, per segment with
         its matched kind), ``accuracy_ok``, ``boundaries_ok``, plus ``seconds``,

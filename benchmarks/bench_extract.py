@@ -46,10 +46,10 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 import cyclecoord as cc
-from cyclecoord.coordinates import unwrap
+from cyclecoord.periodic.coordinates import unwrap
 from cyclecoord.errors import CycleCoordError, ParameterError
 from cyclecoord.io._atomic import atomic_write
-from cyclecoord.metrics import monotonicity
+from cyclecoord.quality.metrics import monotonicity
 
 #: ``../shared/data`` beside the checkout (real CMU captures; never copied into the repo).
 DATA_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -403,7 +403,7 @@ def phase_agreement(theta: np.ndarray, true_phase: np.ndarray, n_bins: int = N_P
         empty bins count as not advancing); ``cycles`` -- unwrapped change of the
         coordinate from the first to the last frame; ``cycles_true`` -- the same for the
         true phase; ``mean_abs_error`` -- mean circular error after the best rotation /
-        reflection (:func:`cyclecoord.metrics.monotonicity`), in cycles.
+        reflection (:func:`cyclecoord.quality.metrics.monotonicity`), in cycles.
     """
     th = _orient(np.asarray(theta, dtype=float))
     ph = np.asarray(true_phase, dtype=float)

@@ -28,7 +28,7 @@ one at a time, so cases and methods do not share memory or warm caches:
 * **full ripser** -- ``ripser.ripser(points, maxdim=1, thresh=<cyclecoord's threshold>,
   coeff=47, do_cocycles=True)`` on every point, only where it fits: ``N <= 4,000`` and the
   estimated memory ``8 N^2`` bytes (distance matrix) ``+ 64 E`` bytes (E = estimated
-  edges at the threshold, :func:`cyclecoord.landmarks.estimate_complex`) within 2 GiB;
+  edges at the threshold, :func:`cyclecoord.periodic.landmarks.estimate_complex`) within 2 GiB;
   same timeout.
 
 Peak memory of a process is its exact high-water resident set size, read with
@@ -69,7 +69,7 @@ import bench_extract as bx  # noqa: E402  (helpers shared with the short-capture
 import cyclecoord as cc  # noqa: E402
 from cyclecoord.errors import NoPeriodicMotionError, ParameterError  # noqa: E402
 from cyclecoord.io._atomic import atomic_write  # noqa: E402
-from cyclecoord.landmarks import DEFAULT_MEMORY_LIMIT, estimate_complex  # noqa: E402
+from cyclecoord.periodic.landmarks import DEFAULT_MEMORY_LIMIT, estimate_complex  # noqa: E402
 
 #: Stages of ``result.timings`` (and "total").
 STAGES = bx.STAGES

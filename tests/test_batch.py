@@ -245,7 +245,7 @@ def test_a_dying_worker_fails_only_its_capture(tmp_path, monkeypatch):
 
 
 def test_memory_error_is_recorded_and_the_batch_goes_on(tmp_path, monkeypatch):
-    import cyclecoord.pipeline as pipeline
+    import cyclecoord.periodic.pipeline as pipeline
 
     src = _build(tmp_path / "in", {"b.npz": ("walk", 2)}, static=False, broken=False)
     cc.save(cc.datasets.make_periodic_capture(n_frames=250, random_state=1).motion, src / "a.npz")

@@ -27,7 +27,7 @@ def test_decorated_call_sees_one_thread_and_the_setting_comes_back():
 
 
 def test_harmonic_solve_inside_extract_runs_on_one_thread(monkeypatch):
-    import cyclecoord.coordinates as coords
+    import cyclecoord.periodic.coordinates as coords
 
     seen = []
     real = coords.harmonic_coordinate

@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 from cyclecoord.errors import ParameterError, ParseError
 from cyclecoord.io import convert, default_asf_path, load, save
 from cyclecoord.motion import Motion
-from cyclecoord.retarget import continuous_euler, to_bvh_convention
+from cyclecoord.conventions import continuous_euler, to_bvh_convention
 from cyclecoord.skeleton import Joint, Skeleton, forward_kinematics
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -61,7 +61,7 @@ def test_to_bvh_convention_preserves_positions(order):
     err = np.abs(pb.positions - pa.positions).max()
     assert err <= 1e-9 * size, err
     # the local rotations agree too, not just positions (0-dof and leaf joints included)
-    from cyclecoord.retarget import local_rotations
+    from cyclecoord.conventions import local_rotations
 
     np.testing.assert_allclose(local_rotations(b), local_rotations(m), atol=1e-12)
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from cyclecoord.barcode import check_prime, compute_barcode, select_bar, temporal_distance_matrix
-from cyclecoord.coordinates import (
+from cyclecoord.periodic.barcode import check_prime, compute_barcode, select_bar, temporal_distance_matrix
+from cyclecoord.periodic.coordinates import (
     CircularCoordinates,
     _edge_values,
     check_cocycle,

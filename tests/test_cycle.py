@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cyclecoord.cycle import (
+from cyclecoord.periodic.cycle import (
     TypicalCycle,
     integrate_root,
     kernel_centroids,
@@ -15,9 +15,9 @@ from cyclecoord.cycle import (
     select_bandwidth,
     typical_cycle,
 )
-from cyclecoord.density import PeriodicDensity
+from cyclecoord.periodic.density import PeriodicDensity
 from cyclecoord.errors import ParameterError
-from cyclecoord.metrics import circular_distance, distance_to_cycle
+from cyclecoord.quality.metrics import circular_distance, distance_to_cycle
 
 PERIOD = 100  # frames per period of the synthetic motion
 WARP = 0.5  # phase speed varies between 1 - WARP and 1 + WARP

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.stats import vonmises
 
-from cyclecoord.density import PeriodicDensity
+from cyclecoord.periodic.density import PeriodicDensity
 from cyclecoord.errors import ParameterError
 
 # A bimodal circular distribution on [0, 1): two von Mises bumps of unequal width.

@@ -7,8 +7,8 @@ import pytest
 
 import cyclecoord as cc
 from cyclecoord.cli import main
-from cyclecoord.metrics import distance_to_cycle
-from cyclecoord.detection import (
+from cyclecoord.quality.metrics import distance_to_cycle
+from cyclecoord.periodic.detection import (
     Segment,
     autocorrelation_period,
     motion_cycles,
@@ -182,7 +182,7 @@ def test_windowed_report_and_parameters(chain):
 
 
 def test_cycle_distance_ignores_rotation_and_reflection():
-    from cyclecoord.detection import binned_cycle, cycle_distance
+    from cyclecoord.periodic.detection import binned_cycle, cycle_distance
 
     t = np.linspace(0, 1, 200, endpoint=False)
     poses = np.column_stack([np.cos(2 * np.pi * t), np.sin(2 * np.pi * t), 0.3 * np.cos(4 * np.pi * t)]) * 20
@@ -196,8 +196,8 @@ def test_cycle_distance_ignores_rotation_and_reflection():
 
 
 def test_window_table_loops_only_where_periodic():
-    from cyclecoord.detection import window_table
-    from cyclecoord.preprocess import Preprocessor
+    from cyclecoord.periodic.detection import window_table
+    from cyclecoord.periodic.preprocess import Preprocessor
 
     periodic = cc.datasets.make_periodic_capture(n_frames=720, period=100, random_state=0).motion
     still = cc.datasets.make_random_walk_capture(n_frames=720, random_state=0).motion

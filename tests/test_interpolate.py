@@ -1,4 +1,4 @@
-"""Alignment, blending and transitions between cycles (cyclecoord.interpolate)."""
+"""Alignment, blending and transitions between cycles (cyclecoord.synthesis.interpolate)."""
 
 from dataclasses import replace
 
@@ -7,7 +7,7 @@ import pytest
 
 import cyclecoord as cc
 from cyclecoord.errors import ParameterError
-from cyclecoord.interpolate import (
+from cyclecoord.synthesis.interpolate import (
     STEP_LIMIT,
     CycleCurve,
     align,
@@ -21,7 +21,7 @@ from cyclecoord.interpolate import (
     rotate_heading,
     transition,
 )
-from cyclecoord.metrics import jerk_summary
+from cyclecoord.quality.metrics import jerk_summary
 
 
 # ------------------------------------------------------------------ synthetic cycles
@@ -309,7 +309,7 @@ def cmu_cycles(cmu_dir):
 
 
 def test_cmu_walk_and_jog_blends(cmu_cycles):
-    from cyclecoord.plausibility import check_plausibility
+    from cyclecoord.quality.plausibility import check_plausibility
 
     w, j = cmu_cycles
     assert 130 <= w.n_frames <= 160 and 38 <= j.n_frames <= 55

@@ -8,11 +8,11 @@ import pytest
 
 import cyclecoord as cc
 from cyclecoord.cli import main
-from cyclecoord.coordinates import CircularCoordinates
+from cyclecoord.periodic.coordinates import CircularCoordinates
 from cyclecoord.errors import ParameterError
-from cyclecoord.landmarks import AUTO_FULL_LIMIT, AUTO_LANDMARKS, choose_landmarks, estimate_complex
-from cyclecoord.model import PhaseModel
-from cyclecoord.preprocess import Preprocessor
+from cyclecoord.periodic.landmarks import AUTO_FULL_LIMIT, AUTO_LANDMARKS, choose_landmarks, estimate_complex
+from cyclecoord.periodic.phase_model import PhaseModel
+from cyclecoord.periodic.preprocess import Preprocessor
 
 
 def median_circular_difference(a, b):
@@ -81,7 +81,7 @@ def test_refine_birth_refuses_a_dense_complex_from_a_sample(monkeypatch):
     """
     import scipy.spatial
 
-    from cyclecoord.barcode import refine_birth
+    from cyclecoord.periodic.barcode import refine_birth
 
     def no_tree(*args, **kwargs):
         raise AssertionError("the exact count ran for a complex the sample already refused")
@@ -95,7 +95,7 @@ def test_refine_birth_budget_is_the_edge_count(monkeypatch):
     """Over budget by a clear margin: refused from the sample; within it: counted exactly."""
     import scipy.spatial
 
-    from cyclecoord.barcode import refine_birth
+    from cyclecoord.periodic.barcode import refine_birth
 
     x = np.random.default_rng(1).standard_normal((3000, 3))
     edges = estimate_complex(x, 1.05).edges  # refine_birth looks at 1.05 x the birth
@@ -115,7 +115,7 @@ def test_refine_birth_budget_is_the_edge_count(monkeypatch):
 
 
 def test_refine_birth_finds_the_full_birth_of_a_circle():
-    from cyclecoord.barcode import refine_birth
+    from cyclecoord.periodic.barcode import refine_birth
 
     t = np.linspace(0, 1, 400, endpoint=False)
     x = np.c_[np.cos(2 * np.pi * t), np.sin(2 * np.pi * t)]
@@ -203,7 +203,7 @@ def test_greedy_landmarks_make_ripsers_choice(shape):
     import ripser
     from scipy.spatial.distance import pdist, squareform
 
-    from cyclecoord.landmarks import greedy_landmarks
+    from cyclecoord.periodic.landmarks import greedy_landmarks
 
     x = np.random.default_rng(shape[1]).standard_normal(shape)
     res = ripser.ripser(x, maxdim=0, thresh=1e-3, n_perm=150)

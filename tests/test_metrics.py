@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from cyclecoord.errors import ParameterError
-from cyclecoord.metrics import (
+from cyclecoord.quality.metrics import (
     PhaseAgreement,
     circular_distance,
     distance_to_cycle,
@@ -121,7 +121,7 @@ def test_distance_to_cycle_on_and_off_the_polyline():
 
 
 def test_distance_to_cycle_matches_brute_force_in_chunks(monkeypatch):
-    import cyclecoord.metrics as metrics
+    import cyclecoord.quality.metrics as metrics
 
     rng = np.random.default_rng(0)
     cycle = rng.standard_normal((17, 6))

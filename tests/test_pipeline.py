@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 import cyclecoord as cc
-from cyclecoord.metrics import distance_to_cycle, loop_closure
-from cyclecoord.pipeline import cycle_lengths, slowest_frame
-from cyclecoord.preprocess import Preprocessor
+from cyclecoord.quality.metrics import distance_to_cycle, loop_closure
+from cyclecoord.periodic.pipeline import cycle_lengths, slowest_frame
+from cyclecoord.periodic.preprocess import Preprocessor
 
 
 def bins_advance(theta, true_phase, n_bins=20):

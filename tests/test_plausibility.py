@@ -1,4 +1,4 @@
-"""Self-intersection and joint-range checks (cyclecoord.plausibility)."""
+"""Self-intersection and joint-range checks (cyclecoord.quality.plausibility)."""
 
 import json
 import re
@@ -8,7 +8,7 @@ import pytest
 
 import cyclecoord as cc
 from cyclecoord.errors import ParameterError
-from cyclecoord.plausibility import (
+from cyclecoord.quality.plausibility import (
     DEFAULT_CLEARANCE,
     bones,
     check_plausibility,

@@ -17,9 +17,9 @@ import pytest  # noqa: E402
 from matplotlib.colors import to_rgba  # noqa: E402
 
 import cyclecoord as cc  # noqa: E402
-from cyclecoord import plot  # noqa: E402
+from cyclecoord.plot import figures as plot  # noqa: E402
 from cyclecoord.errors import NoPeriodicMotionError, ParameterError  # noqa: E402
-from cyclecoord.metrics import jerk  # noqa: E402
+from cyclecoord.quality.metrics import jerk  # noqa: E402
 
 Image = pytest.importorskip("PIL.Image", reason="image checks need Pillow (ships with matplotlib)")
 
@@ -300,7 +300,7 @@ def test_save_figures_writes_five_real_pngs(result, tmp_path):
 
 # ------------------------------------------------------------------ windows (detect)
 def test_windows_one_bar_per_window_coloured_by_motion(tmp_path):
-    from cyclecoord.detection import detect
+    from cyclecoord.periodic.detection import detect
 
     m = cc.datasets.make_motion_chain(kinds=("walk", "squat"), segment_frames=400, random_state=0).motion
     res = detect(m, progress=False)

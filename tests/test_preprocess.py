@@ -5,7 +5,7 @@ import pytest
 
 from cyclecoord import Motion
 from cyclecoord.errors import ParameterError
-from cyclecoord.preprocess import Preprocessor
+from cyclecoord.periodic.preprocess import Preprocessor
 
 ROOT = [("root", d) for d in ("tx", "ty", "tz", "rx", "ry", "rz")]
 
@@ -73,8 +73,8 @@ def test_delay_embedding_turns_an_out_and_back_motion_into_a_loop():
     assert emb.shape == (400, 16)
     np.testing.assert_array_equal(emb[25:, 8:], plain[:-25])
     np.testing.assert_array_equal(emb[:25, 8:], np.repeat(plain[:1], 25, axis=0))
-    from cyclecoord.barcode import select_bar
-    from cyclecoord.coordinates import CircularCoordinates, unwrap
+    from cyclecoord.periodic.barcode import select_bar
+    from cyclecoord.periodic.coordinates import CircularCoordinates, unwrap
 
     # the segment has no loop; with its past (a quarter period back) it is an ellipse
     flat = CircularCoordinates().fit_barcode(plain)

@@ -20,13 +20,13 @@ from typing import TYPE_CHECKING
 # so that `import cyclecoord` and `cyclecoord --help` stay fast: scikit-learn, SciPy's
 # statistics and ripser load only when the pipeline runs.
 _LAZY = {
-    "Barcode": "barcode",
-    "BarSelection": "barcode",
-    "compute_barcode": "barcode",
-    "CircularCoordinates": "coordinates",
-    "TypicalCycle": "cycle",
-    "typical_cycle": "cycle",
-    "PeriodicDensity": "density",
+    "Barcode": "periodic.barcode",
+    "BarSelection": "periodic.barcode",
+    "compute_barcode": "periodic.barcode",
+    "CircularCoordinates": "periodic.coordinates",
+    "TypicalCycle": "periodic.cycle",
+    "typical_cycle": "periodic.cycle",
+    "PeriodicDensity": "periodic.density",
     "CycleCoordError": "errors",
     "NoPeriodicMotionError": "errors",
     "ParameterError": "errors",
@@ -36,25 +36,24 @@ _LAZY = {
     "save": "io",
     "DEFAULT_FPS": "motion",
     "Motion": "motion",
-    "ExtractionResult": "pipeline",
-    "extract": "pipeline",
-    "PreparedData": "preprocess",
-    "Preprocessor": "preprocess",
+    "ExtractionResult": "periodic.pipeline",
+    "extract": "periodic.pipeline",
+    "PreparedData": "periodic.preprocess",
+    "Preprocessor": "periodic.preprocess",
     "Joint": "skeleton",
     "JointPositions": "skeleton",
     "Skeleton": "skeleton",
     "forward_kinematics": "skeleton",
-    "PhaseModel": "model",
-    "detect": "detection",
-    "DetectionResult": "detection",
-    "blend": "interpolate",
-    "transition": "interpolate",
-    "align": "interpolate",
+    "PhaseModel": "periodic.phase_model",
+    "detect": "periodic.detection",
+    "DetectionResult": "periodic.detection",
+    "blend": "synthesis.interpolate",
+    "transition": "synthesis.interpolate",
+    "align": "synthesis.interpolate",
     "run_batch": "batch",
 }
 _SUBMODULES = {
-    "datasets", "io", "plot", "metrics", "pipeline", "barcode", "coordinates", "cycle", "density",
-    "detection", "interpolate", "plausibility", "batch", "model", "landmarks", "preprocess",
+    "batch", "cli", "conventions", "datasets", "io", "periodic", "plot", "quality", "skeleton", "synthesis",
 }
 
 
@@ -76,15 +75,15 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
     from . import datasets
-    from .barcode import Barcode, BarSelection, compute_barcode
-    from .coordinates import CircularCoordinates
-    from .cycle import TypicalCycle, typical_cycle
-    from .density import PeriodicDensity
+    from .periodic.barcode import Barcode, BarSelection, compute_barcode
+    from .periodic.coordinates import CircularCoordinates
+    from .periodic.cycle import TypicalCycle, typical_cycle
+    from .periodic.density import PeriodicDensity
     from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
     from .io import convert, load, save
     from .motion import DEFAULT_FPS, Motion
-    from .pipeline import ExtractionResult, extract
-    from .preprocess import PreparedData, Preprocessor
+    from .periodic.pipeline import ExtractionResult, extract
+    from .periodic.preprocess import PreparedData, Preprocessor
     from .skeleton import Joint, JointPositions, Skeleton, forward_kinematics
 
 __version__ = "0.1.0"

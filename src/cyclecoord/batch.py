@@ -1,11 +1,11 @@
-"""Batch extraction: run :func:`~cyclecoord.pipeline.extract` over every capture in a folder.
+"""Batch extraction: run :func:`~cyclecoord.periodic.pipeline.extract` over every capture in a folder.
 
 :func:`run_batch` finds the captures under a folder (recursively, in sorted order), runs
 load + extract on each -- in this process, in a local process pool or on a Dask
 distributed cluster -- and writes, mirroring the input tree under the output folder:
 
 * ``<relative path without suffix>.report.json`` per capture: the extraction report
-  (:meth:`~cyclecoord.pipeline.ExtractionResult.to_report`) plus a ``"batch"`` block
+  (:meth:`~cyclecoord.periodic.pipeline.ExtractionResult.to_report`) plus a ``"batch"`` block
   (status, message, input size and modification time, options and their hash, seconds);
 * ``<relative path without suffix>.cycle.bvh`` (or ``.npz``): the typical cycle;
 * ``summary.csv``: one row per capture with the key figures (see :data:`SUMMARY_COLUMNS`).
@@ -251,7 +251,7 @@ def _check_options(options: dict) -> dict:
     The normalised form (every parameter with its default filled in) feeds the options
     hash, so ``{}`` and ``{"random_state": 0}`` count as the same run.
     """
-    from .pipeline import extract
+    from .periodic.pipeline import extract
 
     if not isinstance(options, dict):
         raise ParameterError(f"extract_options must be a dict, got {type(options).__name__}")
@@ -281,7 +281,7 @@ def _options_hash(normalised: dict, fps: float | None, cycle_format: str | None)
 
 # ------------------------------------------------------------------ reports
 def _json_helpers():
-    from .cli import _clean, _write_json
+    from .cli.main import _clean, _write_json
 
     return _clean, _write_json
 
@@ -349,7 +349,7 @@ def _cycle_path(task: _Task, fmt: str) -> Path:
 def _analyse(task: _Task) -> dict[str, Any]:
     """Load + extract one capture, write its cycle; return its report (not yet written)."""
     from .io import load, save
-    from .pipeline import extract
+    from .periodic.pipeline import extract
 
     motion = load(task.input, fps=task.fps)
     try:
@@ -634,7 +634,7 @@ def run_batch(
     fps: float | None = None,
     progress: bool = True,
 ) -> BatchSummary:
-    """Run :func:`~cyclecoord.pipeline.extract` on every capture under ``folder``.
+    """Run :func:`~cyclecoord.periodic.pipeline.extract` on every capture under ``folder``.
 
     Parameters
     ----------
@@ -658,7 +658,7 @@ def run_batch(
     force : bool, default False
         Recompute every capture, even those whose report is up to date.
     extract_options : dict, optional
-        Keyword arguments for :func:`~cyclecoord.pipeline.extract` (``frames``, ``pca``,
+        Keyword arguments for :func:`~cyclecoord.periodic.pipeline.extract` (``frames``, ``pca``,
         ``max_scale``, ``random_state``, ...), the same for every capture.  Checked
         against extract's signature before anything runs.
     write_cycles : {"bvh", "npz", None}, default "bvh"

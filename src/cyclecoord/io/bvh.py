@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import ParameterError, ParseError
 from ..motion import Motion
 from ..skeleton import Joint, Skeleton, rotation_order_from_dofs
-from ..retarget import _check_order
+from ..conventions import _check_order
 from ._atomic import atomic_write
 
 __all__ = ["read_bvh", "write_bvh", "BVH_CHANNEL_NAMES"]
@@ -522,7 +522,7 @@ def write_bvh(
         Must have a skeleton.  Channel columns may be in any order (mapped by
         ``(joint, dof)``).  A skeleton with non-identity joint axes (ASF conventions), or
         whose rotation orders do not fit ``rotation_order``, is first converted with
-        :func:`cyclecoord.retarget.to_bvh_convention`.
+        :func:`cyclecoord.conventions.to_bvh_convention`.
     path : path-like
         Output file, written atomically.
     rotation_order : str, optional
@@ -545,7 +545,7 @@ def write_bvh(
     forced = None if rotation_order is None else _check_order(rotation_order)
     orders = _bvh_ready_orders(motion.skeleton, forced)
     if orders is None:
-        from ..retarget import to_bvh_convention
+        from ..conventions import to_bvh_convention
 
         motion = to_bvh_convention(motion, rotation_order=forced or "ZXY")
         orders = _bvh_ready_orders(motion.skeleton, forced)

@@ -23,15 +23,15 @@ from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numpy as np
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from .barcode import Barcode, BarSelection
-    from .motion import Motion
-    from .pipeline import ExtractionResult
+    from ..periodic.barcode import Barcode, BarSelection
+    from ..motion import Motion
+    from ..periodic.pipeline import ExtractionResult
 
 __all__ = [
     "plot_barcode",
@@ -79,7 +79,7 @@ def _detached_figure(figsize: tuple[float, float], dpi: float = 100) -> "Figure"
 
 
 def _check_result(result: Any, what: str) -> "ExtractionResult":
-    from .pipeline import ExtractionResult
+    from ..periodic.pipeline import ExtractionResult
 
     if not isinstance(result, ExtractionResult):
         raise ParameterError(f"{what} takes an ExtractionResult (from cyclecoord.extract), got {type(result).__name__}")
@@ -130,7 +130,7 @@ def plot_barcode(
     """
     from matplotlib.collections import LineCollection
 
-    from .barcode import Barcode
+    from ..periodic.barcode import Barcode
 
     if not isinstance(barcode, Barcode):
         raise ParameterError(f"plot_barcode takes a Barcode, got {type(barcode).__name__}")
@@ -382,7 +382,7 @@ def plot_density(
 
 # --------------------------------------------------------------- coordinate
 def _coordinate_series(data: Any, start_frame: int | None) -> tuple[list[tuple[str, np.ndarray]], int]:
-    from .pipeline import ExtractionResult
+    from ..periodic.pipeline import ExtractionResult
 
     if isinstance(data, ExtractionResult):
         if data.coordinate is None:
@@ -509,7 +509,7 @@ def plot_coordinate(
 
 
 def plot_windows(result: Any, *, ax: "Axes | None" = None, fig: "Figure | None" = None) -> "Figure":
-    """The windowed stage of :func:`cyclecoord.detection.detect`: every window as a bar.
+    """The windowed stage of :func:`cyclecoord.periodic.detection.detect`: every window as a bar.
 
     One row per window length; each window is a bar over its frames, coloured by the
     motion it joined (the colours of ``plot_coordinate``'s segments, ``motion k`` ->
@@ -650,7 +650,7 @@ def plot_channels(
         ``"<joint>.<dof>"`` and a dashed one (cycle) labelled ``"<joint>.<dof> (cycle)"``.
         Jerk axes: lines labelled ``"original"`` and ``"cycle"``.
     """
-    from .metrics import jerk
+    from ..quality.metrics import jerk
 
     res = _check_result(result, "plot_channels")
     if not np.isfinite(periods) or periods <= 0:
@@ -741,8 +741,8 @@ def save_figures(result: "ExtractionResult", folder: str | os.PathLike[str], *, 
         extraction (``NoPeriodicMotionError.result``, no coordinate) only
         ``barcode.png`` is written: the barcode shows why nothing stood clear.
     """
-    from .io._atomic import atomic_write
-    from .pipeline import ExtractionResult
+    from ..io._atomic import atomic_write
+    from ..periodic.pipeline import ExtractionResult
 
     if not isinstance(result, ExtractionResult):
         raise ParameterError(f"save_figures takes an ExtractionResult, got {type(result).__name__}")
@@ -823,7 +823,7 @@ def _side_colours(names: list[str], parents: np.ndarray) -> list:
 
 
 def _make_track(motion: "Motion", title: str | None) -> _Track:
-    from .motion import Motion
+    from ..motion import Motion
 
     if not isinstance(motion, Motion):
         raise ParameterError(f"render takes a Motion, got {type(motion).__name__}")
@@ -1113,7 +1113,7 @@ def render(
         writer = anim.FFMpegWriter(fps=play_fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
     import matplotlib as mpl
 
-    from .io._atomic import atomic_path
+    from ..io._atomic import atomic_path
 
     with atomic_path(out, suffix=f".tmp{suffix}") as tmp, mpl.rc_context({"savefig.bbox": None}):
         # (a 'tight' bbox would change the frame size)

@@ -48,9 +48,9 @@ from typing import Any, Sequence
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .errors import ParameterError
-from .metrics import jerk_summary, loop_closure
-from .motion import Motion
+from ..errors import ParameterError
+from ..quality.metrics import jerk_summary, loop_closure
+from ..motion import Motion
 
 __all__ = [
     "Alignment",
@@ -438,7 +438,7 @@ def cycle_summary(motion: Motion) -> dict[str, float]:
     -------
     dict
         ``frames``, ``seconds``, ``loop_closure`` (last-to-first step over the median
-        step; up to about 1.5 loops cleanly; see :func:`cyclecoord.metrics.loop_closure`), ``jerk``
+        step; up to about 1.5 loops cleanly; see :func:`cyclecoord.quality.metrics.loop_closure`), ``jerk``
         (mean jerk norm, looping, channel units / s³) and ``median_step``.
     """
     prep = prepare_cycle(motion)
@@ -649,7 +649,7 @@ def align(a: Motion | CycleCurve, b: Motion | CycleCurve, allow_reverse: bool = 
     Examples
     --------
     >>> import numpy as np, cyclecoord as cc
-    >>> from cyclecoord.interpolate import align
+    >>> from cyclecoord.synthesis.interpolate import align
     >>> cap = cc.datasets.make_periodic_capture(n_frames=100, period=100, noise=0,
     ...                                           speed_variation=0, random_state=0)
     >>> cycle = cap.motion
@@ -713,8 +713,8 @@ def _reexpress(motion: Motion, conventions) -> Motion:
     joint's order, with the missing axes placed so that a rotation the dofs can make is
     recovered exactly (a hinge stays a hinge); what they cannot make is dropped.
     """
-    from .retarget import continuous_euler, local_rotations
-    from .skeleton import Joint, Skeleton
+    from ..conventions import continuous_euler, local_rotations
+    from ..skeleton import Joint, Skeleton
 
     skel = motion.skeleton
     local = local_rotations(motion)  # (J, T, 3, 3)
@@ -843,7 +843,7 @@ def common_channels(motions: Sequence[Motion]) -> list[Motion]:
         anchor = motions[asf[0]]
         out = [m if m.skeleton is anchor.skeleton else _reexpress(m, anchor.skeleton) for m in motions]
     else:
-        from .retarget import to_bvh_convention
+        from ..conventions import to_bvh_convention
 
         order = _bvh_ready(skels[0])
         anchor = motions[0]
@@ -1121,7 +1121,7 @@ def _pose_spread(motion: Motion) -> float:
 
 
 def _input_closure(motion: Motion) -> float:
-    from .preprocess import difference_root
+    from ..periodic.preprocess import difference_root
 
     root = _root_columns(motion)
     rot = _angle_columns([motion.channels[c] for c in root])
@@ -1189,7 +1189,7 @@ def as_cycle(
     NoPeriodicMotionError
         When extraction finds no periodic motion.
     """
-    from .pipeline import extract
+    from ..periodic.pipeline import extract
 
     if mode not in ("auto", "cycle", "extract"):
         raise ParameterError(f"mode must be 'auto', 'cycle' or 'extract', got {mode!r}")

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.distance import pdist, squareform
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 __all__ = [
     "Barcode",
@@ -184,7 +184,7 @@ def compute_barcode(
     prime : int, default 47
         Coefficient field Z/p; must be a prime greater than 11.
     n_landmarks : int, optional
-        Greedy max-min subsample size (:func:`cyclecoord.landmarks.greedy_landmarks`,
+        Greedy max-min subsample size (:func:`cyclecoord.periodic.landmarks.greedy_landmarks`,
         the choice ripser's ``n_perm`` makes); ``None`` uses every point.
 
     Returns

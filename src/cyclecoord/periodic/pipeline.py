@@ -14,14 +14,14 @@ from typing import Any
 
 import numpy as np
 
-from ._blas import one_blas_thread
+from .._blas import one_blas_thread
 from .barcode import CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, DEFAULT_PRIME, Barcode, BarSelection
 from .coordinates import CircularCoordinates, unwrap
 from .cycle import TypicalCycle, check_bandwidth, typical_cycle
 from .density import PeriodicDensity
-from .errors import NoPeriodicMotionError, ParameterError
-from .metrics import distance_to_cycle, jerk_summary, loop_closure
-from .motion import Motion
+from ..errors import NoPeriodicMotionError, ParameterError
+from ..quality.metrics import distance_to_cycle, jerk_summary, loop_closure
+from ..motion import Motion
 from .preprocess import PreparedData, Preprocessor
 
 __all__ = ["extract", "ExtractionResult", "loop_cycle", "cycle_lengths", "slowest_frame", "MIN_CYCLES"]
@@ -136,8 +136,8 @@ class ExtractionResult:
 
     @property
     def model(self):
-        """The fitted :class:`~cyclecoord.model.PhaseModel` (phase of new frames, save/load)."""
-        from .model import PhaseModel
+        """The fitted :class:`~cyclecoord.periodic.phase_model.PhaseModel` (phase of new frames, save/load)."""
+        from .phase_model import PhaseModel
 
         return PhaseModel.from_result(self)
 
@@ -209,7 +209,7 @@ def loop_cycle(
     Parameters
     ----------
     typical : TypicalCycle
-        From :func:`~cyclecoord.cycle.typical_cycle` on ``prepared.poses`` (or rows of it).
+        From :func:`~cyclecoord.periodic.cycle.typical_cycle` on ``prepared.poses`` (or rows of it).
     motion : Motion
         The capture ``prepared`` was made from.
     prepared : PreparedData
@@ -308,7 +308,7 @@ def extract(
         Coefficient field Z/p, a prime greater than 11.
     max_scale : float, optional
         Filtration threshold in the analysed space's units (default: half the point
-        cloud's diameter, see :func:`cyclecoord.barcode.default_max_scale`).
+        cloud's diameter, see :func:`cyclecoord.periodic.barcode.default_max_scale`).
     scale : float, optional
         Scale to read the cocycle at (default: ``scale_fraction`` of the way up the bar).
     class_index : int, default 0
@@ -321,7 +321,7 @@ def extract(
     bandwidth : None, "auto" or float
         Width of the kernel average in frames of one period: None for ``n_neighbors``
         frames' worth, ``"auto"`` for leave-one-out cross-validation, or a positive
-        number (see :func:`~cyclecoord.cycle.typical_cycle`); the width used is
+        number (see :func:`~cyclecoord.periodic.cycle.typical_cycle`); the width used is
         ``result.typical.bandwidth``.
     weighting : {"kernel", "mean", "gaussian"}
         How frames near a phase are averaged: a smooth periodic kernel holding about

@@ -18,8 +18,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .errors import CycleCoordError, ParameterError
-from .motion import Motion
+from ..errors import CycleCoordError, ParameterError
+from ..motion import Motion
 
 __all__ = [
     "Bones",
@@ -505,7 +505,7 @@ def _in_convention_of(reference: Motion, motion: Motion) -> Motion:
     A blend of an AMC capture with a BVH cycle is written in one convention; comparing
     joint angles needs the references in the same one.
     """
-    from .interpolate import in_conventions_of
+    from ..synthesis.interpolate import in_conventions_of
 
     return in_conventions_of(reference, motion)
 

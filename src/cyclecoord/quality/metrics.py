@@ -18,7 +18,7 @@ from numbers import Integral, Real
 
 import numpy as np
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 __all__ = [
     "finite_difference_coefficients",

@@ -29,7 +29,7 @@ correctly.  A **windowed stage** looks locally:
 6. **Windows**: sliding windows of 2, 4 and 6 s (``window_lengths``; a window of length
    ``L`` steps by ``max(0.5 s, L / 8)``) over the same prepared points, at most 100
    frames each.  Each gets its full Rips barcode; when its longest bar is clear
-   (:func:`cyclecoord.barcode.select_bar`), its circular coordinate.  The window
+   (:func:`cyclecoord.periodic.barcode.select_bar`), its circular coordinate.  The window
    *loops* when the coordinate turns at least 0.9 times with at least half its steps
    the same way; its typical cycle is then the mean pose (root channels left out) in 16
    phase bins of the coordinate (:func:`binned_cycle`).
@@ -42,7 +42,7 @@ correctly.  A **windowed stage** looks locally:
    cycles, which no single window holds one and a half times: 13_29's alternating toe
    touches take about 4.1 s a cycle and are performed for 6.5 s).
 8. **Labels**: every frame within ``window`` seconds of a motion's windows may take that
-   motion; the cost of a frame is its :func:`~cyclecoord.metrics.distance_to_cycle` to the
+   motion; the cost of a frame is its :func:`~cyclecoord.quality.metrics.distance_to_cycle` to the
    motion's nearest window cycle, over that cycle's typical distance to its own frames,
    and :data:`NONE_COST` for "nothing periodic".  The cheapest labelling that pays half
    a ``window`` of frames per change (Viterbi) gives the labels; runs shorter than half
@@ -76,11 +76,11 @@ from typing import Any
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
-from ._blas import one_blas_thread
+from .._blas import one_blas_thread
 from .barcode import CLEAR_RATIO, DEFAULT_PRIME, Barcode, compute_barcode, select_bar
 from .coordinates import CircularCoordinates, unwrap
-from .errors import NoPeriodicMotionError, ParameterError
-from .motion import Motion
+from ..errors import NoPeriodicMotionError, ParameterError
+from ..motion import Motion
 from .preprocess import Preprocessor
 
 __all__ = [
@@ -359,7 +359,7 @@ class WindowInfo:
     scale : float
         Scale the cocycle was read at (NaN when no coordinate was computed).
     clear : bool
-        Whether the bar stands clear (:func:`cyclecoord.barcode.select_bar`).
+        Whether the bar stands clear (:func:`cyclecoord.periodic.barcode.select_bar`).
     cycles : float
         Unwrapped turns of its circular coordinate from the first frame to the last.
     steadiness : float
@@ -527,7 +527,7 @@ def window_table(
     max_points : int, default 100
         At most this many frames per window (every ``ceil(L / max_points)``-th frame).
     prime, scale_fraction
-        As for :class:`~cyclecoord.coordinates.CircularCoordinates`.
+        As for :class:`~cyclecoord.periodic.coordinates.CircularCoordinates`.
     min_cycles : float, default 0.9
         A window loops when its coordinate completes at least this many turns ...
     min_steadiness : float, default 0.5
@@ -625,7 +625,7 @@ class _Candidate:
 
 
 def _candidate_cost(c: _Candidate, poses: np.ndarray) -> np.ndarray:
-    from .metrics import distance_to_cycle
+    from ..quality.metrics import distance_to_cycle
 
     cost = np.min([distance_to_cycle(poses, cyc) / s for cyc, s in zip(c.cycles, c.scales)], axis=0)
     return np.where(c.allowed, cost, np.inf)
@@ -641,7 +641,7 @@ def _dilate(mask: np.ndarray, margin: int) -> np.ndarray:
 
 def _typical_distance(poses: np.ndarray, cycle: np.ndarray) -> float:
     """Median distance of the frames a cycle was made from to that cycle (its scale)."""
-    from .metrics import distance_to_cycle
+    from ..quality.metrics import distance_to_cycle
 
     return max(float(np.median(distance_to_cycle(poses, cycle))), 1e-9)
 
@@ -839,7 +839,7 @@ class MotionCycle:
     cycle : Motion
         The loopable clip, with the capture's channels, skeleton and frame rate.
     loop_closure : float
-        Seam step over median step (:func:`~cyclecoord.metrics.loop_closure`).
+        Seam step over median step (:func:`~cyclecoord.quality.metrics.loop_closure`).
     """
 
     motion: int
@@ -887,7 +887,7 @@ def motion_cycles(
     """
     from .cycle import typical_cycle
     from .density import PeriodicDensity
-    from .metrics import loop_closure
+    from ..quality.metrics import loop_closure
     from .pipeline import loop_cycle
 
     if not isinstance(result, DetectionResult):

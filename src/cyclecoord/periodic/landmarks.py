@@ -15,7 +15,7 @@ from math import comb
 
 import numpy as np
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 __all__ = [
     "greedy_landmarks",

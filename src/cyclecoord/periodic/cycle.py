@@ -4,7 +4,7 @@ Given each frame's circular coordinate ``theta`` (phase in ``[0, 1)``) and its p
 typical cycle is built in three steps:
 
 1. phases are drawn from the periodic density of ``theta``
-   (:class:`~cyclecoord.density.PeriodicDensity`); the density is proportional to the time
+   (:class:`~cyclecoord.periodic.density.PeriodicDensity`); the density is proportional to the time
    the motion spends at each phase, so the drawn phases are (about) equally spaced in
    *time*;
 2. each phase gets an average pose: by default a periodic Gaussian kernel average over
@@ -27,7 +27,7 @@ from numbers import Integral, Real
 import numpy as np
 
 from .density import PeriodicDensity, _as_generator
-from .errors import ParameterError
+from ..errors import ParameterError
 
 __all__ = [
     "TypicalCycle",

@@ -14,7 +14,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError
+from ..errors import CycleCoordError, NoPeriodicMotionError, ParameterError
 
 __all__ = ["main", "build_parser"]
 
@@ -70,8 +70,8 @@ def _positive_float(text: str) -> float:
 
 def load_input(path: str, skeleton: str | None = None, fps: float | None = None):
     """Load a capture, or a built-in example when ``path`` is ``example[:kind]``."""
-    from . import datasets
-    from .io import load
+    from .. import datasets
+    from ..io import load
 
     if (path == "example" or path.startswith("example:")) and not Path(path).exists():
         kind = path.split(":", 1)[1] if ":" in path else "walk"
@@ -96,7 +96,7 @@ def _check_output(path: str | None, what: str = "output") -> None:
     """Fail fast, before any computation, on an output we could not write."""
     if not path:
         return
-    from .io import SUPPORTED_FORMATS
+    from ..io import SUPPORTED_FORMATS
 
     out = Path(path)
     if what == "output" and out.suffix.lower() not in SUPPORTED_FORMATS:
@@ -113,7 +113,7 @@ def _check_output(path: str | None, what: str = "output") -> None:
 
 
 def _write_json(path: str, payload: dict) -> None:
-    from .io._atomic import atomic_write
+    from ..io._atomic import atomic_write
 
     with atomic_write(path, "w") as fh:
         json.dump(payload, fh, indent=1, allow_nan=False, default=_json_default)
@@ -212,8 +212,8 @@ def _summary_barcode(bc, sel=None) -> str:
 
 # ---------------------------------------------------------------- commands
 def cmd_extract(args: argparse.Namespace) -> int:
-    from .io import save
-    from .pipeline import extract
+    from ..io import save
+    from ..periodic.pipeline import extract
 
     _check_output(args.output)
     _check_output(args.report, "report")
@@ -330,7 +330,7 @@ def cmd_extract(args: argparse.Namespace) -> int:
 
 def _apply_model(args: argparse.Namespace, motion) -> int:
     """``extract --apply MODEL``: phase of every frame from a saved model, no refit."""
-    from .model import PhaseModel
+    from ..periodic.phase_model import PhaseModel
 
     model = PhaseModel.load(args.apply)
     motion = motion.window(args.frames)
@@ -358,7 +358,7 @@ def _apply_model(args: argparse.Namespace, motion) -> int:
 
 def _save_plots(result, folder: str) -> None:
     """``extract --plot DIR``: the standard figures (only the barcode when nothing was found)."""
-    from .plot import save_figures
+    from ..plot.figures import save_figures
 
     for path in save_figures(result, folder):
         print(f"wrote {path}")
@@ -366,8 +366,8 @@ def _save_plots(result, folder: str) -> None:
 
 def cmd_detect(args: argparse.Namespace) -> int:
     """``cyclecoord detect``: several periodic motions, their segments and per-frame labels."""
-    from .detection import detect, motion_cycles
-    from .io import save
+    from ..periodic.detection import detect, motion_cycles
+    from ..io import save
 
     _check_output(args.report, "report")
     if args.extract and Path(args.extract).exists() and not Path(args.extract).is_dir():
@@ -418,7 +418,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 f"{mc.loop_closure:.2f} -> {out}"
             )
     if args.plot:
-        from .plot import plot_barcode, plot_coordinate, plot_windows
+        from ..plot.figures import plot_barcode, plot_coordinate, plot_windows
 
         folder = Path(args.plot)
         folder.mkdir(parents=True, exist_ok=True)
@@ -438,7 +438,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
             )
         if res.windows:
             figs["windows.png"] = plot_windows(res)
-        from .io._atomic import atomic_write
+        from ..io._atomic import atomic_write
 
         for name, fig in figs.items():
             with atomic_write(folder / name, "wb") as fh:
@@ -453,7 +453,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
 
 
 def cmd_render(args: argparse.Namespace) -> int:
-    from .plot import render
+    from ..plot.figures import render
 
     out = Path(args.output)
     if out.suffix.lower() not in (".gif", ".mp4"):
@@ -471,13 +471,13 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 
 def cmd_barcode(args: argparse.Namespace) -> int:
-    from .preprocess import Preprocessor
+    from ..periodic.preprocess import Preprocessor
 
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
     prep = Preprocessor(difference_root=not args.no_root_diff, normalize=args.normalize, pca=args.pca)
     pts = prep.fit_transform(motion).points
-    from .coordinates import CircularCoordinates
+    from ..periodic.coordinates import CircularCoordinates
 
     est = CircularCoordinates(
         max_scale=args.max_scale, prime=args.prime, temporal=args.temporal, landmarks=args.landmarks,
@@ -494,7 +494,7 @@ def cmd_barcode(args: argparse.Namespace) -> int:
 
 
 def cmd_convert(args: argparse.Namespace) -> int:
-    from .io import save
+    from ..io import save
 
     _check_output(args.output)
     if Path(args.output).resolve() == Path(args.input).resolve():
@@ -536,7 +536,7 @@ def _per_input(values: list | None, n: int, option: str) -> list:
 
 def _load_cycles(args: argparse.Namespace) -> list:
     """Every input as a cycle (captures are extracted first), with why."""
-    from .interpolate import as_cycle
+    from ..synthesis.interpolate import as_cycle
 
     n = len(args.inputs)
     windows = _per_input(args.window, n, "--window")
@@ -576,8 +576,8 @@ def _check_outputs(args: argparse.Namespace) -> None:
 
 def _finish(args: argparse.Namespace, motion, payload: dict, report, what: str, problem: str | None = None) -> int:
     """Print the plausibility verdict, honour --strict, write the motion and the report."""
-    from .io import save
-    from .plausibility import ImplausibleMotionError
+    from ..io import save
+    from ..quality.plausibility import ImplausibleMotionError
 
     print(report.summary())
     payload["plausibility"] = report.to_dict()
@@ -599,8 +599,8 @@ def _finish(args: argparse.Namespace, motion, payload: dict, report, what: str, 
 
 
 def cmd_blend(args: argparse.Namespace) -> int:
-    from .interpolate import blend, cycle_summary
-    from .plausibility import check_plausibility
+    from ..synthesis.interpolate import blend, cycle_summary
+    from ..quality.plausibility import check_plausibility
 
     _check_outputs(args)
     try:
@@ -641,8 +641,8 @@ def cmd_blend(args: argparse.Namespace) -> int:
 
 
 def cmd_transition(args: argparse.Namespace) -> int:
-    from .interpolate import transition
-    from .plausibility import check_plausibility
+    from ..synthesis.interpolate import transition
+    from ..quality.plausibility import check_plausibility
 
     _check_outputs(args)
     try:
@@ -685,7 +685,7 @@ def cmd_transition(args: argparse.Namespace) -> int:
 
 
 def cmd_batch(args: argparse.Namespace) -> int:
-    from .batch import DEFAULT_PATTERNS, run_batch
+    from ..batch import DEFAULT_PATTERNS, run_batch
 
     options = dict(
         pca=args.pca, normalize=args.normalize, temporal=args.temporal, prime=args.prime,
@@ -727,7 +727,7 @@ def build_parser() -> argparse.ArgumentParser:
             "exit codes: 0 ok, 1 error, 2 usage, 3 no periodic motion found"
         ),
     )
-    from . import __version__
+    from .. import __version__
 
     p.add_argument("--version", action="version", version=f"cyclecoord {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")

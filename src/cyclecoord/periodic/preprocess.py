@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .errors import ParameterError
-from .motion import Motion
+from ..errors import ParameterError
+from ..motion import Motion
 
 __all__ = ["Preprocessor", "PreparedData", "difference_root"]
 

@@ -21,7 +21,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import lsqr
 from scipy.spatial import cKDTree
 
-from ._blas import one_blas_thread
+from .._blas import one_blas_thread
 from .barcode import (
     DEFAULT_PRIME,
     Barcode,
@@ -33,7 +33,7 @@ from .barcode import (
     select_bar,
     temporal_distance_matrix,
 )
-from .errors import ParameterError
+from ..errors import ParameterError
 from .landmarks import DEFAULT_MEMORY_LIMIT, choose_landmarks
 
 __all__ = [
@@ -299,7 +299,7 @@ class CircularCoordinates:
     Parameters
     ----------
     max_scale : float, optional
-        Filtration threshold (see :func:`cyclecoord.barcode.default_max_scale`).
+        Filtration threshold (see :func:`cyclecoord.periodic.barcode.default_max_scale`).
     scale : float, optional
         Scale at which the cocycle is read; default is high inside the bar.
     class_index : int, default 0
@@ -312,7 +312,7 @@ class CircularCoordinates:
         Use the time-aware metric where consecutive frames are at distance 0.
     landmarks : "auto", int or None, default "auto"
         Build the filtration on greedy max-min landmarks and extend the coordinate to
-        every point (see :func:`cyclecoord.landmarks.choose_landmarks`).  ``None`` uses
+        every point (see :func:`cyclecoord.periodic.landmarks.choose_landmarks`).  ``None`` uses
         every point.
     memory_limit : float, default 2 GiB
         Budget for one filtration; above it landmarks are used (fewer if needed).

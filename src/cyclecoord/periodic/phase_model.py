@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 
 from .coordinates import CircularCoordinates, unwrap
-from .errors import ParameterError, ParseError
-from .io._atomic import atomic_write
-from .motion import Motion
+from ..errors import ParameterError, ParseError
+from ..io._atomic import atomic_write
+from ..motion import Motion
 from .preprocess import Preprocessor
 
 __all__ = ["PhaseModel"]
@@ -51,7 +51,7 @@ class PhaseModel:
 
     @classmethod
     def from_result(cls, result) -> "PhaseModel":
-        """The model behind an :class:`~cyclecoord.pipeline.ExtractionResult`."""
+        """The model behind an :class:`~cyclecoord.periodic.pipeline.ExtractionResult`."""
         if result.estimator is None or result.preprocessor is None:
             raise ParameterError("this result carries no fitted model")
         return cls(

@@ -39,7 +39,7 @@ from sklearn.base import BaseEstimator
 from sklearn.exceptions import ConvergenceWarning
 from sklearn.mixture import GaussianMixture
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 __all__ = ["PeriodicDensity"]
 

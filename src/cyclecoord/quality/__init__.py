@@ -1,0 +1,1 @@
+"""Quality: measures of a motion (jerk, loop closure, distances) and plausibility checks."""

@@ -1,0 +1,1 @@
+"""Synthesis: new motion made from captured motion (blends, transitions, generated paths)."""
