@@ -703,6 +703,13 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
 
 # ------------------------------------------------------------------ parser
+#: Subcommands that live in a module of their own under ``cyclecoord.cli``: each module has
+#: ``add_parser(subparsers)``, which adds its parser and sets ``func`` to the function that
+#: runs it (taking the parsed arguments, returning the exit code).  Modules must import
+#: their heavy dependencies inside that function so ``cyclecoord --help`` stays fast.
+COMMAND_MODULES: tuple[str, ...] = ()
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="cyclecoord",
@@ -949,6 +956,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="memory budget per capture for the filtration, e.g. 2G; above it landmarks are used")
     g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (0)")
     ba.set_defaults(func=cmd_batch)
+    for name in COMMAND_MODULES:
+        import importlib
+
+        importlib.import_module(f".{name}", __package__).add_parser(sub)
     return p
 
 
