@@ -17,17 +17,32 @@ import numpy as np
 from .._blas import one_blas_thread
 from .barcode import CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, DEFAULT_PRIME, Barcode, BarSelection
 from .coordinates import CircularCoordinates, unwrap
-from .cycle import TypicalCycle, check_bandwidth, typical_cycle
+from .cycle import TypicalCycle, check_bandwidth, select_bandwidth, typical_cycle
 from .density import PeriodicDensity
 from ..errors import NoPeriodicMotionError, ParameterError
 from ..quality.metrics import distance_to_cycle, jerk_summary, loop_closure
 from ..motion import Motion
 from .preprocess import PreparedData, Preprocessor
+from .root import compose_root, decompose_root, heading, root_layout
+from .steady import moving_mask, recurrence, steady_mask
+from .windings import Windings, complete_windings, phase_average, retime, stretches
 
-__all__ = ["extract", "ExtractionResult", "loop_cycle", "cycle_lengths", "slowest_frame", "MIN_CYCLES"]
+__all__ = [
+    "extract", "ExtractionResult", "loop_cycle", "capture_cycle", "cycle_lengths", "slowest_frame",
+    "MIN_TURNS", "TIMINGS", "TRAVELS", "CAPTURE_WIDTH",
+]
 
-#: A clip whose coordinate goes round fewer times than this holds no measurable period.
-MIN_CYCLES = 0.75
+#: Fewer turns of the coordinate over the steady frames than this is no periodic motion
+#: (the rule :func:`~cyclecoord.periodic.detection.detect` applies to its segments).
+MIN_TURNS = 1.5
+#: How the cycle is timed: at the capture's pace (re-timed phase) or by the coordinate.
+TIMINGS = ("capture", "coordinate")
+#: What the cycle's root does: travel and turn as captured, walk straight, stay in place.
+TRAVELS = ("keep", "straight", "in_place")
+#: Default width (frames of time) of the kernel that averages the re-timed cycle.
+CAPTURE_WIDTH = 1.5
+#: Landmarks of the rough first pass over a long take (which finds its steady frames).
+FIRST_PASS_LANDMARKS = 150
 
 
 def slowest_frame(frames: np.ndarray, window: int = 5) -> int:
@@ -47,28 +62,21 @@ def slowest_frame(frames: np.ndarray, window: int = 5) -> int:
 
 
 def cycle_lengths(unwrapped: np.ndarray) -> np.ndarray:
-    """Frames taken by each complete cycle.
+    """Frames taken by each complete cycle counted from the first frame.
 
     The unwrapped coordinate ``u`` starts at ``u[0]``; cycle ``k`` ends where ``u`` first
     reaches ``u[0] + k`` (linearly interpolated between frames).  Returns the differences
     between successive crossing times, starting from frame 0.
     """
     u = np.asarray(unwrapped, dtype=float)
-    if u.size < 2:
+    if u.size < 2 or u[-1] - u[0] < 1:
         return np.zeros(0)
-    total = u[-1] - u[0]
-    ends = []
-    for k in range(1, int(np.floor(total)) + 1):
-        level = u[0] + k
-        i = int(np.argmax(u >= level))
-        if u[i] < level:
-            break
-        if i == 0:
-            ends.append(0.0)
-            continue
-        f = (level - u[i - 1]) / (u[i] - u[i - 1]) if u[i] != u[i - 1] else 0.0
-        ends.append(i - 1 + f)
-    return np.diff(np.concatenate([[0.0], ends])) if ends else np.zeros(0)
+    m = np.maximum.accumulate(u)
+    levels = u[0] + np.arange(1, int(np.floor(m[-1] - u[0])) + 1)
+    i = np.searchsorted(m, levels, side="left")
+    lo, hi = m[i - 1], m[i]
+    ends = i - 1 + np.where(hi > lo, (levels - lo) / np.where(hi > lo, hi - lo, 1.0), 0.0)
+    return np.diff(np.concatenate([[0.0], ends]))
 
 
 @dataclass
@@ -85,15 +93,16 @@ class ExtractionResult:
     selection : BarSelection
         Chosen H1 class and scale.
     coordinate : ndarray, shape (T,)
-        Circular coordinate per analysed frame, in [0, 1), increasing with time.
+        Circular coordinate per analysed frame, in [0, 1), increasing with time; NaN on
+        frames outside the steady stretches (:attr:`used_frames`).
     unwrapped : ndarray, shape (T,)
-        The coordinate unwrapped along frame order (in cycles).
+        The coordinate unwrapped along frame order inside each steady stretch (in cycles).
     cycles : float
-        Number of cycles in the clip (unwrapped change from first to last frame).
+        Turns of the coordinate over the steady stretches.
     period_frames : float
-        Mean period in frames, ``(T - 1) / cycles``.
+        Median length in frames of the complete windings (:attr:`windings`).
     cycle_frames : ndarray
-        Length in frames of each complete cycle.
+        Length in frames of each complete winding (at the sharpest level).
     density : PeriodicDensity
     typical : TypicalCycle
         The cycle in the prepared space (root as differences).
@@ -111,6 +120,15 @@ class ExtractionResult:
         Seconds per stage.
     warnings : list of str
         Anything the user should know (H0 components, cocycle repairs, ...).
+    used : ndarray of bool, shape (T,)
+        The steady frames the cycle was built from.
+    phase : ndarray, shape (T,)
+        Re-timed phase (advancing at the capture's pace) on the used frames, NaN
+        elsewhere (all NaN with ``timing="coordinate"``).
+    windings : Windings
+        The complete windings: lengths, spread, anchors.
+    heading_per_cycle : float
+        Heading change of one cycle in degrees (as captured, before ``travel``).
     """
 
     motion: Motion
@@ -133,6 +151,15 @@ class ExtractionResult:
     warnings: list = field(default_factory=list)
     estimator: CircularCoordinates | None = None
     preprocessor: Preprocessor | None = None
+    used: np.ndarray | None = None
+    phase: np.ndarray | None = None
+    windings: Windings | None = None
+    heading_per_cycle: float = float("nan")
+
+    @property
+    def used_frames(self) -> list[tuple[int, int]]:
+        """The steady stretches the cycle was built from, ``[(start, stop), ...]`` (0-based)."""
+        return [] if self.used is None else stretches(self.used)
 
     @property
     def model(self):
@@ -155,11 +182,15 @@ class ExtractionResult:
             "barcode": self.barcode.to_dict(),
             "selected": self.selection.to_dict(),
             "clear_criterion": {"min_ratio": CLEAR_RATIO, "min_gap": CLEAR_GAP, "min_fraction_of_threshold": CLEAR_MIN_FRACTION},
-            "coordinate": [float(v) for v in self.coordinate],
+            "coordinate": _nullable(self.coordinate),
+            "phase": _nullable(self.phase),
+            "used_frames": [[int(a), int(b)] for a, b in self.used_frames],
             "cycles": float(self.cycles),
             "period_frames": float(self.period_frames),
             "period_seconds": float(self.period_frames / self.motion.fps),
             "cycle_frames": [float(v) for v in self.cycle_frames],
+            "period_spread": None if self.windings is None else float(self.windings.spread),
+            "heading_per_cycle_degrees": None if not np.isfinite(self.heading_per_cycle) else float(self.heading_per_cycle),
             "cycle_length": int(self.cycle.n_frames),
             "jerk": self.jerk,
             "loop_closure": float(self.loop_closure),
@@ -176,6 +207,13 @@ class ExtractionResult:
         }
 
 
+def _nullable(values: np.ndarray | None) -> list | None:
+    """A list of floats with None where a value is NaN."""
+    if values is None:
+        return None
+    return [float(v) if np.isfinite(v) else None for v in np.asarray(values, dtype=float)]
+
+
 def _landmark_report(est: CircularCoordinates | None) -> dict | None:
     if est is None or not hasattr(est, "landmark_reason_"):
         return None
@@ -189,7 +227,6 @@ def _landmark_report(est: CircularCoordinates | None) -> dict | None:
     }
 
 
-@one_blas_thread
 def loop_cycle(
     typical: TypicalCycle,
     motion: Motion,
@@ -255,6 +292,76 @@ def loop_cycle(
     return typical, clip
 
 
+def _first_clear(est: CircularCoordinates, points: np.ndarray, class_index: int, scale, scale_fraction: float):
+    """Barcode of ``points`` and the chosen bar, judged by its real death.
+
+    A bar still alive at the threshold reads a death/birth ratio and a gap cut by the
+    threshold.  When that cut makes it fail the clear test, the threshold is raised
+    (1.6x at a time, at most 4 times, never past the point cloud's diameter) until the
+    bar dies, and the bar is judged on the longer filtration.
+    """
+    from .barcode import default_max_scale, select_bar
+
+    barcode = est.fit_barcode(points)
+    if len(barcode.h1) == 0 or class_index >= len(barcode.h1):
+        return barcode, None
+    sel = select_bar(barcode, class_index, scale, scale_fraction)
+    diameter = 2.0 * default_max_scale(points)
+    tries = 0
+    while not sel.clear and sel.death >= barcode.threshold and tries < 4 and barcode.threshold < diameter:
+        birth = sel.birth
+        old = est.max_scale
+        est.max_scale = min(barcode.threshold * 1.6, diameter)
+        try:
+            longer = est.fit_barcode(points)
+        finally:
+            est.max_scale = old
+        match = np.flatnonzero(np.isclose(longer.h1[:, 0], birth, rtol=1e-9, atol=1e-12)) if len(longer.h1) else []
+        if not len(match):
+            break
+        barcode = longer
+        est.class_index = int(match[0])
+        sel = select_bar(barcode, int(match[0]), scale, scale_fraction)
+        tries += 1
+    return barcode, sel
+
+
+def _not_clear_reason(sel: BarSelection, barcode: Barcode) -> str:
+    why = []
+    if sel.ratio < CLEAR_RATIO:
+        why.append(f"death/birth {sel.ratio:.2f} < {CLEAR_RATIO}")
+    if sel.gap < CLEAR_GAP:
+        why.append(f"persistence only {sel.gap:.2f}x the next bar's (< {CLEAR_GAP}x)")
+    if not why:
+        why.append(f"persistence under {CLEAR_MIN_FRACTION:.0%} of the threshold {barcode.threshold:.4g}")
+    ds = "inf" if not np.isfinite(sel.death) else f"{sel.death:.4g}"
+    return f"H1 bar #{sel.index} [{sel.birth:.4g}, {ds}) does not stand clear ({'; '.join(why)})"
+
+
+def _unwrap_runs(theta: np.ndarray, rows: np.ndarray, runs: list[tuple[int, int]], n: int) -> np.ndarray:
+    """The coordinate of ``rows`` unwrapped inside each run, NaN elsewhere (length ``n``)."""
+    full = np.full(n, np.nan)
+    full[rows] = theta
+    out = np.full(n, np.nan)
+    for a, b in runs:
+        if b > a:
+            out[a:b] = unwrap(full[a:b])
+    return out
+
+
+@dataclass
+class _Fit:
+    """One barcode + coordinate fit on some rows of a capture."""
+
+    est: CircularCoordinates
+    barcode: Barcode
+    selection: BarSelection
+    rows: np.ndarray
+    unwrapped: np.ndarray  # (T,), NaN outside rows
+    notes: list
+
+
+@one_blas_thread
 def extract(
     motion: Motion,
     frames: tuple[int | None, int | None] | None = None,
@@ -281,8 +388,21 @@ def extract(
     memory_limit: float | None = None,
     require_clear: bool = True,
     random_state: int | None = 0,
+    steady: bool = True,
+    timing: str = "capture",
+    travel: str = "keep",
+    min_turns: float = MIN_TURNS,
 ) -> ExtractionResult:
     """Find the dominant periodic motion of a capture and its typical cycle.
+
+    On a whole take (a standing start, a pause, a turn, a stop) the cycle is built from
+    the steady stretches only (:mod:`~cyclecoord.periodic.steady`): the barcode and the
+    coordinate are computed on the moving frames, the steady frames are found from the
+    coordinate's pace, the poses' recurrence one period later and the heading, and the
+    coordinate is fitted again on them.  The period is the median length of the
+    complete windings (:mod:`~cyclecoord.periodic.windings`) and the cycle is averaged in
+    a phase re-timed to the capture's pace, so each part of it takes the time it takes
+    in the capture.
 
     Parameters
     ----------
@@ -308,42 +428,42 @@ def extract(
         Coefficient field Z/p, a prime greater than 11.
     max_scale : float, optional
         Filtration threshold in the analysed space's units (default: half the point
-        cloud's diameter, see :func:`cyclecoord.periodic.barcode.default_max_scale`).
+        cloud's diameter).  A bar still alive there that the cut would make fail the
+        clear test is followed to its real death.
     scale : float, optional
         Scale to read the cocycle at (default: ``scale_fraction`` of the way up the bar).
     class_index : int, default 0
         Which H1 class by decreasing persistence.
-    n_samples : int, default 500
-        Phases sampled from the periodic density for the centroid curve.
-    n_neighbors : int, default 10
-        Frames averaged per sampled phase (sets the kernel width when ``bandwidth`` is
-        None).
+    n_samples, n_neighbors, weighting, sampling, n_components
+        Settings of the paper's cycle (``timing="coordinate"``): phases sampled from the
+        periodic density, frames averaged per phase and how, mixture components.
+        ``n_neighbors`` also bounds how short a capture may be.
     bandwidth : None, "auto" or float
-        Width of the kernel average in frames of one period: None for ``n_neighbors``
-        frames' worth, ``"auto"`` for leave-one-out cross-validation, or a positive
-        number (see :func:`~cyclecoord.periodic.cycle.typical_cycle`); the width used is
-        ``result.typical.bandwidth``.
-    weighting : {"kernel", "mean", "gaussian"}
-        How frames near a phase are averaged: a smooth periodic kernel holding about
-        ``n_neighbors`` frames (default), the paper's plain mean of the ``n_neighbors``
-        nearest, or those Gaussian-weighted.
-    sampling : {"quantile", "random"}
-        Deterministic density quantiles (default, less jitter) or random draws (paper).
-    n_components : int, default 30
-        Gaussian mixture components of the periodic density.
+        Width of the average that builds the cycle, in frames of time: None for the
+        default (1.5 frames with ``timing="capture"``), ``"auto"`` for leave-one-out
+        cross-validation, or a positive number.
     cycle_start : {"slowest", "first"}
-        Where the written cycle begins: at its slowest pose (default; the seam of the
-        loop is least visible there) or at the phase of the clip's first frame.
+        Where the written cycle begins: at its slowest pose (default) or at phase 0.
     landmarks : "auto", int or None
         Build the filtration on greedy max-min landmarks (``"auto"``: every frame up to
-        1,000 frames, 500 landmarks beyond) and extend the coordinate to every frame;
-        ``None`` uses every frame.
+        1,000 frames, 500 landmarks beyond) and extend the coordinate to every frame.
     memory_limit : float, optional
         Byte budget for the filtration (default 2 GiB); above it landmarks are used.
     require_clear : bool, default True
         Raise :class:`NoPeriodicMotionError` when the chosen bar does not stand clear.
     random_state : int, optional
         Seed for the density fit and sampling.
+    steady : bool, default True
+        Build the cycle from the steady stretches only (False: every frame, as the paper
+        on hand-picked windows).
+    timing : {"capture", "coordinate"}
+        ``"capture"`` (default): the cycle is averaged in the re-timed phase and moves at
+        the capture's pace; ``"coordinate"``: the paper's density-sampled coordinate.
+    travel : {"keep", "straight", "in_place"}
+        The cycle's root: turn and travel as the capture did on average, walk straight
+        (heading change per cycle removed) or stay in place.
+    min_turns : float, default 1.5
+        Fewer turns of the coordinate over the steady frames is no periodic motion.
 
     Returns
     -------
@@ -352,24 +472,16 @@ def extract(
     Raises
     ------
     NoPeriodicMotionError
-        When the chosen H1 bar does not stand clear (its ``result`` attribute holds a
-        partial :class:`ExtractionResult` with ``cycle`` None and the barcode).
+        When no bar stands clear or the steady frames hold under ``min_turns`` turns (its
+        ``result`` attribute holds a partial :class:`ExtractionResult`).
     ParameterError
         For invalid arguments.
     """
-    if not isinstance(motion, Motion):
-        raise ParameterError(f"extract() takes a Motion, got {type(motion).__name__}")
-    if weighting not in ("kernel", "mean", "gaussian"):
-        raise ParameterError(f"weighting must be 'kernel', 'mean' or 'gaussian', got {weighting!r}")
-    if sampling not in ("quantile", "random"):
-        raise ParameterError(f"sampling must be 'quantile' or 'random', got {sampling!r}")
-    if cycle_start not in ("slowest", "first"):
-        raise ParameterError(f"cycle_start must be 'slowest' or 'first', got {cycle_start!r}")
-    if n_samples < 10:
-        raise ParameterError(f"n_samples must be at least 10, got {n_samples}")
-    if n_neighbors < 1:
-        raise ParameterError(f"n_neighbors must be at least 1, got {n_neighbors}")
-    bandwidth = check_bandwidth(bandwidth, weighting)  # before any work is done
+    opts = _check_options(
+        motion, weighting=weighting, sampling=sampling, cycle_start=cycle_start, n_samples=n_samples,
+        n_neighbors=n_neighbors, bandwidth=bandwidth, timing=timing, travel=travel, min_turns=min_turns,
+    )
+    bandwidth = opts["bandwidth"]
     timings: dict[str, float] = {}
     notes: list[str] = []
     params = dict(
@@ -378,129 +490,312 @@ def extract(
         class_index=class_index, scale_fraction=scale_fraction, n_samples=n_samples,
         n_neighbors=n_neighbors, bandwidth=bandwidth, weighting=weighting, sampling=sampling, n_components=n_components,
         cycle_start=cycle_start, landmarks=landmarks, memory_limit=memory_limit, random_state=random_state,
+        steady=steady, timing=timing, travel=travel, min_turns=min_turns,
     )
     motion = motion.window(frames)
     if motion.n_frames < 2 * n_neighbors or motion.n_frames < 10:
         raise ParameterError(
-            f"{motion.n_frames} frames are too few to find a cycle (need at least {max(10, 2 * n_neighbors)})"
+            f"{motion.source or 'capture'}: {motion.n_frames} frames are too few to find a cycle "
+            f"(need at least {max(10, 2 * n_neighbors)})"
         )
-
+    T = motion.n_frames
     t0 = time.perf_counter()
     lag = int(round(delay * motion.fps)) if delay else None
     prep = Preprocessor(difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=lag)
     prepared = prep.fit_transform(motion)
+    joints = _joint_columns(motion, prepared)
+    moving = moving_mask(prepared.poses[:, joints], motion.fps) if steady else np.ones(T, dtype=bool)
+    if not steady or moving.sum() >= 0.95 * T or moving.sum() < max(10, 2 * n_neighbors):
+        moving = np.ones(T, dtype=bool)
     timings["prepare"] = time.perf_counter() - t0
 
-    est = CircularCoordinates(
-        max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
-        scale_fraction=scale_fraction, temporal=temporal, landmarks=landmarks,
-        **({} if memory_limit is None else {"memory_limit": memory_limit}),
-    )
-    t0 = time.perf_counter()
-    barcode = est.fit_barcode(prepared.points)
-    timings["barcode"] = time.perf_counter() - t0
-    if est.landmarks_ is not None:
-        notes.append(f"barcode on {len(est.landmarks_)} landmarks: {est.landmark_reason_}")
+    def make_estimator(first_pass: bool = False) -> CircularCoordinates:
+        lm = landmarks
+        if first_pass and isinstance(landmarks, str) and landmarks == "auto":
+            lm = FIRST_PASS_LANDMARKS
+        return CircularCoordinates(
+            max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
+            scale_fraction=scale_fraction, temporal=temporal, landmarks=lm,
+            **({} if memory_limit is None else {"memory_limit": memory_limit}),
+        )
 
-    from .barcode import select_bar
-
-    def fail(msg: str) -> NoPeriodicMotionError:
+    def fail(msg: str, fit: _Fit | None = None, barcode: Barcode | None = None) -> NoPeriodicMotionError:
         partial = ExtractionResult(
-            motion=motion, prepared=prepared, barcode=barcode, selection=None, coordinate=None,
+            motion=motion, prepared=prepared, barcode=barcode if fit is None else fit.barcode,
+            selection=None if fit is None else fit.selection, coordinate=None,
             unwrapped=None, cycles=float("nan"), period_frames=float("nan"), cycle_frames=np.zeros(0),
             density=None, typical=None, cycle=None, jerk={}, loop_closure=float("nan"), distance={},
-            timings=timings, parameters=params, warnings=notes, estimator=est, preprocessor=prep,
+            timings=timings, parameters=params, warnings=notes, estimator=None if fit is None else fit.est,
+            preprocessor=prep,
         )
-        return NoPeriodicMotionError(msg, result=partial)
+        where = motion.source or "capture"
+        return NoPeriodicMotionError(f"{where}: {msg}", result=partial)
 
-    if len(barcode.h1) == 0:
-        raise fail(f"no periodic motion found: the barcode has no H1 bar up to scale {barcode.threshold:.4g}")
-    if class_index >= len(barcode.h1):
-        raise ParameterError(f"class index {class_index} out of range: the barcode has {len(barcode.h1)} H1 bars")
-    pre_sel = select_bar(barcode, class_index, scale, scale_fraction)
-    if require_clear and not pre_sel.clear:
-        why = []
-        if pre_sel.ratio < CLEAR_RATIO:
-            why.append(f"death/birth {pre_sel.ratio:.2f} < {CLEAR_RATIO}")
-        if pre_sel.gap < CLEAR_GAP:
-            why.append(f"persistence only {pre_sel.gap:.2f}x the next bar's (< {CLEAR_GAP}x)")
-        if not why:
-            why.append(f"persistence under {CLEAR_MIN_FRACTION:.0%} of the threshold {barcode.threshold:.4g}")
-        ds = "inf" if not np.isfinite(pre_sel.death) else f"{pre_sel.death:.4g}"
+    def fit_rows(rows: np.ndarray, stage: str, first_pass: bool = False) -> _Fit:
+        est = make_estimator(first_pass)
+        t0 = time.perf_counter()
+        barcode, sel = _first_clear(est, prepared.points[rows], class_index, scale, scale_fraction)
+        timings[f"barcode{stage}"] = time.perf_counter() - t0
+        if sel is None:
+            if len(barcode.h1) and class_index >= len(barcode.h1):
+                raise ParameterError(f"class index {class_index} out of range: the barcode has {len(barcode.h1)} H1 bars")
+            raise fail(f"no periodic motion found: the barcode has no H1 bar up to scale {barcode.threshold:.4g}",
+                       barcode=barcode)
+        if require_clear and not sel.clear:
+            raise fail(f"no periodic motion found: {_not_clear_reason(sel, barcode)}; "
+                       "try --max-scale, --pca or --frames", barcode=barcode)
+        t0 = time.perf_counter()
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            est.fit_coordinate()
+        timings[f"coordinate{stage}"] = time.perf_counter() - t0
+        runs = _row_runs(rows)
+        u = _unwrap_runs(est.coordinates_, rows, runs, T)
+        return _Fit(est=est, barcode=est.barcode_, selection=est.selection_, rows=rows, unwrapped=u,
+                    notes=[str(w.message) for w in caught])
+
+    rows = np.flatnonzero(moving)
+    # a long take is first read on a few landmarks: enough to find its steady frames
+    rough = steady and rows.size > FIRST_PASS_LANDMARKS * 2
+    fit = fit_rows(rows, " (first pass)" if rough else "", first_pass=rough)
+    used = moving
+    if steady:
+        t0 = time.perf_counter()
+        first = complete_windings(fit.unwrapped, stretches(moving))
+        if np.isfinite(first.period_frames):
+            used = _steady_frames(motion, prepared, joints, fit.unwrapped, moving, first.period_frames)
+        timings["steady"] = time.perf_counter() - t0
+        if not used.any():
+            raise fail("no periodic motion found: no stretch of the take repeats steadily for a whole period "
+                       f"(the coordinate turns {first.turns:.2f} times over the moving frames)", fit)
+        if used.sum() >= 0.95 * moving.sum():
+            used = moving
+        if rough or used.sum() < moving.sum():
+            fit = fit_rows(np.flatnonzero(used), "")
+    notes.extend(fit.notes)
+    return _finish(
+        motion, prepared, prep, fit, used, notes, timings, params, fail,
+        n_components=n_components, n_samples=n_samples, n_neighbors=n_neighbors, weighting=weighting,
+        sampling=sampling, bandwidth=bandwidth, random_state=random_state, cycle_start=cycle_start,
+        timing=timing, travel=travel, min_turns=min_turns,
+    )
+
+
+def _check_options(motion, **o) -> dict:
+    if not isinstance(motion, Motion):
+        raise ParameterError(f"extract() takes a Motion, got {type(motion).__name__}")
+    if o["weighting"] not in ("kernel", "mean", "gaussian"):
+        raise ParameterError(f"weighting must be 'kernel', 'mean' or 'gaussian', got {o['weighting']!r}")
+    if o["sampling"] not in ("quantile", "random"):
+        raise ParameterError(f"sampling must be 'quantile' or 'random', got {o['sampling']!r}")
+    if o["cycle_start"] not in ("slowest", "first"):
+        raise ParameterError(f"cycle_start must be 'slowest' or 'first', got {o['cycle_start']!r}")
+    if o["timing"] not in TIMINGS:
+        raise ParameterError(f"timing must be one of {TIMINGS}, got {o['timing']!r}")
+    if o["travel"] not in TRAVELS:
+        raise ParameterError(f"travel must be one of {TRAVELS}, got {o['travel']!r}")
+    if not (isinstance(o["min_turns"], (int, float)) and np.isfinite(o["min_turns"]) and o["min_turns"] > 0):
+        raise ParameterError(f"min_turns must be a positive number, got {o['min_turns']!r}")
+    if o["n_samples"] < 10:
+        raise ParameterError(f"n_samples must be at least 10, got {o['n_samples']}")
+    if o["n_neighbors"] < 1:
+        raise ParameterError(f"n_neighbors must be at least 1, got {o['n_neighbors']}")
+    weighting = o["weighting"] if o["timing"] == "coordinate" else "kernel"
+    o["bandwidth"] = check_bandwidth(o["bandwidth"], weighting)  # before any work is done
+    return o
+
+
+def _joint_columns(motion: Motion, prepared: PreparedData) -> np.ndarray:
+    """Columns of the poses that are joint angles (not the root)."""
+    cols = np.setdiff1d(np.arange(prepared.poses.shape[1]), prepared.root_columns)
+    return cols if cols.size else np.arange(prepared.poses.shape[1])
+
+
+def _row_runs(rows: np.ndarray) -> list[tuple[int, int]]:
+    """Runs of consecutive frame indices in a sorted index array."""
+    if rows.size == 0:
+        return []
+    breaks = np.flatnonzero(np.diff(rows) > 1)
+    starts = np.concatenate([[0], breaks + 1])
+    stops = np.concatenate([breaks + 1, [rows.size]])
+    return [(int(rows[a]), int(rows[b - 1]) + 1) for a, b in zip(starts, stops)]
+
+
+def _steady_frames(motion, prepared, joints, unwrapped, moving, period) -> np.ndarray:
+    """Steady frames of a take (see :mod:`~cyclecoord.periodic.steady`)."""
+    rec = recurrence(prepared.poses[:, joints], period)
+    layout = root_layout(motion)
+    hd = heading(motion.frames, layout) if layout is not None else None
+    return steady_mask(unwrapped, moving, period, recurrence_distance=rec, heading=hd)
+
+
+def _run_jerk(poses: np.ndarray, runs: list[tuple[int, int]], fps: float) -> float:
+    """Mean jerk over runs of frames (each run differentiated on its own)."""
+    vals, weights = [], []
+    for a, b in runs:
+        if b - a >= 8:
+            vals.append(jerk_summary(poses[a:b], fps))
+            weights.append(b - a)
+    return float(np.average(vals, weights=weights)) if vals else float("nan")
+
+
+def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o) -> ExtractionResult:
+    """Windings, period, cycle and figures of a fitted coordinate on the used frames."""
+    T = motion.n_frames
+    runs = stretches(used)
+    u = np.where(used, fit.unwrapped, np.nan)
+    wind = complete_windings(u, runs)
+    if wind.turns < o["min_turns"]:
         raise fail(
-            f"no periodic motion found: H1 bar #{class_index} [{pre_sel.birth:.4g}, {ds}) does not stand "
-            f"clear ({'; '.join(why)}); try --max-scale, --pca or --frames"
-        )
-
-    t0 = time.perf_counter()
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        est.fit_coordinate()
-    for w in caught:
-        notes.append(str(w.message))
-    timings["coordinate"] = time.perf_counter() - t0
-    sel = est.selection_
-    barcode = est.barcode_
-    if est.n_components_ > 1:
+            f"no periodic motion found: the coordinate turns only {wind.turns:.2f} times over the "
+            f"{int(used.sum())} steady frames (at least {o['min_turns']:g} are needed); "
+            "a longer take, --frames around the repeated part, or --pca 3 may help", fit)
+    period = wind.period_frames
+    if not np.isfinite(period):
+        period = float(np.sum(used) - len(runs)) / wind.turns
+    if wind.spread > 0.25:
         notes.append(
-            f"the complex at scale {sel.scale:.4g} has {est.n_components_} connected components: "
+            f"the complete windings vary by {wind.spread:.0%} of the period (p10-p90); the motion is not "
+            "steady: use --frames to pick one steady stretch, or check the coordinate figure"
+        )
+    if fit.est.n_components_ > 1:
+        notes.append(
+            f"the complex at scale {fit.selection.scale:.4g} has {fit.est.n_components_} connected components: "
             "frames in different components get unrelated coordinates; raise --max-scale or --scale"
         )
-    long_h0 = int(np.sum(np.isfinite(barcode.h0[:, 1]) & (barcode.h0[:, 1] > sel.birth)))
-    if long_h0:
-        notes.append(
-            f"H0 shows {long_h0 + 1} components still apart when the H1 class is born (at {sel.birth:.4g}); "
-            "the capture may hold separate pieces"
-        )
-    theta = est.coordinates_
-    u = unwrap(theta)
-    cycles = float(u[-1] - u[0])
-    if cycles < MIN_CYCLES:
-        raise fail(
-            f"no periodic motion found: the circular coordinate covers only {cycles:.2f} cycles over the "
-            f"clip (at least {MIN_CYCLES} are needed to measure a period)"
-        )
-    if cycles < 1.5:
-        notes.append(f"the coordinate covers only {cycles:.2f} cycles over the clip; the period estimate is rough")
-    period = (motion.n_frames - 1) / cycles
-    lengths = cycle_lengths(u)
-
+    theta = np.full(T, np.nan)
+    theta[fit.rows] = fit.est.coordinates_
+    theta[~used] = np.nan
+    rows = np.flatnonzero(used)
     t0 = time.perf_counter()
-    density = PeriodicDensity(n_components=n_components, random_state=random_state).fit(theta)
+    density = PeriodicDensity(n_components=o["n_components"], random_state=o["random_state"]).fit(theta[rows])
     timings["density"] = time.perf_counter() - t0
-
     t0 = time.perf_counter()
-    k = min(n_neighbors, motion.n_frames)
-    typ = typical_cycle(
-        theta, prepared.poses, period, density=density, n_samples=n_samples, k=k,
-        weighting=weighting, sampling=sampling, random_state=random_state, bandwidth=bandwidth,
-    )
-    typ, cycle_motion = loop_cycle(
-        typ, motion, prepared, prep, cycle_start=cycle_start,
-        metadata={"period_frames": period, "cycles_in_source": cycles},
-    )
+    phase = np.full(T, np.nan)
+    heading_change = float("nan")
+    if o["timing"] == "coordinate":
+        k = min(o["n_neighbors"], rows.size)
+        typ = typical_cycle(
+            theta[rows], prepared.poses[rows], period, density=density, n_samples=o["n_samples"], k=k,
+            weighting=o["weighting"], sampling=o["sampling"], random_state=o["random_state"],
+            bandwidth=o["bandwidth"],
+        )
+        typ, cycle_motion = loop_cycle(
+            typ, motion, prepared, prep, cycle_start=o["cycle_start"], rows=rows,
+            metadata={"period_frames": period, "cycles_in_source": wind.turns},
+        )
+    else:
+        phase = retime(u, runs, wind)
+        typ, cycle_motion, heading_change = capture_cycle(
+            phase, motion, prepared, prep, period, bandwidth=o["bandwidth"], cycle_start=o["cycle_start"],
+            travel=o["travel"], k=o["n_neighbors"],
+            metadata={"period_frames": period, "cycles_in_source": wind.turns},
+        )
     timings["cycle"] = time.perf_counter() - t0
-
     t0 = time.perf_counter()
     fps = motion.fps
     jerk = {
-        "original": float(jerk_summary(prepared.poses, fps)),
+        "original": _run_jerk(prepared.poses, runs, fps),
         "cycle": float(jerk_summary(typ.frames, fps, cyclic=True)),
     }
     closure = float(loop_closure(typ.frames))
-    dist = distance_to_cycle(prepared.poses, typ.frames)
-    step = np.linalg.norm(np.diff(prepared.poses, axis=0), axis=1)
+    dist = distance_to_cycle(prepared.poses[rows], typ.frames)
+    step = np.concatenate([np.linalg.norm(np.diff(prepared.poses[a:b], axis=0), axis=1) for a, b in runs])
     distance = {
         "median": float(np.median(dist)),
         "p90": float(np.percentile(dist, 90)),
         "max": float(np.max(dist)),
-        "median_frame_step": float(np.median(step)),
+        "median_frame_step": float(np.median(step)) if step.size else float("nan"),
     }
     timings["metrics"] = time.perf_counter() - t0
-    timings["total"] = sum(timings.values())
+    timings["total"] = sum(v for k, v in timings.items())
     return ExtractionResult(
-        motion=motion, prepared=prepared, barcode=barcode, selection=sel, coordinate=theta,
-        unwrapped=u, cycles=cycles, period_frames=float(period), cycle_frames=lengths, density=density,
-        typical=typ, cycle=cycle_motion, jerk=jerk, loop_closure=closure, distance=distance,
-        timings=timings, parameters=params, warnings=notes, estimator=est, preprocessor=prep,
+        motion=motion, prepared=prepared, barcode=fit.barcode, selection=fit.selection, coordinate=theta,
+        unwrapped=u, cycles=float(wind.turns), period_frames=float(period), cycle_frames=wind.lengths,
+        density=density, typical=typ, cycle=cycle_motion, jerk=jerk, loop_closure=closure, distance=distance,
+        timings=timings, parameters=params, warnings=notes, estimator=fit.est, preprocessor=prep,
+        used=used, phase=phase, windings=wind, heading_per_cycle=heading_change,
     )
+
+
+def capture_cycle(
+    phase: np.ndarray,
+    motion: Motion,
+    prepared: PreparedData,
+    preprocessor: Preprocessor,
+    period: float,
+    *,
+    bandwidth: str | float | None = None,
+    cycle_start: str = "slowest",
+    travel: str = "keep",
+    k: int = 10,
+    metadata: dict | None = None,
+) -> tuple[TypicalCycle, Motion, float]:
+    """The typical cycle averaged in a phase that advances at the capture's pace.
+
+    Parameters
+    ----------
+    phase : ndarray, shape (T,)
+        Re-timed phase per frame in ``[0, 1)`` (:func:`~cyclecoord.periodic.windings.retime`),
+        NaN for frames left out.
+    motion, prepared, preprocessor
+        The capture, its prepared data and the fitted preprocessor.
+    period : float
+        Period in frames; the cycle has ``round(period)`` frames.
+    bandwidth : None, "auto" or float
+        Kernel width in frames of time (None: :data:`CAPTURE_WIDTH`).
+    cycle_start : {"slowest", "first"}
+    travel : {"keep", "straight", "in_place"}
+        See :func:`~cyclecoord.periodic.root.compose_root`.
+    k : int
+        Neighbours for the ``"auto"`` bandwidth's cross-validation.
+    metadata : dict, optional
+        Stored on the returned clip.
+
+    Returns
+    -------
+    (TypicalCycle, Motion, float)
+        The cycle in the prepared space, the loopable clip (root pitch, roll and height
+        averaged as absolute values, so they close; heading and ground travel integrated
+        from their mean changes) and the heading change per cycle in degrees (NaN
+        without a six-dof root and a skeleton).
+    """
+    rows = np.flatnonzero(np.isfinite(phase))
+    ph = phase[rows]
+    poses = prepared.poses[rows]
+    P = max(2, int(round(period)))
+    selection = None
+    if bandwidth == "auto":
+        selection = select_bandwidth(ph, poses, float(period), k=min(k, rows.size))
+        width = float(selection.bandwidth)
+    else:
+        width = CAPTURE_WIDTH if bandwidth is None else float(bandwidth)
+    frames = phase_average(ph, poses, P, width / float(period))
+    layout = root_layout(motion) if prepared.root_columns.size else None
+    feats = phase_average(ph, decompose_root(motion.frames, layout)[rows], P, width / float(period)) if layout else None
+    shift = 0
+    if cycle_start == "slowest":
+        joints = np.delete(frames, prepared.root_columns, axis=1) if prepared.root_columns.size < frames.shape[1] else frames
+        shift = slowest_frame(joints)
+    frames = np.roll(frames, -shift, axis=0)
+    phases = np.mod((np.arange(P) + shift) / P, 1.0)
+    cyc = frames.copy()
+    heading_change = float("nan")
+    if feats is not None:
+        feats = np.roll(feats, -shift, axis=0)
+        heading_change = float(feats[:, 4].sum())
+        first = motion.frames[rows[0]]
+        start_heading = float(heading(first[None, :], layout)[0])
+        ground = (float(first[layout.column("tx")]), float(first[layout.column("tz")]))
+        cyc[:, layout.columns] = compose_root(feats, layout, start_heading, ground, travel=travel)
+    elif prepared.root_columns.size:
+        root = prepared.root_columns
+        mean_delta = frames[:, root].mean(axis=0) if travel == "keep" else np.zeros(root.size)
+        cyc[:, root] = preprocessor.integrate_root(frames[:, root], motion.frames[rows[0], root], mean_delta, motion)
+    typ = TypicalCycle(frames=frames, phases=phases, curve=frames, sample_phases=phases, bandwidth=width,
+                       bandwidth_selection=selection)
+    for arr in (typ.frames, typ.phases):
+        arr.flags.writeable = False
+    clip = motion.with_frames(cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}",
+                              metadata=dict(metadata or {}))
+    return typ, clip, heading_change

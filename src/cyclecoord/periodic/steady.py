@@ -1,0 +1,173 @@
+"""Where a take is steady: moving, repeating itself, at its own pace, not turning.
+
+People record whole takes: a standing start, a few steps to reach speed, the motion, a
+pause or a turn, a stop.  An animator cutting a loop by hand works on the steady part
+only.  This module finds it from three per-frame signals:
+
+* **moving** (:func:`moving_mask`): the joint angles' speed, smoothed over half a second,
+  is at least ``min_speed`` of the take's moving level (its 80th percentile); standing
+  still and pauses fall below it;
+* **repeating** (:func:`recurrence`): the pose comes back one period later (or came one
+  period before): its distance to the nearest pose 0.85-1.15 periods away, over the
+  take's median of that distance;
+* **at the take's pace and heading** (:func:`steady_mask`): the circular coordinate
+  advances about one turn per period over a period-long window, and the heading turns
+  less than ``max_turn`` degrees over it.
+
+Frames passing all three, in runs of at least one period (gaps shorter than a quarter
+period inside a run are bridged), are the steady frames the cycle is built from.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.ndimage import uniform_filter1d
+
+from .windings import stretches
+
+__all__ = ["moving_mask", "recurrence", "steady_mask", "clean_runs"]
+
+
+def _smooth(x: np.ndarray, width: int) -> np.ndarray:
+    return uniform_filter1d(np.asarray(x, dtype=float), size=max(1, int(width)), mode="nearest")
+
+
+def clean_runs(mask: np.ndarray, min_run: int, max_gap: int) -> np.ndarray:
+    """Bridge gaps of at most ``max_gap`` frames between runs, then drop runs under ``min_run``."""
+    m = np.asarray(mask, dtype=bool).copy()
+    runs = stretches(m)
+    for (a0, b0), (a1, _) in zip(runs[:-1], runs[1:]):
+        if a1 - b0 <= max_gap:
+            m[b0:a1] = True
+    for a, b in stretches(m):
+        if b - a < min_run:
+            m[a:b] = False
+    return m
+
+
+def moving_mask(joints: np.ndarray, fps: float, *, min_speed: float = 0.35, smooth_seconds: float = 0.5) -> np.ndarray:
+    """Frames whose joints move at a good fraction of the take's moving level.
+
+    Parameters
+    ----------
+    joints : ndarray, shape (T, J)
+        Joint-angle channels (degrees), root excluded.
+    fps : float
+    min_speed : float
+        Fraction of the 80th percentile of the smoothed speed below which a frame is
+        still.
+    smooth_seconds : float
+        Width of the moving average of the speed.
+
+    Returns
+    -------
+    ndarray of bool, shape (T,)
+        Still stretches shorter than half a second inside motion count as moving; moving
+        stretches shorter than a second count as still.
+    """
+    j = np.asarray(joints, dtype=float)
+    if len(j) < 3 or j.shape[1] == 0:
+        return np.ones(len(j), dtype=bool)
+    step = np.linalg.norm(np.diff(j, axis=0), axis=1)
+    step = np.concatenate([step, step[-1:]])
+    speed = _smooth(step, round(smooth_seconds * fps))
+    level = np.percentile(speed, 80)
+    if level <= 0:
+        return np.zeros(len(j), dtype=bool)
+    mask = speed >= min_speed * level
+    return clean_runs(mask, min_run=int(round(fps)), max_gap=int(round(0.5 * fps)))
+
+
+def recurrence(poses: np.ndarray, period: float, *, tolerance: float = 0.15, chunk: int = 20000) -> np.ndarray:
+    """Distance from each pose to its nearest pose one period earlier or later.
+
+    Parameters
+    ----------
+    poses : ndarray, shape (T, D)
+    period : float
+        Period in frames.
+    tolerance : float
+        Lags from ``(1 - tolerance)`` to ``(1 + tolerance)`` periods are searched.
+
+    Returns
+    -------
+    ndarray, shape (T,)
+        The smallest distance over the lags, both directions; ``inf`` for a frame with
+        no pose at those lags (a take shorter than a period).
+    """
+    x = np.asarray(poses, dtype=float)
+    T = len(x)
+    lo = max(1, int(np.floor((1 - tolerance) * period)))
+    hi = max(lo, int(np.ceil((1 + tolerance) * period)))
+    best = np.full(T, np.inf)
+    for lag in range(lo, min(hi, T - 1) + 1):
+        for a in range(0, T - lag, chunk):
+            b = min(T - lag, a + chunk)
+            d = np.linalg.norm(x[a + lag : b + lag] - x[a:b], axis=1)
+            np.minimum(best[a:b], d, out=best[a:b])  # forward partner
+            np.minimum(best[a + lag : b + lag], d, out=best[a + lag : b + lag])  # backward partner
+    return best
+
+
+def steady_mask(
+    unwrapped: np.ndarray,
+    candidates: np.ndarray,
+    period: float,
+    *,
+    recurrence_distance: np.ndarray | None = None,
+    heading: np.ndarray | None = None,
+    pace_tolerance: float = 0.3,
+    max_recurrence: float = 2.0,
+    max_turn: float = 30.0,
+) -> np.ndarray:
+    """Frames where the periodic motion is steady.
+
+    Parameters
+    ----------
+    unwrapped : ndarray, shape (T,)
+        The circular coordinate unwrapped along the frames (NaN outside ``candidates``).
+    candidates : ndarray of bool, shape (T,)
+        Frames that may be steady (moving frames).
+    period : float
+        Period in frames (from the complete windings).
+    recurrence_distance : ndarray, shape (T,), optional
+        From :func:`recurrence`; a frame whose distance is over ``max_recurrence`` times
+        the median over candidate frames is not steady.
+    heading : ndarray, shape (T,), optional
+        Heading in degrees (continuous); a frame whose period-long window turns by more
+        than ``max_turn`` degrees is not steady.
+    pace_tolerance : float
+        Turns per period over a period-long window must be within this of 1.
+
+    Returns
+    -------
+    ndarray of bool, shape (T,)
+    """
+    cand = np.asarray(candidates, dtype=bool)
+    T = cand.size
+    ok = cand.copy()
+    half = max(1, int(round(period / 2)))
+    for a, b in stretches(cand):
+        u = np.asarray(unwrapped[a:b], dtype=float)
+        n = b - a
+        idx = np.arange(n)
+        lo = np.clip(idx - half, 0, n - 1)
+        hi = np.clip(idx + half, 0, n - 1)
+        # a window of one period, shifted inside the run near its ends
+        short = hi - lo < 2 * half
+        lo = np.where(short & (lo == 0), 0, lo)
+        hi = np.where(short & (lo == 0), np.minimum(n - 1, 2 * half), hi)
+        lo = np.where(short & (hi == n - 1), np.maximum(0, n - 1 - 2 * half), lo)
+        span = np.maximum(hi - lo, 1)
+        pace = (u[hi] - u[lo]) / span * period
+        good = np.abs(pace - 1.0) <= pace_tolerance
+        if heading is not None:
+            h = np.asarray(heading[a:b], dtype=float)
+            turn = np.abs(h[hi] - h[lo]) / span * period
+            good &= turn <= max_turn
+        ok[a:b] &= good
+    if recurrence_distance is not None:
+        r = np.asarray(recurrence_distance, dtype=float)
+        ref = np.median(r[cand & np.isfinite(r)]) if np.any(cand & np.isfinite(r)) else np.inf
+        ok &= ~(r > max_recurrence * ref)
+    return clean_runs(ok, min_run=int(round(period)), max_gap=int(round(period / 4)))
