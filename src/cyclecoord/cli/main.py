@@ -198,6 +198,33 @@ def _add_selection_options(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _add_cycle_options(g: argparse._ArgumentGroup) -> None:
+    """Options of the typical cycle, the same on extract, detect --extract and batch."""
+    g.add_argument("--no-steady", dest="steady", action="store_false",
+                   help="build the cycle from every frame (default: only the steady stretches of the take, "
+                   "leaving out standing, starting, turning and stopping)")
+    g.add_argument("--timing", choices=("capture", "coordinate"), default="capture",
+                   help="capture (default): the cycle moves at the capture's pace (phase re-timed between "
+                   "the coordinate's crossings and aligned by time warping); coordinate: the paper's "
+                   "density-sampled coordinate (--samples, --neighbors, --weighting, --sampling)")
+    g.add_argument("--travel", choices=("keep", "straight", "in_place"), default="keep",
+                   help="the cycle's root: travel and turn as captured on average (keep, default), walk "
+                   "along a line (straight: the heading change per cycle removed) or stay in place")
+    g.add_argument("--min-turns", type=_positive_float, default=1.5, metavar="N",
+                   help="fewer turns of the coordinate over the steady frames is no periodic motion, exit 3 (1.5)")
+    g.add_argument("--bandwidth", type=_bandwidth, default=None, metavar="auto|F",
+                   help="width of the average that builds the cycle, in frames of time: a number fixes it "
+                   "(default 1 with --timing capture), 'auto' picks it by leave-one-out cross-validation")
+    g.add_argument("--cycle-start", choices=("slowest", "first"), default="slowest",
+                   help="begin the cycle at its slowest pose (default, hides the loop seam) or at phase 0")
+
+
+def _cycle_options(args: argparse.Namespace) -> dict:
+    """The typical-cycle keyword arguments of :func:`extract` from parsed options."""
+    return dict(steady=args.steady, timing=args.timing, travel=args.travel, min_turns=args.min_turns,
+                bandwidth=args.bandwidth, cycle_start=args.cycle_start)
+
+
 def _summary_barcode(bc, sel=None) -> str:
     pers = bc.persistence(1)
     lines = [f"barcode up to {bc.threshold:.4g} (Z/{bc.prime}): {len(bc.h0)} H0 bars, {len(bc.h1)} H1 bars"]
@@ -240,13 +267,12 @@ def cmd_extract(args: argparse.Namespace) -> int:
             class_index=args.class_index,
             n_samples=args.samples,
             n_neighbors=args.neighbors,
-            bandwidth=args.bandwidth,
             weighting=args.weighting,
             sampling=args.sampling,
-            cycle_start=args.cycle_start,
             landmarks=args.landmarks,
             memory_limit=args.memory_limit,
             random_state=args.seed,
+            **_cycle_options(args),
         )
     except NoPeriodicMotionError as exc:
         partial = exc.result
@@ -270,47 +296,8 @@ def cmd_extract(args: argparse.Namespace) -> int:
                 _save_plots(partial, args.plot)
         code = EXIT_NO_PERIODIC
     else:
-        m = res.motion
-        sel = res.selection
-        print(
-            f"{m.source or args.input}: frames {m.start_frame}:{m.start_frame + m.n_frames} "
-            f"({m.n_frames} frames, {res.prepared.points.shape[1]} dims analysed, {m.fps:g} fps)"
-        )
-        print(_summary_barcode(res.barcode, sel))
-        ds = "inf" if not np.isfinite(sel.death) else f"{sel.death:.4g}"
-        gap = "alone" if not np.isfinite(sel.gap) else f"{sel.gap:.1f}x the next bar"
-        print(
-            f"class #{sel.index} [{sel.birth:.4g}, {ds}) read at scale {sel.scale:.4g}: "
-            f"death/birth {sel.ratio:.2f}, persistence {gap}"
-        )
-        chk = res.estimator.cocycle_check_
-        print(f"cocycle check: {chk.n_violations} of {chk.n_triangles} triangles violate (prime {res.estimator.prime_})")
-        per = ", ".join(f"{v:.1f}" for v in res.cycle_frames[:8])
-        print(
-            f"coordinate: {res.cycles:.2f} cycles in the clip, period {res.period_frames:.1f} frames "
-            f"({res.period_frames / m.fps:.3f} s)" + (f"; complete cycles: {per}" if per else "")
-        )
-        ratio = res.jerk["cycle"] / res.jerk["original"] if res.jerk["original"] > 0 else float("nan")
-        print(
-            f"cycle: {res.cycle.n_frames} frames, loop closure {res.loop_closure:.2f} (seam step / median step; up to 1.5 loops cleanly), "
-            f"jerk {res.jerk['cycle']:.4g} vs original {res.jerk['original']:.4g} (ratio {ratio:.2f})"
-            + (f"; kernel width {res.typical.bandwidth:.3g} frames in time"
-               + (" (cross-validated)" if res.typical.bandwidth_selection is not None else "")
-               if args.bandwidth is not None else "")
-        )
-        print(
-            f"frames to cycle: median distance {res.distance['median']:.3g} "
-            f"(median frame step {res.distance['median_frame_step']:.3g})"
-        )
-        for w in res.warnings:
-            print(f"warning: {w}")
-        lm = res.estimator.landmarks_
-        if lm is not None:
-            fb = res.selection.full_birth
-            print(
-                f"landmarks: {len(lm)} of {m.n_frames} frames (covering radius {res.estimator.covering_radius_:.3g})"
-                + (f"; birth on every frame {fb:.4g}" if fb is not None else "")
-            )
+        for line in describe_extraction(res, args.input, verbose=args.verbose):
+            print(line)
         if args.output:
             save(res.cycle, args.output)
             print(f"wrote {args.output}")
@@ -320,12 +307,75 @@ def cmd_extract(args: argparse.Namespace) -> int:
         if args.plot:
             _save_plots(res, args.plot)
         report_payload = res.to_report()
-        t = res.timings
-        print("time: " + ", ".join(f"{k} {v:.3f}s" for k, v in t.items()))
+        if args.verbose:
+            print("time: " + ", ".join(f"{k} {v:.3f}s" for k, v in res.timings.items()))
     if args.report and report_payload is not None:
         _write_json(args.report, _clean(report_payload))
         print(f"wrote {args.report}")
     return code
+
+
+def _frames_text(runs: list, offset: int) -> str:
+    return ", ".join(f"{a + offset}-{b + offset}" for a, b in runs)
+
+
+def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
+    """What an animator needs first (period, cycles, where the loop was taken, quality in
+    words); the barcode, cocycle and landmark details with ``verbose``."""
+    m = res.motion
+    fps = m.fps
+    used = res.used_frames
+    n_used = sum(b - a for a, b in used)
+    lines = [f"{m.source or name}: {m.n_frames} frames at {fps:g} fps"
+             + (f" (frames {m.start_frame}:{m.start_frame + m.n_frames})" if m.start_frame else "")]
+    if n_used < m.n_frames:
+        lines.append(
+            f"steady motion in frames {_frames_text(used, m.start_frame)} ({n_used} of {m.n_frames} frames); "
+            "the rest (standing, starting, turning or stopping) has no phase"
+        )
+    wind = res.windings
+    spread = f", spread {wind.spread:.0%}" if wind is not None and wind.pooled.size > 1 else ""
+    lines.append(
+        f"period: {res.period_frames:.1f} frames ({res.period_frames / fps:.3f} s), "
+        f"{res.cycles:.2f} cycles over the steady frames"
+        + (f"; complete windings {', '.join(f'{v:.0f}' for v in res.cycle_frames[:8])} frames{spread}"
+           if len(res.cycle_frames) else spread)
+    )
+    ratio = res.jerk["cycle"] / res.jerk["original"] if res.jerk.get("original", 0) > 0 else float("nan")
+    seam = "seamless" if res.loop_closure <= 1.5 else "a visible seam"
+    smooth = "as smooth as the capture or smoother" if ratio <= 1.0 else f"{ratio:.1f}x the capture's jerk"
+    lines.append(
+        f"cycle: {res.cycle.n_frames} frames ({res.cycle.n_frames / fps:.3f} s), {seam} "
+        f"(last-to-first step {res.loop_closure:.2f} median steps), {smooth} (jerk ratio {ratio:.2f})"
+    )
+    if np.isfinite(res.heading_per_cycle):
+        travel = res.parameters.get("travel", "keep")
+        kept = {"keep": "kept; --travel straight removes it", "straight": "removed (--travel straight)",
+                "in_place": "removed, and the cycle stays in place (--travel in_place)"}[travel]
+        lines.append(f"heading: turns {res.heading_per_cycle:+.1f} degrees per cycle ({kept})")
+    for w in res.warnings:
+        lines.append(f"warning: {w}")
+    if not verbose:
+        return lines
+    sel = res.selection
+    lines.append(_summary_barcode(res.barcode, sel))
+    ds = "inf" if not np.isfinite(sel.death) else f"{sel.death:.4g}"
+    gap = "alone" if not np.isfinite(sel.gap) else f"{sel.gap:.1f}x the next bar"
+    lines.append(f"class #{sel.index} [{sel.birth:.4g}, {ds}) read at scale {sel.scale:.4g}: "
+                 f"death/birth {sel.ratio:.2f}, persistence {gap}")
+    chk = res.estimator.cocycle_check_
+    lines.append(f"cocycle check: {chk.n_violations} of {chk.n_triangles} triangles violate "
+                 f"(prime {res.estimator.prime_})")
+    lines.append(f"frames to cycle: median distance {res.distance['median']:.3g} "
+                 f"(median frame step {res.distance['median_frame_step']:.3g}); "
+                 f"kernel width {res.typical.bandwidth:.3g} frames")
+    lm = res.estimator.landmarks_
+    if lm is not None:
+        fb = res.selection.full_birth
+        lines.append(f"landmarks: {len(lm)} of {len(res.estimator.points_)} frames "
+                     f"(covering radius {res.estimator.covering_radius_:.3g})"
+                     + (f"; birth on every frame {fb:.4g}" if fb is not None else ""))
+    return lines
 
 
 def _apply_model(args: argparse.Namespace, motion) -> int:
@@ -757,18 +807,15 @@ def build_parser() -> argparse.ArgumentParser:
                    help="use the I-th most persistent H1 class (default 0)")
     g.add_argument("--samples", type=_positive_int, default=500, metavar="N", help="phases sampled from the density (500)")
     g.add_argument("--neighbors", type=_positive_int, default=10, metavar="K", help="frames averaged per phase (10; should exceed the number of cycles)")
-    g.add_argument("--bandwidth", type=_bandwidth, default=None, metavar="auto|F",
-                   help="width of the kernel average in frames of one period, run in time rather "
-                   "than phase: 'auto' picks it by leave-one-out cross-validation (smoother cycles "
-                   "from noisy captures; slower on long ones), a number fixes it (default: K frames' worth)")
     g.add_argument("--weighting", choices=("kernel", "mean", "gaussian"), default="kernel",
                    help="how frames near a phase are averaged: smooth kernel (default), the paper's "
                    "k-nearest mean, or k-nearest Gaussian-weighted")
     g.add_argument("--sampling", choices=("quantile", "random"), default="quantile",
                    help="density quantiles (default, smooth) or random draws as in the paper")
-    g.add_argument("--cycle-start", choices=("slowest", "first"), default="slowest",
-                   help="begin the cycle at its slowest pose (default, hides the loop seam) or at the clip's first phase")
     g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (0)")
+    _add_cycle_options(e.add_argument_group("the cycle"))
+    e.add_argument("-v", "--verbose", action="store_true",
+                   help="also print the barcode, the chosen class, the cocycle check, landmarks and timings")
     o = e.add_argument_group("output")
     o.add_argument("-o", "--output", metavar="OUT", help="write the cycle (.bvh, .amc, .npz or .csv)")
     o.add_argument("--report", metavar="R.json", help="write a JSON report (barcode, coordinate, figures, timings)")

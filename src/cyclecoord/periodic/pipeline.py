@@ -24,6 +24,7 @@ from ..quality.metrics import distance_to_cycle, jerk_summary, loop_closure
 from ..motion import Motion
 from .preprocess import PreparedData, Preprocessor
 from .root import compose_root, decompose_root, heading, root_layout
+from .registration import register
 from .steady import moving_mask, recurrence, steady_mask
 from .windings import Windings, complete_windings, phase_average, retime, stretches
 
@@ -40,7 +41,7 @@ TIMINGS = ("capture", "coordinate")
 #: What the cycle's root does: travel and turn as captured, walk straight, stay in place.
 TRAVELS = ("keep", "straight", "in_place")
 #: Default width (frames of time) of the kernel that averages the re-timed cycle.
-CAPTURE_WIDTH = 1.5
+CAPTURE_WIDTH = 1.0
 #: Landmarks of the rough first pass over a long take (which finds its steady frames).
 FIRST_PASS_LANDMARKS = 150
 
@@ -440,7 +441,7 @@ def extract(
         ``n_neighbors`` also bounds how short a capture may be.
     bandwidth : None, "auto" or float
         Width of the average that builds the cycle, in frames of time: None for the
-        default (1.5 frames with ``timing="capture"``), ``"auto"`` for leave-one-out
+        default (1 frame with ``timing="capture"``), ``"auto"`` for leave-one-out
         cross-validation, or a positive number.
     cycle_start : {"slowest", "first"}
         Where the written cycle begins: at its slowest pose (default) or at phase 0.
@@ -729,6 +730,7 @@ def capture_cycle(
     cycle_start: str = "slowest",
     travel: str = "keep",
     k: int = 10,
+    register_iter: int = 2,
     metadata: dict | None = None,
 ) -> tuple[TypicalCycle, Motion, float]:
     """The typical cycle averaged in a phase that advances at the capture's pace.
@@ -749,6 +751,10 @@ def capture_cycle(
         See :func:`~cyclecoord.periodic.root.compose_root`.
     k : int
         Neighbours for the ``"auto"`` bandwidth's cross-validation.
+    register_iter : int
+        Rounds of :func:`~cyclecoord.periodic.registration.register` (0: none), which
+        align every repetition to the cycle so that sharp features are not averaged
+        away.
     metadata : dict, optional
         Stored on the returned clip.
 
@@ -760,16 +766,19 @@ def capture_cycle(
         from their mean changes) and the heading change per cycle in degrees (NaN
         without a six-dof root and a skeleton).
     """
+    P = max(2, int(round(period)))
+    width = CAPTURE_WIDTH if bandwidth is None or bandwidth == "auto" else float(bandwidth)
+    if register_iter:
+        joints = _joint_columns(motion, prepared)
+        phase = register(phase, prepared.poses[:, joints], stretches(np.isfinite(phase)), P,
+                         width / float(period), n_iter=register_iter)
     rows = np.flatnonzero(np.isfinite(phase))
     ph = phase[rows]
     poses = prepared.poses[rows]
-    P = max(2, int(round(period)))
     selection = None
     if bandwidth == "auto":
         selection = select_bandwidth(ph, poses, float(period), k=min(k, rows.size))
         width = float(selection.bandwidth)
-    else:
-        width = CAPTURE_WIDTH if bandwidth is None else float(bandwidth)
     frames = phase_average(ph, poses, P, width / float(period))
     layout = root_layout(motion) if prepared.root_columns.size else None
     feats = phase_average(ph, decompose_root(motion.frames, layout)[rows], P, width / float(period)) if layout else None

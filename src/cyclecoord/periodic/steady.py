@@ -8,10 +8,10 @@ only.  This module finds it from three per-frame signals:
   is at least ``min_speed`` of the take's moving level (its 80th percentile); standing
   still and pauses fall below it;
 * **repeating** (:func:`recurrence`): the pose comes back one period later (or came one
-  period before): its distance to the nearest pose 0.85-1.15 periods away, over the
+  period before): its distance to the nearest pose 0.7-1.45 periods away, over the
   take's median of that distance;
 * **at the take's pace and heading** (:func:`steady_mask`): the circular coordinate
-  advances about one turn per period over a period-long window, and the heading turns
+  advances between 1/1.6 and 1.6 turns per period over a two-period window, and the heading turns
   less than ``max_turn`` degrees over it.
 
 Frames passing all three, in runs of at least one period (gaps shorter than a quarter
@@ -78,7 +78,9 @@ def moving_mask(joints: np.ndarray, fps: float, *, min_speed: float = 0.35, smoo
     return clean_runs(mask, min_run=int(round(fps)), max_gap=int(round(0.5 * fps)))
 
 
-def recurrence(poses: np.ndarray, period: float, *, tolerance: float = 0.15, chunk: int = 20000) -> np.ndarray:
+def recurrence(
+    poses: np.ndarray, period: float, *, shortest: float = 0.7, longest: float = 1.45, chunk: int = 20000
+) -> np.ndarray:
     """Distance from each pose to its nearest pose one period earlier or later.
 
     Parameters
@@ -86,8 +88,9 @@ def recurrence(poses: np.ndarray, period: float, *, tolerance: float = 0.15, chu
     poses : ndarray, shape (T, D)
     period : float
         Period in frames.
-    tolerance : float
-        Lags from ``(1 - tolerance)`` to ``(1 + tolerance)`` periods are searched.
+    shortest, longest : float
+        Lags from ``shortest`` to ``longest`` periods are searched (repetitions of a
+        real take vary in length; a synthetic one may vary by 30%).
 
     Returns
     -------
@@ -97,8 +100,8 @@ def recurrence(poses: np.ndarray, period: float, *, tolerance: float = 0.15, chu
     """
     x = np.asarray(poses, dtype=float)
     T = len(x)
-    lo = max(1, int(np.floor((1 - tolerance) * period)))
-    hi = max(lo, int(np.ceil((1 + tolerance) * period)))
+    lo = max(1, int(np.floor(shortest * period)))
+    hi = max(lo, int(np.ceil(longest * period)))
     best = np.full(T, np.inf)
     for lag in range(lo, min(hi, T - 1) + 1):
         for a in range(0, T - lag, chunk):
@@ -109,6 +112,14 @@ def recurrence(poses: np.ndarray, period: float, *, tolerance: float = 0.15, chu
     return best
 
 
+def _window(n: int, half: int) -> tuple[np.ndarray, np.ndarray]:
+    """Ends of a window of ``2 * half`` frames around each of ``n`` frames, kept inside."""
+    idx = np.arange(n)
+    lo = np.clip(idx - half, 0, max(0, n - 1 - 2 * half))
+    hi = np.minimum(lo + 2 * half, n - 1)
+    return lo, hi
+
+
 def steady_mask(
     unwrapped: np.ndarray,
     candidates: np.ndarray,
@@ -116,7 +127,8 @@ def steady_mask(
     *,
     recurrence_distance: np.ndarray | None = None,
     heading: np.ndarray | None = None,
-    pace_tolerance: float = 0.3,
+    max_pace: float = 1.6,
+    pace_window: float = 2.0,
     max_recurrence: float = 2.0,
     max_turn: float = 30.0,
 ) -> np.ndarray:
@@ -136,34 +148,33 @@ def steady_mask(
     heading : ndarray, shape (T,), optional
         Heading in degrees (continuous); a frame whose period-long window turns by more
         than ``max_turn`` degrees is not steady.
-    pace_tolerance : float
-        Turns per period over a period-long window must be within this of 1.
+    max_pace : float
+        Turns per period over a period-long window must lie between ``1 / max_pace``
+        and ``max_pace`` (starting, stopping and standing turn far slower).
+    pace_window : float
+        A second, longer window the pace is also measured over, in periods; a frame is
+        at pace when either window says so (a coordinate that stalls for part of a
+        cycle and then jumps reads its true pace over two periods).
 
     Returns
     -------
     ndarray of bool, shape (T,)
     """
     cand = np.asarray(candidates, dtype=bool)
-    T = cand.size
     ok = cand.copy()
-    half = max(1, int(round(period / 2)))
     for a, b in stretches(cand):
         u = np.asarray(unwrapped[a:b], dtype=float)
-        n = b - a
-        idx = np.arange(n)
-        lo = np.clip(idx - half, 0, n - 1)
-        hi = np.clip(idx + half, 0, n - 1)
-        # a window of one period, shifted inside the run near its ends
-        short = hi - lo < 2 * half
-        lo = np.where(short & (lo == 0), 0, lo)
-        hi = np.where(short & (lo == 0), np.minimum(n - 1, 2 * half), hi)
-        lo = np.where(short & (hi == n - 1), np.maximum(0, n - 1 - 2 * half), lo)
-        span = np.maximum(hi - lo, 1)
-        pace = (u[hi] - u[lo]) / span * period
-        good = np.abs(pace - 1.0) <= pace_tolerance
-        if heading is not None:
-            h = np.asarray(heading[a:b], dtype=float)
-            turn = np.abs(h[hi] - h[lo]) / span * period
+        h = None if heading is None else np.asarray(heading[a:b], dtype=float)
+        good_pace = np.zeros(b - a, dtype=bool)
+        for periods in sorted({1.0, float(pace_window)}):
+            lo, hi = _window(b - a, max(1, int(round(periods * period / 2))))
+            span = np.maximum(hi - lo, 1)
+            pace = (u[hi] - u[lo]) / span * period
+            good_pace |= (pace >= 1.0 / max_pace) & (pace <= max_pace)
+        good = good_pace
+        if h is not None:
+            lo, hi = _window(b - a, max(1, int(round(period / 2))))
+            turn = np.abs(h[hi] - h[lo]) / np.maximum(hi - lo, 1) * period
             good &= turn <= max_turn
         ok[a:b] &= good
     if recurrence_distance is not None:
