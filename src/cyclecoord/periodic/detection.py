@@ -649,11 +649,15 @@ def _typical_distance(poses: np.ndarray, cycle: np.ndarray) -> float:
 def _class_period(coordinate: np.ndarray, mask: np.ndarray, a: int, b: int) -> tuple[float, float]:
     """Turns of a class's coordinate over frames ``a:b`` and the period they give.
 
-    The period is counted on the frames where the class is excited (``mask``), frames
-    per turn over those stretches, so that a segment running past its motion (into a
-    transition where the coordinate stands still) does not lengthen it; with fewer than
-    0.75 turns there, the whole segment's frames per turn.
+    The period is the median length of the coordinate's complete windings on the frames
+    where the class is excited (``mask``) inside the segment
+    (:func:`~cyclecoord.periodic.windings.complete_windings`), so a segment running past
+    its motion (into a pause or a transition where the coordinate stands still) does not
+    lengthen it.  Without a complete winding there: frames per turn over the excited
+    stretches, or over the whole segment with fewer than 0.75 turns there.
     """
+    from .windings import complete_windings
+
     def turns(lo: int, hi: int) -> float:
         u = unwrap(coordinate[lo:hi])
         return abs(float(u[-1] - u[0]))
@@ -662,8 +666,62 @@ def _class_period(coordinate: np.ndarray, mask: np.ndarray, a: int, b: int) -> t
     runs = [(a + lo, a + hi) for lo, hi in _runs(mask[a:b]) if hi - lo > 1]
     excited = sum(turns(lo, hi) for lo, hi in runs)
     if excited >= 0.75:
+        u = np.full(coordinate.shape, np.nan)
+        for lo, hi in runs:
+            part = unwrap(coordinate[lo:hi])
+            u[lo:hi] = part if part[-1] >= part[0] else -part
+        wind = complete_windings(u, runs)
+        if np.isfinite(wind.period_frames):
+            return cyc, float(wind.period_frames)
         return cyc, sum(hi - lo - 1 for lo, hi in runs) / excited
     return cyc, (b - a - 1) / cyc if cyc > 0 else float("nan")
+
+
+#: Heading change per period (degrees) above which detect labels a stretch as turning.
+MAX_TURN = 45.0
+#: Joint speed, as a fraction of a segment's moving level, below which detect sees a pause.
+MIN_SPEED = 0.2
+
+
+def _drop_unsteady(
+    labels: np.ndarray, segments: list, joints: np.ndarray, motion: Motion, min_run: int
+) -> tuple[np.ndarray, list]:
+    """Label pauses and turns inside segments ``-1`` and split the segments around them.
+
+    A frame of a segment is a pause when its joints move at under a fifth of the
+    segment's own moving level (:data:`MIN_SPEED`) for over half a second
+    (:func:`~cyclecoord.periodic.steady.moving_mask`), and a turn when the root's heading
+    changes by more than :data:`MAX_TURN` degrees over one period around it.  Pieces
+    shorter than ``min_run`` frames are dropped.
+    """
+    from dataclasses import replace
+
+    from .root import heading, root_layout
+    from .steady import centred_window, moving_mask
+
+    layout = root_layout(motion)
+    hd = heading(motion.frames, layout) if layout is not None else None
+    keep = np.ones(labels.size, dtype=bool)
+    for seg in segments:
+        a, b = seg.start, seg.stop
+        bad = ~moving_mask(joints[a:b], motion.fps, min_speed=MIN_SPEED)
+        if hd is not None and np.isfinite(seg.period_frames) and b - a > 2:
+            lo, hi = centred_window(b - a, max(1, int(round(seg.period_frames / 2))))
+            turn = np.abs(hd[a:b][hi] - hd[a:b][lo]) / np.maximum(hi - lo, 1) * seg.period_frames
+            bad |= turn > MAX_TURN
+        keep[a:b] &= ~bad
+    labels = np.where(keep, labels, -1)
+    out = []
+    for seg in segments:
+        length = seg.stop - seg.start
+        for x, y in _runs(labels[seg.start:seg.stop] == seg.motion):
+            x, y = seg.start + x, seg.start + y
+            if y - x < min_run:
+                labels[x:y] = -1
+                continue
+            out.append(replace(seg, start=int(x), stop=int(y), cycles=float(seg.cycles) * (y - x) / max(length, 1)))
+    out.sort(key=lambda s: s.start)
+    return labels, out
 
 
 def autocorrelation_period(poses: np.ndarray, guess: float, min_correlation: float = 0.3) -> float:
@@ -859,6 +917,8 @@ def motion_cycles(
     bandwidth: str | float | None = None,
     cycle_start: str = "slowest",
     random_state: int | None = 0,
+    timing: str = "capture",
+    travel: str = "keep",
 ) -> list[MotionCycle]:
     """A typical cycle for every motion :func:`detect` found, with the phase it found.
 
@@ -868,8 +928,11 @@ def motion_cycles(
     period); for a motion found by the windows alone, time over the segment's period
     (:func:`autocorrelation_period`), which is accurate for the one to three cycles such
     segments hold.  The typical cycle is then built as :func:`cyclecoord.extract` builds
-    it (periodic density, kernel average, slowest pose first, root integrated), in the
-    root-differenced pose space and without a fresh barcode.  (A fresh
+    it: by default (``timing="capture"``) in a phase re-timed to the capture's pace
+    between the coordinate's crossings and aligned by time warping
+    (:func:`~cyclecoord.periodic.pipeline.capture_cycle`), slowest pose first, root tilt
+    averaged and heading integrated; with ``timing="coordinate"`` by the paper's density
+    sampling.  No fresh barcode is computed.  (A fresh
     ``extract`` on the segment picks the segment's most persistent class, which is often
     one pass through the whole segment: on CMU 13_29 it gave the arm circles an
     840-frame "cycle" for a 220-frame period.)
@@ -877,7 +940,7 @@ def motion_cycles(
     Parameters
     ----------
     result : DetectionResult
-    n_samples, n_neighbors, bandwidth, cycle_start, random_state
+    n_samples, n_neighbors, bandwidth, cycle_start, random_state, timing, travel
         As for :func:`cyclecoord.extract`.
 
     Returns
@@ -888,10 +951,13 @@ def motion_cycles(
     from .cycle import typical_cycle
     from .density import PeriodicDensity
     from ..quality.metrics import loop_closure
-    from .pipeline import loop_cycle
+    from .pipeline import TIMINGS, capture_cycle, loop_cycle
+    from .windings import complete_windings, retime, stretches
 
     if not isinstance(result, DetectionResult):
         raise ParameterError(f"motion_cycles() takes a DetectionResult, got {type(result).__name__}")
+    if timing not in TIMINGS:
+        raise ParameterError(f"timing must be one of {TIMINGS}, got {timing!r}")
     motion = result.motion
     prep = Preprocessor(difference_root=result.parameters.get("difference_root", True))
     prepared = prep.fit_transform(motion)
@@ -911,15 +977,29 @@ def motion_cycles(
             theta, source = np.mod(lead.coordinate[rows], 1.0), f"class {lead.index}"
         else:
             theta, source = np.mod((rows - a) / period, 1.0), "time"
-        density = PeriodicDensity(random_state=random_state).fit(theta)
-        typ = typical_cycle(
-            theta, prepared.poses[rows], period, density=density, n_samples=n_samples,
-            k=min(n_neighbors, rows.size), bandwidth=bandwidth, random_state=random_state,
-        )
-        typ, clip = loop_cycle(
-            typ, motion, prepared, prep, cycle_start=cycle_start, rows=rows,
-            metadata={"period_frames": period, "motion": mid, "segment": [a, b], "phase_from": source},
-        )
+        meta = {"period_frames": period, "motion": mid, "segment": [a, b], "phase_from": source}
+        if timing == "capture":
+            mask = np.zeros(motion.n_frames, dtype=bool)
+            mask[rows] = True
+            runs = stretches(mask)
+            u = np.full(motion.n_frames, np.nan)
+            for lo, hi in runs:
+                part = unwrap(np.asarray(theta[np.searchsorted(rows, lo):np.searchsorted(rows, hi)]))
+                u[lo:hi] = part if part[-1] >= part[0] else -part
+            wind = complete_windings(u, runs)
+            phase = retime(u, runs, wind)
+            if not np.isfinite(phase).any():
+                phase = np.full(motion.n_frames, np.nan)
+                phase[rows] = np.mod((rows - a) / period, 1.0)
+            typ, clip, _ = capture_cycle(phase, motion, prepared, prep, period, bandwidth=bandwidth,
+                                         cycle_start=cycle_start, travel=travel, k=n_neighbors, metadata=meta)
+        else:
+            density = PeriodicDensity(random_state=random_state).fit(theta)
+            typ = typical_cycle(
+                theta, prepared.poses[rows], period, density=density, n_samples=n_samples,
+                k=min(n_neighbors, rows.size), bandwidth=bandwidth, random_state=random_state,
+            )
+            typ, clip = loop_cycle(typ, motion, prepared, prep, cycle_start=cycle_start, rows=rows, metadata=meta)
         out.append(MotionCycle(
             motion=mid, start=a, stop=b, phase_from=source, n_frames_used=int(rows.size),
             period_frames=period, cycle=clip, loop_closure=float(loop_closure(typ.frames)),
@@ -1215,6 +1295,13 @@ def detect(
             windows, kept if n_global else [], labels, n_global, poses, w, min_cycles, similarity, merge_overlap,
         )
         timings["segments"] += time.perf_counter() - t0
+    t0 = time.perf_counter()
+    joint_cols = np.setdiff1d(np.arange(prepared.poses.shape[1]), prepared.root_columns)
+    labels, segments = _drop_unsteady(
+        labels, segments, prepared.poses[:, joint_cols] if joint_cols.size else prepared.poses, motion,
+        min_run=max(w // 2, 1),
+    )
+    timings["segments"] = timings.get("segments", 0.0) + time.perf_counter() - t0
     timings["total"] = sum(timings.values())
     result = DetectionResult(
         motion=motion, barcode=barcode, classes=classes, segments=segments, labels=labels,

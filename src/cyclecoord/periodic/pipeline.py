@@ -42,6 +42,8 @@ TIMINGS = ("capture", "coordinate")
 TRAVELS = ("keep", "straight", "in_place")
 #: Default width (frames of time) of the kernel that averages the re-timed cycle.
 CAPTURE_WIDTH = 1.0
+#: A bar alive at the threshold is followed until the threshold is this many times its birth.
+ALIVE_RATIO = 4.0
 #: Landmarks of the rough first pass over a long take (which finds its steady frames).
 FIRST_PASS_LANDMARKS = 150
 
@@ -297,9 +299,12 @@ def _first_clear(est: CircularCoordinates, points: np.ndarray, class_index: int,
     """Barcode of ``points`` and the chosen bar, judged by its real death.
 
     A bar still alive at the threshold reads a death/birth ratio and a gap cut by the
-    threshold.  When that cut makes it fail the clear test, the threshold is raised
-    (1.6x at a time, at most 4 times, never past the point cloud's diameter) until the
-    bar dies, and the bar is judged on the longer filtration.
+    threshold, and its cocycle would be read low in the bar.  While the chosen bar is
+    alive at the threshold and either fails the clear test or lives less than
+    :data:`ALIVE_RATIO` times its birth, the threshold is raised (1.6x at a time, at most
+    6 times, never past the point cloud's diameter), and the bar is judged, and read, on
+    the longer filtration.  ``--max-scale 12`` on CMU 69_01 200:450 (bar born at 9.955)
+    is so raised to 49.2 and gives the coordinate of ``--max-scale 50``.
     """
     from .barcode import default_max_scale, select_bar
 
@@ -309,7 +314,10 @@ def _first_clear(est: CircularCoordinates, points: np.ndarray, class_index: int,
     sel = select_bar(barcode, class_index, scale, scale_fraction)
     diameter = 2.0 * default_max_scale(points)
     tries = 0
-    while not sel.clear and sel.death >= barcode.threshold and tries < 4 and barcode.threshold < diameter:
+    def cut_short(s: BarSelection, bc: Barcode) -> bool:
+        return s.death >= bc.threshold and (not s.clear or bc.threshold < ALIVE_RATIO * s.birth)
+
+    while scale is None and cut_short(sel, barcode) and tries < 6 and barcode.threshold < diameter:
         birth = sel.birth
         old = est.max_scale
         est.max_scale = min(barcode.threshold * 1.6, diameter)

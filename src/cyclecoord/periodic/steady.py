@@ -25,7 +25,7 @@ from scipy.ndimage import uniform_filter1d
 
 from .windings import stretches
 
-__all__ = ["moving_mask", "recurrence", "steady_mask", "clean_runs"]
+__all__ = ["moving_mask", "recurrence", "steady_mask", "clean_runs", "centred_window"]
 
 
 def _smooth(x: np.ndarray, width: int) -> np.ndarray:
@@ -112,7 +112,7 @@ def recurrence(
     return best
 
 
-def _window(n: int, half: int) -> tuple[np.ndarray, np.ndarray]:
+def centred_window(n: int, half: int) -> tuple[np.ndarray, np.ndarray]:
     """Ends of a window of ``2 * half`` frames around each of ``n`` frames, kept inside."""
     idx = np.arange(n)
     lo = np.clip(idx - half, 0, max(0, n - 1 - 2 * half))
@@ -167,13 +167,13 @@ def steady_mask(
         h = None if heading is None else np.asarray(heading[a:b], dtype=float)
         good_pace = np.zeros(b - a, dtype=bool)
         for periods in sorted({1.0, float(pace_window)}):
-            lo, hi = _window(b - a, max(1, int(round(periods * period / 2))))
+            lo, hi = centred_window(b - a, max(1, int(round(periods * period / 2))))
             span = np.maximum(hi - lo, 1)
             pace = (u[hi] - u[lo]) / span * period
             good_pace |= (pace >= 1.0 / max_pace) & (pace <= max_pace)
         good = good_pace
         if h is not None:
-            lo, hi = _window(b - a, max(1, int(round(period / 2))))
+            lo, hi = centred_window(b - a, max(1, int(round(period / 2))))
             turn = np.abs(h[hi] - h[lo]) / np.maximum(hi - lo, 1) * period
             good &= turn <= max_turn
         ok[a:b] &= good
