@@ -40,7 +40,7 @@ _CADENCE_FLOOR = 0.55  # cadence at the first step, relative to the steady one
 _TURN_STRIDE = 0.10  # steps this much shorter at the middle of a turn
 _TURN_CADENCE = 0.05  # and this much slower
 _TURN_LEAN = 0.3  # fraction of the centripetal lean angle actually taken
-_LOOK_AHEAD = 0.3  # seconds: the head faces where the body will face this much later
+_LOOK_AHEAD = 0.3  # seconds: the head turns by half the heading change in this much time
 _PAUSE_STOP = 0.75  # cycles of slowing down before a pause's standing
 _PAUSE_START = 1.0  # cycles of starting again after it
 
@@ -198,9 +198,11 @@ def _script_for_length(rng: np.random.Generator, n: int, period: float, fps: flo
             break
         events.append(nxt)
     spare = n - fixed - sum(p.frames for e in events for p in e)
+    lengths = np.full(len(events) + 1, min(shortest, spare))
+    spare -= int(lengths.sum())
     weights = rng.uniform(0.7, 1.3, size=len(events) + 1)
-    lengths = np.floor(spare * weights / weights.sum()).astype(int)
-    lengths[-1] += spare - int(lengths.sum())
+    lengths += np.floor(spare * weights / weights.sum()).astype(int)
+    lengths[-1] += n - fixed - sum(p.frames for e in events for p in e) - int(lengths.sum())
     parts = list(head)
     for k, length in enumerate(lengths):
         parts.append(_Part("steady", int(length)))
@@ -300,7 +302,7 @@ def _render_take(
     h = np.radians(heading)
     omega = np.gradient(h)  # rad/frame
     lean = -_TURN_LEAN * np.degrees(np.arctan(step * omega / (_GRAVITY / fps**2)))
-    ahead = np.interp(np.arange(n) + _LOOK_AHEAD * fps, np.arange(n), heading) - heading
+    ahead = np.gradient(heading) * _LOOK_AHEAD * fps  # degrees the heading turns in 0.3 s
     frames[:, col[("head", "ry")]] += 0.5 * ahead
     frames[:, col[("thorax", "ry")]] += 0.2 * ahead
 
