@@ -254,12 +254,15 @@ def _continuous_euler(world) -> np.ndarray:
 
     ``ZYX`` Euler angles have two solutions, ``(z, y, x)`` and ``(z + 180, 180 - y,
     x + 180)``; each frame takes the one (shifted by whole turns) nearest the previous
-    frame's, so the channels stay continuous through headings of +-90 degrees.
+    frame's, so the channels stay continuous through headings of +-90 degrees.  The first
+    frame takes the solution with the smaller tilt (``rx``, ``rz`` near 0, ``ry`` near the
+    heading).
     """
     e = world.as_euler("ZYX", degrees=True)
     alt = np.column_stack([e[:, 0] + 180.0, 180.0 - e[:, 1], e[:, 2] + 180.0])
+    alt = (alt + 180.0) % 360.0 - 180.0
     out = np.empty_like(e)
-    prev = e[0]
+    prev = min((e[0], alt[0]), key=lambda c: abs(c[0]) + abs(c[2]))
     for t in range(e.shape[0]):
         best, cost = e[t], np.inf
         for cand in (e[t], alt[t]):
