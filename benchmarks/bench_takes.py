@@ -125,8 +125,9 @@ def main(argv=None) -> int:
         if not args.no_detect:
             de = entry["detect"] = run_detect(cap)
             shares = ", ".join(f"{k} {100 * v:.0f} %" for k, v in de["labelled_share"].items())
-            print(f"   detect: {de['n_motions']} motion(s), periods {de['periods']}; frames labelled "
-                  f"periodic per true part: {shares}; {de['wall_s']:.1f} s wall / {de['cpu_s']:.1f} s CPU")
+            print(f"   detect: {de['n_motions']} motion(s), periods {de['periods']}; "
+                  f"frames labelled periodic per true part: {shares}; "
+                  f"{de['wall_s']:.1f} s wall / {de['cpu_s']:.1f} s CPU")
         report[name] = entry
     if args.json:
         from cyclecoord.io._atomic import atomic_write

@@ -496,7 +496,8 @@ def test_whole_take_default_script_and_ground_truth(take):
     n = take.motion.n_frames
     names = [p[0] for p in take.parts]
     assert names == [
-        "stand", "start", "steady", "turn", "steady", "stop", "stand", "start", "steady", "stop", "stand"
+        "stand", "start", "steady", "turn", "steady", "stop",
+        "stand", "start", "steady", "stop", "stand",
     ]
     assert take.parts[0][1] == 0 and take.parts[-1][2] == n
     assert all(a[2] == b[1] for a, b in zip(take.parts, take.parts[1:]))
@@ -519,7 +520,8 @@ def test_whole_take_default_script_and_ground_truth(take):
         assert (np.diff(take.phase[s:e]) > 0).all()
     turn = take.parts[3]
     assert 90 <= abs(take.heading[turn[2] - 1] - take.heading[turn[1]]) <= 180
-    assert take.name == "synthetic-take(walk)" and take.motion.source == "synthetic:take(walk; seed=0)"
+    assert take.name == "synthetic-take(walk)"
+    assert take.motion.source == "synthetic:take(walk; seed=0)"
 
 
 def test_whole_take_standing_is_still_and_moving_is_not(take):
@@ -541,7 +543,7 @@ def test_whole_take_standing_is_still_and_moving_is_not(take):
 def test_whole_take_is_smooth_across_parts(take):
     """No jump where parts meet, and nowhere a change larger than walking makes."""
     frames = take.clean.frames
-    joints = [i for i, (j, d) in enumerate(take.clean.channels) if j != "root" and d.startswith("r")]
+    joints = [i for i, (j, d) in enumerate(take.clean.channels) if j != "root" and d[0] == "r"]
     step = np.abs(np.diff(frames[:, joints], axis=0))
     accel = np.abs(np.diff(frames[:, joints], 2, axis=0))
     for _, _, b in take.parts[:-1]:
@@ -549,7 +551,8 @@ def test_whole_take_is_smooth_across_parts(take):
         assert (step[b - 1] <= 1.1 * step[around].max(axis=0) + 1e-3).all()
         assert (accel[b - 2 : b].max(axis=0) <= 1.5 * accel[around].max(axis=0) + 1e-3).all()
     not_turning = take.part_labels[1:] != ds.PART_NAMES.index("turn")
-    assert (step[not_turning].max(axis=0) <= 1.1 * step[take.labels[1:] == 0].max(axis=0) + 0.05).all()
+    steady_step = step[take.labels[1:] == 0].max(axis=0)
+    assert (step[not_turning].max(axis=0) <= 1.1 * steady_step + 0.05).all()
     assert accel.max() <= 1.1 * accel[take.labels[2:] == 0].max()
 
 
@@ -595,9 +598,21 @@ def test_whole_take_heading_turns_by_the_scripted_amount(turning_take):
     assert np.abs(np.diff(rot, axis=0)).max() < 90.0
 
 
+def test_whole_take_curve_drifts_the_heading_per_cycle():
+    cap = ds.make_whole_take(script=(("steady", 6),), curve=5.0, noise=0.0, random_state=4)
+    n, period = cap.motion.n_frames, int(round(cap.period))
+    assert cap.heading[-1] - cap.heading[0] == pytest.approx(5.0 * (n - 1) / 120.0)
+    face = facing(cap)
+    drift = face[n - period :].mean() - face[:period].mean()
+    assert drift == pytest.approx(5.0 * (n - period) / 120.0, abs=1.0)
+    straight = ds.make_whole_take(script=(("steady", 6),), noise=0.0, random_state=4)
+    assert np.ptp(straight.heading) == 0.0
+
+
 def test_whole_take_steady_parts_have_the_true_period(turning_take):
     cap = turning_take
-    joints = cap.clean.frames[:, [i for i, (j, d) in enumerate(cap.clean.channels) if j != "root" and d[0] == "r"]]
+    cols = [i for i, (j, d) in enumerate(cap.clean.channels) if j != "root" and d[0] == "r"]
+    joints = cap.clean.frames[:, cols]
     for s, e in cap.steady:
         part = joints[s:e] - joints[s:e].mean(axis=0)
         lags = np.arange(int(0.8 * cap.period), int(1.2 * cap.period))
@@ -635,7 +650,8 @@ def test_whole_take_is_deterministic_and_jogs():
     b = ds.make_whole_take(script=(("steady", 2), ("pause", 1.0), ("steady", 2)), random_state=5)
     assert np.array_equal(a.motion.frames, b.motion.frames)
     assert [p[0] for p in a.parts] == ["steady", "stop", "stand", "start", "steady"]
-    jog = ds.make_whole_take("jog", script=(("stand", 0.5), ("start", 1), ("steady", 3), ("stop", 1)))
+    script = (("stand", 0.5), ("start", 1), ("steady", 3), ("stop", 1))
+    jog = ds.make_whole_take("jog", script=script)
     assert jog.period == pytest.approx(80.0, rel=0.05)
     assert np.isfinite(jog.motion.frames).all() and np.isnan(jog.phase[:60]).all()
 
@@ -649,7 +665,8 @@ def test_whole_take_is_the_cli_example(take):
 
 def test_other_generators_have_no_take_fields():
     cap = ds.make_periodic_capture(n_frames=50, random_state=0)
-    assert cap.parts is None and cap.part_labels is None and cap.steady is None and cap.heading is None
+    assert cap.parts is None and cap.part_labels is None
+    assert cap.steady is None and cap.heading is None
 
 
 @pytest.mark.parametrize(
@@ -673,6 +690,7 @@ def test_other_generators_have_no_take_fields():
         (dict(period=0.5), "period"),
         (dict(noise=-1), "noise"),
         (dict(speed_variation=1.0), "speed_variation"),
+        (dict(curve=float("nan")), "curve"),
     ],
 )
 def test_bad_whole_take_arguments(kwargs, match):

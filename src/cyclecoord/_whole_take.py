@@ -339,6 +339,7 @@ def make_whole_take(
     script: Sequence[tuple] | None = None,
     noise: float = 0.5,
     speed_variation: float = 0.05,
+    curve: float = 0.0,
     fps: float = DEFAULT_FPS,
     random_state: int | np.random.Generator | None = 0,
 ) -> _ds.SyntheticCapture:
@@ -382,6 +383,11 @@ def make_whole_take(
     speed_variation : float
         Relative wobble of the phase speed, ``0 <= speed_variation < 1`` (0.05: single
         cycles a few percent longer or shorter than ``period``).
+    curve : float
+        Heading drift while walking, degrees per ``period`` frames at full amplitude
+        (scaled by the amplitude in starts and stops; positive to the left).  Real
+        straight walks drift a few degrees a cycle (CMU 69_01: about 5); 0 walks straight.
+        The drift is part of ``heading``.
     fps : float
         Frame rate (seconds in the script are converted with it).
     random_state : int, numpy Generator or None
@@ -416,6 +422,7 @@ def make_whole_take(
     period = _ds._check_float("period", period, 1.0, low_open=True)
     noise = _ds._check_float("noise", noise, 0.0)
     variation = _ds._check_float("speed_variation", speed_variation, 0.0, high=1.0)
+    curve = _ds._check_float("curve", curve, -np.inf)
     fps = _ds._check_float("fps", fps, 0.0, low_open=True)
     if script is not None and n_frames is not None:
         raise ParameterError("give either script or n_frames, not both")
@@ -430,6 +437,9 @@ def make_whole_take(
     else:
         parts = _default_script(rng, period, fps)
     line = _timeline(parts, heading0)
+    if curve:
+        drift = curve / period * line["activity"]
+        line["heading"] = line["heading"] + np.concatenate([[0.0], np.cumsum(drift)[:-1]])
     n = line["code"].shape[0]
     law = _ds._draw_phase_law(rng, period, variation, n)
     grid = law(np.arange(n + 1, dtype=float))
@@ -453,6 +463,7 @@ def make_whole_take(
         "speed_variation": variation,
         "script": [(p.name, p.frames, p.degrees) for p in parts],
         "initial_heading": heading0,
+        "curve": curve,
     }
     skeleton, channels = _ds.cmu_skeleton(), _ds._CHANNELS
     return _ds.SyntheticCapture(
