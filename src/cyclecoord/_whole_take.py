@@ -448,14 +448,6 @@ def make_whole_take(
     clean = _render_take(kind, phase, rate, line, style, fps)
     noisy = _ds._add_noise(clean, noise, rng)
 
-    bounds = np.cumsum([0] + [p.frames for p in parts])
-    ranges = [(p.name, int(bounds[k]), int(bounds[k + 1])) for k, p in enumerate(parts)]
-    steady = [(s, e) for name, s, e in ranges if name == "steady"]
-    steady_mask = line["code"] == PART_NAMES.index("steady")
-    moving = line["code"] != PART_NAMES.index("stand")
-    true_period = float(steady_mask.sum() / rate[steady_mask].sum()) if steady else float("nan")
-    seed = _ds._seed_text(random_state)
-    source = f"synthetic:take({kind}; seed={seed})"
     meta = {
         "kind": kind,
         "period": period,
@@ -465,6 +457,29 @@ def make_whole_take(
         "initial_heading": heading0,
         "curve": curve,
     }
+    source = f"synthetic:take({kind}; seed={_ds._seed_text(random_state)})"
+    return _assemble(kind, parts, line, phase, rate, clean, noisy, fps, source, meta)
+
+
+def _assemble(
+    kind: str,
+    parts: list[_Part],
+    line: dict[str, np.ndarray],
+    phase: np.ndarray,
+    rate: np.ndarray,
+    clean: np.ndarray,
+    noisy: np.ndarray,
+    fps: float,
+    source: str,
+    meta: dict,
+) -> _ds.SyntheticCapture:
+    """The capture and its ground truth from the rendered take."""
+    bounds = np.cumsum([0] + [p.frames for p in parts])
+    ranges = [(p.name, int(bounds[k]), int(bounds[k + 1])) for k, p in enumerate(parts)]
+    steady = [(s, e) for name, s, e in ranges if name == "steady"]
+    steady_mask = line["code"] == PART_NAMES.index("steady")
+    moving = line["code"] != PART_NAMES.index("stand")
+    true_period = float(steady_mask.sum() / rate[steady_mask].sum()) if steady else float("nan")
     skeleton, channels = _ds.cmu_skeleton(), _ds._CHANNELS
     return _ds.SyntheticCapture(
         motion=Motion(noisy, channels, fps=fps, skeleton=skeleton, source=source, metadata=meta),
