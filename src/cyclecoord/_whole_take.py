@@ -10,8 +10,9 @@ cadence factor (0 standing, 0.55 -> 1 over a start, a little slower in turns); t
 travels ``stride * a`` per cycle along the current heading, and the heading turns
 smoothly (C2) over each turn while the walker leans into it, looks ahead and takes
 slightly shorter steps.  The root rotation is the exact composition of the heading with
-the gait's pelvis tilt, written back as AMC ``rx ry rz`` Euler angles (tracked on the
-continuous branch), as a capture system would record a person facing any direction.
+the gait's pelvis tilt, written back as AMC ``rx ry rz`` Euler angles (the solution with
+the smaller tilt, ``ry`` unwrapped), as a capture system would record a person facing any
+direction.
 """
 
 from __future__ import annotations
@@ -249,28 +250,22 @@ def _timeline(parts: list[_Part], heading0: float) -> dict[str, np.ndarray]:
     return out
 
 
-def _continuous_euler(world) -> np.ndarray:
-    """AMC root angles ``(T, 3)`` as ``(rz, ry, rx)`` of rotations, on a continuous branch.
+def _amc_euler(world) -> np.ndarray:
+    """AMC root angles ``(T, 3)`` as ``(rz, ry, rx)`` of rotations, as a capture would write them.
 
     ``ZYX`` Euler angles have two solutions, ``(z, y, x)`` and ``(z + 180, 180 - y,
-    x + 180)``; each frame takes the one (shifted by whole turns) nearest the previous
-    frame's, so the channels stay continuous through headings of +-90 degrees.  The first
-    frame takes the solution with the smaller tilt (``rx``, ``rz`` near 0, ``ry`` near the
-    heading).
+    x + 180)``; each frame takes the one with the smaller tilt (``rx`` and ``rz`` nearer
+    0, wrapped to [-180, 180)), and ``ry`` is unwrapped, so it follows the heading through
+    any number of turns.  Where the heading passes +-90 degrees (within the pelvis tilt,
+    a few degrees) both solutions tilt a lot and ``rx``/``rz`` swing fast, as they do in
+    real CMU takes (143_01: jumps of up to 86 degrees between frames).
     """
     e = world.as_euler("ZYX", degrees=True)
     alt = np.column_stack([e[:, 0] + 180.0, 180.0 - e[:, 1], e[:, 2] + 180.0])
-    alt = (alt + 180.0) % 360.0 - 180.0
-    out = np.empty_like(e)
-    prev = min((e[0], alt[0]), key=lambda c: abs(c[0]) + abs(c[2]))
-    for t in range(e.shape[0]):
-        best, cost = e[t], np.inf
-        for cand in (e[t], alt[t]):
-            cand = cand + 360.0 * np.round((prev - cand) / 360.0)
-            c = float(np.abs(cand - prev).sum())
-            if c < cost:
-                best, cost = cand, c
-        out[t] = prev = best
+    e, alt = ((a + 180.0) % 360.0 - 180.0 for a in (e, alt))
+    tilt = np.abs(e[:, [0, 2]]).sum(axis=1)
+    out = np.where((np.abs(alt[:, [0, 2]]).sum(axis=1) < tilt)[:, None], alt, e)
+    out[:, 1] = np.degrees(np.unwrap(np.radians(out[:, 1])))
     return out
 
 
@@ -314,7 +309,7 @@ def _render_take(
     rz = frames[:, col[("root", "rz")]] + lean
     body = Rotation.from_euler("ZYX", np.column_stack([rz, ry, rx]), degrees=True)
     world = Rotation.from_euler("Y", heading[:, None], degrees=True) * body
-    zyx = _continuous_euler(world)
+    zyx = _amc_euler(world)
     frames[:, col[("root", "rz")]] = zyx[:, 0]
     frames[:, col[("root", "ry")]] = zyx[:, 1]
     frames[:, col[("root", "rx")]] = zyx[:, 2]
