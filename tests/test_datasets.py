@@ -459,3 +459,257 @@ def test_bad_chain_arguments(kwargs):
 def test_bad_non_periodic_arguments(call):
     with pytest.raises(ParameterError):
         call()
+
+
+# ------------------------------------------------------------------- whole takes
+TURN_SCRIPT = (
+    ("stand", 1.0), ("start", 1), ("steady", 3), ("turn", 1.5, 120), ("steady", 3),
+    ("turn", 1.2, -150), ("steady", 3), ("stop", 1), ("stand", 1.0),
+)
+
+
+@pytest.fixture(scope="module")
+def take():
+    return ds.make_whole_take(random_state=0)
+
+
+@pytest.fixture(scope="module")
+def turning_take():
+    return ds.make_whole_take(script=TURN_SCRIPT, noise=0.0, random_state=3)
+
+
+def moving_runs(cap) -> list[tuple[int, int]]:
+    """Maximal runs of consecutive frames that are not standing."""
+    moving = cap.part_labels != ds.PART_NAMES.index("stand")
+    edges = np.flatnonzero(np.diff(np.r_[0, moving.astype(int), 0]))
+    return list(zip(edges[::2], edges[1::2]))
+
+
+def facing(cap) -> np.ndarray:
+    """Facing direction (degrees, 0 = +z, positive towards +x) from the hips, unwrapped."""
+    pos = cap.clean.positions()
+    left = pos["lfemur"] - pos["rfemur"]  # points to the body's left
+    return np.degrees(np.unwrap(np.arctan2(-left[:, 2], left[:, 0])))
+
+
+def test_whole_take_default_script_and_ground_truth(take):
+    n = take.motion.n_frames
+    names = [p[0] for p in take.parts]
+    assert names == [
+        "stand", "start", "steady", "turn", "steady", "stop",
+        "stand", "start", "steady", "stop", "stand",
+    ]
+    assert take.parts[0][1] == 0 and take.parts[-1][2] == n
+    assert all(a[2] == b[1] for a, b in zip(take.parts, take.parts[1:]))
+    for name, s, e in take.parts:
+        assert (take.part_labels[s:e] == ds.PART_NAMES.index(name)).all()
+    steady = [(s, e) for name, s, e in take.parts if name == "steady"]
+    assert take.steady == steady and take.boundaries == [(s, e, "walk") for s, e in steady]
+    in_steady = np.zeros(n, bool)
+    for s, e in steady:
+        in_steady[s:e] = True
+    assert ((take.labels == 0) == in_steady).all() and set(np.unique(take.labels)) == {-1, 0}
+    assert 2000 < n < 3200 and take.motion.fps == 120.0
+    assert take.period == pytest.approx(120.0, rel=0.03)
+    assert np.isfinite(take.motion.frames).all() and np.isfinite(take.clean.frames).all()
+    assert take.motion.channels == take.clean.channels == CMU_CHANNELS
+    # phase: NaN exactly where the person stands, strictly increasing while moving
+    standing = take.part_labels == ds.PART_NAMES.index("stand")
+    assert (np.isnan(take.phase) == standing).all()
+    for s, e in moving_runs(take):
+        assert (np.diff(take.phase[s:e]) > 0).all()
+    turn = take.parts[3]
+    assert 90 <= abs(take.heading[turn[2] - 1] - take.heading[turn[1]]) <= 180
+    assert take.name == "synthetic-take(walk)"
+    assert take.motion.source == "synthetic:take(walk; seed=0)"
+
+
+def test_whole_take_standing_is_still_and_moving_is_not(take):
+    clean = take.clean
+    speed = np.linalg.norm(np.diff(clean.positions().positions, axis=0), axis=2).max(axis=1)
+    stand_code = ds.PART_NAMES.index("stand")
+    for name, s, e in take.parts:
+        if name == "stand":
+            assert np.ptp(clean.frames[s:e], axis=0).max() < 1e-9
+            assert speed[s : e - 1].max() < 1e-9
+    steady = take.labels[1:] == 0
+    assert np.median(speed[steady]) > 0.2  # a walk moves its feet about 0.2-0.5 units a frame
+    # the noise is on top of still frames too
+    noisy = take.motion.frames[take.part_labels == stand_code][:, angle_cols(take.motion)]
+    resid = noisy - clean.frames[take.part_labels == stand_code][:, angle_cols(clean)]
+    assert resid.std() == pytest.approx(0.5, rel=0.1)
+
+
+def test_whole_take_is_smooth_across_parts(take):
+    """No jump where parts meet, and nowhere a change larger than walking makes."""
+    frames = take.clean.frames
+    joints = [i for i, (j, d) in enumerate(take.clean.channels) if j != "root" and d[0] == "r"]
+    step = np.abs(np.diff(frames[:, joints], axis=0))
+    accel = np.abs(np.diff(frames[:, joints], 2, axis=0))
+    for _, _, b in take.parts[:-1]:
+        around = np.r_[b - 21 : b - 2, b + 1 : b + 20]
+        assert (step[b - 1] <= 1.1 * step[around].max(axis=0) + 1e-3).all()
+        assert (accel[b - 2 : b].max(axis=0) <= 1.5 * accel[around].max(axis=0) + 1e-3).all()
+    not_turning = take.part_labels[1:] != ds.PART_NAMES.index("turn")
+    steady_step = step[take.labels[1:] == 0].max(axis=0)
+    assert (step[not_turning].max(axis=0) <= 1.1 * steady_step + 0.05).all()
+    assert accel.max() <= 1.1 * accel[take.labels[2:] == 0].max()
+
+
+def test_whole_take_start_and_stop_ramp_the_gait(take):
+    hip = col(take.clean, "rfemur", "rx")
+    root = take.clean.frames[:, [take.clean.channel_index("root", d) for d in ("tx", "tz")]]
+    travel = np.linalg.norm(np.diff(root, axis=0), axis=1)
+    for name, s, e in take.parts:
+        if name not in ("start", "stop"):
+            continue
+        third = (e - s) // 3
+        first, last = np.ptp(hip[s : s + third]), np.ptp(hip[e - third : e])
+        v_first, v_last = travel[s : s + third].mean(), travel[e - third - 1 : e - 1].mean()
+        if name == "start":
+            assert first < 0.3 * last and v_first < 0.3 * v_last
+        else:
+            assert last < 0.3 * first and v_last < 0.3 * v_first
+    # steady walking travels about one stride (26 units) per cycle
+    s, e = take.steady[0]
+    cycles = take.phase[e - 1] - take.phase[s]
+    assert np.linalg.norm(root[e - 1] - root[s]) / cycles == pytest.approx(26.0 * 1.0, rel=0.15)
+
+
+def test_whole_take_heading_turns_by_the_scripted_amount(turning_take):
+    cap = turning_take
+    face = facing(cap)
+    assert np.abs(((face - cap.heading + 180) % 360) - 180).max() < 6.0  # pelvis yaw only
+    period = int(round(cap.period))
+    steady = cap.steady
+    for (s0, e0), (s1, e1), degrees in zip(steady, steady[1:], (120.0, -150.0)):
+        before = face[e0 - period : e0].mean()  # one cycle: the pelvis yaw averages out
+        after = face[s1 : s1 + period].mean()
+        assert after - before == pytest.approx(degrees, abs=2.0)
+        assert cap.heading[s1] - cap.heading[e0 - 1] == pytest.approx(degrees)
+    # the root travels along the heading
+    root = cap.clean.frames[:, [cap.clean.channel_index("root", d) for d in ("tx", "tz")]]
+    for s, e in steady:
+        d = root[e - 1] - root[s]
+        travel = np.degrees(np.arctan2(d[0], d[1]))
+        assert ((travel - cap.heading[s] + 180) % 360) - 180 == pytest.approx(0.0, abs=3.0)
+    # AMC root angles: rx, rz wrapped and small away from headings of +-90 degrees (the
+    # Euler singularity), ry unwrapped and following the heading
+    rot = cap.clean.frames[:, [cap.clean.channel_index("root", d) for d in ("rx", "ry", "rz")]]
+    assert (np.abs(rot[:, [0, 2]]) <= 180.0).all()
+    far = np.abs((cap.heading % 180.0) - 90.0) > 30.0  # heading 30+ degrees from +-90
+    far &= cap.part_labels != ds.PART_NAMES.index("turn")  # (turns lean into the curve)
+    assert far.mean() > 0.3
+    assert np.abs(rot[far][:, [0, 2]]).max() < 10.0
+    assert np.abs(rot[far, 1] - cap.heading[far]).max() < 8.0
+    # and the lean into the turn: the head moves to the inside of the curve
+    pos = cap.clean.positions()
+    left = pos["lfemur"] - pos["rfemur"]
+    left[:, 1] = 0.0
+    inward = np.sum((pos["head"] - pos["root"]) * left, axis=1) / np.linalg.norm(left, axis=1)
+    for name, s, e in cap.parts:
+        middle = inward[s + (e - s) // 3 : e - (e - s) // 3].mean()
+        if name == "turn":
+            assert np.sign(cap.heading[e - 1] - cap.heading[s]) * middle > 0.5
+        elif name == "steady":
+            assert abs(middle) < 0.2
+
+
+def test_whole_take_curve_drifts_the_heading_per_cycle():
+    cap = ds.make_whole_take(script=(("steady", 6),), curve=5.0, noise=0.0, random_state=4)
+    n, period = cap.motion.n_frames, int(round(cap.period))
+    assert cap.heading[-1] - cap.heading[0] == pytest.approx(5.0 * (n - 1) / 120.0)
+    face = facing(cap)
+    drift = face[n - period :].mean() - face[:period].mean()
+    assert drift == pytest.approx(5.0 * (n - period) / 120.0, abs=1.0)
+    straight = ds.make_whole_take(script=(("steady", 6),), noise=0.0, random_state=4)
+    assert np.ptp(straight.heading) == 0.0
+
+
+def test_whole_take_steady_parts_have_the_true_period(turning_take):
+    cap = turning_take
+    cols = [i for i, (j, d) in enumerate(cap.clean.channels) if j != "root" and d[0] == "r"]
+    joints = cap.clean.frames[:, cols]
+    for s, e in cap.steady:
+        part = joints[s:e] - joints[s:e].mean(axis=0)
+        lags = np.arange(int(0.8 * cap.period), int(1.2 * cap.period))
+        score = [np.sum(part[:-lag] * part[lag:]) / np.sum(part[:-lag] ** 2) for lag in lags]
+        true = (e - 1 - s) / (cap.phase[e - 1] - cap.phase[s])
+        assert lags[int(np.argmax(score))] == pytest.approx(true, abs=2.0)
+        assert true == pytest.approx(cap.period, rel=0.05)
+    assert cap.period == pytest.approx(120.0, rel=0.03)
+    # steady frames are the plain gait: the joint angles depend on the phase alone
+    s0, e0 = cap.steady[0]
+    s1, e1 = cap.steady[-1]
+    phi0, phi1 = np.mod(cap.phase[s0:e0], 1.0), np.mod(cap.phase[s1:e1], 1.0)
+    for k in range(0, e0 - s0, 17):
+        j = int(np.argmin(np.abs(((phi1 - phi0[k] + 0.5) % 1.0) - 0.5)))
+        gap = abs(((phi1[j] - phi0[k] + 0.5) % 1.0) - 0.5)
+        assert np.abs(joints[s1 + j] - joints[s0 + k]).max() < 1.0 + 400.0 * gap
+
+
+def test_whole_take_of_6000_frames_repeats_turns_and_pauses():
+    cap = ds.make_whole_take(n_frames=6000, random_state=1)
+    assert cap.motion.n_frames == 6000 and np.isfinite(cap.motion.frames).all()
+    names = [p[0] for p in cap.parts]
+    assert names[:2] == ["stand", "start"] and names[-2:] == ["stop", "stand"]
+    assert names.count("turn") >= 2 and names.count("stand") - 2 >= 2  # pauses
+    assert all(e - s >= 3 * 120 - 1 for s, e in cap.steady)
+    assert cap.period == pytest.approx(120.0, rel=0.03)
+    for s, e in moving_runs(cap):
+        assert (np.diff(cap.phase[s:e]) > 0).all()
+    turns = [cap.heading[e - 1] - cap.heading[s] for name, s, e in cap.parts if name == "turn"]
+    assert all(85 <= abs(t) <= 180 for t in turns)
+
+
+def test_whole_take_is_deterministic_and_jogs():
+    a = ds.make_whole_take(script=(("steady", 2), ("pause", 1.0), ("steady", 2)), random_state=5)
+    b = ds.make_whole_take(script=(("steady", 2), ("pause", 1.0), ("steady", 2)), random_state=5)
+    assert np.array_equal(a.motion.frames, b.motion.frames)
+    assert [p[0] for p in a.parts] == ["steady", "stop", "stand", "start", "steady"]
+    script = (("stand", 0.5), ("start", 1), ("steady", 3), ("stop", 1))
+    jog = ds.make_whole_take("jog", script=script)
+    assert jog.period == pytest.approx(80.0, rel=0.05)
+    assert np.isfinite(jog.motion.frames).all() and np.isnan(jog.phase[:60]).all()
+
+
+def test_whole_take_is_the_cli_example(take):
+    from cyclecoord.cli.main import load_input
+
+    motion = load_input("example:take")
+    assert np.array_equal(motion.frames, take.motion.frames)
+
+
+def test_other_generators_have_no_take_fields():
+    cap = ds.make_periodic_capture(n_frames=50, random_state=0)
+    assert cap.parts is None and cap.part_labels is None
+    assert cap.steady is None and cap.heading is None
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        (dict(kind="squat"), "gait"),
+        (dict(script=[("steady", 3)], n_frames=3000), "not both"),
+        (dict(n_frames=300), "at least"),
+        (dict(script=[]), "at least one"),
+        (dict(script="stand"), "sequence"),
+        (dict(script=[("fly", 2)]), "entry 0: unknown part 'fly'"),
+        (dict(script=[("stand", 1), ("steady", 3)]), "entry 1 .'steady'. .*start"),
+        (dict(script=[("steady", 3), ("stand", 1)]), "entry 1 .'stand'. .*stop"),
+        (dict(script=[("steady", 3), ("start", 1)]), "entry 1"),
+        (dict(script=[("steady", -1)]), "entry 0"),
+        (dict(script=[("steady", "x")]), "entry 0"),
+        (dict(script=[("steady", 3), ("turn", 1, "left")]), "entry 1"),
+        (dict(script=[("steady", 3, 90)]), "entry 0"),
+        (dict(script=[("steady",)]), "entry 0"),
+        (dict(script=[("stand", 0.001)]), "under 2 frames"),
+        (dict(period=0.5), "period"),
+        (dict(noise=-1), "noise"),
+        (dict(speed_variation=1.0), "speed_variation"),
+        (dict(curve=float("nan")), "curve"),
+    ],
+)
+def test_bad_whole_take_arguments(kwargs, match):
+    with pytest.raises(ParameterError, match=match):
+        ds.make_whole_take(**kwargs)

@@ -41,6 +41,8 @@ __all__ = [
     "cmu_skeleton",
     "make_periodic_capture",
     "make_motion_chain",
+    "make_whole_take",
+    "PART_NAMES",
     "make_static_capture",
     "make_random_walk_capture",
     "example_capture",
@@ -244,6 +246,19 @@ class SyntheticCapture:
         Half-open frame ranges ``(start, stop, kind)`` of the periodic segments.
     name : str
         Short name, e.g. ``"synthetic-walk"``.
+    parts : list of (str, int, int) or None
+        Whole takes (:func:`make_whole_take`) only: every scripted part as a half-open
+        range ``(name, start, stop)``, ``name`` one of :data:`PART_NAMES`, in frame order,
+        covering all frames; None for the other generators.
+    part_labels : ndarray of int, shape (T,), or None
+        Whole takes only: per frame, the index in :data:`PART_NAMES` of its part.
+    steady : list of (int, int) or None
+        Whole takes only: half-open frame ranges of the steady parts (constant amplitude,
+        straight heading, the period's own speed wobble); the same ranges as
+        ``boundaries``.
+    heading : ndarray, shape (T,), or None
+        Whole takes only: the body's heading in degrees (yaw of the facing direction about
+        the vertical, 0 = +z, positive towards +x, i.e. turning left), unwrapped.
     """
 
     motion: Motion
@@ -253,6 +268,10 @@ class SyntheticCapture:
     labels: np.ndarray
     boundaries: list[tuple[int, int, str]]
     name: str
+    parts: list[tuple[str, int, int]] | None = None
+    part_labels: np.ndarray | None = None
+    steady: list[tuple[int, int]] | None = None
+    heading: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         phase = np.array(self.phase, dtype=float)
@@ -261,6 +280,12 @@ class SyntheticCapture:
         labels.flags.writeable = False
         object.__setattr__(self, "phase", phase)
         object.__setattr__(self, "labels", labels)
+        for name, dtype in (("part_labels", int), ("heading", float)):
+            value = getattr(self, name)
+            if value is not None:
+                arr = np.array(value, dtype=dtype)
+                arr.flags.writeable = False
+                object.__setattr__(self, name, arr)
 
 
 # ------------------------------------------------------------------- shape helpers
@@ -1003,3 +1028,8 @@ def example_capture() -> SyntheticCapture:
     """
     cap = make_periodic_capture(n_frames=480, period=120.0, noise=0.5, random_state=0)
     return replace(cap, name="synthetic-walk")
+
+
+# The whole-take generator lives in its own module (it uses the helpers above); imported
+# last so that module can import this one.
+from ._whole_take import PART_NAMES, make_whole_take

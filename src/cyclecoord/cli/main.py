@@ -20,7 +20,7 @@ __all__ = ["main", "build_parser"]
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_NO_PERIODIC = 0, 1, 2, 3
 
-EXAMPLES = ("walk", "jog", "jumping_jack", "arm_circles", "squat", "chain")
+EXAMPLES = ("walk", "jog", "jumping_jack", "arm_circles", "squat", "chain", "take")
 
 
 # ----------------------------------------------------------------- helpers
@@ -81,6 +81,8 @@ def load_input(path: str, skeleton: str | None = None, fps: float | None = None)
             cap = datasets.example_capture()
         elif kind == "chain":
             cap = datasets.make_motion_chain(random_state=0)
+        elif kind == "take":
+            cap = datasets.make_whole_take(random_state=0)
         else:
             cap = datasets.make_periodic_capture(kind=kind, n_frames=480, random_state=0)
         m = cap.motion
@@ -766,7 +768,8 @@ def build_parser() -> argparse.ArgumentParser:
         description=(
             "Find, parameterise and reuse periodic motion in motion capture with persistent "
             "cohomology. INPUT is an .amc (skeleton found beside it), .bvh, .npz or .csv file, "
-            "or 'example' for the built-in synthetic walk (example:jog, example:chain, ...)."
+            "or 'example' for the built-in synthetic walk (example:jog, example:chain, "
+            "example:take, ...)."
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog=(
