@@ -331,7 +331,9 @@ HEADERS = [
     "jerk/cut",
     "leg/cut",
     "low leg",
+    "fem/tib",
     "seam",
+    "p90/p10",
     "cover",
     "skate/take",
     "root deg",
@@ -374,7 +376,9 @@ def table_rows(report: dict) -> list[list[str]]:
                     _f(q["jerk_ratio"]),
                     _f(q["min_leg_range_ratio"]),
                     q["min_leg_channel"] or "-",
+                    _f(q["min_femur_tibia_ratio"]),
                     _f(q["seam"]),
+                    _f(q["step_spread"], "{:.1f}"),
                     _f(q["coverage"]),
                     _f(q["skating_ratio"]),
                     _f(q["root_closure_degrees"]),
@@ -397,15 +401,22 @@ def format_report(report: dict) -> str:
         _table(HEADERS, table_rows(report)),
         "",
         "period: frames (ours: result.period_frames; loop cut: its length; average: mean piece);",
-        "err%: vs the autocorrelation (ac) of the used frames; jerk/cut, leg/cut (smallest ratio of a",
-        "leg channel's range, channel named): over the loop cut's; cover: mean distance of the used",
-        "frames to the cycle (deg); skate/take: foot skating over the take's; root deg / st: root",
-        "pitch+roll last-to-first (deg / median steps); head: heading turn per cycle (deg).",
+        "err%: vs the autocorrelation (ac) of the used frames; jerk/cut, leg/cut (smallest ratio",
+        "of a leg channel's range, channel named), fem/tib (the same over femur and tibia only):",
+        "over the loop cut's; p90/p10: spread of the cycle's frame steps (hold-and-snap; no",
+        "target); cover: mean distance of the used frames to the cycle (deg); skate/take: foot",
+        "skating over the take's; root deg / st: root pitch+roll last-to-first (deg / median",
+        "steps); head: heading turn per cycle (deg).",
         "targets: " + ", ".join(f"{k} {v}" for k, v in TARGETS.items()),
     ]
     for row in report["rows"]:
         if row["status"] == "refused":
             lines.append(f"{row['take']}: refused: {row['reason']}")
+        if row["autocorrelation_period"] is None or not np.isfinite(row["autocorrelation_period"]):
+            lines.append(
+                f"{row['take']}: no autocorrelation peak of r >= 0.3 at 0.3-{MAX_LAG:g} s: "
+                "no reference period"
+            )
         for key in ("loop_cut_error", "average_error"):
             if key in row:
                 lines.append(f"{row['take']}: {key.replace('_', ' ')}: {row[key]}")

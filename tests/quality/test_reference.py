@@ -23,6 +23,7 @@ from cyclecoord.quality.cycle_quality import (
     period_error,
     root_closure,
     seam,
+    step_spread,
     targets,
 )
 from cyclecoord.quality.reference import (
@@ -143,6 +144,11 @@ def test_figures_against_hand_computed_values():
     # cyclic third differences of 0,0,0,1: 1, -3, 3, -1 -> mean norm 2, times fps^3
     assert cycle_jerk(np.array([[0.0], [0.0], [0.0], [1.0]]), fps=10.0) == pytest.approx(2000.0)
     assert seam(np.array([[0.0, 0], [1, 0], [2, 0], [3, 0]])) == pytest.approx(3.0)
+    # steps around the loop: nine of 1 and the seam of 9: p90 = 1.8 (interpolated), p10 = 1
+    ramp = np.arange(11.0)[:, None]
+    assert step_spread(ramp[:-1]) == pytest.approx(1.8)
+    held = np.array([[0.0]] * 9 + [[1.0]])  # holds, then one snap: zero steps
+    assert step_spread(held) == np.inf
     square = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
     take = np.array([[0.5, 0], [0.5, 0.5], [2, 0]])
     assert coverage(take, square) == pytest.approx(0.5)
@@ -225,6 +231,8 @@ def test_targets_thresholds():
         leg_range_ratios={},
         min_leg_range_ratio=0.85,
         min_leg_channel="lfemur.rx",
+        min_femur_tibia_ratio=0.9,
+        step_spread=2.0,
         seam=1.5,
         coverage=1.0,
         coverage_ratio=1.0,

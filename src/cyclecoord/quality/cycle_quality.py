@@ -37,6 +37,7 @@ __all__ = [
     "leg_channels",
     "leg_ranges",
     "seam",
+    "step_spread",
     "coverage",
     "foot_skating_speed",
     "root_orientation",
@@ -135,6 +136,21 @@ def seam(angles: np.ndarray) -> float:
     """Last-to-first step of a cycle over its median frame step (dimensionless; about 1
     for a clean loop).  See :func:`cyclecoord.quality.metrics.loop_closure`."""
     return float(loop_closure(angles))
+
+
+def step_spread(angles: np.ndarray) -> float:
+    """Hold-and-snap: the 90th over the 10th percentile of a cycle's frame steps.
+
+    Steps ``|x[t+1] - x[t]|`` around the loop (the seam included).  A cycle that holds
+    still and then moves in a few frames has many tiny steps and some huge ones (tens);
+    a capture's own cycle stays within a few.  Dimensionless; ``inf`` when a tenth of
+    the steps are zero.  Not one of the issue's targets: a diagnostic, since the jerk of
+    a raw loop cut is dominated by capture noise and does not see a hold-and-snap.
+    """
+    x = np.asarray(angles, dtype=float)
+    steps = np.linalg.norm(np.roll(x, -1, axis=0) - x, axis=1)
+    lo, hi = np.percentile(steps, [10, 90])
+    return float(hi / lo) if lo > 0 else float("inf")
 
 
 def coverage(
@@ -296,8 +312,10 @@ def heading_change(cycle: Motion) -> float:
 class CycleQuality:
     """The figures of one cycle of one take (see the module functions for units).
 
-    ``*_ratio`` fields compare with the reference (the best loop cut) or the take and
-    are NaN when there is none.
+    ``min_femur_tibia_ratio`` is the smallest leg range ratio over femur and tibia
+    channels only (the toes and feet of a raw capture carry the most noise, which widens
+    the loop cut's ranges).  ``*_ratio`` fields compare with the reference (the best loop
+    cut) or the take and are NaN when there is none.
     """
 
     method: str
@@ -311,7 +329,9 @@ class CycleQuality:
     leg_range_ratios: dict
     min_leg_range_ratio: float
     min_leg_channel: str | None
+    min_femur_tibia_ratio: float
     seam: float
+    step_spread: float
     coverage: float
     coverage_ratio: float
     skating: float
@@ -407,6 +427,11 @@ def cycle_quality(
         leg_range_ratios=ratios,
         min_leg_range_ratio=float(ratios[low]) if low else float("nan"),
         min_leg_channel=low,
+        min_femur_tibia_ratio=min(
+            (v for k, v in ratios.items() if k.split(".")[0].endswith(("femur", "tibia"))),
+            default=float("nan"),
+        ),
+        step_spread=step_spread(cyc_x),
         seam=seam(cyc_x),
         coverage=cov,
         coverage_ratio=_ratio(cov, reference.coverage) if reference else float("nan"),
