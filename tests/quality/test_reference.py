@@ -272,3 +272,35 @@ def test_benchmark_smoke_on_one_synthetic_walk():
     assert set(row["targets"]) == {"period", "root", "jerk", "legs", "seam", "coverage", "skating"}
     text = bench.format_report(report)
     assert "loop cut" in text and "average" in text and "load average" in text
+
+
+def test_benchmark_uses_used_frames_and_a_phase_with_gaps(steady, monkeypatch):
+    """When extract reports used_frames and a phase with NaN outside them, they are used."""
+    from types import SimpleNamespace
+
+    spec = importlib.util.spec_from_file_location("bench_quality_used", BENCH)
+    bench = importlib.util.module_from_spec(spec)
+    sys.modules["bench_quality_used"] = bench
+    spec.loader.exec_module(bench)
+    m = steady.motion
+    still = np.repeat(m.frames[:1], 150, axis=0)
+    take = m.with_frames(np.vstack([still, m.frames]))
+    phase = np.concatenate([np.full(150, np.nan), np.mod(steady.phase, 1.0)])
+    cycle = m[100:200].with_frames(m.frames[100:200])
+    fake = SimpleNamespace(
+        cycle=cycle,
+        period_frames=100.0,
+        coordinate=np.nan_to_num(phase),
+        phase=phase,
+        used_frames=[[150, 750]],
+        warnings=[],
+    )
+    monkeypatch.setattr(bench.cc, "extract", lambda motion: fake)
+    row = bench.run_case(bench.Case("standing start", take))
+    assert row["used_frames"] == [[150, 750]]
+    assert row["autocorrelation_period"] == pytest.approx(100.0, rel=0.02)
+    cut = row["methods"]["loop cut"]["extra"]
+    assert cut["start"] >= 150
+    avg = row["methods"]["average"]
+    assert avg["extra"]["pieces"] == 5 and avg["period_frames"] == pytest.approx(100.0)
+    assert row["methods"]["ours"]["period_error"] == pytest.approx(0.0, abs=0.02)
