@@ -2,7 +2,7 @@
 
 Run from a checkout::
 
-    python benchmarks/bench_quality.py [--json rows.json] [--synthetic] [--no-progress]
+    python benchmarks/bench_quality.py [--json rows.json] [--plot DIR] [--synthetic] [--no-progress]
 
 For every shared walk, whole and windowed (69_01 whole and 200:450; 35_07, 35_08, 35_13,
 35_16 whole -- they walk from their first frame, so no window is needed; 143_01 whole
@@ -51,7 +51,7 @@ import numpy as np
 
 import cyclecoord as cc
 from cyclecoord.errors import CycleCoordError, NoPeriodicMotionError
-from cyclecoord.io._atomic import atomic_write
+from cyclecoord.io._atomic import atomic_path, atomic_write
 from cyclecoord.quality.cycle_quality import TARGETS, cycle_quality, foot_skating_speed, targets
 from cyclecoord.quality.reference import (
     autocorrelation_period,
@@ -147,9 +147,11 @@ def _take_skating(take: cc.Motion, used: list | None) -> float:
     )
 
 
-def run_case(case: Case) -> dict:
-    """Extract, build the references and measure all three cycles of one take."""
+def run_case(case: Case, plot_dir: Path | None = None) -> dict:
+    """Extract, build the references and measure all three cycles of one take; with
+    ``plot_dir``, also draw them (:func:`plot_cycles`)."""
     take = case.take
+    clips: dict[str, cc.Motion] = {}
     row: dict[str, Any] = {"take": case.name, "frames": take.n_frames, "fps": take.fps}
     c0, w0 = time.process_time(), time.perf_counter()
     result = None
@@ -196,6 +198,7 @@ def run_case(case: Case) -> dict:
             )
             ref.extra.update(start=cut.start, stop=cut.stop, pose_distance=cut.distance)
             methods["loop cut"] = ref
+            clips["loop cut"] = cut.clip
         except CycleCoordError as exc:
             row["loop_cut_error"] = str(exc)
     if result is not None:
@@ -209,6 +212,7 @@ def run_case(case: Case) -> dict:
             used_frames=used,
             skating_take=skate_take,
         )
+        clips["ours"] = result.cycle
         phase = _phase_of(result)
         pieces = (
             [b - a for w in wrap_times(phase) for a, b in zip(w[:-1], w[1:])]
@@ -229,12 +233,68 @@ def run_case(case: Case) -> dict:
             )
             q.extra["pieces"] = len(pieces)
             methods["average"] = q
+            clips["average"] = avg
         else:
             row["average_error"] = "our phase wraps fewer than twice: no complete piece to average"
     row["methods"] = {k: v.to_dict() for k, v in methods.items()}
     if "ours" in methods:
         row["targets"] = targets(methods["ours"])
+    if plot_dir is not None and clips:
+        slug = "".join(ch if ch.isalnum() else "_" for ch in case.name)
+        row["figure"] = str(
+            plot_cycles(take, clips, Path(plot_dir) / f"quality_{slug}.png", case.name)
+        )
     return row
+
+
+#: Leg channels drawn by :func:`plot_cycles` (those present).
+PLOT_CHANNELS = ("lfemur.rx", "rfemur.rx", "ltibia.rx", "rtibia.rx", "lfoot.rx", "rtoes.rx")
+
+
+def plot_cycles(take: cc.Motion, clips: dict, path: Path, title: str = "", n: int = 200) -> Path:
+    """Leg channels over one cycle for every clip, resampled to ``n`` points of the cycle
+    and turned (circularly) to best match the loop cut (or the first clip); PNG at ``path``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from cyclecoord.quality.reference import joint_angles, joint_columns
+
+    mean = joint_angles(take).mean(axis=0)
+    names = ["{}.{}".format(*take.channels[c]) for c in joint_columns(take)]
+
+    def resample(m: cc.Motion) -> np.ndarray:
+        x = joint_angles(m, like=mean)
+        t = np.arange(n) * len(x) / n
+        k = np.floor(t).astype(int)
+        f = (t - k)[:, None]
+        return (1 - f) * x[k] + f * x[(k + 1) % len(x)]
+
+    curves = {k: resample(m) for k, m in clips.items()}
+    ref = curves.get("loop cut", next(iter(curves.values())))
+    for k, c in curves.items():
+        shift = int(np.argmin([np.linalg.norm(np.roll(c, -s, axis=0) - ref) for s in range(n)]))
+        curves[k] = np.roll(c, -shift, axis=0)
+    shown = [c for c in PLOT_CHANNELS if c in names]
+    fig, axes = plt.subplots(2, 3, figsize=(14, 7))
+    phase = np.arange(n) / n
+    for ax, name in zip(axes.ravel(), shown):
+        i = names.index(name)
+        for (k, c), style in zip(curves.items(), ("-", "--", ":")):
+            ax.plot(phase, c[:, i], style, label=f"{k} ({clips[k].n_frames} frames)")
+        ax.set_title(name)
+        ax.set_xlabel("fraction of the cycle (turned to match the loop cut)")
+        ax.set_ylabel("degrees")
+    for ax in axes.ravel()[len(shown) :]:
+        ax.set_visible(False)
+    axes.ravel()[0].legend()
+    fig.suptitle(f"{title}: leg channels over one cycle")
+    fig.tight_layout()
+    with atomic_path(path, suffix=".png") as tmp:
+        fig.savefig(tmp, dpi=70)
+    plt.close(fig)
+    return path
 
 
 # ------------------------------------------------------------------------ run
@@ -267,7 +327,10 @@ def _load() -> list[float] | None:
 
 
 def run_benchmark(
-    cases: Sequence[Case], progress: bool = True, skipped: Sequence[str] = ()
+    cases: Sequence[Case],
+    progress: bool = True,
+    skipped: Sequence[str] = (),
+    plot_dir: Path | None = None,
 ) -> dict:
     """Every case; returns ``{"machine", "skipped", "rows", "cpu_seconds", "wall_seconds"}``."""
     machine = {
@@ -287,7 +350,7 @@ def run_benchmark(
 
         it = tqdm(cases, desc="takes", unit="take", file=sys.stderr)
     for case in it:
-        rows.append(run_case(case))
+        rows.append(run_case(case, plot_dir))
     machine["load_average_end"] = _load()
     return {
         "machine": machine,
@@ -457,11 +520,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--synthetic", action="store_true", help="one synthetic walk instead of the real takes"
     )
     ap.add_argument("--no-progress", action="store_true", help="no progress bar")
+    ap.add_argument(
+        "--plot", metavar="DIR", type=Path, help="draw leg channels of the three cycles per take"
+    )
     args = ap.parse_args(argv)
     if args.json:
         out = Path(args.json)
         if not (out.parent if str(out.parent) else Path(".")).is_dir():
             ap.error(f"--json: folder {out.parent} does not exist")
+    if args.plot is not None and not args.plot.is_dir():
+        ap.error(f"--plot: folder {args.plot} does not exist")
     if args.synthetic:
         cases, skipped = synthetic_cases(), []
     else:
@@ -469,7 +537,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not cases:
             skipped.append("no real takes found: running the synthetic walk")
             cases = synthetic_cases()
-    report = run_benchmark(cases, progress=not args.no_progress, skipped=skipped)
+    report = run_benchmark(
+        cases, progress=not args.no_progress, skipped=skipped, plot_dir=args.plot
+    )
     print(format_report(report), flush=True)
     if args.json:
         with atomic_write(args.json, "w") as fh:
