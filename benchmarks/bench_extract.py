@@ -55,7 +55,7 @@ from cyclecoord.quality.metrics import monotonicity
 DATA_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
 #: Stages reported by :func:`cyclecoord.extract` in ``result.timings``.
-STAGES = ("prepare", "barcode", "coordinate", "density", "cycle", "metrics", "total")
+STAGES = ("prepare", "steady", "barcode", "coordinate", "density", "cycle", "metrics", "total")
 
 #: Published timing for CMU 69_01 frames 200-450 (Vejdemo-Johansson et al. 2014, Fig. 7):
 #: cohomology 7.07 s (Dionysus) + post-processing 18.71 s, on a MacBook Air (2 GHz Core i7).

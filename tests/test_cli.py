@@ -19,7 +19,7 @@ def test_extract_example_writes_cycle_and_report(tmp_path, capsys):
     bvh, rep = tmp_path / "cycle.bvh", tmp_path / "r.json"
     code, out, err = run(capsys, "extract", "example", "-o", bvh, "--report", rep)
     assert code == 0, err
-    assert "cycles in the clip" in out and "loop closure" in out
+    assert "cycles over the steady frames" in out and "last-to-first step" in out
     cycle = cc.load(bvh)
     report = json.loads(rep.read_text())
     assert cycle.n_frames == report["cycle_length"] == round(report["period_frames"])
@@ -33,11 +33,18 @@ def test_extract_example_writes_cycle_and_report(tmp_path, capsys):
 def test_extract_options_reach_the_pipeline(tmp_path, capsys):
     rep = tmp_path / "r.json"
     code, out, err = run(capsys, "extract", "example", "--frames", "0:300", "--pca", "5", "--max-scale", "30",
-                         "--samples", "200", "--neighbors", "8", "--report", rep)
+                         "--samples", "200", "--neighbors", "8", "--timing", "coordinate", "--report", rep)
     assert code == 0, err
     r = json.loads(rep.read_text())
     assert r["frames"] == [0, 300] and r["dims"] == 5 and r["threshold"] == 30
+    assert r["parameters"]["timing"] == "coordinate" and r["parameters"]["n_neighbors"] == 8
     assert r["bandwidth_frames"] == pytest.approx(8 / (300 * np.sqrt(2 * np.pi)) * r["period_frames"])
+    code, out, err = run(capsys, "extract", "example", "--travel", "straight", "--no-steady", "--min-turns", "2",
+                         "--report", rep)
+    assert code == 0, err
+    r = json.loads(rep.read_text())
+    assert r["parameters"]["travel"] == "straight" and r["parameters"]["steady"] is False
+    assert r["parameters"]["min_turns"] == 2 and r["used_frames"] == [[0, 480]]
 
 
 def test_extract_bandwidth_option(tmp_path, capsys):
@@ -51,7 +58,8 @@ def test_extract_bandwidth_option(tmp_path, capsys):
     assert code == 0 and json.loads(rep.read_text())["bandwidth_frames"] == 3.5
     with pytest.raises(SystemExit):
         run(capsys, "extract", "example", "--bandwidth", "wide")
-    code, out, err = run(capsys, "extract", "example", "--bandwidth", "auto", "--weighting", "mean")
+    code, out, err = run(capsys, "extract", "example", "--bandwidth", "auto", "--weighting", "mean",
+                         "--timing", "coordinate")
     assert code == 1 and "needs weighting='kernel'" in err and "Traceback" not in err
 
 

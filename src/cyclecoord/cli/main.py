@@ -346,9 +346,13 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
     ratio = res.jerk["cycle"] / res.jerk["original"] if res.jerk.get("original", 0) > 0 else float("nan")
     seam = "seamless" if res.loop_closure <= 1.5 else "a visible seam"
     smooth = "as smooth as the capture or smoother" if ratio <= 1.0 else f"{ratio:.1f}x the capture's jerk"
+    width = ""
+    if res.parameters.get("bandwidth") is not None:
+        chosen = " (cross-validated)" if res.typical.bandwidth_selection is not None else ""
+        width = f"; kernel width {res.typical.bandwidth:.3g} frames{chosen}"
     lines.append(
         f"cycle: {res.cycle.n_frames} frames ({res.cycle.n_frames / fps:.3f} s), {seam} "
-        f"(last-to-first step {res.loop_closure:.2f} median steps), {smooth} (jerk ratio {ratio:.2f})"
+        f"(last-to-first step {res.loop_closure:.2f} median steps), {smooth} (jerk ratio {ratio:.2f}){width}"
     )
     if np.isfinite(res.heading_per_cycle):
         travel = res.parameters.get("travel", "keep")

@@ -373,6 +373,7 @@ def refine_birth(
     prime: int = DEFAULT_PRIME,
     max_edges: int = 3_000_000,
     margin: float = 1.05,
+    covering_radius: float | None = None,
 ) -> float | None:
     """Birth of a landmark class in the Rips filtration on *every* point.
 
@@ -381,6 +382,11 @@ def refine_birth(
     only up to ``margin * landmark_birth`` is cheap — a sparse complex far below the
     threshold — and the class is there the H1 bar alive at that scale that was born
     first (bars of noise alive at that scale were born just below it).
+
+    With ``covering_radius`` (the landmarks' covering radius ``r``) only bars born within
+    ``2 r`` below the landmark birth can be the class (moving every point to its landmark
+    changes a distance by at most ``2 r``); an older loop alive at that scale (a small
+    loop elsewhere in the data) is not taken for it.
 
     Returns ``None`` when the sparse complex would exceed ``max_edges`` edges or no bar
     is alive there.
@@ -416,6 +422,8 @@ def refine_birth(
     res = ripser.ripser(mat, maxdim=1, thresh=t, coeff=check_prime(prime), distance_matrix=True)
     h1 = np.asarray(res["dgms"][1]).reshape(-1, 2)
     alive = h1[~np.isfinite(h1[:, 1])] if h1.size else h1
+    if covering_radius is not None and alive.size:
+        alive = alive[alive[:, 0] >= float(landmark_birth) - 2.0 * float(covering_radius) * 1.001]
     if alive.size == 0:
         return None
     return float(alive[:, 0].min())

@@ -574,7 +574,8 @@ class CircularCoordinates:
             )
         theta, sign, offset = orient_with_time(raw, return_transform=True)
         if self.landmarks_ is not None and not self.temporal and self.refine_birth:
-            sel = BarSelection(**{**sel.__dict__, "full_birth": refine_birth(self.points_, sel.birth, p)})
+            full = refine_birth(self.points_, sel.birth, p, covering_radius=self.covering_radius_)
+            sel = BarSelection(**{**sel.__dict__, "full_birth": full})
         self.barcode_ = bc
         self.selection_ = sel
         self.prime_ = p

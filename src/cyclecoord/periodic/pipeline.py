@@ -7,6 +7,7 @@ typical cycle as a loopable :class:`~cyclecoord.motion.Motion`.
 
 from __future__ import annotations
 
+import copy
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -15,7 +16,9 @@ from typing import Any
 import numpy as np
 
 from .._blas import one_blas_thread
-from .barcode import CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, DEFAULT_PRIME, Barcode, BarSelection
+from .barcode import (
+    CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, DEFAULT_PRIME, Barcode, BarSelection, refine_birth, select_bar,
+)
 from .coordinates import CircularCoordinates, unwrap
 from .cycle import TypicalCycle, check_bandwidth, select_bandwidth, typical_cycle
 from .density import PeriodicDensity
@@ -42,6 +45,8 @@ TIMINGS = ("capture", "coordinate")
 TRAVELS = ("keep", "straight", "in_place")
 #: Default width (frames of time) of the kernel that averages the re-timed cycle.
 CAPTURE_WIDTH = 1.0
+#: Complete windings varying by more than this (p10-p90 over the median) are not steady.
+MAX_SPREAD = 0.25
 #: A bar alive at the threshold is followed until the threshold is this many times its birth.
 ALIVE_RATIO = 4.0
 #: Landmarks of the rough first pass over a long take (which finds its steady frames).
@@ -306,7 +311,7 @@ def _first_clear(est: CircularCoordinates, points: np.ndarray, class_index: int,
     the longer filtration.  ``--max-scale 12`` on CMU 69_01 200:450 (bar born at 9.955)
     is so raised to 49.2 and gives the coordinate of ``--max-scale 50``.
     """
-    from .barcode import default_max_scale, select_bar
+    from .barcode import default_max_scale
 
     barcode = est.fit_barcode(points)
     if len(barcode.h1) == 0 or class_index >= len(barcode.h1):
@@ -368,6 +373,7 @@ class _Fit:
     rows: np.ndarray
     unwrapped: np.ndarray  # (T,), NaN outside rows
     notes: list
+    weak_gap: bool = False  # clear but for the gap to the next bar
 
 
 @one_blas_thread
@@ -524,7 +530,7 @@ def extract(
             lm = FIRST_PASS_LANDMARKS
         return CircularCoordinates(
             max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
-            scale_fraction=scale_fraction, temporal=temporal, landmarks=lm,
+            scale_fraction=scale_fraction, temporal=temporal, landmarks=lm, refine_birth=False,
             **({} if memory_limit is None else {"memory_limit": memory_limit}),
         )
 
@@ -550,14 +556,51 @@ def extract(
                 raise ParameterError(f"class index {class_index} out of range: the barcode has {len(barcode.h1)} H1 bars")
             raise fail(f"no periodic motion found: the barcode has no H1 bar up to scale {barcode.threshold:.4g}",
                        barcode=barcode)
-        if require_clear and not sel.clear:
+        # a bar that is clear but for its gap to the next one (long takes hold several
+        # loops) is judged by its coordinate's windings instead (see _finish)
+        gap_only = sel.ratio >= CLEAR_RATIO and sel.gap < CLEAR_GAP and (
+            barcode.persistence(1)[sel.index] >= CLEAR_MIN_FRACTION * barcode.threshold)
+        if require_clear and not sel.clear and not first_pass and not gap_only:
             raise fail(f"no periodic motion found: {_not_clear_reason(sel, barcode)}; "
                        "try --max-scale, --pca or --frames", barcode=barcode)
         t0 = time.perf_counter()
+        fit = coordinate_of(est, sel, rows)
+        if class_index == 0 and scale is None and len(barcode.h1) > 1:
+            # the most persistent class of a long take can be a loop of the whole take (a
+            # circuit, a drift); a later clear class that winds regularly is the motion's
+            wind = complete_windings(fit.unwrapped, _row_runs(rows))
+            j = 1
+            while (wind.turns < min_turns or not wind.spread <= MAX_SPREAD) and j < min(4, len(barcode.h1)):
+                other = select_bar(barcode, j, None, scale_fraction)
+                if other.ratio >= CLEAR_RATIO:
+                    alt_est = copy.copy(est)
+                    alt_est.class_index = j
+                    try:
+                        alt = coordinate_of(alt_est, other, rows)
+                    except ParameterError:
+                        alt = None
+                    alt_wind = complete_windings(alt.unwrapped, _row_runs(rows)) if alt is not None else None
+                    if alt_wind is not None and alt_wind.turns >= min_turns and alt_wind.spread <= MAX_SPREAD:
+                        alt.notes.append(
+                            f"H1 class #{j} chosen: the most persistent class turns {wind.turns:.2f} times over "
+                            f"the frames (spread {wind.spread:.0%}), class #{j} {alt_wind.turns:.2f} times, regularly")
+                        fit, wind = alt, alt_wind
+                        break
+                j += 1
+        if not first_pass and fit.est.landmarks_ is not None and not temporal:
+            # the class's birth on every frame, for the report (landmarks are born later)
+            full = refine_birth(prepared.points[rows], fit.selection.birth, fit.est.prime_,
+                                covering_radius=fit.est.covering_radius_)
+            fit.selection = BarSelection(**{**fit.selection.__dict__, "full_birth": full})
+            fit.est.selection_ = fit.selection
+        timings[f"coordinate{stage}"] = time.perf_counter() - t0
+        fit.weak_gap = bool(require_clear and not fit.selection.clear)
+        return fit
+
+    def coordinate_of(est: CircularCoordinates, sel: BarSelection, rows: np.ndarray) -> _Fit:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             est.fit_coordinate()
-        timings[f"coordinate{stage}"] = time.perf_counter() - t0
         runs = _row_runs(rows)
         u = _unwrap_runs(est.coordinates_, rows, runs, T)
         return _Fit(est=est, barcode=est.barcode_, selection=est.selection_, rows=rows, unwrapped=u,
@@ -566,20 +609,29 @@ def extract(
     rows = np.flatnonzero(moving)
     # a long take is first read on a few landmarks: enough to find its steady frames
     rough = steady and rows.size > FIRST_PASS_LANDMARKS * 2
-    fit = fit_rows(rows, " (first pass)" if rough else "", first_pass=rough)
+    fit = fit_rows(rows, " (first pass)" if steady else "", first_pass=rough)
     used = moving
     if steady:
         t0 = time.perf_counter()
         first = complete_windings(fit.unwrapped, stretches(moving))
         if np.isfinite(first.period_frames):
             used = _steady_frames(motion, prepared, joints, fit.unwrapped, moving, first.period_frames)
-        timings["steady"] = time.perf_counter() - t0
-        if not used.any():
-            raise fail("no periodic motion found: no stretch of the take repeats steadily for a whole period "
-                       f"(the coordinate turns {first.turns:.2f} times over the moving frames)", fit)
         if used.sum() >= 0.95 * moving.sum():
             used = moving
-        if rough or used.sum() < moving.sum():
+        refit = rough or used.sum() < moving.sum()
+        first_pass = [timings.pop(k) for k in ("barcode (first pass)", "coordinate (first pass)")]
+        # stages: "steady" is the time spent finding the steady frames (a first pass when
+        # the coordinate is fitted again on them); "barcode" and "coordinate" the final fit
+        timings["steady"] = time.perf_counter() - t0 + (sum(first_pass) if refit else 0.0)
+        if not refit:
+            timings["barcode"], timings["coordinate"] = first_pass
+        if first.turns < min_turns:
+            raise fail(_too_few_turns(first.turns, int(moving.sum()), min_turns), fit)
+        if not used.any():
+            raise fail("no periodic motion found: no stretch of the take repeats steadily for a whole period "
+                       f"(the coordinate turns {first.turns:.2f} times over the moving frames); "
+                       "check the coordinate figure (--plot), or try --no-steady or --frames", fit)
+        if refit:
             fit = fit_rows(np.flatnonzero(used), "")
     notes.extend(fit.notes)
     return _finish(
@@ -638,6 +690,12 @@ def _steady_frames(motion, prepared, joints, unwrapped, moving, period) -> np.nd
     return steady_mask(unwrapped, moving, period, recurrence_distance=rec, heading=hd)
 
 
+def _too_few_turns(turns: float, n_frames: int, min_turns: float) -> str:
+    return (f"no periodic motion found: the coordinate turns only {turns:.2f} times over the {n_frames} "
+            f"steady frames (at least {min_turns:g} are needed to call a motion periodic); a longer take, "
+            "--frames around the repeated part, or --pca 3 may help")
+
+
 def _run_jerk(poses: np.ndarray, runs: list[tuple[int, int]], fps: float) -> float:
     """Mean jerk over runs of frames (each run differentiated on its own)."""
     vals, weights = [], []
@@ -655,14 +713,21 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     u = np.where(used, fit.unwrapped, np.nan)
     wind = complete_windings(u, runs)
     if wind.turns < o["min_turns"]:
-        raise fail(
-            f"no periodic motion found: the coordinate turns only {wind.turns:.2f} times over the "
-            f"{int(used.sum())} steady frames (at least {o['min_turns']:g} are needed); "
-            "a longer take, --frames around the repeated part, or --pca 3 may help", fit)
+        raise fail(_too_few_turns(wind.turns, int(used.sum()), o["min_turns"]), fit)
+    if fit.weak_gap:
+        if wind.spread > MAX_SPREAD or not np.isfinite(wind.period_frames):
+            raise fail(
+                f"no periodic motion found: {_not_clear_reason(fit.selection, fit.barcode)}, and its coordinate "
+                f"winds irregularly (complete windings spread {wind.spread:.0%} of the period); "
+                "try --max-scale, --pca or --frames", fit)
+        notes.append(
+            f"the H1 bar stands only {fit.selection.gap:.2f}x the next bar's persistence (under {CLEAR_GAP}x); "
+            f"accepted because its coordinate winds {wind.turns:.1f} times, regularly (spread {wind.spread:.0%})"
+        )
     period = wind.period_frames
     if not np.isfinite(period):
         period = float(np.sum(used) - len(runs)) / wind.turns
-    if wind.spread > 0.25:
+    if wind.spread > MAX_SPREAD:
         notes.append(
             f"the complete windings vary by {wind.spread:.0%} of the period (p10-p90); the motion is not "
             "steady: use --frames to pick one steady stretch, or check the coordinate figure"

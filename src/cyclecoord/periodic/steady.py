@@ -4,7 +4,8 @@ People record whole takes: a standing start, a few steps to reach speed, the mot
 pause or a turn, a stop.  An animator cutting a loop by hand works on the steady part
 only.  This module finds it from three per-frame signals:
 
-* **moving** (:func:`moving_mask`): the joint angles' speed, smoothed over half a second,
+* **moving** (:func:`moving_mask`): the speed of the (lightly smoothed) joint angles,
+  averaged over half a second,
   is at least ``min_speed`` of the take's moving level (its 80th percentile); standing
   still and pauses fall below it;
 * **repeating** (:func:`recurrence`): the pose comes back one period later (or came one
@@ -21,7 +22,7 @@ period inside a run are bridged), are the steady frames the cycle is built from.
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
+from scipy.ndimage import gaussian_filter1d, uniform_filter1d
 
 from .windings import stretches
 
@@ -68,6 +69,9 @@ def moving_mask(joints: np.ndarray, fps: float, *, min_speed: float = 0.35, smoo
     j = np.asarray(joints, dtype=float)
     if len(j) < 3 or j.shape[1] == 0:
         return np.ones(len(j), dtype=bool)
+    # measurement noise adds a constant to the norm of raw frame steps (0.5 degrees of noise
+    # on 56 channels reads as 5 degrees a frame); steps of lightly smoothed poses do not
+    j = gaussian_filter1d(j, sigma=max(1.0, 0.04 * fps), axis=0, mode="nearest")
     step = np.linalg.norm(np.diff(j, axis=0), axis=1)
     step = np.concatenate([step, step[-1:]])
     speed = _smooth(step, round(smooth_seconds * fps))

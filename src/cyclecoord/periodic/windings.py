@@ -96,7 +96,9 @@ class Windings:
     lengths : ndarray
         Frames taken by each complete winding at the reference level, in time order.
     pooled : ndarray
-        Complete winding lengths at every anchor level (the period is their median).
+        Complete winding lengths at every level (the period is their median; a level
+        the coordinate passes slowly has a blurred crossing time, which the median
+        shrugs off).
     period_frames : float
         Median of :attr:`pooled` (NaN when there is no complete winding).
     spread : float
@@ -179,7 +181,7 @@ def complete_windings(
         if all(min(abs(levels[j] - levels[k]), 1 - abs(levels[j] - levels[k])) >= min_anchor_gap for k in anchors):
             anchors.append(int(j))
     ref = anchors[0] if anchors else 0
-    pooled = np.concatenate([lengths_by_level[j] for j in anchors]) if anchors else np.zeros(0)
+    pooled = np.concatenate(lengths_by_level) if anchors else np.zeros(0)
     pooled = pooled[pooled > 0]
     period = float(np.median(pooled)) if pooled.size else float("nan")
     spread = float((np.percentile(pooled, 90) - np.percentile(pooled, 10)) / period) if pooled.size > 1 else 0.0

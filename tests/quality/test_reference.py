@@ -1,0 +1,307 @@
+"""Hand-made references (loop cut, average cycle, autocorrelation period) and the cycle
+figures of cyclecoord.quality.cycle_quality, on synthetic captures and tiny arrays."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.errors import ParameterError
+from cyclecoord.quality.cycle_quality import (
+    CycleQuality,
+    coverage,
+    cycle_jerk,
+    cycle_quality,
+    foot_skating_speed,
+    heading_change,
+    leg_ranges,
+    period_error,
+    root_closure,
+    seam,
+    step_spread,
+    targets,
+)
+from cyclecoord.quality.reference import (
+    autocorrelation_period,
+    average_cycle,
+    best_loop_cut,
+    joint_angles,
+    wrap_times,
+)
+
+BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_quality.py"
+ROOT = [("root", d) for d in ("tx", "ty", "tz", "rx", "ry", "rz")]
+
+
+@pytest.fixture(scope="module")
+def steady():
+    """A walk at constant speed: period exactly 100 frames, phase t / 100."""
+    return cc.datasets.make_periodic_capture(
+        n_frames=600, period=100.0, noise=0.5, speed_variation=0.0, random_state=3
+    )
+
+
+def _motion(joint_cols: dict, root: np.ndarray | None = None, fps: float = 10.0) -> cc.Motion:
+    names = list(joint_cols)
+    n = len(next(iter(joint_cols.values())))
+    root = np.zeros((n, 6)) if root is None else root
+    frames = np.column_stack([root] + [np.asarray(joint_cols[k], dtype=float) for k in names])
+    return cc.Motion(frames, ROOT + [tuple(k.split(".")) for k in names], fps=fps)
+
+
+# ------------------------------------------------------------------ joint angles
+def test_joint_angles_drop_the_root_and_unwrap():
+    m = _motion({"lfemur.rx": [170.0, 179.0, -172.0, -165.0], "lhumerus.rz": [1.0, 2.0, 3.0, 4.0]})
+    x = joint_angles(m)
+    assert x.shape == (4, 2)
+    np.testing.assert_allclose(x[:, 0], [170, 179, 188, 195])
+    shifted = joint_angles(m, like=np.array([-180.0, 0.0]))  # the same branch as a take near -180
+    np.testing.assert_allclose(shifted[:, 0], [-190, -181, -172, -165])
+
+
+# ----------------------------------------------------------------------- period
+def test_autocorrelation_period_finds_the_true_period(steady):
+    p = autocorrelation_period(steady.motion)
+    assert p == pytest.approx(100.0, rel=0.02)
+    # only some frames used: still the period, and NaN when the used frames are too short
+    assert autocorrelation_period(
+        steady.motion, used_frames=[[0, 250], [300, 600]]
+    ) == pytest.approx(100.0, rel=0.02)
+    assert np.isnan(autocorrelation_period(steady.motion, used_frames=[[0, 40]]))
+
+
+def test_autocorrelation_period_of_noise_is_nan():
+    rng = np.random.default_rng(0)
+    m = _motion({"lfemur.rx": rng.normal(size=400), "ltibia.rx": rng.normal(size=400)}, fps=120.0)
+    assert np.isnan(autocorrelation_period(m))
+
+
+# --------------------------------------------------------------------- loop cut
+def test_loop_cut_is_one_period_long_and_closes(steady):
+    cut = best_loop_cut(steady.motion, 100.0)
+    assert abs(cut.n_frames - 100) <= 3
+    assert cut.clip.n_frames == cut.n_frames
+    np.testing.assert_array_equal(cut.clip.frames, steady.motion.frames[cut.start : cut.stop])
+    # pose(i) and pose(j) differ by about the noise only, well under a typical step
+    assert cut.distance < 0.5 * cut.median_step * 10
+
+
+def test_loop_cut_skips_a_standing_start(steady):
+    m = steady.motion
+    rng = np.random.default_rng(1)
+    still = np.repeat(m.frames[:1], 200, axis=0) + rng.normal(0, 0.05, size=(200, m.n_channels))
+    take = m.with_frames(np.vstack([still, m.frames]))
+    cut = best_loop_cut(take, 100.0)
+    assert cut.start >= 200  # the still poses match best but do not move
+    assert abs(cut.n_frames - 100) <= 3
+    with pytest.raises(ParameterError):
+        best_loop_cut(take, 100.0, used_frames=[[0, 150]])
+    with pytest.raises(ParameterError):
+        best_loop_cut(take, float("nan"))
+
+
+# ---------------------------------------------------------------- average cycle
+def test_wrap_times_unwrap_split_at_nan_and_ignore_jitter():
+    c = np.mod(np.arange(25) / 10.0, 1.0)
+    (w,) = wrap_times(c)
+    np.testing.assert_allclose(w, [0.0, 10.0, 20.0])  # a run starting on a wrap counts it
+    jitter = np.array([0.8, 0.9, 0.02, 0.97, 0.05, 0.3, 0.6, 0.9, 0.1])  # back across 0 once
+    (w,) = wrap_times(jitter)
+    assert len(w) == 2
+    with_gap = np.concatenate([c[:15], [np.nan] * 3, c[:15]])
+    runs = wrap_times(with_gap)
+    assert len(runs) == 2
+    np.testing.assert_allclose(runs[1], [18.0, 28.0])
+
+
+def test_average_cycle_recovers_the_noise_free_cycle(steady):
+    phase = np.mod(steady.phase, 1.0)
+    avg = average_cycle(steady.motion, phase, 100)
+    assert avg.n_frames == 100 and avg.channels == steady.motion.channels
+    assert len(avg.metadata["pieces"]) == 5
+    clean = joint_angles(steady.clean[:100])
+    err = joint_angles(avg) - clean
+    assert np.abs(err).mean() < 0.35  # noise 0.5 deg averaged over 5 pieces: about 0.2
+    assert np.abs(joint_angles(steady.motion[:100]) - clean).mean() > 0.35  # one piece is noisier
+    # the list of wraps gives the same average; the root starts where the first piece starts
+    by_wraps = average_cycle(steady.motion, [0, 100, 200, 300, 400, 500], 100)
+    np.testing.assert_allclose(by_wraps.frames[:, 6:], avg.frames[:, 6:], atol=1e-9)
+    tz = steady.motion.channel_index("root", "tz")
+    assert avg.frames[0, tz] == pytest.approx(steady.motion.frames[0, tz])
+    with pytest.raises(ParameterError):
+        average_cycle(steady.motion, [50.0], 100)
+
+
+# ---------------------------------------------------------------------- figures
+def test_figures_against_hand_computed_values():
+    assert period_error(105.0, 100.0) == pytest.approx(0.05)
+    assert np.isnan(period_error(105.0, float("nan")))
+    # cyclic third differences of 0,0,0,1: 1, -3, 3, -1 -> mean norm 2, times fps^3
+    assert cycle_jerk(np.array([[0.0], [0.0], [0.0], [1.0]]), fps=10.0) == pytest.approx(2000.0)
+    assert seam(np.array([[0.0, 0], [1, 0], [2, 0], [3, 0]])) == pytest.approx(3.0)
+    # steps around the loop: nine of 1 and the seam of 9: p90 = 1.8 (interpolated), p10 = 1
+    ramp = np.arange(11.0)[:, None]
+    assert step_spread(ramp[:-1]) == pytest.approx(1.8)
+    held = np.array([[0.0]] * 9 + [[1.0]])  # holds, then one snap: zero steps
+    assert step_spread(held) == np.inf
+    square = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
+    take = np.array([[0.5, 0], [0.5, 0.5], [2, 0]])
+    assert coverage(take, square) == pytest.approx(0.5)
+    assert coverage(take, square, mask=np.array([True, False, True])) == pytest.approx(0.5)
+
+
+def test_leg_ranges_root_closure_and_heading():
+    n = 10
+    root = np.zeros((n, 6))
+    root[:, 3] = np.arange(n) * 0.1  # rx: 0 .. 0.9, does not close
+    root[:, 4] = np.arange(n) * 1.0  # ry: turns 1 degree a frame
+    m = _motion(
+        {
+            "lfemur.rx": np.linspace(-10, 20, n),
+            "rtibia.rx": [0, 5] * 5,
+            "lhumerus.rx": np.arange(n) * 9.0,
+        },
+        root,
+    )
+    assert leg_ranges(m) == {"lfemur.rx": pytest.approx(30.0), "rtibia.rx": pytest.approx(5.0)}
+    gap, steps = root_closure(m)
+    assert gap == pytest.approx(0.9) and steps == pytest.approx(9.0)
+    assert heading_change(m) == pytest.approx(10.0)
+
+
+@pytest.mark.parametrize("facing", [0.0, 90.0])
+def test_root_pitch_is_free_of_the_heading(steady, facing):
+    """Facing 90 degrees the Euler rx and rz of a ZYX root are degenerate; pitch is not."""
+    n = 10
+    frames = np.repeat(steady.clean.frames[:1], n, axis=0)
+    m = steady.clean.with_frames(frames)
+    frames[:, m.channel_index("root", "rz")] = 0.0
+    frames[:, m.channel_index("root", "ry")] = facing + np.arange(n) * 0.5  # turns 0.5 deg a frame
+    frames[:, m.channel_index("root", "rx")] = np.arange(n) * 0.1  # pitches 0.1 deg a frame
+    m = m.with_frames(frames)
+    gap, steps = root_closure(m)
+    assert gap == pytest.approx(0.9, abs=1e-6) and steps == pytest.approx(9.0, rel=1e-4)
+    assert heading_change(m) == pytest.approx(5.0, abs=1e-6)
+
+
+def test_foot_skating_of_a_sliding_stand(steady):
+    pose = steady.clean.frames[:1]
+    n = 60
+    still = steady.clean.with_frames(np.repeat(pose, n, axis=0))
+    assert foot_skating_speed(still) == pytest.approx(0.0, abs=1e-9)
+    frames = np.repeat(pose, n, axis=0)
+    frames[:, still.channel_index("root", "tx")] += 2.0 * np.arange(n) / still.fps  # 2 units/s
+    assert foot_skating_speed(still.with_frames(frames)) == pytest.approx(2.0)
+    assert np.isnan(foot_skating_speed(cc.Motion(frames, still.channels)))  # no skeleton
+
+
+def test_cycle_quality_and_targets(steady):
+    take = steady.motion
+    cut = best_loop_cut(take, 100.0)
+    q0 = cycle_quality(cut.clip, take, method="loop cut", reference_period=100.0)
+    q = cycle_quality(cut.clip, take, method="loop cut", reference_period=100.0, reference=q0)
+    assert q.jerk_ratio == pytest.approx(1.0) and q.min_leg_range_ratio == pytest.approx(1.0)
+    assert q.coverage_ratio == pytest.approx(1.0)
+    assert q.seam < 1.5 * 10
+    d = q.to_dict()
+    assert d["method"] == "loop cut" and isinstance(d["leg_ranges"], dict)
+    # a frozen cycle (one pose held) loses the legs' range and the coverage
+    frozen = cut.clip.with_frames(np.repeat(cut.clip.frames[:1], cut.n_frames, axis=0))
+    qf = cycle_quality(frozen, take, method="frozen", reference_period=100.0, reference=q)
+    verdict = targets(qf)
+    assert verdict["legs"] is False and verdict["coverage"] is False and verdict["period"] is True
+    assert targets(q)["legs"] is True
+
+
+def test_targets_thresholds():
+    base = dict(
+        method="x",
+        n_frames=100,
+        period_frames=100.0,
+        reference_period=100.0,
+        period_error=0.04,
+        jerk=1.0,
+        jerk_ratio=1.5,
+        leg_ranges={},
+        leg_range_ratios={},
+        min_leg_range_ratio=0.85,
+        min_leg_channel="lfemur.rx",
+        min_femur_tibia_ratio=0.9,
+        step_spread=2.0,
+        seam=1.5,
+        coverage=1.0,
+        coverage_ratio=1.0,
+        skating=1.0,
+        skating_take=1.0,
+        skating_ratio=1.0,
+        root_closure_degrees=0.4,
+        root_closure_steps=3.0,
+        heading_change=0.0,
+    )
+    assert all(targets(CycleQuality(**base)).values())
+    bad = targets(
+        CycleQuality(**{**base, "period_error": -0.06, "root_closure_degrees": 0.6, "seam": 1.6})
+    )
+    assert (
+        bad["period"] is False
+        and bad["root"] is False
+        and bad["seam"] is False
+        and bad["jerk"] is True
+    )
+    assert targets(CycleQuality(**{**base, "jerk_ratio": float("nan")}))["jerk"] is None
+
+
+# -------------------------------------------------------------------- benchmark
+def test_benchmark_smoke_on_one_synthetic_walk(tmp_path):
+    spec = importlib.util.spec_from_file_location("bench_quality", BENCH)
+    bench = importlib.util.module_from_spec(spec)
+    sys.modules["bench_quality"] = bench
+    spec.loader.exec_module(bench)
+    cases = bench.synthetic_cases(n_frames=240, period=60.0)
+    report = bench.run_benchmark(cases, progress=False, plot_dir=tmp_path)
+    (row,) = report["rows"]
+    assert row["status"] == "ok"
+    assert set(row["methods"]) == {"ours", "loop cut", "average"}
+    assert row["autocorrelation_period"] == pytest.approx(60.0, rel=0.1)
+    assert abs(row["methods"]["loop cut"]["period_error"]) < 0.16
+    assert set(row["targets"]) == {"period", "root", "jerk", "legs", "seam", "coverage", "skating"}
+    assert Path(row["figure"]).is_file() and Path(row["figure"]).parent == tmp_path
+    text = bench.format_report(report)
+    assert "loop cut" in text and "average" in text and "load average" in text
+
+
+def test_benchmark_uses_used_frames_and_a_phase_with_gaps(steady, monkeypatch):
+    """When extract reports used_frames and a phase with NaN outside them, they are used."""
+    from types import SimpleNamespace
+
+    spec = importlib.util.spec_from_file_location("bench_quality_used", BENCH)
+    bench = importlib.util.module_from_spec(spec)
+    sys.modules["bench_quality_used"] = bench
+    spec.loader.exec_module(bench)
+    m = steady.motion
+    still = np.repeat(m.frames[:1], 150, axis=0)
+    take = m.with_frames(np.vstack([still, m.frames]))
+    phase = np.concatenate([np.full(150, np.nan), np.mod(steady.phase, 1.0)])
+    cycle = m[100:200].with_frames(m.frames[100:200])
+    fake = SimpleNamespace(
+        cycle=cycle,
+        period_frames=100.0,
+        coordinate=np.nan_to_num(phase),
+        phase=phase,
+        used_frames=[[150, 750]],
+        warnings=[],
+    )
+    monkeypatch.setattr(bench.cc, "extract", lambda motion: fake)
+    row = bench.run_case(bench.Case("standing start", take))
+    assert row["used_frames"] == [[150, 750]]
+    assert row["autocorrelation_period"] == pytest.approx(100.0, rel=0.02)
+    cut = row["methods"]["loop cut"]["extra"]
+    assert cut["start"] >= 150
+    avg = row["methods"]["average"]
+    assert avg["extra"]["pieces"] == 5 and avg["period_frames"] == pytest.approx(100.0)
+    assert row["methods"]["ours"]["period_error"] == pytest.approx(0.0, abs=0.02)
