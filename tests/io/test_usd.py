@@ -9,7 +9,7 @@ from cyclecoord.motion import Motion
 
 pytest.importorskip("pxr", reason="usd-core (the optional 'usd' extra) is not installed")
 
-from cyclecoord.io.usd import read_usd, usd_joint_positions, write_usd  # noqa: E402
+from cyclecoord.io.usd import read_usd, usd_joint_positions, write_usd
 
 
 @pytest.mark.parametrize("suffix", [".usda", ".usdc"])
