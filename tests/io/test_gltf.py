@@ -21,10 +21,14 @@ from cyclecoord.skeleton import Joint, Skeleton
 
 
 def _arm(T=5, fps=30.0):
-    skel = Skeleton((
-        Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
-        Joint("arm", 0, [0, 1, 0], ("rx", "rz"), "ZX", end_site=[1, 0, 0]),
-    ), name="arm", source_format="bvh")
+    skel = Skeleton(
+        (
+            Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
+            Joint("arm", 0, [0, 1, 0], ("rx", "rz"), "ZX", end_site=[1, 0, 0]),
+        ),
+        name="arm",
+        source_format="bvh",
+    )
     frames = np.zeros((T, 8))
     frames[:, 1] = 2.0  # root ty
     frames[:, 4] = np.linspace(0, 90, T)  # root ry
@@ -38,7 +42,7 @@ def _glb_json(path):
     assert magic == b"glTF" and version == 2 and length == len(data)
     n, kind = struct.unpack("<I4s", data[12:20])
     assert kind == b"JSON" and (20 + n) % 4 == 0
-    return json.loads(data[20:20 + n])
+    return json.loads(data[20 : 20 + n])
 
 
 def _names_to_fk(names):
@@ -98,8 +102,9 @@ def test_quaternion_order(tmp_path):
     ch = next(c for c in anim.channels if c.target.node == 0 and c.target.path == "rotation")
     acc = gltf.accessors[anim.samplers[ch.sampler].output]
     view = gltf.bufferViews[acc.bufferView]
-    q = np.frombuffer(gltf.binary_blob()[view.byteOffset: view.byteOffset + view.byteLength],
-                      np.float32).reshape(-1, 4)
+    q = np.frombuffer(
+        gltf.binary_blob()[view.byteOffset : view.byteOffset + view.byteLength], np.float32
+    ).reshape(-1, 4)
     s = np.sqrt(0.5)
     assert np.allclose(q[-1], [0, s, 0, s], atol=1e-6)
     assert np.allclose(q[0], [0, 0, 0, 1], atol=1e-6)
@@ -154,7 +159,11 @@ def test_unreadable_files(tmp_path):
 def test_cli_convert_to_glb(walk_69_01, tmp_path):
     src = walk_69_01.source
     out = tmp_path / "69_01.glb"
-    r = subprocess.run([sys.executable, "-m", "cyclecoord", "convert", src, "-o", str(out)],
-                       capture_output=True, text=True, check=False)
+    r = subprocess.run(
+        [sys.executable, "-m", "cyclecoord", "convert", src, "-o", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert r.returncode == 0, r.stderr
     assert read_gltf(out).n_frames == walk_69_01.n_frames

@@ -17,11 +17,16 @@ from cyclecoord.quality.contacts import (
 from cyclecoord.skeleton import Joint, Skeleton
 
 
-def legs_skeleton(names=("lfemur", "ltibia", "lfoot", "ltoes", "rfemur", "rtibia", "rfoot", "rtoes")):
+def legs_skeleton(
+    names=("lfemur", "ltibia", "lfoot", "ltoes", "rfemur", "rtibia", "rfoot", "rtoes"),
+):
     """Root at hip height 10 over a floor at 3 (not 0); thigh 4, shin 4, foot 1, toes 0.5."""
     lf, lt, lfo, lto, rf, rt, rfo, rto = names
     joints = [Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX")]
-    for side, (f, t, fo, to), x in (("l", (lf, lt, lfo, lto), 1.0), ("r", (rf, rt, rfo, rto), -1.0)):
+    for side, (f, t, fo, to), x in (
+        ("l", (lf, lt, lfo, lto), 1.0),
+        ("r", (rf, rt, rfo, rto), -1.0),
+    ):
         base = len(joints)
         joints += [
             Joint(f, 0, [x, -1, 0], ("rx", "ry", "rz"), "ZYX"),
@@ -47,8 +52,18 @@ def test_find_feet_and_leg_length():
     skel = legs_skeleton()
     assert find_feet(skel) == ("lfoot", "ltoes", "rfoot", "rtoes")
     assert leg_length(skel) == pytest.approx(8.0)
-    bvh = legs_skeleton(("LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase",
-                         "RightUpLeg", "RightLeg", "RightFoot", "RightToeBase"))
+    bvh = legs_skeleton(
+        (
+            "LeftUpLeg",
+            "LeftLeg",
+            "LeftFoot",
+            "LeftToeBase",
+            "RightUpLeg",
+            "RightLeg",
+            "RightFoot",
+            "RightToeBase",
+        )
+    )
     assert find_feet(bvh) == ("LeftFoot", "LeftToeBase", "RightFoot", "RightToeBase")
 
 

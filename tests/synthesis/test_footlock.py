@@ -11,11 +11,16 @@ from cyclecoord.synthesis.footlock import lock_feet
 
 
 # the two-legged skeleton of tests/quality/test_contacts.py
-def legs_skeleton(names=("lfemur", "ltibia", "lfoot", "ltoes", "rfemur", "rtibia", "rfoot", "rtoes")):
+def legs_skeleton(
+    names=("lfemur", "ltibia", "lfoot", "ltoes", "rfemur", "rtibia", "rfoot", "rtoes"),
+):
     """Root at hip height 10 over a floor at 3 (not 0); thigh 4, shin 4, foot 1, toes 0.5."""
     lf, lt, lfo, lto, rf, rt, rfo, rto = names
     joints = [Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX")]
-    for side, (f, t, fo, to), x in (("l", (lf, lt, lfo, lto), 1.0), ("r", (rf, rt, rfo, rto), -1.0)):
+    for side, (f, t, fo, to), x in (
+        ("l", (lf, lt, lfo, lto), 1.0),
+        ("r", (rf, rt, rfo, rto), -1.0),
+    ):
         base = len(joints)
         joints += [
             Joint(f, 0, [x, -1, 0], ("rx", "ry", "rz"), "ZYX"),
@@ -35,8 +40,6 @@ def make_motion(skel, T=120, fps=60.0, root_speed=0.0, lift_left=None):
     if lift_left is not None:
         frames[lift_left, col[(skel.names[1], "rx")]] = -40.0  # swing the left thigh forward
     return Motion(frames, channels, fps=fps, skeleton=skel)
-
-
 
 
 def _walkish(T=120, fps=60.0):

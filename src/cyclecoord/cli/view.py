@@ -25,17 +25,28 @@ def add_parser(subparsers) -> None:
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("input", metavar="INPUT", help="motion file (.amc, .bvh, .npz, .csv, .glb, .gltf, .usd*)")
+    p.add_argument(
+        "input", metavar="INPUT", help="motion file (.amc, .bvh, .npz, .csv, .glb, .gltf, .usd*)"
+    )
     p.add_argument("-o", "--output", metavar="OUT", required=True, help="the page to write (.html)")
     p.add_argument("--side-by-side", metavar="OTHER", help="a second motion shown beside INPUT")
-    p.add_argument("--frames", metavar="A:B", help="0-based half-open frame range of INPUT, e.g. 200:450")
+    p.add_argument(
+        "--frames", metavar="A:B", help="0-based half-open frame range of INPUT, e.g. 200:450"
+    )
     p.add_argument("--other-frames", metavar="A:B", help="frame range of OTHER")
     p.add_argument("--cycle", action="store_true", help="INPUT is a loop: show its phase and seam")
     p.add_argument("--other-cycle", action="store_true", help="OTHER is a loop")
-    p.add_argument("--skeleton", metavar="ASF", help="skeleton for an .amc INPUT (default: beside it)")
+    p.add_argument(
+        "--skeleton", metavar="ASF", help="skeleton for an .amc INPUT (default: beside it)"
+    )
     p.add_argument("--fps", type=float, metavar="HZ", help="frame rate of INPUT (AMC default 120)")
-    p.add_argument("--max-fps", type=float, default=30.0, metavar="HZ",
-                   help="animate at most this many frames per second (default 30; more are skipped)")
+    p.add_argument(
+        "--max-fps",
+        type=float,
+        default=30.0,
+        metavar="HZ",
+        help="animate at most this many frames per second (default 30; more are skipped)",
+    )
     p.add_argument("--no-contacts", action="store_true", help="do not mark planted feet")
     p.set_defaults(func=run)
 
@@ -49,7 +60,9 @@ def _range(text: str | None):
         a, b = text.split(":")
         return (int(a) if a else None, int(b) if b else None)
     except ValueError:
-        raise ParameterError(f"frame range must look like A:B (0-based, half-open), got {text!r}") from None
+        raise ParameterError(
+            f"frame range must look like A:B (0-based, half-open), got {text!r}"
+        ) from None
 
 
 def run(args: argparse.Namespace) -> int:

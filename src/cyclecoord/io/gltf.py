@@ -52,8 +52,10 @@ def check_exportable(motion: Motion, what: str) -> Skeleton:
     """The skeleton of a motion that can be exported, or one clear ParameterError."""
     name = motion.source or "motion"
     if motion.skeleton is None:
-        raise ParameterError(f"{name}: {what} export needs a skeleton; this motion has none "
-                             "(load it from ASF/AMC, BVH or an .npz with a skeleton)")
+        raise ParameterError(
+            f"{name}: {what} export needs a skeleton; this motion has none "
+            "(load it from ASF/AMC, BVH or an .npz with a skeleton)"
+        )
     if motion.n_frames < 1:
         raise ParameterError(f"{name}: no frames to write")
     bad = np.flatnonzero(~np.isfinite(motion.frames).all(axis=1))
@@ -103,8 +105,12 @@ def skeleton_from_dict(d: dict) -> Skeleton:
         )
         for j in d["joints"]
     )
-    return Skeleton(joints, name=d.get("name", ""), length_unit=float(d.get("length_unit", 1.0)),
-                    source_format=d.get("source_format", ""))
+    return Skeleton(
+        joints,
+        name=d.get("name", ""),
+        length_unit=float(d.get("length_unit", 1.0)),
+        source_format=d.get("source_format", ""),
+    )
 
 
 # --------------------------------------------------------------------- buffer building
@@ -119,8 +125,11 @@ class _Blob:
         import pygltflib as g
 
         array = np.ascontiguousarray(array)
-        comp = {np.dtype(np.float32): _FLOAT, np.dtype(np.uint16): _UINT16,
-                np.dtype(np.uint32): _UINT32}[array.dtype]
+        comp = {
+            np.dtype(np.float32): _FLOAT,
+            np.dtype(np.uint16): _UINT16,
+            np.dtype(np.uint32): _UINT32,
+        }[array.dtype]
         while len(self.data) % 4:
             self.data.append(0)
         offset = len(self.data)
@@ -136,8 +145,14 @@ class _Blob:
         if comp != _FLOAT and lo is not None:
             lo, hi = [int(v) for v in lo], [int(v) for v in hi]
         self.gltf.accessors.append(
-            g.Accessor(bufferView=len(self.gltf.bufferViews) - 1, componentType=comp,
-                       count=int(array.shape[0]), type=kind, min=lo, max=hi)
+            g.Accessor(
+                bufferView=len(self.gltf.bufferViews) - 1,
+                componentType=comp,
+                count=int(array.shape[0]),
+                type=kind,
+                min=lo,
+                max=hi,
+            )
         )
         return len(self.gltf.accessors) - 1
 
@@ -178,8 +193,12 @@ def _stick_mesh(rest: np.ndarray, bones: list[tuple[int, int]], radius: float):
         for k in range(4):
             k2 = (k + 1) % 4
             tris += [(base + k, base + k2, base + 4 + k2), (base + k, base + 4 + k2, base + 4 + k)]
-        tris += [(base, base + 2, base + 1), (base, base + 3, base + 2),
-                 (base + 4, base + 5, base + 6), (base + 4, base + 6, base + 7)]
+        tris += [
+            (base, base + 2, base + 1),
+            (base, base + 3, base + 2),
+            (base + 4, base + 5, base + 6),
+            (base + 4, base + 6, base + 7),
+        ]
     return np.array(verts), np.array(joints), np.array(tris)
 
 
@@ -208,7 +227,9 @@ def _build(motion: Motion, scale: float, mesh: bool):
         if j.end_site is not None:
             children[i].append(len(gltf.nodes))
             end_parent.append(i)
-            gltf.nodes.append(g.Node(name=f"{j.name}_end", translation=(j.end_site * scale).tolist()))
+            gltf.nodes.append(
+                g.Node(name=f"{j.name}_end", translation=(j.end_site * scale).tolist())
+            )
     for i, ch in enumerate(children):
         if ch:
             gltf.nodes[i].children = ch
@@ -225,13 +246,20 @@ def _build(motion: Motion, scale: float, mesh: bool):
         if any(d.startswith("t") for d in j.dofs):
             acc = blob.add((trans[:, i] * scale).astype(np.float32), "VEC3")
             samplers.append(g.AnimationSampler(input=t_acc, output=acc, interpolation="LINEAR"))
-            channels.append(g.AnimationChannel(sampler=len(samplers) - 1,
-                                               target=g.AnimationChannelTarget(node=i, path="translation")))
+            channels.append(
+                g.AnimationChannel(
+                    sampler=len(samplers) - 1,
+                    target=g.AnimationChannelTarget(node=i, path="translation"),
+                )
+            )
         q = _continuous_quaternions(Rotation.from_matrix(rots[:, i]).as_quat())  # x y z w
         acc = blob.add(q.astype(np.float32), "VEC4")
         samplers.append(g.AnimationSampler(input=t_acc, output=acc, interpolation="LINEAR"))
-        channels.append(g.AnimationChannel(sampler=len(samplers) - 1,
-                                           target=g.AnimationChannelTarget(node=i, path="rotation")))
+        channels.append(
+            g.AnimationChannel(
+                sampler=len(samplers) - 1, target=g.AnimationChannelTarget(node=i, path="rotation")
+            )
+        )
     anim_name = Path(motion.source).stem if motion.source else "motion"
     gltf.animations.append(g.Animation(name=str(anim_name), samplers=samplers, channels=channels))
 
@@ -241,8 +269,14 @@ def _build(motion: Motion, scale: float, mesh: bool):
     ibm = np.tile(np.eye(4), (n_nodes, 1, 1))
     ibm[:, :3, 3] = -rest
     ibm_acc = blob.add(ibm.transpose(0, 2, 1).reshape(n_nodes, 16).astype(np.float32), "MAT4")
-    gltf.skins.append(g.Skin(name=skel.name or "skeleton", joints=list(range(n_nodes)),
-                             skeleton=0, inverseBindMatrices=ibm_acc))
+    gltf.skins.append(
+        g.Skin(
+            name=skel.name or "skeleton",
+            joints=list(range(n_nodes)),
+            skeleton=0,
+            inverseBindMatrices=ibm_acc,
+        )
+    )
     scene_nodes = [0]
     if mesh:
         bones = [(j.parent, (j.parent, i)) for i, j in enumerate(skel.joints) if j.parent >= 0]
@@ -252,26 +286,36 @@ def _build(motion: Motion, scale: float, mesh: bool):
         if len(verts):
             attrs = g.Attributes(
                 POSITION=blob.add(verts.astype(np.float32), "VEC3", _ARRAY_BUFFER),
-                JOINTS_0=blob.add(np.stack([vj, 0 * vj, 0 * vj, 0 * vj], 1).astype(np.uint16),
-                                  "VEC4", _ARRAY_BUFFER),
-                WEIGHTS_0=blob.add(np.tile([1.0, 0, 0, 0], (len(verts), 1)).astype(np.float32),
-                                   "VEC4", _ARRAY_BUFFER),
+                JOINTS_0=blob.add(
+                    np.stack([vj, 0 * vj, 0 * vj, 0 * vj], 1).astype(np.uint16),
+                    "VEC4",
+                    _ARRAY_BUFFER,
+                ),
+                WEIGHTS_0=blob.add(
+                    np.tile([1.0, 0, 0, 0], (len(verts), 1)).astype(np.float32),
+                    "VEC4",
+                    _ARRAY_BUFFER,
+                ),
             )
             idx = blob.add(tris.reshape(-1).astype(np.uint32), "SCALAR", _ELEMENT_ARRAY_BUFFER)
-            gltf.meshes.append(g.Mesh(name="sticks", primitives=[g.Primitive(attributes=attrs, indices=idx)]))
+            gltf.meshes.append(
+                g.Mesh(name="sticks", primitives=[g.Primitive(attributes=attrs, indices=idx)])
+            )
             gltf.nodes.append(g.Node(name="sticks", mesh=0, skin=0))
             scene_nodes.append(len(gltf.nodes) - 1)
     gltf.scenes.append(g.Scene(name=skel.name or "scene", nodes=scene_nodes))
     gltf.scene = 0
-    gltf.extras = {_EXTRAS_KEY: {
-        "fps": motion.fps,
-        "frames": T,
-        "scale": scale,
-        "start_frame": motion.start_frame,
-        "source": motion.source,
-        "channels": [list(c) for c in motion.channels],
-        "skeleton": skeleton_to_dict(skel),
-    }}
+    gltf.extras = {
+        _EXTRAS_KEY: {
+            "fps": motion.fps,
+            "frames": T,
+            "scale": scale,
+            "start_frame": motion.start_frame,
+            "source": motion.source,
+            "channels": [list(c) for c in motion.channels],
+            "skeleton": skeleton_to_dict(skel),
+        }
+    }
     data = blob.finish()
     gltf.buffers.append(g.Buffer(byteLength=len(data)))
     return gltf, data
@@ -306,7 +350,9 @@ def write_gltf(
     p = Path(path)
     suffix = p.suffix.lower()
     if suffix not in (".glb", ".gltf"):
-        raise ParameterError(f"{p}: glTF files end in .glb or .gltf, got {p.suffix or '(no suffix)'!r}")
+        raise ParameterError(
+            f"{p}: glTF files end in .glb or .gltf, got {p.suffix or '(no suffix)'!r}"
+        )
     skel = check_exportable(motion, "glTF")
     s = default_scale(skel) if scale is None else float(scale)
     if not (np.isfinite(s) and s > 0):
@@ -334,7 +380,9 @@ def _load(path: Path):
     try:
         gltf = g.GLTF2.load(str(path))
     except Exception as exc:  # noqa: BLE001 - pygltflib raises assorted errors on bad files
-        raise ParseError(f"not a readable glTF file ({type(exc).__name__}: {exc})", str(path)) from None
+        raise ParseError(
+            f"not a readable glTF file ({type(exc).__name__}: {exc})", str(path)
+        ) from None
     if gltf is None:
         raise ParseError("not a readable glTF file", str(path))
     buffers = []
@@ -355,8 +403,14 @@ def _load(path: Path):
 
 
 _NCOMP = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
-_DTYPE = {5126: np.float32, 5123: np.uint16, 5125: np.uint32, 5121: np.uint8,
-          5122: np.int16, 5120: np.int8}
+_DTYPE = {
+    5126: np.float32,
+    5123: np.uint16,
+    5125: np.uint32,
+    5121: np.uint8,
+    5122: np.int16,
+    5120: np.int8,
+}
 
 
 def _accessor(gltf, buffers, index: int) -> np.ndarray:
@@ -367,14 +421,19 @@ def _accessor(gltf, buffers, index: int) -> np.ndarray:
     start = (view.byteOffset or 0) + (acc.byteOffset or 0)
     stride = view.byteStride or dtype.itemsize * ncomp
     raw = np.frombuffer(buffers[view.buffer], dtype=np.uint8)
-    rows = [raw[start + k * stride: start + k * stride + dtype.itemsize * ncomp] for k in range(acc.count)]
+    rows = [
+        raw[start + k * stride : start + k * stride + dtype.itemsize * ncomp]
+        for k in range(acc.count)
+    ]
     out = np.frombuffer(b"".join(r.tobytes() for r in rows), dtype=dtype).reshape(acc.count, ncomp)
     if acc.normalized and dtype.kind in "iu":
         out = out / np.iinfo(dtype).max
     return out.astype(float)
 
 
-def _sample(times: np.ndarray, values: np.ndarray, interp: str, at: np.ndarray, quat: bool) -> np.ndarray:
+def _sample(
+    times: np.ndarray, values: np.ndarray, interp: str, at: np.ndarray, quat: bool
+) -> np.ndarray:
     if interp == "CUBICSPLINE":
         values = values.reshape(len(times), 3, -1)[:, 1]
     if interp == "STEP":
@@ -394,7 +453,9 @@ def _node_tracks(gltf, buffers, anim_index: int = 0):
     extras = (gltf.extras or {}).get(_EXTRAS_KEY, {}) if isinstance(gltf.extras, dict) else {}
     N = len(gltf.nodes)
     anim = gltf.animations[anim_index] if gltf.animations else None
-    inputs = [] if anim is None else [_accessor(gltf, buffers, s.input)[:, 0] for s in anim.samplers]
+    inputs = (
+        [] if anim is None else [_accessor(gltf, buffers, s.input)[:, 0] for s in anim.samplers]
+    )
     if extras.get("fps"):
         fps = float(extras["fps"])
     elif inputs and max(len(t) for t in inputs) > 1:
@@ -408,7 +469,24 @@ def _node_tracks(gltf, buffers, anim_index: int = 0):
     trans = np.empty((T, N, 3))
     quats = np.empty((T, N, 4))
     for k, node in enumerate(gltf.nodes):
-        if node.matrix is not None and node.matrix != [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]:
+        if node.matrix is not None and node.matrix != [
+            1,
+            0,
+            0,
+            0,
+            0,
+            1,
+            0,
+            0,
+            0,
+            0,
+            1,
+            0,
+            0,
+            0,
+            0,
+            1,
+        ]:
             m = np.asarray(node.matrix, float).reshape(4, 4).T
             trans[:, k] = m[:3, 3]
             quats[:, k] = Rotation.from_matrix(m[:3, :3]).as_quat()
@@ -494,8 +572,14 @@ def read_gltf(path: str | os.PathLike[str]) -> Motion:
         cols = [by_name[j.name] for j in skel.joints]
         scale = float(extras.get("scale", 1.0))
         frames = channels_from_local(skel, trans[:, cols] / scale, rots[:, cols])
-        motion = Motion(frames, skel.channels, fps=fps, skeleton=skel, source=str(p),
-                        start_frame=int(extras.get("start_frame", 0)))
+        motion = Motion(
+            frames,
+            skel.channels,
+            fps=fps,
+            skeleton=skel,
+            source=str(p),
+            start_frame=int(extras.get("start_frame", 0)),
+        )
         wanted = [tuple(c) for c in extras.get("channels", [])]
         if wanted and set(wanted) == set(motion.channels):
             motion = motion.select(wanted)
@@ -503,7 +587,9 @@ def read_gltf(path: str | os.PathLike[str]) -> Motion:
     order, parents = _joint_nodes(gltf)
     animated = set()
     if gltf.animations:
-        animated = {c.target.node for c in gltf.animations[0].channels if c.target.path == "translation"}
+        animated = {
+            c.target.node for c in gltf.animations[0].channels if c.target.path == "translation"
+        }
     joints = []
     for i, (k, par) in enumerate(zip(order, parents)):
         dofs: tuple[str, ...] = ("rx", "ry", "rz")

@@ -1,4 +1,6 @@
-"""USD export and import of a motion as a UsdSkel skeleton and animation (``.usda``/``.usdc``/``.usd``).
+"""USD export and import of a motion as a UsdSkel skeleton and animation.
+
+Files: ``.usda`` (text), ``.usdc`` and ``.usd`` (binary crate).
 
 Needs the optional ``usd-core`` package (``pip install cyclecoord[usd]``); it is imported
 inside the functions so the rest of cyclecoord works without it.
@@ -107,7 +109,9 @@ def write_usd(
 
     p = Path(path)
     if p.suffix.lower() not in USD_SUFFIXES:
-        raise ParameterError(f"{p}: USD files end in {', '.join(USD_SUFFIXES)}, got {p.suffix or '(no suffix)'!r}")
+        raise ParameterError(
+            f"{p}: USD files end in {', '.join(USD_SUFFIXES)}, got {p.suffix or '(no suffix)'!r}"
+        )
     skel = check_exportable(motion, "USD")
     mpu = default_scale(skel) if meters_per_unit is None else float(meters_per_unit)
     if not (np.isfinite(mpu) and mpu > 0):
@@ -140,13 +144,18 @@ def write_usd(
     usd_skel.CreateJointNamesAttr(Vt.TokenArray(names))
     usd_skel.CreateRestTransformsAttr(Vt.Matrix4dArray.FromNumpy(_matrices(rest_t, rest_r)))
     usd_skel.CreateBindTransformsAttr(Vt.Matrix4dArray.FromNumpy(_matrices(bind_p[0], bind_r[0])))
-    usd_skel.GetPrim().SetCustomDataByKey(_KEY, json.dumps({
-        "fps": motion.fps,
-        "start_frame": motion.start_frame,
-        "source": motion.source,
-        "channels": [list(c) for c in motion.channels],
-        "skeleton": skeleton_to_dict(skel),
-    }))
+    usd_skel.GetPrim().SetCustomDataByKey(
+        _KEY,
+        json.dumps(
+            {
+                "fps": motion.fps,
+                "start_frame": motion.start_frame,
+                "source": motion.source,
+                "channels": [list(c) for c in motion.channels],
+                "skeleton": skeleton_to_dict(skel),
+            }
+        ),
+    )
     anim = UsdSkel.Animation.Define(stage, "/Motion/Skeleton/Animation")
     anim.CreateJointsAttr(Vt.TokenArray(paths))
     t_attr = anim.CreateTranslationsAttr()
@@ -158,7 +167,9 @@ def write_usd(
     for t in range(T):
         t_attr.Set(Vt.Vec3fArray.FromNumpy(tf[t]), Usd.TimeCode(t))
         r_attr.Set(Vt.QuatfArray([Gf.Quatf(*map(float, w)) for w in wxyz[t]]), Usd.TimeCode(t))
-    UsdSkel.BindingAPI.Apply(usd_skel.GetPrim()).CreateAnimationSourceRel().SetTargets([anim.GetPath()])
+    UsdSkel.BindingAPI.Apply(usd_skel.GetPrim()).CreateAnimationSourceRel().SetTargets(
+        [anim.GetPath()]
+    )
     with atomic_path(p, suffix=p.suffix) as tmp:
         if not stage.GetRootLayer().Export(str(tmp)):
             raise ParameterError(f"{p}: usd-core could not write the stage")
@@ -196,9 +207,12 @@ def usd_joint_positions(path: str | os.PathLike[str]) -> tuple[list[str], np.nda
 
     skel = UsdSkel.Skeleton(prim)
     names = list(skel.GetJointNamesAttr().Get() or query.GetJointOrder())
-    pos = np.array([
-        np.array(query.ComputeJointSkelTransforms(Usd.TimeCode(float(t))))[:, 3, :3] for t in times
-    ])
+    pos = np.array(
+        [
+            np.array(query.ComputeJointSkelTransforms(Usd.TimeCode(float(t))))[:, 3, :3]
+            for t in times
+        ]
+    )
     return names, pos, fps
 
 
@@ -215,8 +229,9 @@ def read_usd(path: str | os.PathLike[str]) -> Motion:
 
     p = Path(path)
     _stage, prim, query, times, fps = _open(p)
-    local = np.array([np.array(query.ComputeJointLocalTransforms(Usd.TimeCode(float(t))))
-                      for t in times])  # (T, J, 4, 4), row vectors
+    local = np.array(
+        [np.array(query.ComputeJointLocalTransforms(Usd.TimeCode(float(t)))) for t in times]
+    )  # (T, J, 4, 4), row vectors
     trans = local[..., 3, :3]
     rots = np.swapaxes(local[..., :3, :3], -1, -2)
     meta = prim.GetCustomDataByKey(_KEY)
@@ -225,8 +240,14 @@ def read_usd(path: str | os.PathLike[str]) -> Motion:
         skel = skeleton_from_dict(info["skeleton"])
         n = len(skel.joints)
         frames = channels_from_local(skel, trans[:, :n], rots[:, :n])
-        motion = Motion(frames, skel.channels, fps=fps, skeleton=skel, source=str(p),
-                        start_frame=int(info.get("start_frame", 0)))
+        motion = Motion(
+            frames,
+            skel.channels,
+            fps=fps,
+            skeleton=skel,
+            source=str(p),
+            start_frame=int(info.get("start_frame", 0)),
+        )
         wanted = [tuple(c) for c in info.get("channels", [])]
         return motion.select(wanted) if wanted and set(wanted) == set(motion.channels) else motion
     order = list(query.GetJointOrder())
@@ -235,7 +256,11 @@ def read_usd(path: str | os.PathLike[str]) -> Motion:
     for i, jp in enumerate(order):
         par = int(topo.GetParent(i))
         dofs = ("rx", "ry", "rz") if par >= 0 else ("tx", "ty", "tz", "rx", "ry", "rz")
-        joints.append(Joint(str(jp).rsplit("/", 1)[-1] if par >= 0 else str(jp), par, trans[0, i], dofs, "ZYX"))
+        joints.append(
+            Joint(
+                str(jp).rsplit("/", 1)[-1] if par >= 0 else str(jp), par, trans[0, i], dofs, "ZYX"
+            )
+        )
     skel = Skeleton(tuple(joints), name=p.stem, source_format="usd")
     frames = channels_from_local(skel, trans, rots)
     return Motion(frames, skel.channels, fps=fps, skeleton=skel, source=str(p))

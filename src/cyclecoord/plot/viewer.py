@@ -70,10 +70,14 @@ def _segments(pos: np.ndarray, parents: np.ndarray) -> np.ndarray:
 def _prepare(item: ViewerInput, offset: float, contacts: bool):
     m = item.motion
     if m.skeleton is None:
-        raise ParameterError(f"{item.label}: the viewer needs a skeleton (forward kinematics); this motion has none")
+        raise ParameterError(
+            f"{item.label}: the viewer needs a skeleton (forward kinematics); this motion has none"
+        )
     bad = np.flatnonzero(~np.isfinite(m.frames).all(axis=1))
     if bad.size:
-        raise ParameterError(f"{item.label}: frame {m.start_frame + int(bad[0])} holds NaN or infinite values")
+        raise ParameterError(
+            f"{item.label}: frame {m.start_frame + int(bad[0])} holds NaN or infinite values"
+        )
     fk = m.positions()
     pos = fk.positions.copy()
     pos[..., 0] += offset
@@ -146,35 +150,18 @@ def skeleton_figure(
     phase_of = next((it for it in items if it.cycle), None)
 
     if has_cycle:
-        fig = make_subplots(rows=1, cols=2, column_widths=[0.78, 0.22],
-                            specs=[[{"type": "scene"}, {"type": "xy"}]],
-                            subplot_titles=("", "phase"))
+        fig = make_subplots(
+            rows=1,
+            cols=2,
+            column_widths=[0.78, 0.22],
+            specs=[[{"type": "scene"}, {"type": "xy"}]],
+            subplot_titles=("", "phase"),
+        )
     else:
         fig = make_subplots(rows=1, cols=1, specs=[[{"type": "scene"}]])
 
     def traces_at(k: int) -> list:
-        out = []
-        for it, (pos, parents, feet, _), colour in zip(items, prepared, _COLOURS * 4):
-            t = _frame_index(k, it.motion.n_frames, it.cycle)
-            seg = _segments(pos[t: t + 1], parents)[0]
-            out.append(go.Scatter3d(x=seg[:, 0], y=seg[:, 1], z=seg[:, 2], mode="lines+markers",
-                                    line={"color": colour, "width": 6}, marker={"size": 2.5, "color": colour},
-                                    name=it.label, legendgroup=it.label, hoverinfo="skip"))
-            if feet is not None:
-                fpos, planted = feet
-                pts = fpos[t][planted[t]]
-                out.append(go.Scatter3d(x=pts[:, 0], y=pts[:, 1], z=pts[:, 2], mode="markers",
-                                        marker={"size": 6, "color": "#ff7f0e", "symbol": "square"},
-                                        name=f"{it.label}: planted feet", legendgroup=it.label,
-                                        showlegend=k == 0, hoverinfo="skip"))
-        if has_cycle:
-            n = phase_of.motion.n_frames
-            ph = _frame_index(k, n, True) / n
-            out.append(go.Scatter(x=[np.sin(2 * np.pi * ph)], y=[np.cos(2 * np.pi * ph)], mode="markers+text",
-                                  marker={"size": 14, "color": _COLOURS[items.index(phase_of) % 4]},
-                                  text=[f"{ph:.2f}"], textposition="bottom center", showlegend=False,
-                                  hoverinfo="skip"))
-        return out
+        return _traces_at(go, items, prepared, phase_of, k)
 
     first = traces_at(0)
     n_anim = len(first)
@@ -184,32 +171,51 @@ def skeleton_figure(
         else:
             fig.add_trace(tr, row=1, col=1)
     animated = list(range(n_anim))
-    if has_cycle:  # the dial: circle and seam tick (static, after the animated traces)
-        a = np.linspace(0, 2 * np.pi, 121)
-        fig.add_trace(go.Scatter(x=np.sin(a), y=np.cos(a), mode="lines", line={"color": "#999"},
-                                 showlegend=False, hoverinfo="skip"), row=1, col=2)
-        fig.add_trace(go.Scatter(x=[0, 0], y=[0.8, 1.2], mode="lines+text", line={"color": "black", "width": 3},
-                                 text=["", "seam"], textposition="top center", showlegend=False,
-                                 hoverinfo="skip"), row=1, col=2)
-        fig.update_xaxes(range=[-1.5, 1.5], visible=False, row=1, col=2)
-        fig.update_yaxes(range=[-1.5, 1.5], visible=False, scaleanchor="x", row=1, col=2)
-    # floor and fixed axes
-    allpos = np.concatenate([p[0].reshape(-1, 3) for p in prepared])
-    lo, hi = np.nanmin(allpos, axis=0), np.nanmax(allpos, axis=0)
-    pad = 0.1 * float(np.max(hi - lo))
-    lo, hi = lo - pad, hi + pad
-    floor = min(p[3] for p in prepared)
-    lo[2] = min(lo[2], floor)
-    fig.add_trace(go.Mesh3d(x=[lo[0], hi[0], hi[0], lo[0]], y=[lo[1], lo[1], hi[1], hi[1]], z=[floor] * 4,
-                            i=[0, 0], j=[1, 2], k=[2, 3], color="#cccccc", opacity=0.35,
-                            name="floor", hoverinfo="skip", showlegend=False), row=1, col=1)
-    span = hi - lo
-    fig.update_scenes(xaxis={"range": [lo[0], hi[0]], "title": "x"},
-                      yaxis={"range": [lo[1], hi[1]], "title": "-z"},
-                      zaxis={"range": [lo[2], hi[2]], "title": "y (up)"},
-                      aspectmode="manual", aspectratio={"x": span[0] / span.max(), "y": span[1] / span.max(),
-                                                        "z": span[2] / span.max()},
-                      camera={"eye": {"x": 1.6, "y": -1.6, "z": 0.6}})
+    if has_cycle:
+        _add_dial(fig, go)
+    _add_floor(fig, go, prepared)
+
+    frames = [go.Frame(data=traces_at(k), traces=animated, name=str(k)) for k in shown]
+    fig.frames = frames
+    slider, buttons = _controls(shown, step, fps, phase_of)
+    heading = title or " | ".join(
+        f"{it.label}: {it.motion.n_frames} frames at {it.motion.fps:g} fps"
+        + (" (cycle)" if it.cycle else "")
+        for it in items
+    )
+    fig.update_layout(
+        title=heading,
+        sliders=[slider],
+        height=650,
+        updatemenus=[
+            {
+                "type": "buttons",
+                "buttons": buttons,
+                "direction": "left",
+                "x": 0.0,
+                "y": 0.0,
+                "xanchor": "left",
+                "yanchor": "top",
+                "pad": {"t": 60},
+            }
+        ],
+        legend={"x": 0.0, "y": 1.0},
+        margin={"l": 10, "r": 10, "t": 60, "b": 10},
+    )
+    fig.layout.meta = {
+        "cyclecoord": {
+            "frames_shown": shown,
+            "step": step,
+            "fps": fps,
+            "labels": [it.label for it in items],
+            "cycle": [it.cycle for it in items],
+        }
+    }
+    return fig
+
+
+def _controls(shown: list, step: int, fps: float, phase_of):
+    """The frame slider (seam frames labelled) and the play/pause buttons."""
 
     def label(k: int) -> str:
         if phase_of is None:
@@ -217,30 +223,180 @@ def skeleton_figure(
         t = _frame_index(k, phase_of.motion.n_frames, True)
         return f"{k} seam" if t == 0 else str(k)
 
-    frames = [go.Frame(data=traces_at(k), traces=animated, name=str(k)) for k in shown]
-    fig.frames = frames
     duration = 1000.0 * step / fps
-    play = {"args": [None, {"frame": {"duration": duration, "redraw": True}, "fromcurrent": True,
-                            "transition": {"duration": 0}, "mode": "immediate"}],
-            "label": "Play", "method": "animate"}
-    pause = {"args": [[None], {"frame": {"duration": 0, "redraw": False}, "mode": "immediate",
-                               "transition": {"duration": 0}}], "label": "Pause", "method": "animate"}
-    slider = {"active": 0, "currentvalue": {"prefix": "frame "}, "pad": {"t": 40},
-              "steps": [{"args": [[str(k)], {"frame": {"duration": 0, "redraw": True}, "mode": "immediate",
-                                              "transition": {"duration": 0}}],
-                         "label": label(k), "method": "animate"} for k in shown]}
-    heading = title or " | ".join(
-        f"{it.label}: {it.motion.n_frames} frames at {it.motion.fps:g} fps" + (" (cycle)" if it.cycle else "")
-        for it in items)
-    fig.update_layout(title=heading, sliders=[slider], height=650,
-                      updatemenus=[{"type": "buttons", "buttons": [play, pause], "direction": "left",
-                                    "x": 0.0, "y": 0.0, "xanchor": "left", "yanchor": "top",
-                                    "pad": {"t": 60}}],
-                      legend={"x": 0.0, "y": 1.0}, margin={"l": 10, "r": 10, "t": 60, "b": 10})
-    fig.layout.meta = {"cyclecoord": {"frames_shown": shown, "step": step, "fps": fps,
-                                      "labels": [it.label for it in items],
-                                      "cycle": [it.cycle for it in items]}}
-    return fig
+    play = {
+        "args": [
+            None,
+            {
+                "frame": {"duration": duration, "redraw": True},
+                "fromcurrent": True,
+                "transition": {"duration": 0},
+                "mode": "immediate",
+            },
+        ],
+        "label": "Play",
+        "method": "animate",
+    }
+    pause = {
+        "args": [
+            [None],
+            {
+                "frame": {"duration": 0, "redraw": False},
+                "mode": "immediate",
+                "transition": {"duration": 0},
+            },
+        ],
+        "label": "Pause",
+        "method": "animate",
+    }
+    slider = {
+        "active": 0,
+        "currentvalue": {"prefix": "frame "},
+        "pad": {"t": 40},
+        "steps": [
+            {
+                "args": [
+                    [str(k)],
+                    {
+                        "frame": {"duration": 0, "redraw": True},
+                        "mode": "immediate",
+                        "transition": {"duration": 0},
+                    },
+                ],
+                "label": label(k),
+                "method": "animate",
+            }
+            for k in shown
+        ],
+    }
+    return slider, [play, pause]
+
+
+def _traces_at(go, items, prepared, phase_of, k: int) -> list:
+    """The animated traces of animation frame ``k``: bones and planted feet per motion, and
+    the phase dial's marker."""
+    out = []
+    for it, (pos, parents, feet, _), colour in zip(items, prepared, _COLOURS * 4):
+        t = _frame_index(k, it.motion.n_frames, it.cycle)
+        seg = _segments(pos[t : t + 1], parents)[0]
+        out.append(
+            go.Scatter3d(
+                x=seg[:, 0],
+                y=seg[:, 1],
+                z=seg[:, 2],
+                mode="lines+markers",
+                line={"color": colour, "width": 6},
+                marker={"size": 2.5, "color": colour},
+                name=it.label,
+                legendgroup=it.label,
+                hoverinfo="skip",
+            )
+        )
+        if feet is not None:
+            fpos, planted = feet
+            pts = fpos[t][planted[t]]
+            out.append(
+                go.Scatter3d(
+                    x=pts[:, 0],
+                    y=pts[:, 1],
+                    z=pts[:, 2],
+                    mode="markers",
+                    marker={"size": 6, "color": "#ff7f0e", "symbol": "square"},
+                    name=f"{it.label}: planted feet",
+                    legendgroup=it.label,
+                    showlegend=k == 0,
+                    hoverinfo="skip",
+                )
+            )
+    if phase_of is not None:
+        n = phase_of.motion.n_frames
+        ph = _frame_index(k, n, True) / n
+        out.append(
+            go.Scatter(
+                x=[np.sin(2 * np.pi * ph)],
+                y=[np.cos(2 * np.pi * ph)],
+                mode="markers+text",
+                marker={"size": 14, "color": _COLOURS[items.index(phase_of) % 4]},
+                text=[f"{ph:.2f}"],
+                textposition="bottom center",
+                showlegend=False,
+                hoverinfo="skip",
+            )
+        )
+    return out
+
+
+def _add_dial(fig, go) -> None:
+    """The phase dial's circle and seam tick (static traces in the second panel)."""
+    a = np.linspace(0, 2 * np.pi, 121)
+    fig.add_trace(
+        go.Scatter(
+            x=np.sin(a),
+            y=np.cos(a),
+            mode="lines",
+            line={"color": "#999"},
+            showlegend=False,
+            hoverinfo="skip",
+        ),
+        row=1,
+        col=2,
+    )
+    fig.add_trace(
+        go.Scatter(
+            x=[0, 0],
+            y=[0.8, 1.2],
+            mode="lines+text",
+            line={"color": "black", "width": 3},
+            text=["", "seam"],
+            textposition="top center",
+            showlegend=False,
+            hoverinfo="skip",
+        ),
+        row=1,
+        col=2,
+    )
+    fig.update_xaxes(range=[-1.5, 1.5], visible=False, row=1, col=2)
+    fig.update_yaxes(range=[-1.5, 1.5], visible=False, scaleanchor="x", row=1, col=2)
+
+
+def _add_floor(fig, go, prepared) -> None:
+    """The floor plane and fixed scene ranges covering every frame of every motion."""
+    allpos = np.concatenate([p[0].reshape(-1, 3) for p in prepared])
+    lo, hi = np.nanmin(allpos, axis=0), np.nanmax(allpos, axis=0)
+    pad = 0.1 * float(np.max(hi - lo))
+    lo, hi = lo - pad, hi + pad
+    floor = min(p[3] for p in prepared)
+    lo[2] = min(lo[2], floor)
+    fig.add_trace(
+        go.Mesh3d(
+            x=[lo[0], hi[0], hi[0], lo[0]],
+            y=[lo[1], lo[1], hi[1], hi[1]],
+            z=[floor] * 4,
+            i=[0, 0],
+            j=[1, 2],
+            k=[2, 3],
+            color="#cccccc",
+            opacity=0.35,
+            name="floor",
+            hoverinfo="skip",
+            showlegend=False,
+        ),
+        row=1,
+        col=1,
+    )
+    span = hi - lo
+    fig.update_scenes(
+        xaxis={"range": [lo[0], hi[0]], "title": "x"},
+        yaxis={"range": [lo[1], hi[1]], "title": "-z"},
+        zaxis={"range": [lo[2], hi[2]], "title": "y (up)"},
+        aspectmode="manual",
+        aspectratio={
+            "x": span[0] / span.max(),
+            "y": span[1] / span.max(),
+            "z": span[2] / span.max(),
+        },
+        camera={"eye": {"x": 1.6, "y": -1.6, "z": 0.6}},
+    )
 
 
 def _as_inputs(motions, labels, cycle) -> list[ViewerInput]:
@@ -259,7 +415,11 @@ def _as_inputs(motions, labels, cycle) -> list[ViewerInput]:
         if isinstance(m, ViewerInput):
             out.append(m)
             continue
-        name = labels[i] if labels is not None else (Path(m.source).name if m.source else f"motion {i + 1}")
+        name = (
+            labels[i]
+            if labels is not None
+            else (Path(m.source).name if m.source else f"motion {i + 1}")
+        )
         out.append(ViewerInput(m, name, bool(cycles[i])))
     return out
 
@@ -270,9 +430,15 @@ def write_viewer(figure, path: str | os.PathLike[str]) -> Path:
 
     p = Path(path)
     if p.suffix.lower() not in (".html", ".htm"):
-        raise ParameterError(f"{p}: the viewer writes an .html page, got {p.suffix or '(no suffix)'!r}")
-    html = figure.to_html(include_plotlyjs=True, full_html=True, auto_play=False,
-                          config={"displaylogo": False, "responsive": True})
+        raise ParameterError(
+            f"{p}: the viewer writes an .html page, got {p.suffix or '(no suffix)'!r}"
+        )
+    html = figure.to_html(
+        include_plotlyjs=True,
+        full_html=True,
+        auto_play=False,
+        config={"displaylogo": False, "responsive": True},
+    )
     with atomic_write(p, "w") as fh:
         fh.write(html)
     return p

@@ -180,7 +180,7 @@ def _side_and_kind(name: str) -> tuple[str, str] | None:
     for side, prefixes in (("left", ("left", "l")), ("right", ("right", "r"))):
         for pre in prefixes:
             if n.startswith(pre):
-                rest = n[len(pre):]
+                rest = n[len(pre) :]
                 break
         else:
             continue
@@ -258,7 +258,9 @@ def leg_length(skeleton: Skeleton, feet: tuple[str, ...] | None = None) -> float
         lengths.append(shin + thigh)
     value = float(np.mean(lengths)) if lengths else 0.0
     if not value > 0:
-        raise ParameterError("cannot measure the leg length: the foot joints have no bones above them")
+        raise ParameterError(
+            "cannot measure the leg length: the foot joints have no bones above them"
+        )
     return value
 
 
@@ -270,7 +272,8 @@ def _check_motion(motion: Motion) -> Skeleton:
         )
     if motion.n_frames < 2:
         raise ParameterError(
-            f"{motion.source or 'motion'}: foot contacts need at least 2 frames, got {motion.n_frames}"
+            f"{motion.source or 'motion'}: foot contacts need at least 2 frames, "
+            f"got {motion.n_frames}"
         )
     bad = np.flatnonzero(~np.isfinite(motion.frames).all(axis=1))
     if bad.size:
@@ -361,7 +364,9 @@ def foot_contacts(
         raise ParameterError("feet must name at least one joint")
     for f in feet:
         if f not in skel.names:
-            raise ParameterError(f"no joint {f!r} in the skeleton (joints: {', '.join(skel.names)})")
+            raise ParameterError(
+                f"no joint {f!r} in the skeleton (joints: {', '.join(skel.names)})"
+            )
     axis = _UP[up]
     horiz = [k for k in range(3) if k != axis]
     legs = leg_length(skel, feet)
@@ -434,7 +439,9 @@ def foot_skating(
     FootSkating
     """
     if not (np.isfinite(skate_speed) and skate_speed >= 0):
-        raise ParameterError(f"skate_speed must be >= 0 leg lengths per second, got {skate_speed!r}")
+        raise ParameterError(
+            f"skate_speed must be >= 0 leg lengths per second, got {skate_speed!r}"
+        )
     if contacts is None:
         contacts = foot_contacts(motion, **contact_options)
     elif contact_options:

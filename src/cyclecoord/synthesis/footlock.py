@@ -93,8 +93,9 @@ def _lock_weights(planted: np.ndarray, nb: int, cyclic: bool):
     runs and the frame shift of the timeline they index.
 
     A frame gets the label of its nearest run within ``nb + 1`` frames, ``w = 1`` inside
-    runs and on the frame either side, then a smoothstep down to 0 over ``nb`` frames.  A cyclic motion is
-    tiled three times so runs and blends wrap around; the middle copy is returned.
+    runs and on the frame either side, then a smoothstep down to 0 over ``nb`` frames.
+    A cyclic motion is tiled three times so runs and blends wrap around; the middle copy
+    is returned.
     """
     T = planted.size
     reps = 3 if cyclic else 1
@@ -113,7 +114,7 @@ def _lock_weights(planted: np.ndarray, nb: int, cyclic: bool):
     w = np.where(dist <= 1, 1.0, _smoothstep(1.0 - (dist - 1) / (nb + 1)))
     label[w <= 0] = -1
     if cyclic:
-        return w[T: 2 * T], label[T: 2 * T], runs, T
+        return w[T : 2 * T], label[T : 2 * T], runs, T
     return w, label, runs, 0
 
 
@@ -236,7 +237,9 @@ def _solve(ik: _LegIK, rows, targets, weights, scale, iterations=30):
     return q
 
 
-def _lock_once(motion: Motion, contacts: FootContacts, nb: int, cyclic: bool) -> tuple[Motion, float]:
+def _lock_once(
+    motion: Motion, contacts: FootContacts, nb: int, cyclic: bool
+) -> tuple[Motion, float]:
     """One locking pass: the edited motion and the largest horizontal lock error."""
     from .._kinematics import global_transforms, local_transforms
 
@@ -265,7 +268,9 @@ def _lock_once(motion: Motion, contacts: FootContacts, nb: int, cyclic: bool) ->
         active = np.zeros(T, bool)
         horiz = [k for k in range(3) if k != contacts.up]
         for m, i in enumerate(cols):
-            tgt, _, label = _targets(wpos[:, pts[m]], contacts.planted[:, i], contacts.up, nb, cyclic)
+            tgt, _, label = _targets(
+                wpos[:, pts[m]], contacts.planted[:, i], contacts.up, nb, cyclic
+            )
             targets[:, m] = tgt
             locked = label >= 0
             for k in horiz:
@@ -281,7 +286,9 @@ def _lock_once(motion: Motion, contacts: FootContacts, nb: int, cyclic: bool) ->
         for m, i in enumerate(cols):
             lock_rows = contacts.planted[rows, i]
             if lock_rows.any():
-                err = np.linalg.norm((new[lock_rows, m] - targets[rows][lock_rows, m])[:, horiz], axis=1)
+                err = np.linalg.norm(
+                    (new[lock_rows, m] - targets[rows][lock_rows, m])[:, horiz], axis=1
+                )
                 worst = max(worst, float(err.max()))
     return motion.with_frames(frames), worst
 
@@ -327,7 +334,9 @@ def lock_feet(
     else:
         _check_motion(motion)
     if contacts.n_frames != motion.n_frames:
-        raise ParameterError(f"contacts cover {contacts.n_frames} frames, the motion has {motion.n_frames}")
+        raise ParameterError(
+            f"contacts cover {contacts.n_frames} frames, the motion has {motion.n_frames}"
+        )
     nb = round(blend * motion.fps)
     out, worst = _lock_once(motion, contacts, nb, cyclic)
     locked = contacts
