@@ -83,3 +83,61 @@ def test_cli_view(walk_69_01, tmp_path, capsys):
     assert spec and json.loads(spec.group(1))[:3] == [0, 4, 8]
     assert main(["view", walk_69_01.source, "-o", str(tmp_path / "x.png")]) == 1
     assert "html" in capsys.readouterr().err
+
+
+_PROBE = """
+var gd = document.getElementById('{plot_id}');
+function probe(tag) {
+  var el = document.createElement('pre');
+  el.id = tag;
+  el.textContent = JSON.stringify({x: Array.from(gd._fullData[0].x).slice(0, 6),
+                                   frames: gd._transitionData._frames.length});
+  document.body.appendChild(el);
+}
+probe('probe0');
+Plotly.animate(gd, ['30'], {frame: {duration: 0, redraw: true}, mode: 'immediate',
+                            transition: {duration: 0}}).then(function () {
+  probe('probe30');
+  var btn = Array.from(document.querySelectorAll('.updatemenu-button'))
+    .find(function (b) { return b.textContent.indexOf('Play') >= 0; });
+  btn.dispatchEvent(new MouseEvent('click', {bubbles: true}));
+  setTimeout(function () { probe('probePlay'); }, 300);
+});
+"""
+
+
+@pytest.mark.slow
+def test_page_in_headless_chromium(walk, tmp_path):
+    """Chromium (Debian's, when installed) draws the page offline: frame 30 puts the bones
+    where forward kinematics does, and the Play button moves the animation on."""
+    import shutil
+    import subprocess
+
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    if browser is None:
+        pytest.skip("no chromium on PATH (apt-get install chromium)")
+    page = write_viewer(skeleton_figure(walk, max_fps=120), tmp_path / "probe.html", _PROBE)
+    cmd = [
+        browser,
+        "--headless=new",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--enable-unsafe-swiftshader",
+        "--use-angle=swiftshader",
+        "--virtual-time-budget=5000",
+        "--dump-dom",
+        page.as_uri(),
+    ]
+    dom = subprocess.run(cmd, capture_output=True, text=True, timeout=180, check=False).stdout
+    found = dict(re.findall(r'<pre id="(probe\w*)">([^<]*)</pre>', dom))
+    assert set(found) == {"probe0", "probe30", "probePlay"}, dom[-2000:]
+    fk = walk.positions()
+    kids = np.flatnonzero(fk.parents >= 0)
+    for tag, k in (("probe0", 0), ("probe30", 30)):
+        x = json.loads(found[tag])["x"]
+        assert json.loads(found[tag])["frames"] == 60
+        assert x[2] is None
+        assert x[0] == pytest.approx(fk.positions[k, fk.parents[kids[0]], 0])
+        assert x[4] == pytest.approx(fk.positions[k, kids[1], 0])
+    played = json.loads(found["probePlay"])["x"]
+    assert played[0] != pytest.approx(json.loads(found["probe30"])["x"][0])

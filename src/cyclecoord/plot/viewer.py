@@ -67,7 +67,7 @@ def _segments(pos: np.ndarray, parents: np.ndarray) -> np.ndarray:
     return seg
 
 
-def _prepare(item: ViewerInput, offset: float, contacts: bool):
+def _prepare(item: ViewerInput, offset: float, contacts: bool, center: bool):
     m = item.motion
     if m.skeleton is None:
         raise ParameterError(
@@ -80,6 +80,8 @@ def _prepare(item: ViewerInput, offset: float, contacts: bool):
         )
     fk = m.positions()
     pos = fk.positions.copy()
+    if center:  # start above the origin, so motions stand side by side whatever their capture
+        pos[..., [0, 2]] -= pos[0, 0, [0, 2]]
     pos[..., 0] += offset
     feet = None
     floor = float(np.quantile(pos[..., 1].min(axis=1), 0.05))
@@ -127,6 +129,8 @@ def skeleton_figure(
         Highest animation rate; longer motions are shown every ``k``-th frame.
     spacing : float, optional
         Distance between figures along x (default: 0.6 of the first skeleton's height).
+        With several motions each starts with its root above the origin before that
+        shift; a single motion is shown in its own coordinates.
     title : str, optional
 
     Returns
@@ -143,7 +147,8 @@ def skeleton_figure(
     step = max(1, int(np.ceil(fps / max_fps)))
     height = float(np.ptp(items[0].motion.positions().positions[0, :, 1])) or 1.0
     gap = 0.6 * height if spacing is None else float(spacing)
-    prepared = [_prepare(it, i * gap, contacts) for i, it in enumerate(items)]
+    center = len(items) > 1
+    prepared = [_prepare(it, i * gap, contacts, center) for i, it in enumerate(items)]
     n_total = max(it.motion.n_frames for it in items)
     shown = list(range(0, n_total, step))
     has_cycle = any(it.cycle for it in items)
@@ -252,6 +257,8 @@ def _controls(shown: list, step: int, fps: float, phase_of):
     slider = {
         "active": 0,
         "currentvalue": {"prefix": "frame "},
+        "x": 0.14,
+        "len": 0.86,
         "pad": {"t": 40},
         "steps": [
             {
@@ -424,8 +431,12 @@ def _as_inputs(motions, labels, cycle) -> list[ViewerInput]:
     return out
 
 
-def write_viewer(figure, path: str | os.PathLike[str]) -> Path:
-    """Write ``figure`` as one self-contained HTML page (plotly.js inlined), atomically."""
+def write_viewer(figure, path: str | os.PathLike[str], post_script: str | None = None) -> Path:
+    """Write ``figure`` as one self-contained HTML page (plotly.js inlined), atomically.
+
+    ``post_script`` is JavaScript run once the figure is drawn (``{plot_id}`` names its
+    element), as in :meth:`plotly.graph_objects.Figure.to_html`.
+    """
     from ..io._atomic import atomic_write
 
     p = Path(path)
@@ -437,6 +448,7 @@ def write_viewer(figure, path: str | os.PathLike[str]) -> Path:
         include_plotlyjs=True,
         full_html=True,
         auto_play=False,
+        post_script=post_script,
         config={"displaylogo": False, "responsive": True},
     )
     with atomic_write(p, "w") as fh:
