@@ -157,6 +157,24 @@ class FootSkating:
     skate_threshold: float
     leg_length: float
 
+    def to_dict(self) -> dict:
+        """JSON-ready figures (per foot point as name -> value)."""
+        return {
+            "mean_speed_units_per_s": self.mean_speed,
+            "mean_speed_leg_lengths_per_s": self.mean_speed_legs,
+            "skating_frames": self.skating_frames,
+            "skating_fraction": self.skating_fraction,
+            "skate_threshold_units_per_s": self.skate_threshold,
+            "leg_length": self.leg_length,
+            "per_foot": {
+                f: {
+                    "mean_speed_units_per_s": (None if not np.isfinite(v) else float(v)),
+                    "skating_fraction": float(r),
+                }
+                for f, v, r in zip(self.feet, self.foot_mean_speed, self.foot_skating_fraction)
+            },
+        }
+
     def summary(self) -> str:
         """One line for reports."""
         return (
