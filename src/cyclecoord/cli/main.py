@@ -770,7 +770,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="begin the cycle at its slowest pose (default, hides the loop seam) or at the clip's first phase")
     g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (0)")
     o = e.add_argument_group("output")
-    o.add_argument("-o", "--output", metavar="OUT", help="write the cycle (.bvh, .amc, .npz or .csv)")
+    o.add_argument("-o", "--output", metavar="OUT", help="write the cycle (.bvh, .amc, .npz, .csv, .glb, .gltf, .usda, .usdc)")
     o.add_argument("--report", metavar="R.json", help="write a JSON report (barcode, coordinate, figures, timings)")
     o.add_argument("--plot", metavar="DIR",
                    help="write figures into DIR (created if missing): barcode, pca, density, coordinate, channels (.png)")
@@ -878,7 +878,7 @@ def build_parser() -> argparse.ArgumentParser:
         m.add_argument("--strict", action="store_true",
                        help="refuse to write an output that fails the plausibility checks (exit 1)")
         o = q.add_argument_group("output")
-        o.add_argument("-o", "--output", metavar="OUT", help="write the result (.bvh, .amc, .npz or .csv)")
+        o.add_argument("-o", "--output", metavar="OUT", help="write the result (.bvh, .amc, .npz, .csv, .glb, .gltf, .usda, .usdc)")
         o.add_argument("--report", metavar="R.json",
                        help="write a JSON report (inputs, alignment, figures, plausibility)")
 
