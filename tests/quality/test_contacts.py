@@ -157,3 +157,18 @@ def test_jog_143_01_alternates_with_flight(cmu_dir):
     assert all(a != b for a, b in itertools.pairwise(labels))
     flight = ~(c.side_planted("left") | c.side_planted("right"))
     assert flight.mean() > 0.3  # a jog leaves the ground
+
+
+def test_skating_report(walk_69_01):
+    from cyclecoord.quality.contacts import skating_report
+
+    rep = skating_report(walk_69_01[200:450])
+    assert rep["skating_frames"] > 0 and set(rep["per_foot"]) == {
+        "lfoot",
+        "ltoes",
+        "rfoot",
+        "rtoes",
+    }
+    assert 0 < rep["planted_fraction"]["lfoot"] < 1
+    bare = Motion(walk_69_01.frames[:5], walk_69_01.channels, fps=120)
+    assert skating_report(bare) is None

@@ -460,7 +460,9 @@ def _node_tracks(gltf, buffers, anim_index: int = 0):
         fps = float(extras["fps"])
     elif inputs and max(len(t) for t in inputs) > 1:
         longest = max(inputs, key=len)
-        fps = float(1.0 / np.median(np.diff(longest)))
+        fps = float((len(longest) - 1) / (longest[-1] - longest[0]))
+        if abs(fps - round(fps)) < 1e-4 * fps:  # float32 key times: 120.0001 -> 120
+            fps = float(round(fps))
     else:
         fps = 30.0
     end = max((float(t[-1]) for t in inputs), default=0.0)

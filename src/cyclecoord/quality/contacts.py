@@ -34,6 +34,7 @@ __all__ = [
     "foot_contacts",
     "foot_skating",
     "leg_length",
+    "skating_report",
 ]
 
 #: Height band (fraction of leg length) above a point's contact level counted as "down".
@@ -496,3 +497,18 @@ def foot_skating(
         skate_threshold=thr,
         leg_length=contacts.leg_length,
     )
+
+
+def skating_report(motion: Motion, **options) -> dict | None:
+    """Foot skating of ``motion`` as a JSON-ready dict for reports, or ``None`` when it
+    cannot be measured (no skeleton, no recognisable feet, fewer than 2 frames)."""
+    try:
+        contacts = foot_contacts(motion, **options)
+    except ParameterError:
+        return None
+    out = foot_skating(motion, contacts).to_dict()
+    out["planted_fraction"] = {
+        f: float(contacts.planted[:, i].mean()) for i, f in enumerate(contacts.feet)
+    }
+    out["floor"] = contacts.floor
+    return out
