@@ -408,7 +408,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
         folder = Path(args.extract)
         folder.mkdir(parents=True, exist_ok=True)
         for mc in motion_cycles(res):
-            out = folder / f"motion{mc.motion}_cycle.bvh"
+            out = folder / f"motion{mc.motion}_cycle.{args.extract_format}"
             save(mc.cycle, out)
             how = (f"phase from H1 {mc.phase_from}'s coordinate on {mc.n_frames_used} excited frames"
                    if mc.phase_from != "time" else f"phase from time over {mc.n_frames_used} frames")
@@ -820,6 +820,8 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--no-progress", action="store_true", help="no progress bar over the windows")
     d.add_argument("--report", metavar="R.json", help="JSON: segments, labels per frame, classes, windows, barcode")
     d.add_argument("--extract", metavar="OUTDIR", help="write a typical cycle (BVH) for each detected motion")
+    d.add_argument("--extract-format", default="bvh", choices=("bvh", "glb", "gltf", "usda", "usdc", "npz", "csv"),
+                   help="file format of the --extract cycles (default bvh)")
     d.add_argument("--plot", metavar="DIR", help="write the barcode (barcode.png), the coordinates with segments shaded (coordinates.png) and the windows coloured by motion (windows.png)")
     d.set_defaults(func=cmd_detect)
 
