@@ -167,3 +167,12 @@ def test_cli_convert_to_glb(walk_69_01, tmp_path):
     )
     assert r.returncode == 0, r.stderr
     assert read_gltf(out).n_frames == walk_69_01.n_frames
+
+
+def test_truncated_buffer_is_one_parse_error(tmp_path):
+    m = _arm()
+    write_gltf(m, tmp_path / "t.gltf", mesh=False)
+    data = (tmp_path / "t.bin").read_bytes()
+    (tmp_path / "t.bin").write_bytes(data[: len(data) // 2])
+    with pytest.raises(ParseError, match=r"t\.gltf"):
+        cc.load(tmp_path / "t.gltf")

@@ -414,18 +414,26 @@ _DTYPE = {
 
 
 def _accessor(gltf, buffers, index: int) -> np.ndarray:
+    """The values ``(count, components)`` of accessor ``index`` as floats."""
     acc = gltf.accessors[index]
+    if acc.sparse is not None or acc.bufferView is None:
+        raise ParseError(f"accessor {index}: sparse or view-less accessors are not supported")
     view = gltf.bufferViews[acc.bufferView]
-    dtype = np.dtype(_DTYPE[acc.componentType])
+    dtype = np.dtype(_DTYPE[acc.componentType]).newbyteorder("<")
     ncomp = _NCOMP[acc.type]
     start = (view.byteOffset or 0) + (acc.byteOffset or 0)
-    stride = view.byteStride or dtype.itemsize * ncomp
-    raw = np.frombuffer(buffers[view.buffer], dtype=np.uint8)
-    rows = [
-        raw[start + k * stride : start + k * stride + dtype.itemsize * ncomp]
-        for k in range(acc.count)
-    ]
-    out = np.frombuffer(b"".join(r.tobytes() for r in rows), dtype=dtype).reshape(acc.count, ncomp)
+    width = dtype.itemsize * ncomp
+    stride = view.byteStride or width
+    data = buffers[view.buffer]
+    if acc.count and start + stride * (acc.count - 1) + width > len(data):
+        raise ParseError(f"accessor {index} runs past the end of buffer {view.buffer}")
+    if stride == width:
+        out = np.frombuffer(data, dtype=dtype, count=acc.count * ncomp, offset=start)
+    else:
+        raw = np.frombuffer(data, dtype=np.uint8)
+        rows = [raw[start + k * stride : start + k * stride + width] for k in range(acc.count)]
+        out = np.frombuffer(b"".join(r.tobytes() for r in rows), dtype=dtype)
+    out = out.reshape(acc.count, ncomp)
     if acc.normalized and dtype.kind in "iu":
         out = out / np.iinfo(dtype).max
     return out.astype(float)
@@ -509,6 +517,20 @@ def _node_tracks(gltf, buffers, anim_index: int = 0):
     return trans, rots, fps
 
 
+def _tracks(gltf, buffers, path: Path):
+    """:func:`_node_tracks`, with malformed files reported as one ParseError naming ``path``."""
+    try:
+        return _node_tracks(gltf, buffers)
+    except ParseError as exc:
+        if exc.path is None:
+            raise ParseError(exc.message, str(path)) from None
+        raise
+    except (IndexError, KeyError, TypeError, ValueError) as exc:
+        raise ParseError(
+            f"malformed glTF animation ({type(exc).__name__}: {exc})", str(path)
+        ) from None
+
+
 def _joint_nodes(gltf) -> tuple[list[int], list[int]]:
     """Node indices of the skeleton (skin joints, else every node without a mesh) in an order
     where parents come first, and each one's parent position in that list (-1 at roots)."""
@@ -543,7 +565,7 @@ def gltf_joint_positions(path: str | os.PathLike[str]) -> tuple[list[str], np.nd
 
     p = Path(path)
     gltf, buffers = _load(p)
-    trans, rots, fps = _node_tracks(gltf, buffers)
+    trans, rots, fps = _tracks(gltf, buffers, p)
     order, parents = _joint_nodes(gltf)
     pos, _ = global_transforms(trans[:, order], rots[:, order], np.asarray(parents))
     return [gltf.nodes[k].name or f"node{k}" for k in order], pos, fps
@@ -563,7 +585,7 @@ def read_gltf(path: str | os.PathLike[str]) -> Motion:
     gltf, buffers = _load(p)
     if not gltf.nodes:
         raise ParseError("the file holds no nodes (no skeleton to read)", str(p))
-    trans, rots, fps = _node_tracks(gltf, buffers)
+    trans, rots, fps = _tracks(gltf, buffers, p)
     extras = gltf.extras.get(_EXTRAS_KEY) if isinstance(gltf.extras, dict) else None
     if extras and "skeleton" in extras:
         skel = skeleton_from_dict(extras["skeleton"])
