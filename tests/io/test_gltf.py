@@ -176,3 +176,14 @@ def test_truncated_buffer_is_one_parse_error(tmp_path):
     (tmp_path / "t.bin").write_bytes(data[: len(data) // 2])
     with pytest.raises(ParseError, match=r"t\.gltf"):
         cc.load(tmp_path / "t.gltf")
+
+
+def test_save_with_lock_feet(walk_69_01, tmp_path):
+    from cyclecoord.quality.contacts import foot_contacts, foot_skating
+
+    m = walk_69_01[200:330]
+    contacts = foot_contacts(m)
+    assert foot_skating(m, contacts).skating_frames > 0
+    cc.save(m, tmp_path / "locked.glb", lock_feet=True)
+    back = cc.load(tmp_path / "locked.glb")
+    assert foot_skating(back, contacts).skating_frames <= 1
