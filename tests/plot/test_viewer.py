@@ -124,7 +124,7 @@ def test_page_in_headless_chromium(walk, tmp_path):
         "--disable-gpu",
         "--enable-unsafe-swiftshader",
         "--use-angle=swiftshader",
-        "--virtual-time-budget=5000",
+        "--virtual-time-budget=3000",
         "--dump-dom",
         page.as_uri(),
     ]
