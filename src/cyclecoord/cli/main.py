@@ -464,7 +464,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
         folder = Path(args.extract)
         folder.mkdir(parents=True, exist_ok=True)
         for mc in motion_cycles(res):
-            out = folder / f"motion{mc.motion}_cycle.bvh"
+            out = folder / f"motion{mc.motion}_cycle.{args.extract_format}"
             save(mc.cycle, out)
             how = (f"phase from H1 {mc.phase_from}'s coordinate on {mc.n_frames_used} excited frames"
                    if mc.phase_from != "time" else f"phase from time over {mc.n_frames_used} frames")
@@ -763,7 +763,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
 #: ``add_parser(subparsers)``, which adds its parser and sets ``func`` to the function that
 #: runs it (taking the parsed arguments, returning the exit code).  Modules must import
 #: their heavy dependencies inside that function so ``cyclecoord --help`` stays fast.
-COMMAND_MODULES: tuple[str, ...] = ()
+COMMAND_MODULES: tuple[str, ...] = ("view", "feet")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -824,7 +824,7 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("-v", "--verbose", action="store_true",
                    help="also print the barcode, the chosen class, the cocycle check, landmarks and timings")
     o = e.add_argument_group("output")
-    o.add_argument("-o", "--output", metavar="OUT", help="write the cycle (.bvh, .amc, .npz or .csv)")
+    o.add_argument("-o", "--output", metavar="OUT", help="write the cycle (.bvh, .amc, .npz, .csv, .glb, .gltf, .usda, .usdc)")
     o.add_argument("--report", metavar="R.json", help="write a JSON report (barcode, coordinate, figures, timings)")
     o.add_argument("--plot", metavar="DIR",
                    help="write figures into DIR (created if missing): barcode, pca, density, coordinate, channels (.png)")
@@ -874,6 +874,8 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--no-progress", action="store_true", help="no progress bar over the windows")
     d.add_argument("--report", metavar="R.json", help="JSON: segments, labels per frame, classes, windows, barcode")
     d.add_argument("--extract", metavar="OUTDIR", help="write a typical cycle (BVH) for each detected motion")
+    d.add_argument("--extract-format", default="bvh", choices=("bvh", "glb", "gltf", "usda", "usdc", "npz", "csv"),
+                   help="file format of the --extract cycles (default bvh)")
     d.add_argument("--plot", metavar="DIR", help="write the barcode (barcode.png), the coordinates with segments shaded (coordinates.png) and the windows coloured by motion (windows.png)")
     d.set_defaults(func=cmd_detect)
 
@@ -932,7 +934,7 @@ def build_parser() -> argparse.ArgumentParser:
         m.add_argument("--strict", action="store_true",
                        help="refuse to write an output that fails the plausibility checks (exit 1)")
         o = q.add_argument_group("output")
-        o.add_argument("-o", "--output", metavar="OUT", help="write the result (.bvh, .amc, .npz or .csv)")
+        o.add_argument("-o", "--output", metavar="OUT", help="write the result (.bvh, .amc, .npz, .csv, .glb, .gltf, .usda, .usdc)")
         o.add_argument("--report", metavar="R.json",
                        help="write a JSON report (inputs, alignment, figures, plausibility)")
 

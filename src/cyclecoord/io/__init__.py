@@ -1,9 +1,11 @@
 """Motion file input/output: ``load``/``save``/``convert`` dispatching on the file suffix.
 
 Supported formats: ``.amc`` (Acclaim motion, with its ``.asf`` skeleton), ``.bvh``
-(Biovision Hierarchy), ``.npz`` (NumPy archive of a whole motion and skeleton) and
-``.csv`` (a ``joint.dof`` table).  The per-format readers and writers are re-exported
-here; the ASF/AMC ones are imported on first use.
+(Biovision Hierarchy), ``.npz`` (NumPy archive of a whole motion and skeleton), ``.csv``
+(a ``joint.dof`` table), ``.glb``/``.gltf`` (glTF 2.0, :mod:`~cyclecoord.io.gltf`) and
+``.usda``/``.usdc``/``.usd`` (UsdSkel through the optional usd-core,
+:mod:`~cyclecoord.io.usd`).  The per-format readers and writers are re-exported here; the
+ASF/AMC, glTF and USD ones are imported on first use.
 """
 
 from __future__ import annotations
@@ -38,6 +40,10 @@ __all__ = [
     "write_asf",
     "read_amc",
     "write_amc",
+    "read_gltf",
+    "write_gltf",
+    "read_usd",
+    "write_usd",
 ]
 
 #: Suffix -> description, in the order error messages list them.
@@ -46,16 +52,32 @@ SUPPORTED_FORMATS = {
     ".bvh": "Biovision Hierarchy",
     ".npz": "NumPy archive written by cyclecoord",
     ".csv": "CSV table with a joint.dof header",
+    ".glb": "glTF 2.0 binary",
+    ".gltf": "glTF 2.0 JSON with a .bin beside it",
+    ".usda": "USD (UsdSkel) text, needs usd-core",
+    ".usdc": "USD (UsdSkel) binary crate, needs usd-core",
+    ".usd": "USD (UsdSkel), crate encoding, needs usd-core",
 }
-_LAZY = {"read_asf", "write_asf", "read_amc", "write_amc"}
+_LAZY = {
+    "read_asf": "asfamc",
+    "write_asf": "asfamc",
+    "read_amc": "asfamc",
+    "write_amc": "asfamc",
+    "read_gltf": "gltf",
+    "write_gltf": "gltf",
+    "read_usd": "usd",
+    "write_usd": "usd",
+}
+_GLTF = (".glb", ".gltf")
+_USD = (".usda", ".usdc", ".usd")
 
 
 def __getattr__(name: str) -> Any:
-    """Import the ASF/AMC functions on first access (PEP 562)."""
+    """Import the ASF/AMC, glTF and USD functions on first access (PEP 562)."""
     if name in _LAZY:
-        from . import asfamc
+        import importlib
 
-        return getattr(asfamc, name)
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
@@ -95,7 +117,8 @@ def load(
     Parameters
     ----------
     path : path-like
-        ``.amc``, ``.bvh``, ``.npz`` or ``.csv`` (case-insensitive suffix).
+        ``.amc``, ``.bvh``, ``.npz``, ``.csv``, ``.glb``/``.gltf`` or ``.usda``/``.usdc``/``.usd``
+        (case-insensitive suffix).
     skeleton : Skeleton or path, optional
         For AMC: the skeleton or ``.asf`` path (passed to
         :func:`~cyclecoord.io.asfamc.read_amc`).  For NPZ/CSV: attached to (or replacing
@@ -122,6 +145,15 @@ def load(
     if p.is_dir():
         raise ParseError(f"is a directory, expected a motion file ({_formats()})", str(p))
     rate = _check_fps(fps)
+    if suffix in _GLTF + _USD:
+        if skeleton is not None:
+            raise ParameterError(f"{p}: a {suffix} file carries its own skeleton; do not pass skeleton=")
+        if suffix in _GLTF:
+            from .gltf import read_gltf as reader
+        else:
+            from .usd import read_usd as reader
+        motion = reader(p)
+        return motion if rate is None else replace(motion, fps=rate)
     if suffix == ".amc":
         from .asfamc import read_amc
 
@@ -207,7 +239,7 @@ def save(motion: Motion, path: str | os.PathLike[str], **kwargs: Any) -> None:
     motion : Motion
         The motion to write.
     path : path-like
-        ``.amc``, ``.bvh``, ``.npz`` or ``.csv``.
+        Any suffix of :data:`SUPPORTED_FORMATS`.
     **kwargs
         Per format:
 
@@ -219,7 +251,13 @@ def save(motion: Motion, path: str | os.PathLike[str], **kwargs: Any) -> None:
           already describes the motion's skeleton it is reused, otherwise
           :class:`ParameterError` asks for ``asf_path``.
         * ``.bvh``: ``rotation_order`` (see :func:`~cyclecoord.io.bvh.write_bvh`).
+        * ``.glb``, ``.gltf``: ``scale`` (metres per length unit) and ``mesh`` (see
+          :func:`~cyclecoord.io.gltf.write_gltf`).
+        * ``.usda``, ``.usdc``, ``.usd``: ``meters_per_unit`` (see
+          :func:`~cyclecoord.io.usd.write_usd`).
         * ``.npz``, ``.csv``: none.
+        * every format: ``lock_feet`` (default False): pin planted feet first with
+          :func:`~cyclecoord.synthesis.footlock.lock_feet` (needs a skeleton).
 
     Raises
     ------
@@ -231,6 +269,22 @@ def save(motion: Motion, path: str | os.PathLike[str], **kwargs: Any) -> None:
     """
     p = Path(path)
     suffix = _suffix(p)
+    if kwargs.pop("lock_feet", False):
+        from ..synthesis.footlock import lock_feet
+
+        motion = lock_feet(motion).motion
+    if suffix in _GLTF:
+        _check_kwargs(suffix, kwargs, ("scale", "mesh"))
+        from .gltf import write_gltf
+
+        write_gltf(motion, p, **kwargs)
+        return
+    if suffix in _USD:
+        _check_kwargs(suffix, kwargs, ("meters_per_unit",))
+        from .usd import write_usd
+
+        write_usd(motion, p, **kwargs)
+        return
     if suffix == ".amc":
         _check_kwargs(suffix, kwargs, ("asf_path", "write_skeleton"))
         from .asfamc import write_amc

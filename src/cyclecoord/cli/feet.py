@@ -1,0 +1,130 @@
+"""``cyclecoord feet``: foot contacts and foot skating of a motion, and foot locking."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+
+def add_parser(subparsers) -> None:
+    p = subparsers.add_parser(
+        "feet",
+        help="foot contacts and foot skating; --lock pins planted feet (small leg IK)",
+        description=(
+            "Find when each foot point (ankle and toe of each leg) is planted, from forward "
+            "kinematics with thresholds scaled to the leg length and a floor estimated from "
+            "the motion, and measure foot skating: the horizontal speed of planted feet and "
+            "the frames on which a planted foot moves faster than --skate-speed. With --lock "
+            "and -o, planted feet are pinned by re-solving each leg's thigh, shin and foot "
+            "rotations (the rest of the body is untouched) and the result is written in the "
+            "format of OUT's suffix."
+        ),
+        epilog=(
+            "examples:\n"
+            "  cyclecoord feet 69_01.amc --frames 200:450\n"
+            "  cyclecoord feet cycle.bvh --cycle --lock -o cycle_locked.glb --report feet.json"
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("input", metavar="INPUT", help="motion file with a skeleton")
+    p.add_argument("--frames", metavar="A:B", help="0-based half-open frame range")
+    p.add_argument("--skeleton", metavar="ASF", help="skeleton for an .amc INPUT")
+    p.add_argument("--fps", type=float, metavar="HZ", help="frame rate of INPUT")
+    p.add_argument(
+        "--height",
+        type=float,
+        default=0.05,
+        metavar="H",
+        help="contact height band, leg lengths (0.05)",
+    )
+    p.add_argument(
+        "--speed",
+        type=float,
+        default=0.5,
+        metavar="V",
+        help="planted feet move slower than V leg lengths/s (0.5)",
+    )
+    p.add_argument(
+        "--skate-speed",
+        type=float,
+        default=0.1,
+        metavar="V",
+        help="a planted foot faster than V leg lengths/s skates (0.1)",
+    )
+    p.add_argument("--lock", action="store_true", help="pin planted feet (needs -o)")
+    p.add_argument(
+        "--cycle",
+        action="store_true",
+        help="INPUT is a loop: contacts and locks wrap around the seam",
+    )
+    p.add_argument("-o", "--output", metavar="OUT", help="write the (locked) motion")
+    p.add_argument("--report", metavar="JSON", help="write contacts and skating figures")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..errors import ParameterError
+    from ..io import save
+    from ..quality.contacts import contact_runs, foot_contacts, foot_skating
+    from .main import _check_output, _write_json, load_input
+    from .view import _range
+
+    if args.lock and not args.output:
+        raise ParameterError("--lock writes the locked motion: give -o OUT")
+    _check_output(args.output)
+    _check_output(args.report, "report")
+    for out in (args.output, args.report):
+        if out and Path(out).exists() and Path(out).resolve() == Path(args.input).resolve():
+            raise ParameterError(f"{out} is the input; choose another output name")
+    motion = load_input(args.input, args.skeleton, args.fps).window(_range(args.frames))
+    options = {"height": args.height, "speed": args.speed}
+    contacts = foot_contacts(motion, **options)
+    skating = foot_skating(motion, contacts, skate_speed=args.skate_speed)
+    print(
+        f"{Path(args.input).name}: {motion.n_frames} frames, leg length "
+        f"{contacts.leg_length:.3g} units, floor at {contacts.floor:.3g}"
+    )
+    for i, f in enumerate(contacts.feet):
+        runs = contact_runs(contacts.planted[:, i])
+        shown = ", ".join(f"{a}:{b}" for a, b in runs[:6]) + (" ..." if len(runs) > 6 else "")
+        print(f"  {f:>12}: planted {100 * contacts.planted[:, i].mean():5.1f}% ({shown})")
+    print(skating.summary())
+    payload = {
+        "input": args.input,
+        "frames": motion.n_frames,
+        "feet": list(contacts.feet),
+        "floor": contacts.floor,
+        "leg_length": contacts.leg_length,
+        "contacts": {f: contact_runs(contacts.planted[:, i]) for i, f in enumerate(contacts.feet)},
+        "skating": skating.to_dict(),
+    }
+    result = motion
+    if args.lock:
+        from ..synthesis.footlock import lock_feet
+
+        locked = lock_feet(motion, contacts, cyclic=args.cycle)
+        after = foot_skating(locked.motion, contacts, skate_speed=args.skate_speed)
+        again = foot_skating(locked.motion, skate_speed=args.skate_speed, **options)
+        print(f"locked: {after.summary()}")
+        print(f"  contacts found again on the locked motion: {again.skating_frames} frames skating")
+        moved = {k: v for k, v in locked.joint_change.items() if v > 0}
+        print(
+            "  mean joint change (deg): "
+            + ", ".join(f"{k} {v:.2f}" for k, v in moved.items())
+            + f"; all {len(locked.joint_change)} joints {locked.mean_joint_change:.3f}"
+        )
+        payload["locked"] = {
+            "skating": after.to_dict(),
+            "skating_redetected": again.to_dict(),
+            "joint_change_deg": locked.joint_change,
+            "max_lock_error": locked.max_error,
+        }
+        result = locked.motion
+    if args.output:
+        save(result, args.output)
+        print(f"wrote {args.output}")
+    if args.report:
+        _write_json(args.report, json.loads(json.dumps(payload, default=float)))
+        print(f"wrote {args.report}")
+    return 0

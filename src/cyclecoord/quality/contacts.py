@@ -1,0 +1,514 @@
+"""Foot contacts and foot skating from forward kinematics.
+
+A foot point (ankle/heel or toe joint) is *planted* on a frame when it is close to the
+level it rests at on the floor and barely moves horizontally.  Both thresholds are scaled
+to the skeleton (its leg length), so the same defaults serve CMU's ASF units (about
+5.6 cm), BVH centimetres or metres.
+
+The floor is not assumed at height 0 (CMU root heights are not): :func:`foot_contacts`
+estimates it as a low quantile of the lowest foot point over the motion, and each foot
+point's own contact level (an ankle rests higher than a toe) as a low quantile of that
+point's height, kept within a band above the floor so that a foot that never touches down
+is not called planted at the top of its swing.
+
+:func:`foot_skating` measures how much planted feet slide: their mean horizontal speed
+and the fraction of frames on which a planted foot moves faster than a small threshold.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..motion import Motion
+from ..skeleton import Skeleton
+
+__all__ = [
+    "FootContacts",
+    "FootSkating",
+    "contact_runs",
+    "find_feet",
+    "foot_contacts",
+    "foot_skating",
+    "leg_length",
+    "skating_report",
+]
+
+#: Height band (fraction of leg length) above a point's contact level counted as "down".
+DEFAULT_HEIGHT = 0.05
+#: Horizontal speed (leg lengths per second) under which a low foot point is planted.
+DEFAULT_SPEED = 0.5
+#: Horizontal speed (leg lengths per second) above which a planted point skates.
+DEFAULT_SKATE_SPEED = 0.1
+#: Shortest contact kept and longest gap closed, in seconds.
+DEFAULT_MIN_DURATION = 0.03
+#: Quantile of heights taken as the floor / a point's contact level.
+_LOW_QUANTILE = 0.05
+#: A point's contact level may lie at most this many leg lengths above the floor.
+_MAX_LEVEL = 0.25
+
+_UP = {"x": 0, "y": 1, "z": 2}
+
+
+# --------------------------------------------------------------------- results
+@dataclass(frozen=True)
+class FootContacts:
+    """Per-frame contact state of the foot points of a motion.
+
+    Attributes
+    ----------
+    feet : tuple of str
+        Joint names of the foot points, e.g. ``("lfoot", "ltoes", "rfoot", "rtoes")``
+        (ankle then toe of each leg).
+    sides : tuple of str
+        ``"left"`` or ``"right"`` per foot point.
+    planted : ndarray of bool, shape (T, F)
+        Whether each foot point is planted on each frame.
+    height : ndarray, shape (T, F)
+        Height of each point above its own contact level (length units).
+    speed : ndarray, shape (T, F)
+        Horizontal speed of each point (length units per second, central differences).
+    floor : float
+        Estimated floor height along the up axis (length units), from the lowest foot
+        points including the toe end sites.
+    contact_level : ndarray, shape (F,)
+        Absolute height each point rests at when planted (``height`` is relative to it).
+    leg_length : float
+        Hip-to-ankle length of the skeleton (thigh plus shin), the scale of thresholds.
+    height_threshold, speed_threshold : float
+        Thresholds used, in length units and length units per second.
+    fps : float
+        Frame rate of the motion.
+    up : int
+        Index of the up axis (1 for y).
+    """
+
+    feet: tuple[str, ...]
+    sides: tuple[str, ...]
+    planted: np.ndarray
+    height: np.ndarray
+    speed: np.ndarray
+    floor: float
+    contact_level: np.ndarray
+    leg_length: float
+    height_threshold: float
+    speed_threshold: float
+    fps: float
+    up: int = 1
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.planted.shape[0])
+
+    def side_planted(self, side: str) -> np.ndarray:
+        """Frames ``(T,)`` on which any point of the ``"left"`` or ``"right"`` foot is planted."""
+        cols = [i for i, s in enumerate(self.sides) if s == side]
+        if not cols:
+            raise ParameterError(f"no {side} foot among {self.feet}")
+        return self.planted[:, cols].any(axis=1)
+
+    def summary(self) -> str:
+        """One line: fraction of frames each foot point is planted."""
+        parts = [f"{n} {100 * self.planted[:, i].mean():.0f}%" for i, n in enumerate(self.feet)]
+        return "planted: " + ", ".join(parts)
+
+
+@dataclass(frozen=True)
+class FootSkating:
+    """How much planted feet slide.
+
+    Attributes
+    ----------
+    feet : tuple of str
+        Foot point names, as in :class:`FootContacts`.
+    mean_speed : float
+        Mean horizontal speed of planted foot points over all planted (frame, point)
+        pairs, in length units per second (0 when nothing is planted).
+    mean_speed_legs : float
+        The same in leg lengths per second.
+    skating_fraction : float
+        Fraction of frames on which at least one planted point moves faster than the
+        skate threshold.
+    skating_frames : int
+        Number of such frames.
+    foot_mean_speed : ndarray, shape (F,)
+        Mean horizontal speed of each point while planted (NaN for a point never
+        planted), length units per second.
+    foot_skating_fraction : ndarray, shape (F,)
+        Fraction of frames each point skates.
+    skating : ndarray of bool, shape (T, F)
+        Which point skates on which frame.
+    skate_threshold : float
+        Speed above which a planted point skates, length units per second.
+    leg_length : float
+        The scale used, length units.
+    """
+
+    feet: tuple[str, ...]
+    mean_speed: float
+    mean_speed_legs: float
+    skating_fraction: float
+    skating_frames: int
+    foot_mean_speed: np.ndarray
+    foot_skating_fraction: np.ndarray
+    skating: np.ndarray
+    skate_threshold: float
+    leg_length: float
+
+    def to_dict(self) -> dict:
+        """JSON-ready figures (per foot point as name -> value)."""
+        return {
+            "mean_speed_units_per_s": self.mean_speed,
+            "mean_speed_leg_lengths_per_s": self.mean_speed_legs,
+            "skating_frames": self.skating_frames,
+            "skating_fraction": self.skating_fraction,
+            "skate_threshold_units_per_s": self.skate_threshold,
+            "leg_length": self.leg_length,
+            "per_foot": {
+                f: {
+                    "mean_speed_units_per_s": (None if not np.isfinite(v) else float(v)),
+                    "skating_fraction": float(r),
+                }
+                for f, v, r in zip(self.feet, self.foot_mean_speed, self.foot_skating_fraction)
+            },
+        }
+
+    def summary(self) -> str:
+        """One line for reports."""
+        return (
+            f"foot skating: {self.mean_speed:.3g} units/s "
+            f"({self.mean_speed_legs:.3g} leg lengths/s) while planted, "
+            f"{self.skating_frames} frames skating ({100 * self.skating_fraction:.1f}%)"
+        )
+
+
+# ---------------------------------------------------------------- skeleton help
+def _normalise(name: str) -> str:
+    name = name.rsplit(":", 1)[-1]  # "mixamorig:LeftFoot" -> "LeftFoot"
+    return re.sub(r"[^a-z0-9]", "", name.lower())
+
+
+def _side_and_kind(name: str) -> tuple[str, str] | None:
+    """``(side, kind)`` for a foot-like joint name, kind ``"ankle"`` or ``"toe"``."""
+    n = _normalise(name)
+    if n.endswith("end") or "nub" in n:
+        return None
+    for side, prefixes in (("left", ("left", "l")), ("right", ("right", "r"))):
+        for pre in prefixes:
+            if n.startswith(pre):
+                rest = n[len(pre) :]
+                break
+        else:
+            continue
+        if rest in ("foot", "ankle", "heel"):
+            return side, "ankle"
+        if rest in ("toe", "toes", "toebase", "ball", "toe0", "toe1"):
+            return side, "toe"
+    return None
+
+
+def find_feet(skeleton: Skeleton) -> tuple[str, ...]:
+    """Foot point joint names of a skeleton: ankle then toe of the left, then right leg.
+
+    Recognises CMU ASF names (``lfoot``, ``ltoes``, ...) and the usual BVH ones
+    (``LeftFoot``, ``LeftToeBase``, ``RightAnkle``, ``mixamorig:LeftToe`` ...).
+
+    Raises
+    ------
+    ParameterError
+        If no ankle or toe joint is found for either leg.
+    """
+    found: dict[tuple[str, str], str] = {}
+    for j in skeleton.joints:
+        sk = _side_and_kind(j.name)
+        if sk is not None and sk not in found:
+            found[sk] = j.name
+    feet = [found[(s, k)] for s in ("left", "right") for k in ("ankle", "toe") if (s, k) in found]
+    sides = {s for s, _ in found}
+    if sides != {"left", "right"}:
+        raise ParameterError(
+            f"skeleton {skeleton.name or '(unnamed)'}: no foot joints found for both legs "
+            "(expected names like lfoot/ltoes or LeftFoot/LeftToeBase); pass feet= explicitly"
+        )
+    return tuple(feet)
+
+
+def _side_of(name: str) -> str:
+    sk = _side_and_kind(name)
+    if sk is not None:
+        return sk[0]
+    n = _normalise(name)
+    if n.startswith(("left", "l")):
+        return "left"
+    if n.startswith(("right", "r")):
+        return "right"
+    return "?"
+
+
+def _ankle_of(skeleton: Skeleton, feet: tuple[str, ...], foot: str) -> int:
+    """Index of the highest foot point on ``foot``'s chain (the ankle), foot itself if alone."""
+    idx = skeleton.index(foot)
+    members = {skeleton.index(f) for f in feet}
+    ankle = idx
+    p = skeleton.joints[idx].parent
+    while p >= 0:
+        if p in members:
+            ankle = p
+        p = skeleton.joints[p].parent
+    return ankle
+
+
+def leg_length(skeleton: Skeleton, feet: tuple[str, ...] | None = None) -> float:
+    """Mean hip-to-ankle length (thigh plus shin bone) over the legs, in length units.
+
+    The ankle is the highest foot point of each leg; its offset is the shin and its
+    parent's offset the thigh.
+    """
+    feet = find_feet(skeleton) if feet is None else tuple(feet)
+    ankles = sorted({_ankle_of(skeleton, feet, f) for f in feet})
+    lengths = []
+    for a in ankles:
+        shin = float(np.linalg.norm(skeleton.joints[a].offset))
+        parent = skeleton.joints[a].parent
+        thigh = float(np.linalg.norm(skeleton.joints[parent].offset)) if parent > 0 else 0.0
+        lengths.append(shin + thigh)
+    value = float(np.mean(lengths)) if lengths else 0.0
+    if not value > 0:
+        raise ParameterError(
+            "cannot measure the leg length: the foot joints have no bones above them"
+        )
+    return value
+
+
+def _check_motion(motion: Motion) -> Skeleton:
+    if motion.skeleton is None:
+        raise ParameterError(
+            f"{motion.source or 'motion'}: foot contacts need a skeleton "
+            "(forward kinematics); this motion has none"
+        )
+    if motion.n_frames < 2:
+        raise ParameterError(
+            f"{motion.source or 'motion'}: foot contacts need at least 2 frames, "
+            f"got {motion.n_frames}"
+        )
+    bad = np.flatnonzero(~np.isfinite(motion.frames).all(axis=1))
+    if bad.size:
+        raise ParameterError(
+            f"{motion.source or 'motion'}: frame {motion.start_frame + int(bad[0])} holds "
+            f"NaN or infinite values ({bad.size} such frames)"
+        )
+    return motion.skeleton
+
+
+def contact_runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """Half-open ``(start, stop)`` frame ranges where a boolean ``(T,)`` mask is true."""
+    m = np.asarray(mask, dtype=bool).astype(np.int8)
+    d = np.diff(np.concatenate([[0], m, [0]]))
+    starts = np.flatnonzero(d == 1)
+    stops = np.flatnonzero(d == -1)
+    return list(zip(starts.tolist(), stops.tolist()))
+
+
+def _clean(mask: np.ndarray, min_frames: int) -> np.ndarray:
+    """Close gaps and drop runs shorter than ``min_frames`` in a ``(T,)`` mask."""
+    out = mask.copy()
+    if min_frames <= 1:
+        return out
+    for a, b in contact_runs(~out):
+        if 0 < a and b < out.size and b - a < min_frames:
+            out[a:b] = True
+    for a, b in contact_runs(out):
+        if b - a < min_frames:
+            out[a:b] = False
+    return out
+
+
+# -------------------------------------------------------------------- contacts
+def foot_contacts(
+    motion: Motion,
+    feet: tuple[str, ...] | list[str] | None = None,
+    *,
+    height: float = DEFAULT_HEIGHT,
+    speed: float = DEFAULT_SPEED,
+    min_duration: float = DEFAULT_MIN_DURATION,
+    up: str = "y",
+    floor: float | None = None,
+) -> FootContacts:
+    """Which foot points are planted on each frame.
+
+    Parameters
+    ----------
+    motion : Motion
+        Any motion with a skeleton.
+    feet : sequence of str, optional
+        Foot joint names; default :func:`find_feet` (``lfoot ltoes rfoot rtoes`` on a
+        CMU skeleton).
+    height : float
+        Height band above a point's contact level, as a fraction of the leg length
+        (0.05: about 4 cm on an adult).
+    speed : float
+        Horizontal speed limit of a planted point, in leg lengths per second (0.5:
+        about 0.4 m/s).
+    min_duration : float
+        Contacts shorter than this (seconds) are dropped and gaps shorter than this
+        closed.
+    up : {"x", "y", "z"}
+        Up axis of the skeleton's world frame (``"y"`` for ASF and BVH).
+    floor : float, optional
+        Floor height when known; estimated from the motion otherwise.
+
+    Returns
+    -------
+    FootContacts
+
+    Raises
+    ------
+    ParameterError
+        A motion without a skeleton, fewer than 2 frames, non-finite frames, unknown
+        foot joints or non-positive thresholds.
+    """
+    skel = _check_motion(motion)
+    if up not in _UP:
+        raise ParameterError(f"up axis must be one of x, y, z, got {up!r}")
+    for label, value in (("height", height), ("speed", speed)):
+        if not (np.isfinite(value) and value > 0):
+            raise ParameterError(f"{label} threshold must be a positive number, got {value!r}")
+    if not (np.isfinite(min_duration) and min_duration >= 0):
+        raise ParameterError(f"min_duration must be >= 0 seconds, got {min_duration!r}")
+    feet = find_feet(skel) if feet is None else tuple(feet)
+    if not feet:
+        raise ParameterError("feet must name at least one joint")
+    for f in feet:
+        if f not in skel.names:
+            raise ParameterError(
+                f"no joint {f!r} in the skeleton (joints: {', '.join(skel.names)})"
+            )
+    axis = _UP[up]
+    horiz = [k for k in range(3) if k != axis]
+    legs = leg_length(skel, feet)
+
+    pos = motion.positions()
+    cols = [pos.names.index(f) for f in feet]
+    # lowest points of the feet: the foot points and the end sites below them
+    low_cols = list(cols)
+    for i, n in enumerate(pos.names):
+        if n.endswith("/end") and pos.parents[i] in cols:
+            low_cols.append(i)
+    y = pos.positions[:, cols, axis]
+    if floor is None:
+        lowest = pos.positions[:, low_cols, axis].min(axis=1)
+        floor_level = float(np.quantile(lowest, _LOW_QUANTILE))
+    else:
+        floor_level = float(floor)
+    level = np.quantile(y, _LOW_QUANTILE, axis=0)
+    level = np.clip(level, floor_level, floor_level + _MAX_LEVEL * legs)
+    rel = y - level
+
+    xz = pos.positions[:, cols][:, :, horiz]
+    vel = np.gradient(xz, axis=0) * motion.fps
+    spd = np.linalg.norm(vel, axis=2)
+
+    h_thr = height * legs
+    v_thr = speed * legs
+    planted = (rel < h_thr) & (spd < v_thr)
+    min_frames = round(min_duration * motion.fps)
+    planted = np.stack([_clean(planted[:, i], min_frames) for i in range(len(feet))], axis=1)
+    return FootContacts(
+        feet=feet,
+        sides=tuple(_side_of(f) for f in feet),
+        planted=planted,
+        height=rel,
+        speed=spd,
+        floor=floor_level,
+        contact_level=level,
+        leg_length=legs,
+        height_threshold=h_thr,
+        speed_threshold=v_thr,
+        fps=motion.fps,
+        up=axis,
+    )
+
+
+def foot_skating(
+    motion: Motion,
+    contacts: FootContacts | None = None,
+    *,
+    skate_speed: float = DEFAULT_SKATE_SPEED,
+    **contact_options,
+) -> FootSkating:
+    """Horizontal sliding of planted feet.
+
+    Parameters
+    ----------
+    motion : Motion
+        Any motion with a skeleton.
+    contacts : FootContacts, optional
+        Contacts to measure on (computed with :func:`foot_contacts` and
+        ``contact_options`` when not given).  Speeds are always taken from ``motion``,
+        so contacts of an original motion can be used to measure an edited one.
+    skate_speed : float
+        A planted point moving faster than this (leg lengths per second; 0.1 is about
+        8 cm/s) skates.
+
+    Returns
+    -------
+    FootSkating
+    """
+    if not (np.isfinite(skate_speed) and skate_speed >= 0):
+        raise ParameterError(
+            f"skate_speed must be >= 0 leg lengths per second, got {skate_speed!r}"
+        )
+    if contacts is None:
+        contacts = foot_contacts(motion, **contact_options)
+    elif contact_options:
+        raise ParameterError("pass either contacts or contact options, not both")
+    else:
+        _check_motion(motion)
+    if contacts.n_frames != motion.n_frames:
+        raise ParameterError(
+            f"contacts cover {contacts.n_frames} frames, the motion has {motion.n_frames}"
+        )
+    pos = motion.positions()
+    cols = [pos.names.index(f) for f in contacts.feet]
+    horiz = [k for k in range(3) if k != contacts.up]
+    xz = pos.positions[:, cols][:, :, horiz]
+    spd = np.linalg.norm(np.gradient(xz, axis=0), axis=2) * motion.fps
+    planted = contacts.planted
+    thr = skate_speed * contacts.leg_length
+    skating = planted & (spd > thr)
+    n_planted = planted.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        foot_mean = np.where(n_planted > 0, (spd * planted).sum(axis=0) / n_planted, np.nan)
+    total = int(planted.sum())
+    mean = float((spd * planted).sum() / total) if total else 0.0
+    frames = int(skating.any(axis=1).sum())
+    return FootSkating(
+        feet=contacts.feet,
+        mean_speed=mean,
+        mean_speed_legs=mean / contacts.leg_length,
+        skating_fraction=frames / motion.n_frames,
+        skating_frames=frames,
+        foot_mean_speed=foot_mean,
+        foot_skating_fraction=skating.mean(axis=0),
+        skating=skating,
+        skate_threshold=thr,
+        leg_length=contacts.leg_length,
+    )
+
+
+def skating_report(motion: Motion, **options) -> dict | None:
+    """Foot skating of ``motion`` as a JSON-ready dict for reports, or ``None`` when it
+    cannot be measured (no skeleton, no recognisable feet, fewer than 2 frames)."""
+    try:
+        contacts = foot_contacts(motion, **options)
+    except ParameterError:
+        return None
+    out = foot_skating(motion, contacts).to_dict()
+    out["planted_fraction"] = {
+        f: float(contacts.planted[:, i].mean()) for i, f in enumerate(contacts.feet)
+    }
+    out["floor"] = contacts.floor
+    return out

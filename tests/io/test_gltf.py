@@ -1,0 +1,189 @@
+"""glTF 2.0 export: round trips through our reader and through the file's own nodes."""
+
+import json
+import struct
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.errors import ParameterError, ParseError
+from cyclecoord.io.gltf import (
+    default_scale,
+    gltf_joint_positions,
+    read_gltf,
+    write_gltf,
+)
+from cyclecoord.motion import Motion
+from cyclecoord.skeleton import Joint, Skeleton
+
+
+def _arm(T=5, fps=30.0):
+    skel = Skeleton(
+        (
+            Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
+            Joint("arm", 0, [0, 1, 0], ("rx", "rz"), "ZX", end_site=[1, 0, 0]),
+        ),
+        name="arm",
+        source_format="bvh",
+    )
+    frames = np.zeros((T, 8))
+    frames[:, 1] = 2.0  # root ty
+    frames[:, 4] = np.linspace(0, 90, T)  # root ry
+    frames[:, 7] = 30.0  # arm rz
+    return Motion(frames, skel.channels, fps=fps, skeleton=skel, source="arm")
+
+
+def _glb_json(path):
+    data = path.read_bytes()
+    magic, version, length = struct.unpack("<4sII", data[:12])
+    assert magic == b"glTF" and version == 2 and length == len(data)
+    n, kind = struct.unpack("<I4s", data[12:20])
+    assert kind == b"JSON" and (20 + n) % 4 == 0
+    return json.loads(data[20 : 20 + n])
+
+
+def _names_to_fk(names):
+    return [n[: -len("_end")] + "/end" if n.endswith("_end") else n for n in names]
+
+
+@pytest.mark.parametrize("suffix", [".glb", ".gltf"])
+def test_69_01_round_trip_every_frame(walk_69_01, tmp_path, suffix):
+    out = tmp_path / ("walk" + suffix)
+    cc.save(walk_69_01, out)
+    if suffix == ".gltf":
+        assert (tmp_path / "walk.bin").is_file()
+    fk = walk_69_01.positions()
+    names, pos, fps = gltf_joint_positions(out)
+    assert fps == 120 and pos.shape[0] == walk_69_01.n_frames
+    cols = [fk.names.index(n) for n in _names_to_fk(names)]
+    scale = default_scale(walk_69_01.skeleton)
+    err = np.abs(pos / scale - fk.positions[:, cols]).max(axis=(1, 2))
+    assert err.max() < 1e-3  # every frame, in ASF length units
+    back = cc.load(out)
+    assert back.channels == walk_69_01.channels and back.fps == 120
+    assert np.abs(back.positions().positions - fk.positions).max() < 1e-3
+
+
+def test_document_structure(tmp_path):
+    m = _arm()
+    out = tmp_path / "arm.glb"
+    write_gltf(m, out)
+    doc = _glb_json(out)
+    assert doc["asset"]["version"] == "2.0"
+    for view in doc["bufferViews"]:
+        assert view.get("byteOffset", 0) % 4 == 0
+    for acc in doc["accessors"]:
+        if acc["type"] != "MAT4":
+            assert "min" in acc and "max" in acc
+    anim = doc["animations"][0]
+    paths = sorted((c["target"]["node"], c["target"]["path"]) for c in anim["channels"])
+    assert paths == [(0, "rotation"), (0, "translation"), (1, "rotation")]
+    times = doc["accessors"][anim["samplers"][0]["input"]]
+    assert times["count"] == 5 and times["max"][0] == pytest.approx(4 / 30)
+    # the root's last rotation is 90 degrees about y: (x, y, z, w) = (0, s, 0, s)
+    g = read_gltf(out)
+    assert np.allclose(g.frames, m.frames, atol=1e-4)
+    names = [n["name"] for n in doc["nodes"]]
+    assert names[:3] == ["root", "arm", "arm_end"] and "sticks" in names
+    assert doc["skins"][0]["joints"] == [0, 1, 2]
+
+
+def test_quaternion_order(tmp_path):
+    import pygltflib
+
+    m = _arm()
+    out = tmp_path / "arm.glb"
+    write_gltf(m, out, mesh=False)
+    gltf = pygltflib.GLTF2.load(str(out))
+    anim = gltf.animations[0]
+    ch = next(c for c in anim.channels if c.target.node == 0 and c.target.path == "rotation")
+    acc = gltf.accessors[anim.samplers[ch.sampler].output]
+    view = gltf.bufferViews[acc.bufferView]
+    q = np.frombuffer(
+        gltf.binary_blob()[view.byteOffset : view.byteOffset + view.byteLength], np.float32
+    ).reshape(-1, 4)
+    s = np.sqrt(0.5)
+    assert np.allclose(q[-1], [0, s, 0, s], atol=1e-6)
+    assert np.allclose(q[0], [0, 0, 0, 1], atol=1e-6)
+
+
+def test_foreign_gltf_without_extras(tmp_path):
+    """A file from elsewhere (no cyclecoord extras) still reads, in metres."""
+    import pygltflib
+
+    m = _arm()
+    out = tmp_path / "arm.gltf"
+    write_gltf(m, out, mesh=False)
+    gltf = pygltflib.GLTF2.load(str(out))
+    gltf.extras = {}
+    (tmp_path / "plain.gltf").write_text(gltf.gltf_to_json())
+    back = read_gltf(tmp_path / "plain.gltf")
+    assert back.skeleton.names == ["root", "arm", "arm_end"]
+    fk = m.positions().positions  # root, arm, arm/end
+    assert np.abs(back.positions().positions[:, :3] - fk).max() < 1e-5
+
+
+def test_bad_input_writes_nothing(tmp_path):
+    m = _arm()
+    bare = Motion(m.frames, m.channels, fps=m.fps)
+    with pytest.raises(ParameterError, match="skeleton"):
+        cc.save(bare, tmp_path / "a.glb")
+    frames = m.frames.copy()
+    frames[3, 2] = np.nan
+    with pytest.raises(ParameterError, match="frame 3"):
+        cc.save(m.with_frames(frames), tmp_path / "b.gltf")
+    with pytest.raises(ParameterError, match="scale"):
+        write_gltf(m, tmp_path / "c.glb", scale=0)
+    with pytest.raises(ParameterError, match="unknown option"):
+        cc.save(m, tmp_path / "d.glb", rotation_order="XYZ")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_unreadable_files(tmp_path):
+    bad = tmp_path / "bad.glb"
+    bad.write_bytes(b"not a gltf at all")
+    with pytest.raises(ParseError, match="bad.glb"):
+        cc.load(bad)
+    with pytest.raises(ParseError, match="no such"):
+        read_gltf(tmp_path / "missing.gltf")
+    m = _arm()
+    write_gltf(m, tmp_path / "x.gltf")
+    (tmp_path / "x.bin").unlink()
+    with pytest.raises(ParseError, match="missing file x.bin"):
+        cc.load(tmp_path / "x.gltf")
+
+
+def test_cli_convert_to_glb(walk_69_01, tmp_path):
+    src = walk_69_01.source
+    out = tmp_path / "69_01.glb"
+    r = subprocess.run(
+        [sys.executable, "-m", "cyclecoord", "convert", src, "-o", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert r.returncode == 0, r.stderr
+    assert read_gltf(out).n_frames == walk_69_01.n_frames
+
+
+def test_truncated_buffer_is_one_parse_error(tmp_path):
+    m = _arm()
+    write_gltf(m, tmp_path / "t.gltf", mesh=False)
+    data = (tmp_path / "t.bin").read_bytes()
+    (tmp_path / "t.bin").write_bytes(data[: len(data) // 2])
+    with pytest.raises(ParseError, match=r"t\.gltf"):
+        cc.load(tmp_path / "t.gltf")
+
+
+def test_save_with_lock_feet(walk_69_01, tmp_path):
+    from cyclecoord.quality.contacts import foot_contacts, foot_skating
+
+    m = walk_69_01[200:330]
+    contacts = foot_contacts(m)
+    assert foot_skating(m, contacts).skating_frames > 0
+    cc.save(m, tmp_path / "locked.glb", lock_feet=True)
+    back = cc.load(tmp_path / "locked.glb")
+    assert foot_skating(back, contacts).skating_frames <= 1

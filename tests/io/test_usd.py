@@ -1,0 +1,56 @@
+"""UsdSkel export: joint positions computed by usd-core match our forward kinematics."""
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.errors import ParameterError, ParseError
+from cyclecoord.motion import Motion
+
+pytest.importorskip("pxr", reason="usd-core (the optional 'usd' extra) is not installed")
+
+from cyclecoord.io.usd import read_usd, usd_joint_positions, write_usd
+
+
+@pytest.mark.parametrize("suffix", [".usda", ".usdc"])
+def test_69_01_round_trip_every_frame(walk_69_01, tmp_path, suffix):
+    out = tmp_path / ("walk" + suffix)
+    cc.save(walk_69_01, out)
+    fk = walk_69_01.positions()
+    names, pos, fps = usd_joint_positions(out)
+    assert fps == 120 and pos.shape[0] == walk_69_01.n_frames
+    assert names == fk.names
+    assert np.abs(pos - fk.positions).max(axis=(1, 2)).max() < 1e-3
+    back = read_usd(out)
+    assert back.channels == walk_69_01.channels
+    assert np.abs(back.positions().positions - fk.positions).max() < 1e-3
+
+
+def test_stage_metadata(walk_69_01, tmp_path):
+    from pxr import Usd, UsdGeom, UsdSkel
+
+    out = tmp_path / "w.usda"
+    write_usd(walk_69_01[:10], out)
+    stage = Usd.Stage.Open(str(out))
+    assert UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.y
+    assert UsdGeom.GetStageMetersPerUnit(stage) == pytest.approx(0.0254 / 0.45)
+    assert stage.GetTimeCodesPerSecond() == 120
+    assert (stage.GetStartTimeCode(), stage.GetEndTimeCode()) == (0, 9)
+    skel = UsdSkel.Skeleton(stage.GetPrimAtPath("/Motion/Skeleton"))
+    assert len(skel.GetJointsAttr().Get()) == len(walk_69_01.positions().names)
+
+
+def test_bad_input_writes_nothing(walk_69_01, tmp_path):
+    m = walk_69_01[:5]
+    bare = Motion(m.frames, m.channels, fps=m.fps)
+    with pytest.raises(ParameterError, match="skeleton"):
+        cc.save(bare, tmp_path / "a.usda")
+    frames = m.frames.copy()
+    frames[2, 7] = np.inf
+    with pytest.raises(ParameterError, match="frame 2"):
+        cc.save(m.with_frames(frames), tmp_path / "b.usdc")
+    assert list(tmp_path.iterdir()) == []
+    bad = tmp_path / "bad.usda"
+    bad.write_text("#usda 1.0\n(\n broken")
+    with pytest.raises(ParseError, match="bad.usda"):
+        cc.load(bad)

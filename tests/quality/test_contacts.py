@@ -1,0 +1,174 @@
+"""Foot contacts and foot skating: synthetic legs with known answers and the CMU walk/jog."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from cyclecoord.errors import ParameterError
+from cyclecoord.motion import Motion
+from cyclecoord.quality.contacts import (
+    contact_runs,
+    find_feet,
+    foot_contacts,
+    foot_skating,
+    leg_length,
+)
+from cyclecoord.skeleton import Joint, Skeleton
+
+
+def legs_skeleton(
+    names=("lfemur", "ltibia", "lfoot", "ltoes", "rfemur", "rtibia", "rfoot", "rtoes"),
+):
+    """Root at hip height 10 over a floor at 3 (not 0); thigh 4, shin 4, foot 1, toes 0.5."""
+    lf, lt, lfo, lto, rf, rt, rfo, rto = names
+    joints = [Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX")]
+    for side, (f, t, fo, to), x in (
+        ("l", (lf, lt, lfo, lto), 1.0),
+        ("r", (rf, rt, rfo, rto), -1.0),
+    ):
+        base = len(joints)
+        joints += [
+            Joint(f, 0, [x, -1, 0], ("rx", "ry", "rz"), "ZYX"),
+            Joint(t, base, [0, -4, 0], ("rx",), "X"),
+            Joint(fo, base + 1, [0, -4, 0], ("rx",), "X"),
+            Joint(to, base + 2, [0, -0.5, 1], ("rx",), "X", end_site=[0, 0, 0.5]),
+        ]
+    return Skeleton(tuple(joints), name="legs")
+
+
+def make_motion(skel, T=120, fps=60.0, root_speed=0.0, lift_left=None):
+    channels = skel.channels
+    frames = np.zeros((T, len(channels)))
+    col = {c: i for i, c in enumerate(channels)}
+    frames[:, col[("root", "ty")]] = 10.0
+    frames[:, col[("root", "tz")]] = root_speed * np.arange(T) / fps
+    if lift_left is not None:
+        frames[lift_left, col[(skel.names[1], "rx")]] = -40.0  # swing the left thigh forward
+    return Motion(frames, channels, fps=fps, skeleton=skel)
+
+
+def test_find_feet_and_leg_length():
+    skel = legs_skeleton()
+    assert find_feet(skel) == ("lfoot", "ltoes", "rfoot", "rtoes")
+    assert leg_length(skel) == pytest.approx(8.0)
+    bvh = legs_skeleton(
+        (
+            "LeftUpLeg",
+            "LeftLeg",
+            "LeftFoot",
+            "LeftToeBase",
+            "RightUpLeg",
+            "RightLeg",
+            "RightFoot",
+            "RightToeBase",
+        )
+    )
+    assert find_feet(bvh) == ("LeftFoot", "LeftToeBase", "RightFoot", "RightToeBase")
+
+
+def test_standing_still_is_planted_and_does_not_skate():
+    m = make_motion(legs_skeleton())
+    c = foot_contacts(m)
+    assert c.planted.all()
+    assert c.floor == pytest.approx(10 - 1 - 8 - 0.5)  # toe end site, on a floor at 0.5
+    assert np.allclose(c.speed, 0)
+    s = foot_skating(m, c)
+    assert s.skating_frames == 0 and s.mean_speed == 0
+
+
+def test_sliding_feet_skate_at_the_root_speed():
+    skel = legs_skeleton()
+    v = 0.3 * leg_length(skel)  # below the contact speed limit, above the skate threshold
+    m = make_motion(skel, root_speed=v)
+    s = foot_skating(m)
+    assert s.skating_fraction == 1.0
+    assert s.mean_speed == pytest.approx(v)
+    assert s.mean_speed_legs == pytest.approx(0.3)
+    assert np.allclose(s.foot_mean_speed, v)
+
+
+def test_lifted_foot_is_not_planted():
+    T = 120
+    lift = np.zeros(T, bool)
+    lift[40:80] = True
+    m = make_motion(legs_skeleton(), T=T, lift_left=lift)
+    c = foot_contacts(m)
+    left = c.side_planted("left")
+    right = c.side_planted("right")
+    assert right.all()
+    assert not left[41:79].any()
+    assert left[:39].all() and left[81:].all()
+    assert contact_runs(~left) == [(39, 81)]  # central differences see the jump a frame early
+
+
+def test_errors():
+    skel = legs_skeleton()
+    m = make_motion(skel)
+    bare = Motion(m.frames, m.channels, fps=m.fps)
+    with pytest.raises(ParameterError, match="skeleton"):
+        foot_contacts(bare)
+    with pytest.raises(ParameterError, match="skeleton"):
+        foot_skating(bare)
+    frames = m.frames.copy()
+    frames[7, 3] = np.nan
+    with pytest.raises(ParameterError, match="frame 7"):
+        foot_contacts(m.with_frames(frames))
+    with pytest.raises(ParameterError, match="no joint"):
+        foot_contacts(m, feet=("nosuch",))
+    with pytest.raises(ParameterError, match="positive"):
+        foot_contacts(m, height=0)
+    other = Skeleton((Joint("root", -1, [0, 0, 0], ("tx",), ""), Joint("a", 0, [0, 1, 0])))
+    with pytest.raises(ParameterError, match="foot joints"):
+        find_feet(other)
+
+
+def _alternates(c):
+    """Left-only and right-only stance stretches alternate (merging double support)."""
+    left, right = c.side_planted("left"), c.side_planted("right")
+    labels = []
+    for lo, ro in zip(left & ~right, right & ~left):
+        lab = "L" if lo else "R" if ro else None
+        if lab and (not labels or labels[-1] != lab):
+            labels.append(lab)
+    return labels
+
+
+def test_walk_69_01_alternates(walk_69_01):
+    c = foot_contacts(walk_69_01)
+    assert c.feet == ("lfoot", "ltoes", "rfoot", "rtoes")
+    labels = _alternates(c)
+    assert len(labels) >= 4
+    assert all(a != b for a, b in itertools.pairwise(labels))
+    # a walk always has a foot down; the floor is estimated well above 0 for CMU
+    assert (c.side_planted("left") | c.side_planted("right")).mean() > 0.97
+    assert 0.2 < c.floor < 1.5
+    s = foot_skating(walk_69_01, c)
+    assert 0 < s.mean_speed_legs < 0.2
+
+
+def test_jog_143_01_alternates_with_flight(cmu_dir):
+    import cyclecoord as cc
+
+    m = cc.load(cmu_dir / "143" / "143_01.amc")
+    c = foot_contacts(m)
+    labels = _alternates(c)
+    assert len(labels) >= 4
+    assert all(a != b for a, b in itertools.pairwise(labels))
+    flight = ~(c.side_planted("left") | c.side_planted("right"))
+    assert flight.mean() > 0.3  # a jog leaves the ground
+
+
+def test_skating_report(walk_69_01):
+    from cyclecoord.quality.contacts import skating_report
+
+    rep = skating_report(walk_69_01[200:450])
+    assert rep["skating_frames"] > 0 and set(rep["per_foot"]) == {
+        "lfoot",
+        "ltoes",
+        "rfoot",
+        "rtoes",
+    }
+    assert 0 < rep["planted_fraction"]["lfoot"] < 1
+    bare = Motion(walk_69_01.frames[:5], walk_69_01.channels, fps=120)
+    assert skating_report(bare) is None

@@ -1,0 +1,112 @@
+"""Foot locking: sliding feet are pinned, only the legs move, and by little."""
+
+import numpy as np
+import pytest
+
+from cyclecoord.errors import ParameterError
+from cyclecoord.motion import Motion
+from cyclecoord.quality.contacts import foot_contacts, foot_skating
+from cyclecoord.skeleton import Joint, Skeleton
+from cyclecoord.synthesis.footlock import lock_feet
+
+
+# the two-legged skeleton of tests/quality/test_contacts.py
+def legs_skeleton(
+    names=("lfemur", "ltibia", "lfoot", "ltoes", "rfemur", "rtibia", "rfoot", "rtoes"),
+):
+    """Root at hip height 10 over a floor at 3 (not 0); thigh 4, shin 4, foot 1, toes 0.5."""
+    lf, lt, lfo, lto, rf, rt, rfo, rto = names
+    joints = [Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX")]
+    for side, (f, t, fo, to), x in (
+        ("l", (lf, lt, lfo, lto), 1.0),
+        ("r", (rf, rt, rfo, rto), -1.0),
+    ):
+        base = len(joints)
+        joints += [
+            Joint(f, 0, [x, -1, 0], ("rx", "ry", "rz"), "ZYX"),
+            Joint(t, base, [0, -4, 0], ("rx",), "X"),
+            Joint(fo, base + 1, [0, -4, 0], ("rx",), "X"),
+            Joint(to, base + 2, [0, -0.5, 1], ("rx",), "X", end_site=[0, 0, 0.5]),
+        ]
+    return Skeleton(tuple(joints), name="legs")
+
+
+def make_motion(skel, T=120, fps=60.0, root_speed=0.0, lift_left=None):
+    channels = skel.channels
+    frames = np.zeros((T, len(channels)))
+    col = {c: i for i, c in enumerate(channels)}
+    frames[:, col[("root", "ty")]] = 10.0
+    frames[:, col[("root", "tz")]] = root_speed * np.arange(T) / fps
+    if lift_left is not None:
+        frames[lift_left, col[(skel.names[1], "rx")]] = -40.0  # swing the left thigh forward
+    return Motion(frames, channels, fps=fps, skeleton=skel)
+
+
+def _walkish(T=120, fps=60.0):
+    """Legs swinging so each foot in turn slides slowly on the floor while the other swings."""
+    skel = legs_skeleton()
+    m = make_motion(skel, T=T, fps=fps, root_speed=2.0)
+    frames = m.frames.copy()
+    col = {c: i for i, c in enumerate(m.channels)}
+    t = np.arange(T) / fps
+    phase = 2 * np.pi * t / 1.0
+    frames[:, col[("lfemur", "rx")]] = -25 * np.clip(np.sin(phase), 0, None)
+    frames[:, col[("rfemur", "rx")]] = -25 * np.clip(-np.sin(phase), 0, None)
+    return m.with_frames(frames)
+
+
+def test_lock_removes_skating_and_touches_only_legs():
+    m = _walkish()
+    c = foot_contacts(m)
+    assert c.planted.any()
+    before = foot_skating(m, c)
+    assert before.skating_frames > 0  # the root slides at 0.25 leg lengths/s
+    r = lock_feet(m, c)
+    assert r.after.skating_frames == 0
+    assert r.max_error < 1e-3 * c.leg_length
+    root_cols = [i for i, (j, _) in enumerate(m.channels) if j == "root"]
+    assert np.array_equal(r.motion.frames[:, root_cols], m.frames[:, root_cols])
+    changed = {k for k, v in r.joint_change.items() if v > 0}
+    assert changed <= {"lfemur", "ltibia", "lfoot", "rfemur", "rtibia", "rfoot"}
+    assert r.joint_change["ltoes"] == 0 and r.joint_change["root"] == 0
+    # locked feet are pinned: horizontal positions constant over each contact
+    pos = r.motion.positions()["ltoes"]
+    runs = np.flatnonzero(c.planted[:, 1])
+    assert np.ptp(pos[runs[:5]][:, [0, 2]], axis=0).max() < 1e-3
+
+
+def test_lock_errors():
+    m = _walkish()
+    bare = Motion(m.frames, m.channels, fps=m.fps)
+    with pytest.raises(ParameterError, match="skeleton"):
+        lock_feet(bare)
+    with pytest.raises(ParameterError, match="blend"):
+        lock_feet(m, blend=-1)
+    with pytest.raises(ParameterError, match="cover"):
+        lock_feet(m[:50], foot_contacts(m))
+
+
+def test_lock_69_01_window(walk_69_01):
+    """The raw capture: stance runs are long, heel and toe locks nearly agree."""
+    m = walk_69_01[200:450]
+    r = lock_feet(m)
+    assert r.before.skating_frames > 100
+    assert r.after.skating_frames <= 2
+    legs = ("lfemur", "ltibia", "lfoot", "rfemur", "rtibia", "rfoot")
+    assert all(v == 0 for k, v in r.joint_change.items() if k not in legs)
+    assert r.mean_joint_change < 1.0
+
+
+@pytest.mark.slow
+def test_lock_69_01_extracted_cycle(walk_69_01):
+    """The README's figures: the 200:450 cycle skates; locked, no frame does and the legs
+    move less than a degree on average."""
+    from cyclecoord.periodic.pipeline import extract
+
+    cycle = extract(walk_69_01, frames=(200, 450), max_scale=50).cycle
+    r = lock_feet(cycle, cyclic=True)
+    assert r.before.skating_frames > 20
+    assert r.after.skating_frames == 0
+    legs = ("lfemur", "ltibia", "lfoot", "rfemur", "rtibia", "rfoot")
+    assert all(v == 0 for k, v in r.joint_change.items() if k not in legs)
+    assert max(r.joint_change[k] for k in legs) < 1.0
