@@ -203,6 +203,7 @@ class ExtractionResult:
             "jerk": self.jerk,
             "loop_closure": float(self.loop_closure),
             "bandwidth_frames": float(self.typical.bandwidth) if np.isfinite(self.typical.bandwidth) else None,
+            "foot_skating": _cycle_skating(self.cycle),
             "distance_to_cycle": self.distance,
             "landmarks": _landmark_report(self.estimator),
             "cocycle_check": {
@@ -213,6 +214,13 @@ class ExtractionResult:
             "timings": {k: round(float(v), 6) for k, v in self.timings.items()},
             "warnings": list(self.warnings),
         }
+
+
+def _cycle_skating(cycle: Motion) -> dict | None:
+    """Foot skating of the cycle (:func:`~cyclecoord.quality.contacts.skating_report`)."""
+    from ..quality.contacts import skating_report
+
+    return skating_report(cycle) if cycle is not None and cycle.skeleton is not None else None
 
 
 def _nullable(values: np.ndarray | None) -> list | None:
