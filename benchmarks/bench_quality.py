@@ -394,6 +394,8 @@ HEADERS = [
     "jerk/cut",
     "leg/cut",
     "low leg",
+    "joint/cut",
+    "low joint",
     "fem/tib",
     "seam",
     "p90/p10",
@@ -439,6 +441,8 @@ def table_rows(report: dict) -> list[list[str]]:
                     _f(q["jerk_ratio"]),
                     _f(q["min_leg_range_ratio"]),
                     q["min_leg_channel"] or "-",
+                    _f(q["min_joint_range_ratio"]),
+                    q["min_joint"] or "-",
                     _f(q["min_femur_tibia_ratio"]),
                     _f(q["seam"]),
                     _f(q["step_spread"], "{:.1f}"),
@@ -464,6 +468,8 @@ def format_report(report: dict) -> str:
         _table(HEADERS, table_rows(report)),
         "",
         "period: frames (ours: result.period_frames; loop cut: its length; average: mean piece);",
+        "joint/cut: smallest ratio over leg joints of the joint's range of motion (all its dofs,\n"
+        "1-2 frame marker spikes removed by a 5-frame running median; the 'legs' target);\n"
         "err%: vs the autocorrelation (ac) of the used frames; jerk/cut, leg/cut (smallest ratio",
         "of a leg channel's range, channel named), fem/tib (the same over femur and tibia only):",
         "over the loop cut's; p90/p10: spread of the cycle's frame steps (hold-and-snap; no",

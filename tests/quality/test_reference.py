@@ -19,6 +19,7 @@ from cyclecoord.quality.cycle_quality import (
     cycle_quality,
     foot_skating_speed,
     heading_change,
+    leg_joint_ranges,
     leg_ranges,
     period_error,
     root_closure,
@@ -232,6 +233,10 @@ def test_targets_thresholds():
         min_leg_range_ratio=0.85,
         min_leg_channel="lfemur.rx",
         min_femur_tibia_ratio=0.9,
+        joint_ranges={},
+        joint_range_ratios={},
+        min_joint_range_ratio=0.85,
+        min_joint="lfemur",
         step_spread=2.0,
         seam=1.5,
         coverage=1.0,
@@ -305,3 +310,20 @@ def test_benchmark_uses_used_frames_and_a_phase_with_gaps(steady, monkeypatch):
     avg = row["methods"]["average"]
     assert avg["extra"]["pieces"] == 5 and avg["period_frames"] == pytest.approx(100.0)
     assert row["methods"]["ours"]["period_error"] == pytest.approx(0.0, abs=0.02)
+
+
+def test_leg_joint_ranges_ignore_marker_spikes_but_keep_held_extremes():
+    cap = cc.datasets.make_periodic_capture(n_frames=240, period=120.0, noise=0.0, speed_variation=0.0,
+                                            random_state=0)
+    clip = cap.motion.window((0, 120))
+    base = leg_joint_ranges(clip)
+    i = clip.channel_index("ltoes", "rx")
+    spiked = clip.frames.copy()
+    spiked[60, i] += 40.0  # a one-frame marker glitch
+    assert leg_joint_ranges(clip.with_frames(spiked))["ltoes"] == pytest.approx(base["ltoes"], rel=0.05)
+    held = clip.frames.copy()
+    held[60:64, i] += 40.0  # an extreme held for four frames is motion
+    assert leg_joint_ranges(clip.with_frames(held))["ltoes"] > base["ltoes"] + 20
+    # a joint's range spans its dofs: at least the largest single-dof range
+    j = clip.channel_index("lfemur", "rx")
+    assert base["lfemur"] >= np.ptp(clip.frames[:, j]) * 0.95

@@ -30,6 +30,7 @@ from .reference import joint_angles, joint_columns, used_mask
 
 __all__ = [
     "LEG_JOINTS",
+    "leg_joint_ranges",
     "TARGETS",
     "CycleQuality",
     "period_error",
@@ -130,6 +131,34 @@ def leg_ranges(motion: Motion) -> dict[str, float]:
         "{}.{}".format(*motion.channels[cols[k]]): float(np.ptp(x[:, k]))
         for k in leg_channels(motion)
     }
+
+
+def leg_joint_ranges(motion: Motion, spike: int = 5) -> dict[str, float]:
+    """Range of motion of every leg joint, degrees: the diameter of its angle trajectory.
+
+    For each joint named like a leg joint (:data:`LEG_JOINTS`), the largest distance
+    between two frames' angle vectors over the joint's rotation dofs, after a cyclic
+    running median over ``spike`` frames.  The median removes the one- and two-frame
+    spikes of raw marker data (a toe flicking 25 degrees for a frame) that would
+    otherwise decide a raw clip's range, and leaves any extreme held for three frames or
+    more.  Per joint, so a femur's 40 degrees of flexion is not judged by its few degrees
+    of twist.
+    """
+    from scipy.ndimage import median_filter
+
+    x = joint_angles(motion)
+    cols = joint_columns(motion)
+    by_joint: dict[str, list[int]] = {}
+    for k in leg_channels(motion):
+        by_joint.setdefault(motion.channels[cols[k]][0], []).append(k)
+    out = {}
+    for joint, ks in by_joint.items():
+        y = x[:, ks]
+        if spike > 1 and len(y) > spike:
+            y = median_filter(y, size=(spike, 1), mode="wrap")
+        d = np.linalg.norm(y[:, None, :] - y[None, :, :], axis=2) if len(y) <= 2000 else None
+        out[joint] = float(d.max()) if d is not None else float(np.linalg.norm(np.ptp(y, axis=0)))
+    return out
 
 
 def seam(angles: np.ndarray) -> float:
@@ -330,6 +359,10 @@ class CycleQuality:
     min_leg_range_ratio: float
     min_leg_channel: str | None
     min_femur_tibia_ratio: float
+    joint_ranges: dict
+    joint_range_ratios: dict
+    min_joint_range_ratio: float
+    min_joint: str | None
     seam: float
     step_spread: float
     coverage: float
@@ -410,6 +443,15 @@ def cycle_quality(
             if reference.leg_ranges.get(k, 0.0) >= MIN_LEG_RANGE
         }
     low = min(ratios, key=ratios.get) if ratios else None
+    joints = leg_joint_ranges(cycle)
+    joint_ratios = {}
+    if reference is not None:
+        joint_ratios = {
+            k: _ratio(v, reference.joint_ranges[k])
+            for k, v in joints.items()
+            if reference.joint_ranges.get(k, 0.0) >= MIN_LEG_RANGE
+        }
+    low_joint = min(joint_ratios, key=joint_ratios.get) if joint_ratios else None
     jerk = cycle_jerk(cyc_x, cycle.fps)
     cov = coverage(take_x, cyc_x, mask)
     skate = foot_skating_speed(cycle)
@@ -431,6 +473,10 @@ def cycle_quality(
             (v for k, v in ratios.items() if k.split(".")[0].endswith(("femur", "tibia"))),
             default=float("nan"),
         ),
+        joint_ranges=joints,
+        joint_range_ratios=joint_ratios,
+        min_joint_range_ratio=float(joint_ratios[low_joint]) if low_joint else float("nan"),
+        min_joint=low_joint,
         step_spread=step_spread(cyc_x),
         seam=seam(cyc_x),
         coverage=cov,
@@ -465,7 +511,7 @@ def targets(q: CycleQuality) -> dict[str, bool | None]:
         "period": check(q.period_error, lambda v: abs(v) <= t["period_error"]),
         "root": root_ok,
         "jerk": check(q.jerk_ratio, lambda v: v <= t["jerk_ratio"]),
-        "legs": check(q.min_leg_range_ratio, lambda v: v >= t["leg_range_ratio"]),
+        "legs": check(q.min_joint_range_ratio, lambda v: v >= t["leg_range_ratio"]),
         "seam": check(q.seam, lambda v: v <= t["seam"]),
         "coverage": check(q.coverage_ratio, lambda v: v <= t["coverage_ratio"]),
         "skating": check(q.skating_ratio, lambda v: v <= t["skating_ratio"]),
