@@ -463,7 +463,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
     if args.extract and code == EXIT_OK:
         folder = Path(args.extract)
         folder.mkdir(parents=True, exist_ok=True)
-        for mc in motion_cycles(res):
+        for mc in motion_cycles(res, bandwidth=args.bandwidth, cycle_start=args.cycle_start,
+                                timing=args.timing, travel=args.travel):
             out = folder / f"motion{mc.motion}_cycle.{args.extract_format}"
             save(mc.cycle, out)
             how = (f"phase from H1 {mc.phase_from}'s coordinate on {mc.n_frames_used} excited frames"
@@ -747,6 +748,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
         pca=args.pca, normalize=args.normalize, temporal=args.temporal, prime=args.prime,
         max_scale=args.max_scale, landmarks=args.landmarks, random_state=args.seed,
         **({} if args.memory_limit is None else {"memory_limit": args.memory_limit}),
+        **_cycle_options(args),
     )
     summary = run_batch(
         args.folder, args.output, jobs=args.jobs, scheduler=args.scheduler,
@@ -874,6 +876,15 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--no-progress", action="store_true", help="no progress bar over the windows")
     d.add_argument("--report", metavar="R.json", help="JSON: segments, labels per frame, classes, windows, barcode")
     d.add_argument("--extract", metavar="OUTDIR", help="write a typical cycle (BVH) for each detected motion")
+    dc = d.add_argument_group("the cycles written by --extract (as extract's)")
+    dc.add_argument("--timing", choices=("capture", "coordinate"), default="capture",
+                    help="capture (default): at the capture's pace, repetitions aligned; coordinate: the paper's")
+    dc.add_argument("--travel", choices=("keep", "straight", "in_place"), default="keep",
+                    help="keep the heading change and travel of a cycle, walk straight, or stay in place")
+    dc.add_argument("--bandwidth", type=_bandwidth, default=None, metavar="auto|F",
+                    help="kernel width in frames of time (default 1), or 'auto' (cross-validated)")
+    dc.add_argument("--cycle-start", choices=("slowest", "first"), default="slowest",
+                    help="begin each cycle at its slowest pose (default) or at phase 0")
     d.add_argument("--extract-format", default="bvh", choices=("bvh", "glb", "gltf", "usda", "usdc", "npz", "csv"),
                    help="file format of the --extract cycles (default bvh)")
     d.add_argument("--plot", metavar="DIR", help="write the barcode (barcode.png), the coordinates with segments shaded (coordinates.png) and the windows coloured by motion (windows.png)")
@@ -1011,6 +1022,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--memory-limit", type=_bytes, default=None, metavar="SIZE",
                    help="memory budget per capture for the filtration, e.g. 2G; above it landmarks are used")
     g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (0)")
+    _add_cycle_options(ba.add_argument_group("the cycle (the same for every capture)"))
     ba.set_defaults(func=cmd_batch)
     for name in COMMAND_MODULES:
         import importlib
