@@ -189,7 +189,6 @@ def _landmark_report(est: CircularCoordinates | None) -> dict | None:
     }
 
 
-@one_blas_thread
 def loop_cycle(
     typical: TypicalCycle,
     motion: Motion,
@@ -255,6 +254,7 @@ def loop_cycle(
     return typical, clip
 
 
+@one_blas_thread
 def extract(
     motion: Motion,
     frames: tuple[int | None, int | None] | None = None,
