@@ -53,16 +53,16 @@ def test_choice_of_landmarks():
 
 
 def test_memory_guard_switches_before_building(monkeypatch, synthetic_2000):
-    import ripser
+    from cyclecoord.periodic import _rips
 
     calls = []
-    real = ripser.ripser
+    real = _rips.rips_cohomology
 
     def spy(*args, **kwargs):
         calls.append(len(args[0]))  # points handed to ripser
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(ripser, "ripser", spy)
+    monkeypatch.setattr(_rips, "rips_cohomology", spy)
     est = CircularCoordinates(landmarks=None, memory_limit=5e6)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -191,7 +191,7 @@ def compute_barcode(
     -------
     Barcode
     """
-    import ripser  # local import keeps `import cyclecoord` light
+    from ._rips import rips_cohomology  # ripser's filtration without scikit-learn's imports
 
     p = check_prime(prime)
     x = np.asarray(points, dtype=float)
@@ -213,14 +213,7 @@ def compute_barcode(
         x = x[np.ix_(idx, idx)] if distance_matrix else x[idx]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = ripser.ripser(
-            x,
-            maxdim=1,
-            thresh=max_scale,
-            coeff=p,
-            do_cocycles=True,
-            distance_matrix=distance_matrix,
-        )
+        res = rips_cohomology(x, max_scale, p, distance_matrix=distance_matrix)
     h0 = np.asarray(res["dgms"][0], dtype=float).reshape(-1, 2)
     h1 = np.asarray(res["dgms"][1], dtype=float).reshape(-1, 2)
     cocycles = [np.asarray(c, dtype=np.int64).reshape(-1, 3) for c in res["cocycles"][1]]
@@ -385,7 +378,7 @@ def refine_birth(
     Returns ``None`` when the sparse complex would exceed ``max_edges`` edges or no bar
     is alive there.
     """
-    import ripser
+    from ._rips import sparse_rips_cohomology
 
     x = np.asarray(points, dtype=float)
     t = float(landmark_birth) * margin
@@ -412,8 +405,9 @@ def refine_birth(
     from scipy.sparse import coo_matrix
 
     n = len(x)
-    mat = coo_matrix((np.r_[d, d], (np.r_[pairs[:, 0], pairs[:, 1]], np.r_[pairs[:, 1], pairs[:, 0]])), shape=(n, n)).tocsr()
-    res = ripser.ripser(mat, maxdim=1, thresh=t, coeff=check_prime(prime), distance_matrix=True)
+    mat = coo_matrix((np.r_[d, d], (np.r_[pairs[:, 0], pairs[:, 1]], np.r_[pairs[:, 1], pairs[:, 0]])), shape=(n, n))
+    mat = mat.tocsr().tocoo()  # sorted by (row, col), as ripser.py hands it over
+    res = sparse_rips_cohomology(mat.row, mat.col, mat.data, n, t, check_prime(prime))
     h1 = np.asarray(res["dgms"][1]).reshape(-1, 2)
     alive = h1[~np.isfinite(h1[:, 1])] if h1.size else h1
     if alive.size == 0:
