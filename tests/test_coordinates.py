@@ -161,3 +161,42 @@ def test_invalid_points():
         CircularCoordinates().fit(np.zeros((2, 3)))
     with pytest.raises(ParameterError, match="not fitted"):
         CircularCoordinates().transform(np.zeros((5, 3)))
+
+
+def _check_by_unique(edges, z, n):
+    """Reference: distinct triangles by sorting their vertex keys (the former method)."""
+    import scipy.sparse as sp
+
+    from cyclecoord.periodic.coordinates import _lookup
+
+    support = np.flatnonzero(z)
+    i, j = edges[:, 0], edges[:, 1]
+    adj = sp.csr_matrix((np.ones(len(edges)), (i, j)), shape=(n, n))
+    adj = (adj + adj.T).tocsr()
+    a, b = i[support], j[support]
+    common = adj[a].multiply(adj[b]).tocoo()
+    ea, eb, c = a[common.row], b[common.row], common.col.astype(np.int64)
+    val = z[support][common.row] + _lookup(edges, z, n, eb, c) + _lookup(edges, z, n, c, ea)
+    bad = np.abs(val) > 0.5
+    tri = np.sort(np.column_stack([ea, eb, c]), axis=1)
+    key = (tri[:, 0] * n + tri[:, 1]) * n + tri[:, 2]
+    return len(np.unique(key)), len(np.unique(key[bad]))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_cocycle_check_counts_distinct_triangles_as_sorting_does(seed):
+    from cyclecoord.periodic.coordinates import check_cocycle, rips_edges
+
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=(80, 3))
+    edges = rips_edges(x, 1.2)
+    z = np.where(rng.random(len(edges)) < 0.3, rng.integers(-3, 4, len(edges)), 0).astype(float)
+    got = check_cocycle(edges, z, 80)
+    want = _check_by_unique(edges, z, 80)
+    assert got.n_triangles > 50 and got.n_violations > 10
+    assert (got.n_triangles, got.n_violations) == want
+    # a true coboundary has no violations
+    w = rng.integers(-2, 3, 80).astype(float)
+    cob = w[edges[:, 1]] - w[edges[:, 0]]
+    got = check_cocycle(edges, cob, 80)
+    assert got.n_violations == 0 and got.n_triangles == _check_by_unique(edges, cob, 80)[0]

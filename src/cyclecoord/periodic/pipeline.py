@@ -20,7 +20,7 @@ from .coordinates import CircularCoordinates, unwrap
 from .cycle import TypicalCycle, check_bandwidth, typical_cycle
 from .density import PeriodicDensity
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..quality.metrics import distance_to_cycle, jerk_summary, loop_closure
+from ..quality.metrics import distance_to_cycle, frame_steps, jerk_summary, loop_closure
 from ..motion import Motion
 from .preprocess import PreparedData, Preprocessor
 
@@ -489,7 +489,7 @@ def extract(
     }
     closure = float(loop_closure(typ.frames))
     dist = distance_to_cycle(prepared.poses, typ.frames)
-    step = np.linalg.norm(np.diff(prepared.poses, axis=0), axis=1)
+    step = frame_steps(prepared.poses)
     distance = {
         "median": float(np.median(dist)),
         "p90": float(np.percentile(dist, 90)),
