@@ -63,7 +63,11 @@ def test_memory_guard_switches_before_building(monkeypatch, synthetic_2000):
         return real(*args, **kwargs)
 
     monkeypatch.setattr(_rips, "rips_cohomology", spy)
-    est = CircularCoordinates(landmarks=None, memory_limit=5e6)
+    from cyclecoord.periodic.landmarks import run_bytes
+
+    # a stated limit covers the per-frame arrays too: leave 5 MB for the filtration
+    limit = run_bytes(*synthetic_2000.shape) + 5e6
+    est = CircularCoordinates(landmarks=None, memory_limit=limit)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         est.fit_barcode(synthetic_2000)

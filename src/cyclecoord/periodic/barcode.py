@@ -26,6 +26,7 @@ __all__ = [
     "DEFAULT_PRIME",
     "temporal_distance_matrix",
     "refine_birth",
+    "REFINE_BYTES_PER_EDGE",
 ]
 
 #: Coefficient field used by default: a prime well above 11 (the paper asks for p > 11).
@@ -358,6 +359,11 @@ def select_bar(
         ratio=ratio,
         gap=gap,
     )
+
+
+#: Peak bytes per edge of :func:`refine_birth`'s sparse complex (the pairs, their
+#: distances, the symmetric COO/CSR copies, ripser's own copy).
+REFINE_BYTES_PER_EDGE = 256
 
 
 def refine_birth(

@@ -22,8 +22,10 @@ from scipy.sparse.linalg import lsqr
 from scipy.spatial import cKDTree
 
 from .._blas import one_blas_thread
+from ._rips import DENSE_BYTES_PER_PAIR
 from .barcode import (
     DEFAULT_PRIME,
+    REFINE_BYTES_PER_EDGE,
     Barcode,
     BarSelection,
     check_prime,
@@ -34,7 +36,7 @@ from .barcode import (
     temporal_distance_matrix,
 )
 from ..errors import ParameterError
-from .landmarks import DEFAULT_MEMORY_LIMIT, choose_landmarks
+from .landmarks import choose_landmarks, memory_budget, run_bytes
 
 __all__ = [
     "CircularCoordinates",
@@ -226,7 +228,7 @@ def extend_coordinate(
     harmonic: np.ndarray,
     radius: float,
     max_neighbors: int = 48,
-    chunk: int = 20_000,
+    chunk: int = 4_000,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Circular coordinate of arbitrary points from a solution on ``centers``.
 
@@ -320,8 +322,16 @@ class CircularCoordinates:
         Build the filtration on greedy max-min landmarks and extend the coordinate to
         every point (see :func:`cyclecoord.periodic.landmarks.choose_landmarks`).  ``None`` uses
         every point.
-    memory_limit : float, default 2 GiB
-        Budget for one filtration; above it landmarks are used (fewer if needed).
+    memory_limit : float, optional
+        Bytes the fit's large arrays may take: the per-point arrays
+        (:func:`~cyclecoord.periodic.landmarks.run_bytes`, plus ``memory_reserved``) and
+        the filtration, whose landmarks are chosen (fewer if needed) to fit what is left.
+        Default: 2 GiB for the filtration alone.  Never more than the machine holds
+        (:func:`~cyclecoord.periodic.landmarks.machine_memory`); a fit whose per-point
+        arrays cannot fit is refused before anything is allocated.
+    memory_reserved : float, default 0
+        Bytes of the caller's own per-frame arrays to count against ``memory_limit``
+        (:func:`cyclecoord.extract` passes its poses).
     refine_birth : bool, default True
         With landmarks, also compute the class's birth on every point when cheap.
 
@@ -363,8 +373,9 @@ class CircularCoordinates:
         scale_fraction: float = 0.9,
         temporal: bool = False,
         landmarks: int | str | None = "auto",
-        memory_limit: float = DEFAULT_MEMORY_LIMIT,
+        memory_limit: float | None = None,
         refine_birth: bool = True,
+        memory_reserved: float = 0.0,
     ) -> None:
         self.max_scale = max_scale
         self.scale = scale
@@ -375,6 +386,7 @@ class CircularCoordinates:
         self.landmarks = landmarks
         self.memory_limit = memory_limit
         self.refine_birth = refine_birth
+        self.memory_reserved = memory_reserved
 
     # ------------------------------------------------------------------
     def _validate(self, X) -> np.ndarray:
@@ -405,13 +417,17 @@ class CircularCoordinates:
         """
         x = self._validate(X)
         self.points_ = x
+        T, K = x.shape
+        reserved = run_bytes(T, K) + float(self.memory_reserved or 0.0)
+        budget, note = memory_budget(self.memory_limit, reserved, f"{T} frames of {K} dimensions")
+        self.memory_budget_ = budget
         if self.temporal:
-            need = 8.0 * len(x) ** 2
-            if need > self.memory_limit:
+            # the (T, T) matrix, then the filtration's copies of it
+            need = (8.0 + DENSE_BYTES_PER_PAIR) * T**2
+            if need > budget:
                 raise ParameterError(
-                    f"the temporal metric needs a full {len(x)} x {len(x)} distance matrix "
-                    f"({need / 1e9:.1f} GB, over the {self.memory_limit / 1e9:.1f} GB limit); "
-                    "drop --temporal or analyse fewer frames"
+                    f"the temporal metric needs a full {T} x {T} distance matrix "
+                    f"({need / 1e9:.1f} GB, over the {note}); drop --temporal or analyse fewer frames"
                 )
             self._dist_ = temporal_distance_matrix(x)
         else:
@@ -419,7 +435,7 @@ class CircularCoordinates:
         self.threshold_ = float(
             self.max_scale if self.max_scale is not None else default_max_scale(x, self._dist_)
         )
-        n, est, reason = choose_landmarks(x, self.threshold_, self.landmarks, self.memory_limit)
+        n, est, reason = choose_landmarks(x, self.threshold_, self.landmarks, budget)
         self.n_landmarks_ = n
         self.complex_estimate_ = est
         self.landmark_reason_ = reason
@@ -580,7 +596,11 @@ class CircularCoordinates:
             )
         theta, sign, offset = orient_with_time(raw, return_transform=True)
         if self.landmarks_ is not None and not self.temporal and self.refine_birth:
-            sel = BarSelection(**{**sel.__dict__, "full_birth": refine_birth(self.points_, sel.birth, p)})
+            # the sparse complex within what the filtration was allowed (it is gone by now)
+            budget = getattr(self, "memory_budget_", None)
+            max_edges = 3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
+            full = refine_birth(self.points_, sel.birth, p, max_edges=max_edges) if max_edges > 0 else None
+            sel = BarSelection(**{**sel.__dict__, "full_birth": full})
         self.barcode_ = bc
         self.selection_ = sel
         self.prime_ = p

@@ -183,7 +183,7 @@ def kernel_centroids(
     poses: np.ndarray,
     phases: np.ndarray,
     k: int = 10,
-    chunk_elements: int = 4_000_000,
+    chunk_elements: int = 250_000,
     bandwidth: float | None = None,
 ) -> np.ndarray:
     """Kernel-weighted average pose at each phase (Nadaraya-Watson on the circle).
@@ -205,7 +205,7 @@ def kernel_centroids(
     k : int, default 10
         Effective number of frames per average; sets the width when ``bandwidth`` is
         None.
-    chunk_elements : int, default 4,000,000
+    chunk_elements : int, default 250,000
         Largest number of weights held at once.
     bandwidth : float, optional
         Kernel width ``σ`` in *phase units* (a fraction of one period, ``0 < σ``);

@@ -339,7 +339,10 @@ def extract(
         1,000 frames, 500 landmarks beyond) and extend the coordinate to every frame;
         ``None`` uses every frame.
     memory_limit : float, optional
-        Byte budget for the filtration (default 2 GiB); above it landmarks are used.
+        Bytes the run's large arrays may take, the per-frame arrays and the filtration
+        (whose landmarks are reduced to fit); default 2 GiB for the filtration alone.
+        Never more than the machine's memory; a run that cannot fit is refused with a
+        :class:`ParameterError` before anything large is allocated.
     require_clear : bool, default True
         Raise :class:`NoPeriodicMotionError` when the chosen bar does not stand clear.
     random_state : int, optional
@@ -393,8 +396,8 @@ def extract(
 
     est = CircularCoordinates(
         max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
-        scale_fraction=scale_fraction, temporal=temporal, landmarks=landmarks,
-        **({} if memory_limit is None else {"memory_limit": memory_limit}),
+        scale_fraction=scale_fraction, temporal=temporal, landmarks=landmarks, memory_limit=memory_limit,
+        memory_reserved=8.0 * max(0, prepared.poses.size - prepared.points.size),  # poses beyond the points
     )
     t0 = time.perf_counter()
     barcode = est.fit_barcode(prepared.points)

@@ -38,7 +38,7 @@ __all__ = [
 _MAX_STENCIL = 32
 #: Elements of the work arrays per block of frames (distance_to_cycle: frames x segments;
 #: jerk_summary, frame_steps: frames x channels).
-_CHUNK_ELEMENTS = 2_000_000
+_CHUNK_ELEMENTS = 500_000
 
 
 def _frames_array(x: object, name: str) -> np.ndarray:
