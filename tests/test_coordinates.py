@@ -200,3 +200,28 @@ def test_cocycle_check_counts_distinct_triangles_as_sorting_does(seed):
     cob = w[edges[:, 1]] - w[edges[:, 0]]
     got = check_cocycle(edges, cob, 80)
     assert got.n_violations == 0 and got.n_triangles == _check_by_unique(edges, cob, 80)[0]
+
+
+@pytest.mark.parametrize("seed, weighted", [(0, False), (1, True), (2, True)])
+def test_direct_harmonic_solve_matches_lsqr(seed, weighted):
+    """The factorised normal equations give LSQR's minimum-norm solution (to 1e-9)."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import lsqr
+
+    from cyclecoord.periodic.coordinates import harmonic_coordinate, rips_edges
+
+    rng = np.random.default_rng(seed)
+    t = rng.random(150) * 2 * np.pi
+    x = np.column_stack([np.cos(t), np.sin(t)]) * 3 + rng.normal(0, 0.1, (150, 2))
+    x = np.concatenate([x, x[:30] + 50.0])  # a second component
+    edges = rips_edges(x, 0.9)
+    n, e = len(x), len(edges)
+    z = np.where(rng.random(e) < 0.1, 1.0, 0.0)
+    wts = rng.uniform(1.0, 20.0, e) if weighted else None
+    theta, harmonic = harmonic_coordinate(edges, z, n, wts)
+    delta = sp.csr_matrix((np.tile([-1.0, 1.0], e), (np.repeat(np.arange(e), 2), edges.ravel())), shape=(e, n))
+    sw = np.ones(e) if wts is None else np.sqrt(wts)
+    w = lsqr(sp.diags(sw) @ delta, -sw * z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
+    np.testing.assert_allclose(harmonic, z + delta @ w, atol=1e-9)
+    d = np.mod(theta - np.mod(-w, 1.0) + 0.5, 1.0) - 0.5
+    assert np.max(np.abs(d)) < 1e-9

@@ -397,8 +397,9 @@ def refine_birth(
     # so 1.25 x the budget is a wide margin.
     from .landmarks import estimate_complex
 
-    if estimate_complex(x, t, n_samples=20_000).edges > 1.25 * max_edges:
-        return None
+    n_pairs = len(x) * (len(x) - 1) / 2
+    if n_pairs > 1.25 * max_edges and estimate_complex(x, t, n_samples=20_000).edges > 1.25 * max_edges:
+        return None  # (with fewer pairs than that the sample could never refuse)
     tree = cKDTree(x)
     # then count exactly (ordered pairs and self-pairs): query_pairs materialises every pair
     if (tree.count_neighbors(tree, t) - len(x)) / 2 > max_edges:

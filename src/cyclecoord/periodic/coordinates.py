@@ -18,7 +18,6 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
-from scipy.sparse.linalg import lsqr
 from scipy.spatial import cKDTree
 
 from .._blas import one_blas_thread
@@ -36,7 +35,7 @@ from .barcode import (
     temporal_distance_matrix,
 )
 from ..errors import ParameterError
-from .landmarks import choose_landmarks, memory_budget, run_bytes
+from .landmarks import choose_landmarks, estimate_complex, memory_budget, run_bytes
 
 __all__ = [
     "CircularCoordinates",
@@ -196,14 +195,42 @@ def harmonic_coordinate(
     cols = edges.ravel()
     vals = np.tile([-1.0, 1.0], e)
     delta = sp.csr_matrix((vals, (rows, cols)), shape=(e, n))
-    if weights is None:
-        w = lsqr(delta, -z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
-    else:
-        sw = np.sqrt(np.asarray(weights, dtype=float))
-        w = lsqr(sp.diags(sw) @ delta, -sw * z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
+    w = _least_squares_potential(delta, edges, z, n, weights)
     harmonic = z + delta @ w
     theta = np.mod(-w, 1.0)
     return theta, harmonic
+
+
+def _least_squares_potential(
+    delta: sp.csr_matrix, edges: np.ndarray, z: np.ndarray, n: int, weights: np.ndarray | None
+) -> np.ndarray:
+    """The minimum-norm ``w`` minimising ``sum_e weights_e (z + δw)_e²``.
+
+    A direct solve of the normal equations instead of LSQR: ``L w = -δᵀ W z`` with the
+    weighted graph Laplacian ``L = δᵀ W δ``, one vertex of each connected component held
+    at 0 (``L`` is singular only along each component's constants), one sparse LU
+    factorisation; then each component's mean is removed, which gives the minimum-norm
+    solution LSQR converges to.  Agrees with LSQR (``atol = btol = 1e-12``) to about
+    1e-10 (tested) and costs one factorisation instead of hundreds of products.
+    """
+    from scipy.sparse.linalg import splu
+
+    wts = np.ones(len(z)) if weights is None else np.asarray(weights, dtype=float)
+    lap = (delta.T @ sp.diags(wts) @ delta).tocsc()
+    rhs = -(delta.T @ (wts * z))
+    ncomp, label = connected_components(
+        sp.csr_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n)), directed=False
+    )
+    first = np.full(ncomp, -1)
+    first[label[::-1]] = np.arange(n)[::-1]  # lowest vertex of each component
+    free = np.ones(n, dtype=bool)
+    free[first] = False
+    w = np.zeros(n)
+    if free.any():
+        idx = np.flatnonzero(free)
+        w[idx] = splu(lap[idx][:, idx].tocsc(), permc_spec="COLAMD").solve(rhs[idx])
+    w -= (np.bincount(label, weights=w, minlength=ncomp) / np.bincount(label, minlength=ncomp))[label]
+    return w
 
 
 def orient_with_time(theta: np.ndarray, return_transform: bool = False):
@@ -438,11 +465,26 @@ class CircularCoordinates:
         n, est, reason = choose_landmarks(x, self.threshold_, self.landmarks, budget)
         self.n_landmarks_ = n
         self.complex_estimate_ = est
+        self._complex_deferred = est is None  # computed on first access (report)
         self.landmark_reason_ = reason
         self.barcode_ = self._barcode(check_prime(self.prime))
         self.landmarks_ = self.barcode_.point_indices
         self.covering_radius_ = float(self.barcode_.extras.get("covering_radius", 0.0))
         return self.barcode_
+
+    @property
+    def complex_estimate_(self):
+        """Size estimate of the filtration that was built (computed when first asked
+        for if the memory guard did not need it)."""
+        if getattr(self, "_complex_deferred", False):
+            self._complex_estimate = estimate_complex(self.points_, self.threshold_, n_vertices=self.n_landmarks_)
+            self._complex_deferred = False
+        return self._complex_estimate
+
+    @complex_estimate_.setter
+    def complex_estimate_(self, value) -> None:
+        self._complex_estimate = value
+        self._complex_deferred = False
 
     def use_barcode(self, X, barcode: Barcode) -> "CircularCoordinates":
         """Adopt a barcode already computed on every point of ``X`` (Euclidean metric).

@@ -336,8 +336,10 @@ def choose_landmarks(
     -------
     n_landmarks : int or None
         ``None`` means every point.
-    estimate : ComplexEstimate
-        For the complex that will be built.
+    estimate : ComplexEstimate or None
+        For the complex that will be built; None when even the complete complex fits the
+        budget (then ``estimate_complex(points, threshold, n_landmarks)`` gives it; the
+        sampled estimate costs more than a small filtration).
     reason : str
         Human-readable account of the decision (for the report).
     """
@@ -364,6 +366,11 @@ def choose_landmarks(
             n, reason = None, f"every frame ({landmarks} landmarks requested, {T} frames)"
         else:
             reason = f"{n} greedy landmarks of {T} frames (requested)"
+    m0 = T if n is None else min(int(n), T)
+    if DENSE_BYTES_PER_PAIR * float(m0) * m0 + _BYTES_PER_EDGE * comb(m0, 2) <= memory_limit:
+        # even the complete complex fits: the estimate cannot change the decision, so it is
+        # left to whoever asks (estimate_complex(points, threshold, n) gives the same figures)
+        return n, None, reason
     x = np.asarray(points, dtype=float)
     fractions = _pair_fractions(x, threshold, 20_000, 0) if T >= 3 else (0.0, 0.0)
 
