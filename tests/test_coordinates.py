@@ -225,3 +225,24 @@ def test_direct_harmonic_solve_matches_lsqr(seed, weighted):
     np.testing.assert_allclose(harmonic, z + delta @ w, atol=1e-9)
     d = np.mod(theta - np.mod(-w, 1.0) + 0.5, 1.0) - 0.5
     assert np.max(np.abs(d)) < 1e-9
+
+
+def test_extension_table_gives_the_binary_search_lookups_bit_for_bit(monkeypatch):
+    import cyclecoord.periodic.coordinates as co
+
+    rng = np.random.default_rng(4)
+    t = rng.random(2000) * 2 * np.pi
+    pts = np.column_stack([np.cos(t), np.sin(t), 0.2 * np.cos(3 * t)]) * 4 + rng.normal(0, 0.2, (2000, 3))
+    centers = pts[:150]
+    edges = co.rips_edges(centers, 2.0)
+    harmonic = rng.normal(0, 0.1, len(edges))
+    ctheta = rng.random(150)
+    u = rng.integers(0, 150, 500)
+    v = rng.integers(0, 150, 500)
+    table = co._increment_table(edges, harmonic, 150)
+    want = co._lookup(edges, harmonic, 150, u, v)
+    assert np.array_equal(table[u, v], want) and np.array_equal(np.signbit(table[u, v]), np.signbit(want))
+    fast = co.extend_coordinate(pts, centers, ctheta, edges, harmonic, 1.0, chunk=700)
+    monkeypatch.setattr(co, "_TABLE_MAX_CENTERS", 0)
+    slow = co.extend_coordinate(pts, centers, ctheta, edges, harmonic, 1.0, chunk=700)
+    assert np.array_equal(fast[0], slow[0]) and np.array_equal(fast[1], slow[1])
