@@ -216,10 +216,11 @@ def _least_squares_potential(
     from scipy.sparse.linalg import splu
 
     wts = np.ones(len(z)) if weights is None else np.asarray(weights, dtype=float)
-    lap = (delta.T @ sp.diags(wts) @ delta).tocsc()
-    rhs = -(delta.T @ (wts * z))
+    a, b = edges[:, 0], edges[:, 1]
+    wz = wts * z
+    rhs = np.bincount(a, weights=wz, minlength=n) - np.bincount(b, weights=wz, minlength=n)  # -δᵀ W z
     ncomp, label = connected_components(
-        sp.csr_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n)), directed=False
+        sp.csr_matrix((np.ones(len(edges)), (a, b)), shape=(n, n)), directed=False
     )
     first = np.full(ncomp, -1)
     first[label[::-1]] = np.arange(n)[::-1]  # lowest vertex of each component
@@ -227,8 +228,16 @@ def _least_squares_potential(
     free[first] = False
     w = np.zeros(n)
     if free.any():
-        idx = np.flatnonzero(free)
-        w[idx] = splu(lap[idx][:, idx].tocsc(), permc_spec="COLAMD").solve(rhs[idx])
+        # the Laplacian δᵀ W δ restricted to the free vertices, assembled from the edges
+        pos = np.cumsum(free) - 1
+        deg = np.bincount(a, weights=wts, minlength=n) + np.bincount(b, weights=wts, minlength=n)
+        both = free[a] & free[b]
+        fv = np.flatnonzero(free)
+        rows = np.concatenate([pos[fv], pos[a[both]], pos[b[both]]])
+        cols = np.concatenate([pos[fv], pos[b[both]], pos[a[both]]])
+        vals = np.concatenate([deg[fv], -wts[both], -wts[both]])
+        lap = sp.csc_matrix((vals, (rows, cols)), shape=(fv.size, fv.size))
+        w[fv] = splu(lap, permc_spec="COLAMD").solve(rhs[fv])
     w -= (np.bincount(label, weights=w, minlength=ncomp) / np.bincount(label, minlength=ncomp))[label]
     return w
 
