@@ -202,7 +202,7 @@ def test_cocycle_check_counts_distinct_triangles_as_sorting_does(seed):
     assert got.n_violations == 0 and got.n_triangles == _check_by_unique(edges, cob, 80)[0]
 
 
-@pytest.mark.parametrize("seed, weighted", [(0, False), (1, True), (2, True)])
+@pytest.mark.parametrize("seed, weighted", [(0, False), (1, False), (2, True)])
 def test_direct_harmonic_solve_matches_lsqr(seed, weighted):
     """The factorised normal equations give LSQR's minimum-norm solution (to 1e-9)."""
     import scipy.sparse as sp

@@ -136,12 +136,22 @@ def _diameter(points: np.ndarray, exact_limit: int = 2000, sweeps: int = 4) -> f
         return float(pdist(points).max())
     best, i = 0.0, 0
     for _ in range(sweeps):
-        d = np.linalg.norm(points - points[i], axis=1)
+        d = _distances_to(points, i)
         j = int(np.argmax(d))
         if d[j] <= best:
             break
         best, i = float(d[j]), j
     return best
+
+
+def _distances_to(points: np.ndarray, i: int, block: int = 1_000_000) -> np.ndarray:
+    """``np.linalg.norm(points - points[i], axis=1)`` in blocks of rows (the same values,
+    each row is computed alone; no (T, K) temporary)."""
+    out = np.empty(len(points))
+    step = max(1, block // max(points.shape[1], 1))
+    for a in range(0, len(points), step):
+        out[a : a + step] = np.linalg.norm(points[a : a + step] - points[i], axis=1)
+    return out
 
 
 def default_max_scale(points: np.ndarray, distances: np.ndarray | None = None) -> float:
@@ -159,8 +169,10 @@ def default_max_scale(points: np.ndarray, distances: np.ndarray | None = None) -
         diam = float(np.max(distances))
         steps = np.diagonal(distances, offset=1)  # zero for the temporal metric: connected by design
     else:
+        from ..quality.metrics import frame_steps
+
         diam = _diameter(points)
-        steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+        steps = frame_steps(points)  # |points[t + 1] - points[t]|, in blocks
     # a high percentile, not the maximum: an Euler flip in one joint (a 360-degree jump)
     # must not inflate the threshold
     step = float(np.percentile(steps, 99.5)) if steps.size else 0.0

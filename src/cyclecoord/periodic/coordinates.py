@@ -211,11 +211,20 @@ def _least_squares_potential(
     at 0 (``L`` is singular only along each component's constants), one sparse LU
     factorisation; then each component's mean is removed, which gives the minimum-norm
     solution LSQR converges to.  Agrees with LSQR (``atol = btol = 1e-12``) to about
-    1e-10 (tested) and costs one factorisation instead of hundreds of products.
+    1e-10 (tested) and costs one factorisation instead of hundreds of products.  Used for
+    the unweighted problem (every point, and detect's windows); the weighted landmark
+    problem is still solved by LSQR (see the comment below).
     """
-    from scipy.sparse.linalg import splu
+    from scipy.sparse.linalg import lsqr, splu
 
-    wts = np.ones(len(z)) if weights is None else np.asarray(weights, dtype=float)
+    if weights is not None:
+        # the landmark problem keeps LSQR: on CMU-like chains detect's segment boundaries
+        # sit on an edge that a 1e-12 change of a landmark coordinate can tip (a synthetic
+        # walk/jog/squat chain moved a boundary 16 frames); its landmarks are few (500),
+        # so this costs little, and every landmark result stays as it was, bit for bit
+        sw = np.sqrt(np.asarray(weights, dtype=float))
+        return lsqr(sp.diags(sw) @ delta, -sw * z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
+    wts = np.ones(len(z))
     a, b = edges[:, 0], edges[:, 1]
     wz = wts * z
     rhs = np.bincount(a, weights=wz, minlength=n) - np.bincount(b, weights=wz, minlength=n)  # -δᵀ W z
