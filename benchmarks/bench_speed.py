@@ -31,7 +31,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -39,10 +39,10 @@ _HERE = Path(__file__).resolve().parent
 if str(_HERE) not in sys.path:
     sys.path.insert(0, str(_HERE))
 
-import bench_extract as bx  # noqa: E402
+import bench_extract as bx
 
-import cyclecoord as cc  # noqa: E402
-from cyclecoord.io._atomic import atomic_write  # noqa: E402
+import cyclecoord as cc
+from cyclecoord.io._atomic import atomic_write
 
 FRAMES = (200, 450)
 MAX_SCALE = 50.0

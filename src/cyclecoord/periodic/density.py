@@ -30,7 +30,6 @@ result is taken modulo 1.
 
 from __future__ import annotations
 
-import warnings
 from numbers import Integral, Real
 
 import numpy as np
