@@ -219,10 +219,12 @@ def time_cyclecoord(case: Case, repeat: int, tick: Callable[[], None] = lambda: 
     tick()
     runs = []
     for _ in range(repeat):
+        w0, c0 = time.perf_counter(), time.process_time()
         result = _extract(case)
-        runs.append(dict(result.timings))
+        runs.append({**result.timings, "wall": time.perf_counter() - w0, "cpu": time.process_time() - c0})
         tick()
-    stages = {s: _median([r.get(s, 0.0) for r in runs]) for s in STAGES}
+    # wall and CPU seconds of the whole call: on a busy machine compare the CPU seconds
+    stages = {s: _median([r.get(s, 0.0) for r in runs]) for s in (*STAGES, "wall", "cpu")}
     return stages, result
 
 
@@ -467,6 +469,7 @@ def run_case(
     try:
         # --- cyclecoord
         stages, result = time_cyclecoord(case, repeat, tick("cyclecoord"))
+        clock = {k: stages.pop(k) for k in ("wall", "cpu")}  # the whole call: clock and CPU seconds
         peak = python_peak_mb(lambda: _extract(case))
         tick("cyclecoord")()
         points = np.asarray(result.prepared.points, dtype=float)
@@ -485,6 +488,7 @@ def run_case(
             "warnings": list(result.warnings),
             "peak_python_mb": peak,
             "maxrss_mb": maxrss_mb(),
+            **clock,
         }
         # --- ripser only
         rip = time_ripser(points, threshold, repeat, tick("ripser"))
@@ -655,8 +659,11 @@ def format_report(report: dict) -> str:
     lines.append("cyclecoord.extract, seconds per stage")
     rows = [[c["name"], str(c["n_frames"]), _f(c["threshold"], "{:.2f}")]
             + [_f(c["cyclecoord"]["stages"][s]) for s in STAGES]
+            + [_f(c["cyclecoord"].get(s)) for s in ("wall", "cpu")]
             + [_f(c.get("load_average_1min"), "{:.2f}")] for c in cases]
-    lines.append(_table(["case", "T", "thresh", *STAGES, "load*"], rows))
+    lines.append(_table(["case", "T", "thresh", *STAGES, "wall", "CPU", "load*"], rows))
+    lines.append("  wall / CPU = seconds of the whole extract call by the clock / by this process's CPU time "
+                 "(on a busy machine wall > CPU: compare CPU seconds)")
     lines.append("  * 1-minute load average after the case (> 0 means other processes competed for the cores)")
     lines.append("")
 

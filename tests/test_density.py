@@ -182,3 +182,36 @@ def test_long_inputs_are_fitted_on_an_even_subsample():
     err_sub = np.mean(np.abs(sub.pdf(GRID[::50]) - true_pdf(GRID[::50])))
     err_full = np.mean(np.abs(full.pdf(GRID[::50]) - true_pdf(GRID[::50])))
     assert err_sub < 0.08 and err_full < 0.05  # mean |pdf - truth|; the pdf peaks near 3
+
+
+@pytest.mark.parametrize("n, seed", [(300, 5), (750, 1), (5000, 2)])
+def test_deterministic_start_fits_as_scikit_learns_k_means_start_did(n, seed):
+    """The cdf (where the typical cycle samples) moves by under 0.01 of a period."""
+    mixture = pytest.importorskip("sklearn.mixture")
+    theta = draw(n, seed=seed)
+    ours = PeriodicDensity(random_state=0).fit(theta)
+    tiled = (theta[None, :] + np.arange(-1.0, 2.0)[:, None]).reshape(-1, 1)
+    gm = mixture.GaussianMixture(30, covariance_type="diag", reg_covar=1e-5, random_state=0).fit(tiled)
+    from scipy.special import ndtr
+
+    # the wrapped scikit-learn mixture's cdf on [0, 1], by hand
+    w, mu, sd = gm.weights_ / gm.weights_.sum(), gm.means_.ravel(), np.sqrt(gm.covariances_.ravel())
+    x = np.linspace(0.0, 1.0, 201)
+    sh = np.arange(-4.0, 5.0)
+    zx = (x[:, None, None] + sh[None, :, None] - mu[None, None, :]) / sd
+    z0 = (sh[None, :, None] - mu[None, None, :]) / sd
+    cdf_ref = ((ndtr(zx) - ndtr(z0)) * w).sum(axis=(1, 2))
+    cdf_ref /= cdf_ref[-1]
+    assert np.max(np.abs(ours.cdf(x) - cdf_ref)) < 0.01
+    assert ours.converged_
+
+
+def test_fit_ignores_the_seed_and_leaves_a_generator_where_it_was():
+    theta = draw(500, seed=4)
+    a = PeriodicDensity(random_state=0).fit(theta)
+    b = PeriodicDensity(random_state=123).fit(theta)
+    np.testing.assert_array_equal(a.means_, b.means_)
+    g1, g2 = np.random.default_rng(9), np.random.default_rng(9)
+    PeriodicDensity(random_state=g1).fit(theta)
+    g2.integers(0, 2**31 - 1)  # one draw, as when the generator seeded scikit-learn
+    assert g1.random() == g2.random()

@@ -53,17 +53,21 @@ def test_choice_of_landmarks():
 
 
 def test_memory_guard_switches_before_building(monkeypatch, synthetic_2000):
-    import ripser
+    from cyclecoord.periodic import _rips
 
     calls = []
-    real = ripser.ripser
+    real = _rips.rips_cohomology
 
     def spy(*args, **kwargs):
         calls.append(len(args[0]))  # points handed to ripser
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(ripser, "ripser", spy)
-    est = CircularCoordinates(landmarks=None, memory_limit=5e6)
+    monkeypatch.setattr(_rips, "rips_cohomology", spy)
+    from cyclecoord.periodic.landmarks import run_bytes
+
+    # a stated limit covers the per-frame arrays too: leave 5 MB for the filtration
+    limit = run_bytes(*synthetic_2000.shape) + 5e6
+    est = CircularCoordinates(landmarks=None, memory_limit=limit)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         est.fit_barcode(synthetic_2000)

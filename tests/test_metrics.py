@@ -196,3 +196,17 @@ def test_monotonicity_bad_input():
         monotonicity(np.zeros(1), np.zeros(1))
     with pytest.raises(ParameterError):
         monotonicity(np.array([0.1, np.nan]), np.zeros(2))
+
+
+def test_blockwise_figures_equal_whole_array_ones_bit_for_bit(monkeypatch):
+    import cyclecoord.quality.metrics as qm
+
+    rng = np.random.default_rng(3)
+    x = np.cumsum(rng.normal(size=(1000, 7)), axis=0)
+    whole_jerk = float(np.linalg.norm(qm.jerk(x, 120.0), axis=1).mean())
+    whole_steps = np.linalg.norm(np.diff(x, axis=0), axis=1)
+    monkeypatch.setattr(qm, "_CHUNK_ELEMENTS", 7 * 33)  # blocks of 33 frames
+    assert qm.jerk_summary(x, 120.0) == whole_jerk
+    np.testing.assert_array_equal(qm.frame_steps(x), whole_steps)
+    with pytest.raises(ParameterError):
+        qm.jerk_summary(x[:5], 120.0)

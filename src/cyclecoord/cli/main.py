@@ -196,7 +196,8 @@ def _add_selection_options(p: argparse.ArgumentParser) -> None:
     )
     g.add_argument(
         "--memory-limit", type=_bytes, default=None, metavar="SIZE",
-        help="memory budget for the filtration, e.g. 2G (default); above it landmarks are used",
+        help="memory for the run's large arrays, e.g. 500M: per-frame arrays and the filtration, whose "
+        "landmarks are reduced to fit (default: 2G for the filtration alone; never more than the machine has)",
     )
 
 

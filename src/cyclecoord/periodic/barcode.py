@@ -26,6 +26,7 @@ __all__ = [
     "DEFAULT_PRIME",
     "temporal_distance_matrix",
     "refine_birth",
+    "REFINE_BYTES_PER_EDGE",
 ]
 
 #: Coefficient field used by default: a prime well above 11 (the paper asks for p > 11).
@@ -135,12 +136,22 @@ def _diameter(points: np.ndarray, exact_limit: int = 2000, sweeps: int = 4) -> f
         return float(pdist(points).max())
     best, i = 0.0, 0
     for _ in range(sweeps):
-        d = np.linalg.norm(points - points[i], axis=1)
+        d = _distances_to(points, i)
         j = int(np.argmax(d))
         if d[j] <= best:
             break
         best, i = float(d[j]), j
     return best
+
+
+def _distances_to(points: np.ndarray, i: int, block: int = 1_000_000) -> np.ndarray:
+    """``np.linalg.norm(points - points[i], axis=1)`` in blocks of rows (the same values,
+    each row is computed alone; no (T, K) temporary)."""
+    out = np.empty(len(points))
+    step = max(1, block // max(points.shape[1], 1))
+    for a in range(0, len(points), step):
+        out[a : a + step] = np.linalg.norm(points[a : a + step] - points[i], axis=1)
+    return out
 
 
 def default_max_scale(points: np.ndarray, distances: np.ndarray | None = None) -> float:
@@ -158,8 +169,10 @@ def default_max_scale(points: np.ndarray, distances: np.ndarray | None = None) -
         diam = float(np.max(distances))
         steps = np.diagonal(distances, offset=1)  # zero for the temporal metric: connected by design
     else:
+        from ..quality.metrics import frame_steps
+
         diam = _diameter(points)
-        steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+        steps = frame_steps(points)  # |points[t + 1] - points[t]|, in blocks
     # a high percentile, not the maximum: an Euler flip in one joint (a 360-degree jump)
     # must not inflate the threshold
     step = float(np.percentile(steps, 99.5)) if steps.size else 0.0
@@ -191,7 +204,7 @@ def compute_barcode(
     -------
     Barcode
     """
-    import ripser  # local import keeps `import cyclecoord` light
+    from ._rips import rips_cohomology  # ripser's filtration without scikit-learn's imports
 
     p = check_prime(prime)
     x = np.asarray(points, dtype=float)
@@ -213,14 +226,7 @@ def compute_barcode(
         x = x[np.ix_(idx, idx)] if distance_matrix else x[idx]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = ripser.ripser(
-            x,
-            maxdim=1,
-            thresh=max_scale,
-            coeff=p,
-            do_cocycles=True,
-            distance_matrix=distance_matrix,
-        )
+        res = rips_cohomology(x, max_scale, p, distance_matrix=distance_matrix)
     h0 = np.asarray(res["dgms"][0], dtype=float).reshape(-1, 2)
     h1 = np.asarray(res["dgms"][1], dtype=float).reshape(-1, 2)
     cocycles = [np.asarray(c, dtype=np.int64).reshape(-1, 3) for c in res["cocycles"][1]]
@@ -367,6 +373,11 @@ def select_bar(
     )
 
 
+#: Peak bytes per edge of :func:`refine_birth`'s sparse complex (the pairs, their
+#: distances, the symmetric COO/CSR copies, ripser's own copy).
+REFINE_BYTES_PER_EDGE = 256
+
+
 def refine_birth(
     points: np.ndarray,
     landmark_birth: float,
@@ -391,7 +402,7 @@ def refine_birth(
     Returns ``None`` when the sparse complex would exceed ``max_edges`` edges or no bar
     is alive there.
     """
-    import ripser
+    from ._rips import sparse_rips_cohomology
 
     x = np.asarray(points, dtype=float)
     t = float(landmark_birth) * margin
@@ -404,8 +415,9 @@ def refine_birth(
     # so 1.25 x the budget is a wide margin.
     from .landmarks import estimate_complex
 
-    if estimate_complex(x, t, n_samples=20_000).edges > 1.25 * max_edges:
-        return None
+    n_pairs = len(x) * (len(x) - 1) / 2
+    if n_pairs > 1.25 * max_edges and estimate_complex(x, t, n_samples=20_000).edges > 1.25 * max_edges:
+        return None  # (with fewer pairs than that the sample could never refuse)
     tree = cKDTree(x)
     # then count exactly (ordered pairs and self-pairs): query_pairs materialises every pair
     if (tree.count_neighbors(tree, t) - len(x)) / 2 > max_edges:
@@ -418,8 +430,9 @@ def refine_birth(
     from scipy.sparse import coo_matrix
 
     n = len(x)
-    mat = coo_matrix((np.r_[d, d], (np.r_[pairs[:, 0], pairs[:, 1]], np.r_[pairs[:, 1], pairs[:, 0]])), shape=(n, n)).tocsr()
-    res = ripser.ripser(mat, maxdim=1, thresh=t, coeff=check_prime(prime), distance_matrix=True)
+    mat = coo_matrix((np.r_[d, d], (np.r_[pairs[:, 0], pairs[:, 1]], np.r_[pairs[:, 1], pairs[:, 0]])), shape=(n, n))
+    mat = mat.tocsr().tocoo()  # sorted by (row, col), as ripser.py hands it over
+    res = sparse_rips_cohomology(mat.row, mat.col, mat.data, n, t, check_prime(prime))
     h1 = np.asarray(res["dgms"][1]).reshape(-1, 2)
     alive = h1[~np.isfinite(h1[:, 1])] if h1.size else h1
     if covering_radius is not None and alive.size:

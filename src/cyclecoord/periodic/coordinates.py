@@ -18,12 +18,13 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
-from scipy.sparse.linalg import lsqr
 from scipy.spatial import cKDTree
 
 from .._blas import one_blas_thread
+from ._rips import DENSE_BYTES_PER_PAIR
 from .barcode import (
     DEFAULT_PRIME,
+    REFINE_BYTES_PER_EDGE,
     Barcode,
     BarSelection,
     check_prime,
@@ -34,7 +35,7 @@ from .barcode import (
     temporal_distance_matrix,
 )
 from ..errors import ParameterError
-from .landmarks import DEFAULT_MEMORY_LIMIT, choose_landmarks
+from .landmarks import choose_landmarks, estimate_complex, memory_budget, run_bytes
 
 __all__ = [
     "CircularCoordinates",
@@ -149,13 +150,19 @@ def check_cocycle(edges: np.ndarray, z: np.ndarray, n: int) -> CocycleCheck:
         return CocycleCheck(0, 0)
     ea, eb, c = a[common.row], b[common.row], common.col.astype(np.int64)
     # oriented cycle a -> b -> c -> a
-    val = z[support][common.row] + _lookup(edges, z, n, eb, c) + _lookup(edges, z, n, c, ea)
+    z_bc = _lookup(edges, z, n, eb, c)
+    z_ca = _lookup(edges, z, n, c, ea)
+    val = z[support][common.row] + z_bc + z_ca
     bad = np.abs(val) > 0.5
-    # a triangle holding k support edges is seen k times: count distinct triangles
-    tri = np.sort(np.column_stack([ea, eb, c]), axis=1)
-    key = (tri[:, 0] * n + tri[:, 1]) * n + tri[:, 2]
-    nbad = len(np.unique(key[bad])) if bad.any() else 0
-    return CocycleCheck(n_triangles=int(len(np.unique(key))), n_violations=int(nbad))
+    # A triangle holding k support edges is seen once from each of them (k = 1 + the
+    # other two edges in the support), with the same |coboundary| every time: the
+    # distinct triangles are sum over k of (rows seen with k) / k -- no sort, no unique.
+    k = 1 + (z_bc != 0).astype(np.int64) + (z_ca != 0).astype(np.int64)
+    seen = np.bincount(k, minlength=4)
+    seen_bad = np.bincount(k[bad], minlength=4)
+    n_tri = int(seen[1] + seen[2] // 2 + seen[3] // 3)
+    nbad = int(seen_bad[1] + seen_bad[2] // 2 + seen_bad[3] // 3)
+    return CocycleCheck(n_triangles=n_tri, n_violations=nbad)
 
 
 def harmonic_coordinate(
@@ -188,14 +195,60 @@ def harmonic_coordinate(
     cols = edges.ravel()
     vals = np.tile([-1.0, 1.0], e)
     delta = sp.csr_matrix((vals, (rows, cols)), shape=(e, n))
-    if weights is None:
-        w = lsqr(delta, -z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
-    else:
-        sw = np.sqrt(np.asarray(weights, dtype=float))
-        w = lsqr(sp.diags(sw) @ delta, -sw * z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
+    w = _least_squares_potential(delta, edges, z, n, weights)
     harmonic = z + delta @ w
     theta = np.mod(-w, 1.0)
     return theta, harmonic
+
+
+def _least_squares_potential(
+    delta: sp.csr_matrix, edges: np.ndarray, z: np.ndarray, n: int, weights: np.ndarray | None
+) -> np.ndarray:
+    """The minimum-norm ``w`` minimising ``sum_e weights_e (z + δw)_e²``.
+
+    A direct solve of the normal equations instead of LSQR: ``L w = -δᵀ W z`` with the
+    weighted graph Laplacian ``L = δᵀ W δ``, one vertex of each connected component held
+    at 0 (``L`` is singular only along each component's constants), one sparse LU
+    factorisation; then each component's mean is removed, which gives the minimum-norm
+    solution LSQR converges to.  Agrees with LSQR (``atol = btol = 1e-12``) to about
+    1e-10 (tested) and costs one factorisation instead of hundreds of products.  Used for
+    the unweighted problem (every point, and detect's windows); the weighted landmark
+    problem is still solved by LSQR (see the comment below).
+    """
+    from scipy.sparse.linalg import lsqr, splu
+
+    if weights is not None:
+        # the landmark problem keeps LSQR: on CMU-like chains detect's segment boundaries
+        # sit on an edge that a 1e-12 change of a landmark coordinate can tip (a synthetic
+        # walk/jog/squat chain moved a boundary 16 frames); its landmarks are few (500),
+        # so this costs little, and every landmark result stays as it was, bit for bit
+        sw = np.sqrt(np.asarray(weights, dtype=float))
+        return lsqr(sp.diags(sw) @ delta, -sw * z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
+    wts = np.ones(len(z))
+    a, b = edges[:, 0], edges[:, 1]
+    wz = wts * z
+    rhs = np.bincount(a, weights=wz, minlength=n) - np.bincount(b, weights=wz, minlength=n)  # -δᵀ W z
+    ncomp, label = connected_components(
+        sp.csr_matrix((np.ones(len(edges)), (a, b)), shape=(n, n)), directed=False
+    )
+    first = np.full(ncomp, -1)
+    first[label[::-1]] = np.arange(n)[::-1]  # lowest vertex of each component
+    free = np.ones(n, dtype=bool)
+    free[first] = False
+    w = np.zeros(n)
+    if free.any():
+        # the Laplacian δᵀ W δ restricted to the free vertices, assembled from the edges
+        pos = np.cumsum(free) - 1
+        deg = np.bincount(a, weights=wts, minlength=n) + np.bincount(b, weights=wts, minlength=n)
+        both = free[a] & free[b]
+        fv = np.flatnonzero(free)
+        rows = np.concatenate([pos[fv], pos[a[both]], pos[b[both]]])
+        cols = np.concatenate([pos[fv], pos[b[both]], pos[a[both]]])
+        vals = np.concatenate([deg[fv], -wts[both], -wts[both]])
+        lap = sp.csc_matrix((vals, (rows, cols)), shape=(fv.size, fv.size))
+        w[fv] = splu(lap, permc_spec="COLAMD").solve(rhs[fv])
+    w -= (np.bincount(label, weights=w, minlength=ncomp) / np.bincount(label, minlength=ncomp))[label]
+    return w
 
 
 def orient_with_time(theta: np.ndarray, return_transform: bool = False):
@@ -220,7 +273,7 @@ def extend_coordinate(
     harmonic: np.ndarray,
     radius: float,
     max_neighbors: int = 48,
-    chunk: int = 20_000,
+    chunk: int = 4_000,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Circular coordinate of arbitrary points from a solution on ``centers``.
 
@@ -257,6 +310,7 @@ def extend_coordinate(
     k = int(min(L, max_neighbors))
     theta = np.empty(len(x))
     covered = np.empty(len(x), dtype=bool)
+    table = _increment_table(edges, harmonic, L) if L <= _TABLE_MAX_CENTERS else None
     for a in range(0, len(x), chunk):
         q = x[a : a + chunk]
         d, idx = tree.query(q, k=k, distance_upper_bound=radius)
@@ -271,7 +325,10 @@ def extend_coordinate(
         if cov.any():
             jj = np.repeat(nearest[cov][:, None], k, axis=1)
             kk = np.where(valid[cov], idx[cov], jj)  # padded slots point at j itself: zero increment
-            inc = -_lookup(edges, harmonic, L, jj.ravel(), kk.ravel()).reshape(jj.shape)
+            if table is not None:
+                inc = -table[jj, kk]
+            else:
+                inc = -_lookup(edges, harmonic, L, jj.ravel(), kk.ravel()).reshape(jj.shape)
             w = phi[cov] / tot[cov][:, None]
             out[cov] = center_theta[nearest[cov]] + (w * inc).sum(axis=1)
         if (~cov).any():
@@ -280,6 +337,20 @@ def extend_coordinate(
         theta[a : a + chunk] = np.mod(out, 1.0)
         covered[a : a + chunk] = cov
     return theta, covered
+
+
+#: Up to this many centers the cochain is held as an (L, L) table (8 L² bytes: 72 MB at
+#: 3,000) for the extension's lookups, instead of a binary search per lookup.
+_TABLE_MAX_CENTERS = 3000
+
+
+def _increment_table(edges: np.ndarray, z: np.ndarray, n: int) -> np.ndarray:
+    """``table[u, v] == _lookup(edges, z, n, u, v)`` for every pair, bit for bit (signed
+    zeros included: ``+0.0`` above the diagonal, ``-0.0`` on and below it)."""
+    table = np.where(np.triu(np.ones((n, n), dtype=bool), k=1), 0.0, -0.0)
+    table[edges[:, 0], edges[:, 1]] = z
+    table[edges[:, 1], edges[:, 0]] = -z
+    return table
 
 
 def unwrap(theta: np.ndarray) -> np.ndarray:
@@ -314,8 +385,16 @@ class CircularCoordinates:
         Build the filtration on greedy max-min landmarks and extend the coordinate to
         every point (see :func:`cyclecoord.periodic.landmarks.choose_landmarks`).  ``None`` uses
         every point.
-    memory_limit : float, default 2 GiB
-        Budget for one filtration; above it landmarks are used (fewer if needed).
+    memory_limit : float, optional
+        Bytes the fit's large arrays may take: the per-point arrays
+        (:func:`~cyclecoord.periodic.landmarks.run_bytes`, plus ``memory_reserved``) and
+        the filtration, whose landmarks are chosen (fewer if needed) to fit what is left.
+        Default: 2 GiB for the filtration alone.  Never more than the machine holds
+        (:func:`~cyclecoord.periodic.landmarks.machine_memory`); a fit whose per-point
+        arrays cannot fit is refused before anything is allocated.
+    memory_reserved : float, default 0
+        Bytes of the caller's own per-frame arrays to count against ``memory_limit``
+        (:func:`cyclecoord.extract` passes its poses).
     refine_birth : bool, default True
         With landmarks, also compute the class's birth on every point when cheap.
 
@@ -357,8 +436,9 @@ class CircularCoordinates:
         scale_fraction: float = 0.9,
         temporal: bool = False,
         landmarks: int | str | None = "auto",
-        memory_limit: float = DEFAULT_MEMORY_LIMIT,
+        memory_limit: float | None = None,
         refine_birth: bool = True,
+        memory_reserved: float = 0.0,
     ) -> None:
         self.max_scale = max_scale
         self.scale = scale
@@ -369,6 +449,7 @@ class CircularCoordinates:
         self.landmarks = landmarks
         self.memory_limit = memory_limit
         self.refine_birth = refine_birth
+        self.memory_reserved = memory_reserved
 
     # ------------------------------------------------------------------
     def _validate(self, X) -> np.ndarray:
@@ -399,13 +480,17 @@ class CircularCoordinates:
         """
         x = self._validate(X)
         self.points_ = x
+        T, K = x.shape
+        reserved = run_bytes(T, K) + float(self.memory_reserved or 0.0)
+        budget, note = memory_budget(self.memory_limit, reserved, f"{T} frames of {K} dimensions")
+        self.memory_budget_ = budget
         if self.temporal:
-            need = 8.0 * len(x) ** 2
-            if need > self.memory_limit:
+            # the (T, T) matrix, then the filtration's copies of it
+            need = (8.0 + DENSE_BYTES_PER_PAIR) * T**2
+            if need > budget:
                 raise ParameterError(
-                    f"the temporal metric needs a full {len(x)} x {len(x)} distance matrix "
-                    f"({need / 1e9:.1f} GB, over the {self.memory_limit / 1e9:.1f} GB limit); "
-                    "drop --temporal or analyse fewer frames"
+                    f"the temporal metric needs a full {T} x {T} distance matrix "
+                    f"({need / 1e9:.1f} GB, over the {note}); drop --temporal or analyse fewer frames"
                 )
             self._dist_ = temporal_distance_matrix(x)
         else:
@@ -413,14 +498,29 @@ class CircularCoordinates:
         self.threshold_ = float(
             self.max_scale if self.max_scale is not None else default_max_scale(x, self._dist_)
         )
-        n, est, reason = choose_landmarks(x, self.threshold_, self.landmarks, self.memory_limit)
+        n, est, reason = choose_landmarks(x, self.threshold_, self.landmarks, budget)
         self.n_landmarks_ = n
         self.complex_estimate_ = est
+        self._complex_deferred = est is None  # computed on first access (report)
         self.landmark_reason_ = reason
         self.barcode_ = self._barcode(check_prime(self.prime))
         self.landmarks_ = self.barcode_.point_indices
         self.covering_radius_ = float(self.barcode_.extras.get("covering_radius", 0.0))
         return self.barcode_
+
+    @property
+    def complex_estimate_(self):
+        """Size estimate of the filtration that was built (computed when first asked
+        for if the memory guard did not need it)."""
+        if getattr(self, "_complex_deferred", False):
+            self._complex_estimate = estimate_complex(self.points_, self.threshold_, n_vertices=self.n_landmarks_)
+            self._complex_deferred = False
+        return self._complex_estimate
+
+    @complex_estimate_.setter
+    def complex_estimate_(self, value) -> None:
+        self._complex_estimate = value
+        self._complex_deferred = False
 
     def use_barcode(self, X, barcode: Barcode) -> "CircularCoordinates":
         """Adopt a barcode already computed on every point of ``X`` (Euclidean metric).
@@ -574,7 +674,11 @@ class CircularCoordinates:
             )
         theta, sign, offset = orient_with_time(raw, return_transform=True)
         if self.landmarks_ is not None and not self.temporal and self.refine_birth:
-            full = refine_birth(self.points_, sel.birth, p, covering_radius=self.covering_radius_)
+            # the sparse complex within what the filtration was allowed (it is gone by now)
+            budget = getattr(self, "memory_budget_", None)
+            max_edges = 3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
+            full = (refine_birth(self.points_, sel.birth, p, max_edges=max_edges,
+                                 covering_radius=self.covering_radius_) if max_edges > 0 else None)
             sel = BarSelection(**{**sel.__dict__, "full_birth": full})
         self.barcode_ = bc
         self.selection_ = sel

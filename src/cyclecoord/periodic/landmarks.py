@@ -6,16 +6,25 @@ the chosen threshold is estimated from random pairs and triples of points; when 
 estimate is over budget, or the capture is long, the barcode is computed on greedy
 max-min landmarks (:func:`greedy_landmarks`, the same choice as ripser's ``n_perm``) and
 the coordinate extended to every frame.
+
+The budget trusts no limit: it is never more than the machine can hold
+(:func:`machine_memory`: physical memory, a cgroup limit, an address-space rlimit).  A
+limit the caller states covers the run's large arrays -- the per-frame arrays
+(:func:`run_bytes`) as well as the filtration -- and a run whose per-frame arrays alone
+do not fit is refused before anything is allocated.  Without a stated limit the
+filtration gets :data:`DEFAULT_MEMORY_LIMIT`, within what the machine has left.
 """
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from math import comb
 
 import numpy as np
 
 from ..errors import ParameterError
+from ._rips import DENSE_BYTES_PER_PAIR
 
 __all__ = [
     "greedy_landmarks",
@@ -25,6 +34,9 @@ __all__ = [
     "AUTO_FULL_LIMIT",
     "AUTO_LANDMARKS",
     "DEFAULT_MEMORY_LIMIT",
+    "machine_memory",
+    "run_bytes",
+    "memory_budget",
 ]
 
 #: With ``landmarks="auto"`` captures up to this many frames use every frame ...
@@ -34,10 +46,127 @@ AUTO_LANDMARKS = 500
 #: Default memory budget for one filtration, in bytes (a laptop-friendly 2 GiB).
 DEFAULT_MEMORY_LIMIT = 2 * 1024**3
 
-# ripser.py keeps an (n_used x n_all) float64 distance array; the reduction keeps a
-# handful of 8-byte words per edge column.
-_BYTES_PER_DISTANCE = 8
+# The filtration on n points: a float64 (n, n) distance matrix and its float32 condensed
+# copies (periodic._rips), then a handful of 8-byte words per edge column in the reduction.
 _BYTES_PER_EDGE = 64
+# Per-frame arrays of a run (extract / CircularCoordinates): the points, the poses and one
+# (T, K) temporary at a time, plus about sixteen float64 or int64 values per frame
+# (coordinates, unwrapped phase, nearest landmark, greedy distances, phase sort, ...) ...
+_COPIES_PER_VALUE = 3
+_WORDS_PER_FRAME = 16
+# ... and work arrays of bounded size: the density's EM (30 components, on three copies
+# of at most 20,000 values: three (values x components) arrays at its peak), the kernel
+# average's, the metrics' and the coordinate extension's blocks.
+_EM_BYTES_PER_VALUE = 8 * 3 * 30 * 3
+_EM_MAX_VALUES = 20_000
+_FIXED_SCRATCH = 40 * 1024**2
+
+
+def _mapped_bytes() -> float:
+    """Virtual memory this process has mapped already (Linux; 0 elsewhere)."""
+    try:
+        with open("/proc/self/statm") as fh:
+            return float(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError, AttributeError):
+        return 0.0
+
+
+def machine_memory() -> float:
+    """Bytes this process can allocate at most: physical memory, lowered by a cgroup
+    memory limit and by an address-space or data rlimit (less what is mapped already).
+    ``inf`` when nothing can be read."""
+    found = []
+    try:
+        found.append(float(os.sysconf("SC_PAGE_SIZE")) * float(os.sysconf("SC_PHYS_PAGES")))
+    except (ValueError, OSError, AttributeError):
+        pass
+    for path in ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"):
+        try:
+            with open(path) as fh:
+                text = fh.read().strip()
+        except OSError:
+            continue
+        if text.isdigit() and int(text) < 2**60:  # "max" or a huge number: no limit
+            found.append(float(text))
+    try:
+        import resource
+
+        for which in (resource.RLIMIT_AS, resource.RLIMIT_DATA):
+            soft, _ = resource.getrlimit(which)
+            if soft != resource.RLIM_INFINITY and soft > 0:
+                found.append(max(float(soft) - _mapped_bytes(), 0.0))
+    except (ImportError, ValueError, OSError):
+        pass
+    return min(found) if found else float("inf")
+
+
+def run_bytes(n_frames: int, n_dims: int, n_channels: int | None = None) -> float:
+    """Estimated peak bytes of a run's per-frame arrays (everything but the filtration).
+
+    Parameters
+    ----------
+    n_frames : int
+        Frames analysed ``T``.
+    n_dims : int
+        Dimensions ``K`` of the analysed points.
+    n_channels : int, optional
+        Channels ``D`` of the poses the cycle is averaged from (default ``K``).
+    """
+    d = n_dims if n_channels is None else n_channels
+    per_frame = 8.0 * (_COPIES_PER_VALUE * max(n_dims, d) + _WORDS_PER_FRAME)
+    em = _EM_BYTES_PER_VALUE * min(int(n_frames), _EM_MAX_VALUES)
+    return per_frame * float(n_frames) + em + _FIXED_SCRATCH
+
+
+def _gb(b: float) -> str:
+    return f"{b / 1e9:.2f} GB"
+
+
+def memory_budget(memory_limit: float | None, reserved: float, what: str = "") -> tuple[float, str]:
+    """Bytes left for the filtration, and a note on where the figure came from.
+
+    Parameters
+    ----------
+    memory_limit : float or None
+        A stated limit for the run's large arrays (bytes), or None for the default
+        (:data:`DEFAULT_MEMORY_LIMIT` for the filtration alone).
+    reserved : float
+        Bytes of the run's other arrays (:func:`run_bytes`).
+    what : str
+        Names the run in messages (e.g. ``"64000 frames of 62 dimensions"``).
+
+    Raises
+    ------
+    ParameterError
+        When the run's other arrays alone exceed the stated limit or the machine's memory.
+    """
+    if memory_limit is not None and (
+        isinstance(memory_limit, bool) or not np.isfinite(memory_limit) or memory_limit <= 0
+    ):
+        raise ParameterError(f"memory limit must be a positive number of bytes, got {memory_limit}")
+    machine = machine_memory()
+    run = f" ({what})" if what else ""
+    if reserved >= machine:
+        raise ParameterError(
+            f"not enough memory: the run's per-frame arrays{run} need about {_gb(reserved)} and this "
+            f"machine allows {_gb(machine)}; analyse fewer frames (--frames) or fewer dimensions (--pca)"
+        )
+    if memory_limit is None:
+        budget = min(float(DEFAULT_MEMORY_LIMIT), machine - reserved)
+        note = f"{_gb(budget)} for the filtration"
+    else:
+        if reserved >= memory_limit:
+            raise ParameterError(
+                f"memory limit {_gb(memory_limit)} is too small: the run's per-frame arrays{run} need "
+                f"about {_gb(reserved)} before the filtration; raise --memory-limit or analyse fewer frames"
+            )
+        budget = min(float(memory_limit), machine) - reserved
+        note = f"{_gb(budget)} for the filtration: the {_gb(memory_limit)} limit less {_gb(reserved)} of per-frame arrays"
+    if memory_limit is not None and memory_limit > machine:
+        note += f" (the stated limit exceeds the machine's {_gb(machine)}; that is used)"
+    elif memory_limit is None and machine - reserved < DEFAULT_MEMORY_LIMIT:
+        note += f" (what the machine's {_gb(machine)} leaves)"
+    return budget, note
 
 
 @dataclass(frozen=True)
@@ -152,20 +281,35 @@ def estimate_complex(
     n = T if n_vertices is None else int(min(n_vertices, T))
     if T < 3:
         return ComplexEstimate(T, 0.0, 0.0, 0.0)
+    return _estimate(n, *_pair_fractions(x, threshold, n_samples, random_state))
+
+
+def _pair_fractions(x: np.ndarray, threshold: float, n_samples: int, random_state: int) -> tuple[float, float]:
+    """Fractions of random pairs (triples) of points within ``threshold`` (of each other)."""
+    T = x.shape[0]
     rng = np.random.default_rng(random_state)
     i = rng.integers(0, T, n_samples)
     j = rng.integers(0, T, n_samples)
     k = rng.integers(0, T, n_samples)
     ok = (i != j) & (j != k) & (i != k)
     i, j, k = i[ok], j[ok], k[ok]
+    if not i.size:
+        return 0.0, 0.0
     dij = np.linalg.norm(x[i] - x[j], axis=1) <= threshold
-    djk = np.linalg.norm(x[j] - x[k], axis=1) <= threshold
-    dik = np.linalg.norm(x[i] - x[k], axis=1) <= threshold
-    p_edge = float(dij.mean()) if dij.size else 0.0
-    p_tri = float((dij & djk & dik).mean()) if dij.size else 0.0
+    # the other two sides only where the first is an edge (the same triangles, less work)
+    e = np.flatnonzero(dij)
+    tri = (np.linalg.norm(x[j[e]] - x[k[e]], axis=1) <= threshold) & (
+        np.linalg.norm(x[i[e]] - x[k[e]], axis=1) <= threshold
+    )
+    return float(dij.mean()), float(np.count_nonzero(tri) / dij.size)
+
+
+def _estimate(n: int, p_edge: float, p_tri: float) -> ComplexEstimate:
     edges = p_edge * comb(n, 2)
     triangles = p_tri * comb(n, 3)
-    mem = _BYTES_PER_DISTANCE * n * T + _BYTES_PER_EDGE * edges
+    # the distance matrix of the n vertices (landmarks are chosen in O(T) memory, counted
+    # with the run's per-frame arrays, see run_bytes) and the reduction's edge columns
+    mem = DENSE_BYTES_PER_PAIR * float(n) * n + _BYTES_PER_EDGE * edges
     return ComplexEstimate(n_points=n, edges=edges, triangles=triangles, bytes=mem)
 
 
@@ -184,21 +328,24 @@ def choose_landmarks(
         :data:`AUTO_LANDMARKS` landmarks; an int: that many; ``None`` or ``"none"``:
         every frame.
     memory_limit : float
-        Bytes.  When the estimate exceeds it, the landmark count is reduced until it
-        fits (down to 50); ``landmarks=None`` then switches to landmarks as well.
+        Bytes for the filtration (see :func:`memory_budget`).  When the estimate
+        exceeds it, the landmark count is reduced until it fits (down to 50);
+        ``landmarks=None`` then switches to landmarks as well.
 
     Returns
     -------
     n_landmarks : int or None
         ``None`` means every point.
-    estimate : ComplexEstimate
-        For the complex that will be built.
+    estimate : ComplexEstimate or None
+        For the complex that will be built; None when even the complete complex fits the
+        budget (then ``estimate_complex(points, threshold, n_landmarks)`` gives it; the
+        sampled estimate costs more than a small filtration).
     reason : str
         Human-readable account of the decision (for the report).
     """
     T = len(points)
     if memory_limit is None or not np.isfinite(memory_limit) or memory_limit <= 0:
-        raise ParameterError(f"memory limit must be a positive number of bytes, got {memory_limit}")
+        raise ParameterError(f"memory budget must be a positive number of bytes, got {memory_limit}")
     if landmarks is None or (isinstance(landmarks, str) and landmarks.lower() in ("none", "all", "full")):
         n, reason = None, "every frame (landmarks off)"
     elif isinstance(landmarks, str):
@@ -219,18 +366,36 @@ def choose_landmarks(
             n, reason = None, f"every frame ({landmarks} landmarks requested, {T} frames)"
         else:
             reason = f"{n} greedy landmarks of {T} frames (requested)"
-    est = estimate_complex(points, threshold, n_vertices=n)
+    m0 = T if n is None else min(int(n), T)
+    if DENSE_BYTES_PER_PAIR * float(m0) * m0 + _BYTES_PER_EDGE * comb(m0, 2) <= memory_limit:
+        # even the complete complex fits: the estimate cannot change the decision, so it is
+        # left to whoever asks (estimate_complex(points, threshold, n) gives the same figures)
+        return n, None, reason
+    x = np.asarray(points, dtype=float)
+    fractions = _pair_fractions(x, threshold, 20_000, 0) if T >= 3 else (0.0, 0.0)
+
+    def size(m: int | None) -> ComplexEstimate:  # estimate_complex(points, threshold, m)
+        m = T if m is None else int(min(m, T))
+        return _estimate(m, *fractions) if T >= 3 else ComplexEstimate(T, 0.0, 0.0, 0.0)
+
+    est = size(n)
     if est.bytes > memory_limit:
         before = est
         m = n if n is not None else min(T, AUTO_LANDMARKS)
-        est = estimate_complex(points, threshold, n_vertices=m)
+        est = size(m)
         while est.bytes > memory_limit and m > 50:
             m = max(50, int(m * 0.7))
-            est = estimate_complex(points, threshold, n_vertices=m)
+            est = size(m)
+        if est.bytes > memory_limit:
+            raise ParameterError(
+                f"not enough memory: even {m} landmarks need about {est.bytes / 1e9:.2f} GB for the "
+                f"filtration at scale {threshold:.4g}, over the {memory_limit / 1e9:.2f} GB left for it; "
+                "lower --max-scale or raise --memory-limit"
+            )
         reason = (
             f"memory guard: the complex on {before.n_points} points was estimated at "
             f"{before.bytes / 1e9:.2f} GB ({before.edges:.3g} edges) over the {memory_limit / 1e9:.2f} GB "
-            f"limit; using {m} greedy landmarks ({est.bytes / 1e9:.2f} GB)"
+            f"budget; using {m} greedy landmarks ({est.bytes / 1e9:.2f} GB)"
         )
         n = m if m < T else None
     return n, est, reason

@@ -19,11 +19,11 @@ from .._blas import one_blas_thread
 from .barcode import (
     CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, DEFAULT_PRIME, Barcode, BarSelection, refine_birth, select_bar,
 )
-from .coordinates import CircularCoordinates, unwrap
+from .coordinates import REFINE_BYTES_PER_EDGE, CircularCoordinates, unwrap
 from .cycle import TypicalCycle, check_bandwidth, select_bandwidth, typical_cycle
 from .density import PeriodicDensity
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..quality.metrics import distance_to_cycle, jerk_summary, loop_closure
+from ..quality.metrics import distance_to_cycle, frame_steps, jerk_summary, loop_closure
 from ..motion import Motion
 from .preprocess import PreparedData, Preprocessor
 from .root import compose_root, decompose_root, heading, root_layout
@@ -471,7 +471,10 @@ def extract(
         Build the filtration on greedy max-min landmarks (``"auto"``: every frame up to
         1,000 frames, 500 landmarks beyond) and extend the coordinate to every frame.
     memory_limit : float, optional
-        Byte budget for the filtration (default 2 GiB); above it landmarks are used.
+        Bytes the run's large arrays may take, the per-frame arrays and the filtration
+        (whose landmarks are reduced to fit); default 2 GiB for the filtration alone.
+        Never more than the machine's memory; a run that cannot fit is refused with a
+        :class:`ParameterError` before anything large is allocated.
     require_clear : bool, default True
         Raise :class:`NoPeriodicMotionError` when the chosen bar does not stand clear.
     random_state : int, optional
@@ -539,7 +542,8 @@ def extract(
         return CircularCoordinates(
             max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
             scale_fraction=scale_fraction, temporal=temporal, landmarks=lm, refine_birth=False,
-            **({} if memory_limit is None else {"memory_limit": memory_limit}),
+            memory_limit=memory_limit,
+            memory_reserved=8.0 * max(0, prepared.poses.size - prepared.points.size),  # poses beyond the points
         )
 
     def fail(msg: str, fit: _Fit | None = None, barcode: Barcode | None = None) -> NoPeriodicMotionError:
@@ -597,8 +601,10 @@ def extract(
                 j += 1
         if not first_pass and fit.est.landmarks_ is not None and not temporal:
             # the class's birth on every frame, for the report (landmarks are born later)
-            full = refine_birth(prepared.points[rows], fit.selection.birth, fit.est.prime_,
-                                covering_radius=fit.est.covering_radius_)
+            budget = getattr(fit.est, "memory_budget_", None)
+            max_edges = 3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
+            full = refine_birth(prepared.points[rows], fit.selection.birth, fit.est.prime_, max_edges=max_edges,
+                                covering_radius=fit.est.covering_radius_) if max_edges > 0 else None
             fit.selection = BarSelection(**{**fit.selection.__dict__, "full_birth": full})
             fit.est.selection_ = fit.selection
         timings[f"coordinate{stage}"] = time.perf_counter() - t0
@@ -782,7 +788,7 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     }
     closure = float(loop_closure(typ.frames))
     dist = distance_to_cycle(prepared.poses[rows], typ.frames)
-    step = np.concatenate([np.linalg.norm(np.diff(prepared.poses[a:b], axis=0), axis=1) for a, b in runs])
+    step = np.concatenate([frame_steps(prepared.poses[a:b]) for a, b in runs])
     distance = {
         "median": float(np.median(dist)),
         "p90": float(np.percentile(dist, 90)),

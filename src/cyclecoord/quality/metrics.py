@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import lru_cache
 from numbers import Integral, Real
 
 import numpy as np
@@ -24,6 +25,7 @@ __all__ = [
     "finite_difference_coefficients",
     "jerk",
     "jerk_summary",
+    "frame_steps",
     "loop_closure",
     "distance_to_cycle",
     "circular_distance",
@@ -34,8 +36,9 @@ __all__ = [
 #: Largest stencil finite_difference_coefficients will build (beyond this the
 #: formulas are numerically useless anyway).
 _MAX_STENCIL = 32
-#: Elements of the (frames x segments) work arrays of distance_to_cycle per chunk.
-_CHUNK_ELEMENTS = 2_000_000
+#: Elements of the work arrays per block of frames (distance_to_cycle: frames x segments;
+#: jerk_summary, frame_steps: frames x channels).
+_CHUNK_ELEMENTS = 500_000
 
 
 def _frames_array(x: object, name: str) -> np.ndarray:
@@ -102,6 +105,14 @@ def finite_difference_coefficients(derivative: int, accuracy: int) -> np.ndarray
     n = derivative + accuracy
     if n > _MAX_STENCIL:
         raise ParameterError(f"stencil of {n} points is too long (at most {_MAX_STENCIL})")
+    return np.array(_exact_coefficients(derivative, accuracy))
+
+
+@lru_cache(maxsize=64)
+def _exact_coefficients(derivative: int, accuracy: int) -> tuple:
+    """The stencil of :func:`finite_difference_coefficients`, solved once per pair
+    (exact rational arithmetic costs a few milliseconds a call)."""
+    n = derivative + accuracy
     # Augmented system [A | b] with A[m][j] = j**m, b[m] = derivative! * [m == derivative]
     factorial = 1
     for i in range(2, derivative + 1):
@@ -120,7 +131,7 @@ def finite_difference_coefficients(derivative: int, accuracy: int) -> np.ndarray
             if r != col and rows[r][col] != 0:
                 factor = rows[r][col]
                 rows[r] = [a - factor * b for a, b in zip(rows[r], rows[col])]
-    return np.array([float(rows[m][n]) for m in range(n)])
+    return tuple(float(rows[m][n]) for m in range(n))
 
 
 def jerk(frames: np.ndarray, fps: float, accuracy: int = 4, cyclic: bool = False) -> np.ndarray:
@@ -190,8 +201,40 @@ def jerk_summary(frames: np.ndarray, fps: float, cyclic: bool = False) -> float:
         angles; mixing translation and angle channels mixes units, so compare like with
         like).  Uses the 4th-order-accurate formula.
     """
-    j = jerk(frames, fps, accuracy=4, cyclic=cyclic)
-    return float(np.linalg.norm(j, axis=1).mean())
+    if cyclic:
+        j = jerk(frames, fps, accuracy=4, cyclic=True)
+        return float(np.linalg.norm(j, axis=1).mean())
+    # in blocks of frames (each row's jerk and norm are computed alone, so the result is
+    # the whole-array one bit for bit) to hold O(block) rather than three (T, D) arrays
+    x = _frames_array(frames, "frames")
+    fps = _check_fps(fps)
+    coef = finite_difference_coefficients(3, 4) * fps**3
+    n = coef.size
+    if x.shape[0] < n:
+        jerk(x, fps, accuracy=4)  # raises the usual error
+    m = x.shape[0] - n + 1
+    norms = np.empty(m)
+    block = max(1, _CHUNK_ELEMENTS // max(x.shape[1], 1))
+    for lo in range(0, m, block):
+        hi = min(m, lo + block)
+        out = np.zeros((hi - lo, x.shape[1]))
+        for j, c in enumerate(coef):
+            out += c * x[lo + j : hi + j]
+        norms[lo:hi] = np.linalg.norm(out, axis=1)
+    return float(norms.mean())
+
+
+def frame_steps(frames: np.ndarray) -> np.ndarray:
+    """Euclidean length of each step ``frames[t + 1] - frames[t]``, shape (T - 1,),
+    computed in blocks of frames (no (T, D) temporary)."""
+    x = np.asarray(frames, dtype=float)
+    m = max(x.shape[0] - 1, 0)
+    out = np.empty(m)
+    block = max(1, _CHUNK_ELEMENTS // max(x.shape[1], 1))
+    for lo in range(0, m, block):
+        hi = min(m, lo + block)
+        out[lo:hi] = np.linalg.norm(x[lo + 1 : hi + 1] - x[lo:hi], axis=1)
+    return out
 
 
 # ---------------------------------------------------------------------- loop quality
@@ -249,7 +292,6 @@ def distance_to_cycle(frames: np.ndarray, cycle: np.ndarray) -> np.ndarray:
         raise ParameterError(f"frames have {x.shape[1]} channels but the cycle has {c.shape[1]}")
     centre = c.mean(axis=0)  # work near the origin to keep the expansion accurate
     a = c - centre
-    x = x - centre
     v = np.roll(a, -1, axis=0) - a  # segment vectors
     vv = np.einsum("pd,pd->p", v, v)
     aa = np.einsum("pd,pd->p", a, a)
@@ -259,7 +301,7 @@ def distance_to_cycle(frames: np.ndarray, cycle: np.ndarray) -> np.ndarray:
     chunk = max(1, _CHUNK_ELEMENTS // max(n_seg, 1))
     out = np.empty(x.shape[0])
     for lo in range(0, x.shape[0], chunk):
-        xs = x[lo : lo + chunk]
+        xs = x[lo : lo + chunk] - centre
         xa = xs @ a.T  # (t, P)
         xv = xs @ v.T
         xx = np.einsum("td,td->t", xs, xs)
