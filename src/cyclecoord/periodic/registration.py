@@ -9,7 +9,8 @@ with steps of 0, 1 or 2 cycle samples per frame (the 0 and 2 steps cost a penalt
 phase keeps the capture's pace unless the poses ask otherwise), and repeats with the
 cycle averaged at the new phases.
 
-Cost: O(frames x band) distances and one vectorised dynamic-programming row per frame.
+Cost: O(frames x band) distances (in blocks, so memory is O(frames x band)) and one
+vectorised dynamic-programming row per frame.
 """
 
 from __future__ import annotations
@@ -20,6 +21,9 @@ from .windings import phase_average
 
 __all__ = ["register"]
 
+#: Frames whose band of distances is computed at once.
+_BLOCK = 256
+
 
 def _align_run(poses: np.ndarray, psi: np.ndarray, template: np.ndarray, band: int, penalty: float) -> np.ndarray:
     """Template sample index (unwrapped, integer) of every frame of one run."""
@@ -28,8 +32,10 @@ def _align_run(poses: np.ndarray, psi: np.ndarray, template: np.ndarray, band: i
     centre = np.round(psi * P).astype(np.int64)  # unwrapped sample index per frame
     offsets = np.arange(-band, band + 1)
     idx = centre[:, None] + offsets[None, :]  # (n, W)
-    sample = template[np.mod(idx, P)]  # (n, W, D)
-    cost = np.linalg.norm(sample - poses[:, None, :], axis=2)
+    cost = np.empty(idx.shape)
+    for a in range(0, n, _BLOCK):  # (block, W, D) at a time: memory O(n W), not O(n W D)
+        b = min(n, a + _BLOCK)
+        cost[a:b] = np.linalg.norm(template[np.mod(idx[a:b], P)] - poses[a:b, None, :], axis=2)
     scale = float(np.median(cost)) if cost.size else 1.0
     pen = penalty * (scale if scale > 0 else 1.0)
     W = offsets.size
