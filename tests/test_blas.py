@@ -55,7 +55,8 @@ def test_every_stage_of_extract_runs_on_one_thread(monkeypatch):
 
         return wrapped
 
-    for name in ("typical_cycle", "loop_cycle", "jerk_summary", "loop_closure", "distance_to_cycle", "unwrap"):
+    for name in ("capture_cycle", "retime", "complete_windings", "jerk_summary", "loop_closure",
+                 "distance_to_cycle", "unwrap"):
         monkeypatch.setattr(pipe, name, spy(name, getattr(pipe, name)))
 
     class Prep(pipe.Preprocessor):
@@ -83,7 +84,7 @@ def test_every_stage_of_extract_runs_on_one_thread(monkeypatch):
     before = blas_threads()
     cap = cc.datasets.make_periodic_capture(n_frames=300, noise=0.5, random_state=0)
     cc.extract(cap.motion)
-    stages = {"prepare", "barcode", "coordinate", "density", "typical_cycle", "loop_cycle",
+    stages = {"prepare", "barcode", "coordinate", "density", "capture_cycle", "retime", "complete_windings",
               "jerk_summary", "loop_closure", "distance_to_cycle", "unwrap"}
     assert set(seen) == stages
     for name, calls in seen.items():
