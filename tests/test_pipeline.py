@@ -230,3 +230,13 @@ def test_synthetic_whole_take():
     used = res.used
     assert np.mean(steady[used]) > 0.85  # the used frames are steady walking
     assert np.mean(used[steady]) > 0.6  # and most steady walking is used
+
+
+def test_out_and_back_motion_is_read_with_a_delay(cmu_dir):
+    """13_29's jumping jacks are a segment in pose space; the automatic delay makes a loop."""
+    m = cc.load(cmu_dir / "13" / "13_29.amc")
+    with pytest.raises(cc.NoPeriodicMotionError, match="turns only"):
+        cc.extract(m, frames=(0, 456), delay=None)
+    res = cc.extract(m, frames=(0, 456))
+    assert "delay embedding" in res.warnings[0]
+    assert res.period_frames == pytest.approx(autocorrelation_period(m.frames[0:456], lo=90, hi=200), rel=0.05)

@@ -144,6 +144,23 @@ def _clean(obj):
     return obj
 
 
+def _delay(text: str) -> str | float | None:
+    if text == "auto":
+        return "auto"
+    v = _nonnegative_float(text)
+    return v or None
+
+
+def _nonnegative_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds or 'auto', got {text!r}") from None
+    if not np.isfinite(v) or v < 0:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds >= 0 or 'auto', got {text!r}")
+    return v
+
+
 def _landmarks(text: str) -> int | str | None:
     t = text.strip().lower()
     if t in ("auto",):
@@ -263,6 +280,7 @@ def cmd_extract(args: argparse.Namespace) -> int:
             pca=args.pca,
             normalize=args.normalize,
             temporal=args.temporal,
+            delay=args.delay,
             difference_root=not args.no_root_diff,
             prime=args.prime,
             max_scale=args.max_scale,
@@ -823,6 +841,9 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--sampling", choices=("quantile", "random"), default="quantile",
                    help="density quantiles (default, smooth) or random draws as in the paper")
     g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (0)")
+    g.add_argument("--delay", type=_delay, default="auto", metavar="S|auto|0",
+                   help="delay embedding in seconds so out-and-back motions (squats, jumping jacks) form "
+                   "loops; auto (default): none, and 0.25 s when the poses alone show no periodic motion")
     _add_cycle_options(e.add_argument_group("the cycle"))
     e.add_argument("-v", "--verbose", action="store_true",
                    help="also print the barcode, the chosen class, the cocycle check, landmarks and timings")

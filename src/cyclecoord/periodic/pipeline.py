@@ -49,6 +49,8 @@ CAPTURE_WIDTH = 1.0
 MAX_SPREAD = 0.25
 #: A bar alive at the threshold is followed until the threshold is this many times its birth.
 ALIVE_RATIO = 4.0
+#: Delay embedding (seconds) tried when a take's poses alone show no periodic motion.
+AUTO_DELAY = 0.25
 #: Landmarks of the rough first pass over a long take (which finds its steady frames).
 FIRST_PASS_LANDMARKS = 150
 
@@ -392,7 +394,7 @@ def extract(
     pca: int | None = None,
     normalize: bool = False,
     temporal: bool = False,
-    delay: float | None = None,
+    delay: float | str | None = "auto",
     difference_root: bool = True,
     root: str = "body",
     prime: int = DEFAULT_PRIME,
@@ -439,9 +441,11 @@ def extract(
         Scale each channel by its standard deviation first.
     temporal : bool
         Use the time-aware metric (consecutive frames at distance 0).
-    delay : float, optional
+    delay : "auto", float or None, default "auto"
         Delay embedding in seconds for the filtration (out-and-back motions such as
-        squats then form loops); the cycle is still averaged from the poses.
+        squats and jumping jacks then form loops); the cycle is still averaged from the
+        poses.  ``"auto"``: none, and when that finds no periodic motion, once more with
+        :data:`AUTO_DELAY` (a note says so); None or 0: none.
     difference_root : bool, default True
         Replace root translation/orientation by per-frame changes.
     root : {"body", "euler"}, default "body"
@@ -503,6 +507,62 @@ def extract(
     ParameterError
         For invalid arguments.
     """
+    if isinstance(delay, str) and delay != "auto":
+        raise ParameterError(f"delay must be 'auto', a number of seconds or None, got {delay!r}")
+    kwargs = dict(
+        pca=pca, normalize=normalize, temporal=temporal, difference_root=difference_root, root=root,
+        prime=prime, max_scale=max_scale, scale=scale, class_index=class_index, scale_fraction=scale_fraction,
+        n_samples=n_samples, n_neighbors=n_neighbors, bandwidth=bandwidth, weighting=weighting,
+        sampling=sampling, n_components=n_components, cycle_start=cycle_start, landmarks=landmarks,
+        memory_limit=memory_limit, require_clear=require_clear, random_state=random_state, steady=steady,
+        timing=timing, travel=travel, min_turns=min_turns,
+    )
+    if delay != "auto":
+        return _extract(motion, frames, delay=delay, **kwargs)
+    try:
+        return _extract(motion, frames, delay=None, **kwargs)
+    except NoPeriodicMotionError as first:
+        try:
+            res = _extract(motion, frames, delay=AUTO_DELAY, **kwargs)
+        except NoPeriodicMotionError:
+            raise first from None
+        res.warnings.insert(0, f"read with a {AUTO_DELAY:g} s delay embedding: the poses alone show no "
+                               "periodic motion (an out-and-back movement, such as a squat)")
+        return res
+
+
+def _extract(
+    motion: Motion,
+    frames: tuple[int | None, int | None] | None = None,
+    *,
+    pca: int | None = None,
+    normalize: bool = False,
+    temporal: bool = False,
+    delay: float | None = None,
+    difference_root: bool = True,
+    root: str = "body",
+    prime: int = DEFAULT_PRIME,
+    max_scale: float | None = None,
+    scale: float | None = None,
+    class_index: int = 0,
+    scale_fraction: float = 0.9,
+    n_samples: int = 500,
+    n_neighbors: int = 10,
+    bandwidth: str | float | None = None,
+    weighting: str = "kernel",
+    sampling: str = "quantile",
+    n_components: int = 30,
+    cycle_start: str = "slowest",
+    landmarks: int | str | None = "auto",
+    memory_limit: float | None = None,
+    require_clear: bool = True,
+    random_state: int | None = 0,
+    steady: bool = True,
+    timing: str = "capture",
+    travel: str = "keep",
+    min_turns: float = MIN_TURNS,
+) -> ExtractionResult:
+    """Body of :func:`extract` for one delay."""
     opts = _check_options(
         motion, weighting=weighting, sampling=sampling, cycle_start=cycle_start, n_samples=n_samples,
         n_neighbors=n_neighbors, bandwidth=bandwidth, timing=timing, travel=travel, min_turns=min_turns,
