@@ -98,7 +98,8 @@ def h1_diagram(points: np.ndarray) -> np.ndarray:
     st = gudhi.AlphaComplex(points=x).create_simplex_tree()
     st.compute_persistence()
     bars = np.asarray(st.persistence_intervals_in_dimension(1), dtype=float).reshape(-1, 2)
-    return np.sqrt(bars[np.isfinite(bars[:, 1])])
+    bars = bars[np.isfinite(bars[:, 1]) & (bars[:, 1] > bars[:, 0])]
+    return np.sqrt(bars)
 
 
 def bottleneck(a: np.ndarray, b: np.ndarray) -> float:

@@ -21,11 +21,7 @@ import numpy as np
 from ...errors import ParameterError
 from ...motion import Motion
 
-__all__ = ["PoseSpace", "angle_columns", "check_takes", "MAX_DIMS"]
-
-#: Latent dimensions supported (the paper uses 2).
-MAX_DIMS = 12
-
+__all__ = ["PoseSpace", "angle_columns", "check_takes"]
 
 def angle_columns(motion: Motion) -> np.ndarray:
     """Columns of the joint-angle channels: every ``r*`` channel but the root's."""
@@ -38,6 +34,17 @@ def angle_columns(motion: Motion) -> np.ndarray:
 
 def _name(m: Motion, i: int) -> str:
     return m.source or f"take {i}"
+
+
+def _same_skeleton(a, b) -> bool:
+    """Same joints, dofs and bone offsets (to 0.1 % of the skeleton's size)."""
+    if a is None or b is None:
+        return a is None and b is None
+    if a.names != b.names or any(x.dofs != y.dofs for x, y in zip(a.joints, b.joints)):
+        return False
+    off_a = np.array([j.offset for j in a.joints])
+    off_b = np.array([j.offset for j in b.joints])
+    return bool(np.abs(off_a - off_b).max() <= 1e-3 * max(a.total_length(), 1e-9))
 
 
 def check_takes(motions: Sequence[Motion], minimum: int = 2) -> list[Motion]:
@@ -76,17 +83,10 @@ def check_takes(motions: Sequence[Motion], minimum: int = 2) -> list[Motion]:
                 f"{_name(m, i)}: its {m.n_channels} channels differ from {_name(first, 0)}'s "
                 f"{first.n_channels} ({what}); every take needs the same skeleton and channels"
             )
-        a, b = first.skeleton, m.skeleton
-        if (a is None) != (b is None) or (
-            a is not None
-            and b is not None
-            and (
-                a.names != b.names or not np.allclose(a.total_length(), b.total_length(), rtol=0.02)
-            )
-        ):
+        if not _same_skeleton(first.skeleton, m.skeleton):
             raise ParameterError(
                 f"{_name(m, i)}: its skeleton differs from {_name(first, 0)}'s (other joints or bone "
-                "lengths beyond 2 %); train on takes of one skeleton"
+                "offsets); train on takes of one skeleton"
             )
         if abs(m.fps - first.fps) > 1e-9:
             raise ParameterError(
@@ -129,8 +129,8 @@ class PoseSpace:
     def fit(self, motions: Sequence[Motion]) -> "PoseSpace":
         takes = list(motions)
         d = self.n_components
-        if isinstance(d, bool) or not isinstance(d, (int, np.integer)) or not 1 <= d <= MAX_DIMS:
-            raise ParameterError(f"the latent space has 1 to {MAX_DIMS} dimensions, got {d!r}")
+        if isinstance(d, bool) or not isinstance(d, (int, np.integer)) or d < 1:
+            raise ParameterError(f"the latent space needs a whole number of dimensions >= 1, got {d!r}")
         self.columns_ = angle_columns(takes[0])
         self.channels_ = tuple(takes[0].channels[c] for c in self.columns_)
         first = np.unwrap(takes[0].frames[:, self.columns_], period=360.0, axis=0)
