@@ -230,9 +230,12 @@ class CrossValidation:
 
 
 def _median(rows: list[dict]) -> dict[str, float]:
-    return {
-        k: float(np.nanmedian([r[k] for r in rows])) for k in ERROR_KEYS if rows and k in rows[0]
-    }
+    keys = [k for k in ERROR_KEYS if rows and k in rows[0]]
+    out = {}
+    for k in keys:
+        vals = np.array([r[k] for r in rows], dtype=float)
+        out[k] = float(np.median(vals[np.isfinite(vals)])) if np.isfinite(vals).any() else float("nan")
+    return out
 
 
 @one_blas_thread
