@@ -173,7 +173,7 @@ def _crossval(args: argparse.Namespace, motions: list) -> int:
     print(cv.table())
     outside = sum(f["outside_hull_steps"] for f in cv.folds)
     print(
-        f"errors A/F: latent (/ longest side of the training box), deg (RMS over joint angles), pos (mean "
+        f"errors A/F: latent (/ longest side of the training box), deg (RMS over joint angles), pos (RMS "
         f"joint distance, skeleton units); topo: bottleneck of H1 barcodes; {outside} steps outside the hull"
     )
     if args.report:

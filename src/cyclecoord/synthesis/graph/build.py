@@ -100,10 +100,11 @@ def _delaunay_pairs(tri: Delaunay) -> np.ndarray:
     return np.concatenate(pairs, axis=0)
 
 
-def _undirected_unique(pairs: np.ndarray) -> np.ndarray:
-    p = np.sort(pairs, axis=1)
-    p = p[p[:, 0] != p[:, 1]]
-    return np.unique(p, axis=0)
+def _undirected_unique(pairs: np.ndarray, n: int) -> np.ndarray:
+    """Distinct unordered pairs ``(a < b)`` of ``pairs`` (one sort of integer keys)."""
+    lo, hi = np.minimum(pairs[:, 0], pairs[:, 1]), np.maximum(pairs[:, 0], pairs[:, 1])
+    keys = np.unique(lo[lo != hi].astype(np.int64) * n + hi[lo != hi])
+    return np.stack([keys // n, keys % n], axis=1)
 
 
 @dataclass
@@ -280,7 +281,7 @@ def build_graph(
         extra.append(_delaunay_pairs(tri))
     if method in ("knn", "union"):
         extra.append(_knn_pairs(tree, points, k))
-    und = _undirected_unique(np.concatenate(extra, axis=0))
+    und = _undirected_unique(np.concatenate(extra, axis=0), n)
     a, b = und[:, 0], und[:, 1]
     vt = (vel[a] + vel[b]) / 2.0
     dot = np.einsum("ij,ij->i", vt, points[b] - points[a])

@@ -19,7 +19,8 @@ Both are measured in three spaces:
   PCA) against the take's own unwrapped angles, as the RMS over channels in degrees
   (Euclidean distance / sqrt(56)); this includes what PCA loses;
 * joint positions (``*_pos``): forward kinematics with the root at the origin facing
-  its rest direction, the mean distance over joints (skeleton units; 5.64 cm on CMU).
+  its rest direction, the RMS over joints of their distances (skeleton units; 5.64 cm
+  on CMU).
 
 ``error_topo`` is the bottleneck distance (gudhi) between the H1 barcodes (alpha filtration, radii)
 of the generated and the true take in the normalised latent space (first 3
@@ -109,12 +110,10 @@ def bottleneck(a: np.ndarray, b: np.ndarray) -> float:
     return float(gudhi.bottleneck_distance(a, b))
 
 
-def _mpjpe_matrix(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Mean per-joint distance between every pose of ``p`` (T, J, 3) and of ``q`` (N, J, 3)."""
-    out = np.zeros((p.shape[0], q.shape[0]))
-    for j in range(p.shape[1]):
-        out += cdist(p[:, j], q[:, j])
-    return out / p.shape[1]
+def _joint_distance_matrix(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """RMS over joints of the joint distances between every pose of ``p`` (T, J, 3) and
+    of ``q`` (N, J, 3): one Euclidean distance over all coordinates, over sqrt(J)."""
+    return cdist(p.reshape(p.shape[0], -1), q.reshape(q.shape[0], -1)) / np.sqrt(p.shape[1])
 
 
 class _Evaluator:
@@ -139,7 +138,7 @@ class _Evaluator:
     def errors(self, latent: np.ndarray, angles: np.ndarray) -> dict[str, float]:
         a, f = path_errors(cdist(self.latent, latent))
         ad, fd = path_errors(cdist(self.angles, angles) / self.rms)
-        ap, fp = path_errors(_mpjpe_matrix(self.pos, self._positions(angles)))
+        ap, fp = path_errors(_joint_distance_matrix(self.pos, self._positions(angles)))
         out = {
             "error_a": a / self.space.scale_,
             "error_f": f / self.space.scale_,
@@ -360,7 +359,7 @@ def cross_validate(
         "units": {
             "error_a/error_f": "latent distance / longest side of the training points' bounding box",
             "*_deg": "RMS over the joint-angle channels, degrees",
-            "*_pos": "mean joint distance, skeleton units (root at the origin)",
+            "*_pos": "RMS joint distance, skeleton units (root at the origin)",
             "error_topo": "bottleneck distance of H1 barcodes (alpha radii), latent units as error_a",
         },
     }

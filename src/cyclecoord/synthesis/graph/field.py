@@ -81,7 +81,7 @@ class VectorField:
         Returns
         -------
         idx : ndarray of int, shape (m, K)
-            Training frames (padded with ``-1`` ... never read: weights are 0 there).
+            Training frames; unused slots (weight 0) hold 0.
         weights : ndarray, shape (m, K)
             Sum to 1 per row.
         inside : ndarray of bool, shape (m,)
@@ -101,9 +101,16 @@ class VectorField:
             tri = g.delaunay
             s = tri.find_simplex(x)
             inside = s >= 0
-            knn = self._knn(x)
+            if self.neighbourhood == "delaunay":  # k-NN only where the point is outside
+                knn = np.zeros((m, self.k), dtype=int)
+                if not inside.all():
+                    knn[~inside] = self._knn(x[~inside])
+            else:
+                knn = self._knn(x)
             verts = tri.simplices[np.maximum(s, 0)]
-            n_extra = max((len(self._extra.get(int(j), ())) for j in s[inside]), default=0)
+            n_extra = 0
+            if self._extra:
+                n_extra = max((len(self._extra.get(int(j), ())) for j in s[inside]), default=0)
             if n_extra:
                 pad = np.full((m, n_extra), -1)
                 for r in np.flatnonzero(inside):
