@@ -31,8 +31,6 @@ import time
 from pathlib import Path
 from typing import Any, Callable
 
-import numpy as np
-
 import cyclecoord as cc
 from cyclecoord.io._atomic import atomic_write
 from cyclecoord.synthesis.graph import (
@@ -53,9 +51,14 @@ def load_w1(data: Path) -> tuple[list, str]:
     paths = [data / "cmu" / "35" / f"{n}.amc" for n in W1]
     if all(p.is_file() for p in paths):
         return [cc.load(p) for p in paths], "CMU 35 (set w1)"
-    print(f"NOTE: set w1 not found under {data}/cmu/35; using four synthetic walks of the same lengths")
+    print(
+        f"NOTE: set w1 not found under {data}/cmu/35; "
+        "using four synthetic walks of the same lengths"
+    )
     walks = [
-        cc.datasets.make_periodic_capture(kind="walk", n_frames=n, period=130, random_state=s).motion
+        cc.datasets.make_periodic_capture(
+            kind="walk", n_frames=n, period=130, random_state=s
+        ).motion
         for s, n in enumerate(LENGTHS)
     ]
     return walks, "synthetic walks"
@@ -97,12 +100,18 @@ def bench_dims(takes: list, repeat: int, dims: tuple[int, ...] = (2, 3, 4, 5)) -
         x0 = latent[0][0]
         follow_field(field, x0, 20)  # barycentric transforms computed once, outside the timing
         tp, path = timed(lambda: follow_field(field, x0, 450), repeat)
-        rows.append({
-            "dims": d, "simplices": int(graph.delaunay.simplices.shape[0]), "edges": int(len(graph.edges)),
-            "graph_wall": tg["wall"], "graph_cpu": tg["cpu"],
-            "step_us_wall": 1e6 * tp["wall"] / 450, "step_us_cpu": 1e6 * tp["cpu"] / 450,
-            "outside_hull_steps": path.outside_hull_steps,
-        })
+        rows.append(
+            {
+                "dims": d,
+                "simplices": int(graph.delaunay.simplices.shape[0]),
+                "edges": int(len(graph.edges)),
+                "graph_wall": tg["wall"],
+                "graph_cpu": tg["cpu"],
+                "step_us_wall": 1e6 * tp["wall"] / 450,
+                "step_us_cpu": 1e6 * tp["cpu"] / 450,
+                "outside_hull_steps": path.outside_hull_steps,
+            }
+        )
     return rows
 
 
@@ -115,26 +124,50 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
     takes, what = load_w1(args.data)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-    print(f"{what}: {sum(m.n_frames for m in takes)} frames; {platform.processor() or platform.machine()}, "
-          f"{os.cpu_count()} cores, load average {load:.1f} at start; medians of {args.repeat} runs")
+    print(
+        f"{what}: {sum(m.n_frames for m in takes)} frames; "
+        f"{platform.processor() or platform.machine()}, "
+        f"{os.cpu_count()} cores, load average {load:.1f} at start; medians of {args.repeat} runs"
+    )
     gen = bench_generate(takes, args.repeat)
-    print(f"graph + field + 450-frame path + playable motion: {gen['wall']:.3f} s wall, "
-          f"{gen['cpu']:.3f} s CPU (target < 1 s)")
+    print(
+        f"graph + field + 450-frame path + playable motion: {gen['wall']:.3f} s wall, "
+        f"{gen['cpu']:.3f} s CPU (target < 1 s)"
+    )
     tcv, cv = bench_crossval(takes, args.repeat)
-    print(f"cross-validation, 3 methods x 4 folds: {tcv['wall']:.2f} s wall, {tcv['cpu']:.2f} s CPU "
-          "(target < 10 s)")
+    print(
+        f"cross-validation, 3 methods x 4 folds: {tcv['wall']:.2f} s wall, {tcv['cpu']:.2f} s CPU "
+        "(target < 10 s)"
+    )
     print(cv.table())
     rows = bench_dims(takes, args.repeat, tuple(range(2, args.max_dims + 1)))
-    print(f"{'dims':>4} {'simplices':>10} {'edges':>8} {'graph s':>9} {'(cpu)':>7} {'step us':>8} {'(cpu)':>7}")
+    print(
+        f"{'dims':>4} {'simplices':>10} {'edges':>8} {'graph s':>9} {'(cpu)':>7} "
+        f"{'step us':>8} {'(cpu)':>7}"
+    )
     for r in rows:
-        print(f"{r['dims']:>4} {r['simplices']:>10} {r['edges']:>8} {r['graph_wall']:>9.3f} {r['graph_cpu']:>7.3f} "
-              f"{r['step_us_wall']:>8.0f} {r['step_us_cpu']:>7.0f}")
+        print(
+            f"{r['dims']:>4} {r['simplices']:>10} {r['edges']:>8} "
+            f"{r['graph_wall']:>9.3f} {r['graph_cpu']:>7.3f} "
+            f"{r['step_us_wall']:>8.0f} {r['step_us_cpu']:>7.0f}"
+        )
     load_end = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"load average {load_end:.1f} at the end (2 cores shared: wall times include waiting)")
     if args.json:
         with atomic_write(args.json, "w") as fh:
-            json.dump({"data": what, "generate": gen, "crossval": tcv, "median": cv.median,
-                       "delaunay_dims": rows, "load": [load, load_end], "python": sys.version}, fh, indent=1)
+            json.dump(
+                {
+                    "data": what,
+                    "generate": gen,
+                    "crossval": tcv,
+                    "median": cv.median,
+                    "delaunay_dims": rows,
+                    "load": [load, load_end],
+                    "python": sys.version,
+                },
+                fh,
+                indent=1,
+            )
         print(f"wrote {args.json}")
     return 0
 

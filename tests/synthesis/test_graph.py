@@ -77,7 +77,12 @@ def test_delaunay_edges_are_simplex_pairs_directed_along_velocity():
     g = build_graph(takes, "delaunay")
     pts = np.vstack(takes)
     tri = Delaunay(pts)
-    pairs = {tuple(sorted((int(s[a]), int(s[b])))) for s in tri.simplices for a in range(3) for b in range(a + 1, 3)}
+    pairs = {
+        tuple(sorted((int(s[a]), int(s[b]))))
+        for s in tri.simplices
+        for a in range(3)
+        for b in range(a + 1, 3)
+    }
     n_own = g.n_nodes - g.n_takes
     got = {tuple(sorted(e)) for e in g.edges[n_own:].tolist()}
     own = {tuple(sorted(e)) for e in g.edges[:n_own].tolist()}
@@ -117,7 +122,10 @@ def test_delaunay_keeps_qhull_dropped_duplicates():
 
 def test_union_contains_both():
     takes = [circle(40, 1.0), circle(40, 1.2, 0.1)]
-    e = {m: {tuple(sorted(x)) for x in build_graph(takes, m, k=4).edges.tolist()} for m in ("delaunay", "knn", "union")}
+    e = {
+        m: {tuple(sorted(x)) for x in build_graph(takes, m, k=4).edges.tolist()}
+        for m in ("delaunay", "knn", "union")
+    }
     assert e["delaunay"] | e["knn"] == e["union"]
 
 
@@ -178,8 +186,12 @@ def test_shortest_path_and_target():
     assert all((a, b) in edges for a, b in zip(nodes[:-1], nodes[1:]))
     p = path_to_target(g, g.points[0], g.points[60])
     assert np.allclose(p.points[0], g.points[0]) and np.allclose(p.points[-1], g.points[60])
-    lines = build_graph([np.stack([np.linspace(0, 1, 10), np.zeros(10)], 1)] * 1 + [
-        np.stack([np.linspace(0, 1, 10), np.full(10, 9.0)], 1)], "knn", k=2)
+    lines = build_graph(
+        [np.stack([np.linspace(0, 1, 10), np.zeros(10)], 1)] * 1
+        + [np.stack([np.linspace(0, 1, 10), np.full(10, 9.0)], 1)],
+        "knn",
+        k=2,
+    )
     with pytest.raises(ParameterError, match="no path"):
         shortest_path(lines, 0, 15)
 
@@ -202,11 +214,21 @@ def test_path_errors_and_bottleneck():
 def test_cross_validate_report_keys(walks):
     cv = cross_validate(walks, methods=("delaunay", "knn"), dims=2)
     assert len(cv.folds) == 6
-    keys = {"held_out", "method", "error_a", "error_f", "error_a_deg", "error_f_deg", "error_topo",
-            "outside_hull_steps"}
+    keys = {
+        "held_out",
+        "method",
+        "error_a",
+        "error_f",
+        "error_a_deg",
+        "error_f_deg",
+        "error_topo",
+        "outside_hull_steps",
+    }
     assert all(keys <= set(f) for f in cv.folds)
     for m in ("delaunay", "knn"):
-        assert {"error_a", "error_f", "error_a_deg", "error_f_deg", "error_topo"} <= set(cv.median[m])
+        assert {"error_a", "error_f", "error_a_deg", "error_f_deg", "error_topo"} <= set(
+            cv.median[m]
+        )
         assert cv.median[m]["error_f_deg"] < cv.baselines["standing_still"]["median"]["error_f_deg"]
     assert set(cv.baselines) == {"standing_still", "nearest_take"}
     assert {"nodes", "edges", "weak_components", "strong_components"} <= set(cv.graph)

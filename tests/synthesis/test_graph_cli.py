@@ -18,7 +18,9 @@ def synthetic_takes(tmp_path_factory):
     folder = tmp_path_factory.mktemp("takes")
     paths = []
     for s, n in ((0, 150), (1, 130), (2, 140)):
-        m = cc.datasets.make_periodic_capture(kind="walk", n_frames=n, period=60, random_state=s).motion
+        m = cc.datasets.make_periodic_capture(
+            kind="walk", n_frames=n, period=60, random_state=s
+        ).motion
         p = folder / f"walk{s}.bvh"
         cc.save(m, p)
         paths.append(str(p))
@@ -34,8 +36,22 @@ def one_error_line(capsys) -> str:
 
 def test_generate_writes_motion_report_and_figures(synthetic_takes, tmp_path, capsys):
     out, rep, figs = tmp_path / "gen.bvh", tmp_path / "gen.json", tmp_path / "figs"
-    rc = main(["graph", *synthetic_takes, "--start", f"{synthetic_takes[1]}:5", "--frames", "90",
-               "-o", str(out), "--report", str(rep), "--plot", str(figs)])
+    rc = main(
+        [
+            "graph",
+            *synthetic_takes,
+            "--start",
+            f"{synthetic_takes[1]}:5",
+            "--frames",
+            "90",
+            "-o",
+            str(out),
+            "--report",
+            str(rep),
+            "--plot",
+            str(figs),
+        ]
+    )
     assert rc == 0
     m = cc.load(out)
     assert m.n_frames == 90
@@ -49,16 +65,28 @@ def test_generate_writes_motion_report_and_figures(synthetic_takes, tmp_path, ca
 
 def test_crossval_report_keys(synthetic_takes, tmp_path, capsys):
     rep = tmp_path / "cv.json"
-    rc = main(["graph", "crossval", *synthetic_takes, "--method", "delaunay,knn", "--report", str(rep)])
+    rc = main(
+        ["graph", "crossval", *synthetic_takes, "--method", "delaunay,knn", "--report", str(rep)]
+    )
     assert rc == 0
     out = capsys.readouterr().out
     assert "paper w1: delaunay" in out and "baseline: standing still" in out
     r = json.loads(rep.read_text())
-    fold_keys = {"held_out", "method", "error_a", "error_f", "error_a_deg", "error_f_deg", "error_topo",
-                 "outside_hull_steps"}
+    fold_keys = {
+        "held_out",
+        "method",
+        "error_a",
+        "error_f",
+        "error_a_deg",
+        "error_f_deg",
+        "error_topo",
+        "outside_hull_steps",
+    }
     assert len(r["folds"]) == 6 and all(fold_keys <= set(f) for f in r["folds"])
     assert set(r["median"]) == {"delaunay", "knn"}
-    assert {"error_a", "error_f", "error_a_deg", "error_f_deg", "error_topo"} <= set(r["median"]["knn"])
+    assert {"error_a", "error_f", "error_a_deg", "error_f_deg", "error_topo"} <= set(
+        r["median"]["knn"]
+    )
     assert set(r["baselines"]) == {"standing_still", "nearest_take"}
     assert {"nodes", "edges", "weak_components", "strong_components"} <= set(r["graph"])
 
@@ -124,7 +152,9 @@ def test_w1_generated_walk_loops_and_is_plausible(w1):
     from cyclecoord.quality.plausibility import check_plausibility
     from cyclecoord.synthesis.graph import MotionGraphSynth
 
-    gen = MotionGraphSynth(method="delaunay", dims=2, step_scale=2.0).fit(w1).generate(450, w1[0], 0)
+    gen = (
+        MotionGraphSynth(method="delaunay", dims=2, step_scale=2.0).fit(w1).generate(450, w1[0], 0)
+    )
     res = cc.extract(gen.motion)
     assert res.cycles >= 1.5
     assert 100 < res.period_frames < 180  # the takes' own: about 131-134 frames

@@ -27,19 +27,22 @@ __all__ = ["add_parser", "run"]
 def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "graph",
-        help="generate motion along a motion graph's vector field; 'graph crossval' for the paper's table",
+        help="generate motion along a motion graph's vector field ('graph crossval': the table)",
         description=(
-            "Motion graph and vector-field synthesis (Gauch & Peters): PCA of the joint angles of the "
-            "training takes, a Delaunay / k-NN / union graph over their frames and the interpolated field "
-            "of their velocities. 'cyclecoord graph TRAIN...' generates a motion from a start pose; "
-            "'cyclecoord graph crossval TAKE...' leaves each take out in turn and prints a Table II-style table."
+            "Motion graph and vector-field synthesis (Gauch & Peters): PCA of the joint angles "
+            "of the training takes, a Delaunay / k-NN / union graph over their frames and the "
+            "interpolated field of their velocities. 'cyclecoord graph TRAIN...' generates a "
+            "motion from a start pose; 'cyclecoord graph crossval TAKE...' leaves each take out "
+            "in turn and prints a Table II-style table."
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog=(
             "examples:\n"
-            "  cyclecoord graph 35_16.amc 35_07.amc 35_08.amc 35_13.amc --start 35_16.amc:0 --frames 450 \\\n"
+            "  cyclecoord graph 35_16.amc 35_07.amc 35_08.amc 35_13.amc \\\n"
+            "      --start 35_16.amc:0 --frames 450 \\\n"
             "      -o walk.bvh --report walk.json --plot figures\n"
-            "  cyclecoord graph crossval 35_16.amc 35_07.amc 35_08.amc 35_13.amc --report table.json\n"
+            "  cyclecoord graph crossval 35_16.amc 35_07.amc 35_08.amc 35_13.amc \\\n"
+            "      --report table.json\n"
             "  cyclecoord graph crossval 35_*.amc --method delaunay --dims 3"
         ),
     )
@@ -173,8 +176,9 @@ def _crossval(args: argparse.Namespace, motions: list) -> int:
     print(cv.table())
     outside = sum(f["outside_hull_steps"] for f in cv.folds)
     print(
-        f"errors A/F: latent (/ longest side of the training box), deg (RMS over joint angles), pos (RMS "
-        f"joint distance, skeleton units); topo: bottleneck of H1 barcodes; {outside} steps outside the hull"
+        "errors A/F: latent (/ longest side of the training box), deg (RMS over joint angles), "
+        "pos (RMS joint distance, skeleton units); topo: bottleneck of H1 barcodes; "
+        f"{outside} steps outside the hull"
     )
     if args.report:
         _write_json(args.report, _clean(cv.to_report()))
@@ -215,7 +219,8 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int
         gen = synth.generate(args.frames, start, frame)
     conn = synth.graph_.connectivity()
     print(
-        f"{synth.graph_.method} graph over {conn['nodes']} frames of {len(motions)} takes: {conn['edges']} edges, "
+        f"{synth.graph_.method} graph over {conn['nodes']} frames of {len(motions)} takes: "
+        f"{conn['edges']} edges, "
         f"{conn['weak_components']} weak / {conn['strong_components']} strong components; "
         f"start/end graph H {'connected' if conn['H']['connected'] else 'NOT connected'}"
     )
@@ -226,7 +231,8 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int
         )
     ev = synth.space_.explained_variance_ratio_
     print(
-        f"latent space: {args.dims} PCA dims explain {100 * ev.sum():.1f} % of the joint-angle variance"
+        f"latent space: {args.dims} PCA dims explain {100 * ev.sum():.1f} % "
+        "of the joint-angle variance"
     )
     print(
         f"generated {gen.motion.n_frames} frames from {gen.start['take']}:{gen.start['frame']} "
@@ -247,7 +253,8 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int
             key: conn[key] for key in ("nodes", "edges", "weak_components", "strong_components")
         },
         "connectivity": conn,
-        "root": "weighted mean of the root steps, turns, heights and tilts of the training frames weighing on "
+        "root": "weighted mean of the root steps, turns, heights and tilts of the training "
+        "frames weighing on "
         "each generated point (the field's neighbourhood), integrated from the start frame's root",
     }
     if args.plot:

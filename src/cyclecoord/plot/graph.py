@@ -129,7 +129,8 @@ def plot_generated_path(
     title: str | None = None,
     label: str = "generated",
 ) -> "Figure":
-    """A generated path (blue) against the left-out take (red) over the training frames (Figs. 5-6)."""
+    """A generated path (blue) against the left-out take (red) over the training frames
+    (Figs. 5-6)."""
     fig, ax = _axes(ax, fig, (6, 5.5))
     ax.plot(training[:, 0], training[:, 1], ".", color="0.75", ms=1.5, label="training frames")
     if true is not None:

@@ -66,7 +66,8 @@ def check_delaunay_dims(d: int, n_points: int) -> None:
         raise ParameterError(f"a Delaunay triangulation needs at least 2 dimensions, got {d}")
     if n_points < d + 2:
         raise ParameterError(
-            f"a Delaunay triangulation in {d} dimensions needs at least {d + 2} frames, got {n_points}"
+            f"a Delaunay triangulation in {d} dimensions needs at least {d + 2} frames, "
+            f"got {n_points}"
         )
 
 

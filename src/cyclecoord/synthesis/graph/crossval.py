@@ -233,8 +233,48 @@ def _median(rows: list[dict]) -> dict[str, float]:
     out = {}
     for k in keys:
         vals = np.array([r[k] for r in rows], dtype=float)
-        out[k] = float(np.median(vals[np.isfinite(vals)])) if np.isfinite(vals).any() else float("nan")
+        out[k] = (
+            float(np.median(vals[np.isfinite(vals)])) if np.isfinite(vals).any() else float("nan")
+        )
     return out
+
+
+def _baseline_rows(
+    ev: _Evaluator, space: PoseSpace, train: list, train_names: list, n: int
+) -> dict:
+    """Standing still at the true start pose; replaying the nearest take from its nearest
+    frame (cut where that take ends)."""
+    still = np.repeat(ev.angles[:1], n, axis=0)
+    train_angles = [space.angles(m) for m in train]
+    d = [np.linalg.norm(a - ev.angles[0], axis=1) for a in train_angles]
+    j = int(np.argmin([x.min() for x in d]))
+    f0 = int(np.argmin(d[j]))
+    replay = train_angles[j][f0 : f0 + n]
+    return {
+        "standing_still": ev.errors(space.transform(still), still),
+        "nearest_take": {
+            "replayed": f"{train_names[j]}:{f0}",
+            "frames": int(replay.shape[0]),
+            **ev.errors(space.transform(replay), replay),
+        },
+    }
+
+
+def _graph_summary(takes: list, methods: list, dims: int, k: int, names: list) -> dict[str, Any]:
+    """Nodes, and per method edges and components, of the graphs over all the takes."""
+    full = PoseSpace(dims).fit(takes)
+    latent_all = [full.transform(m) for m in takes]
+    graph: dict[str, Any] = {
+        "nodes": int(sum(len(z) for z in latent_all)),
+        "edges": {},
+        "weak_components": {},
+        "strong_components": {},
+    }
+    for method in methods:
+        c = build_graph(latent_all, method, k, names).connectivity()
+        for key in ("edges", "weak_components", "strong_components"):
+            graph[key][method] = c[key]
+    return graph
 
 
 @one_blas_thread
@@ -317,37 +357,12 @@ def cross_validate(
                     "H_connected": c["H"]["connected"],
                 }
             )
-        # baselines: standing still at the true start pose; replaying the nearest take
-        still = np.repeat(ev.angles[:1], n, axis=0)
-        base["standing_still"].append(
-            {"held_out": names[i], **ev.errors(space.transform(still), still)}
-        )
-        train_angles = [space.angles(m) for m in train]
-        d = [np.linalg.norm(a - ev.angles[0], axis=1) for a in train_angles]
-        j = int(np.argmin([x.min() for x in d]))
-        f0 = int(np.argmin(d[j]))
-        replay = train_angles[j][f0 : f0 + n]
-        row = {
-            "held_out": names[i],
-            "replayed": f"{names[[q for q in range(len(takes)) if q != i][j]]}:{f0}",
-            "frames": int(replay.shape[0]),
-        }
-        row.update(ev.errors(space.transform(replay), replay))
-        base["nearest_take"].append(row)
+        train_names = [names[q] for q in range(len(takes)) if q != i]
+        for key, row in _baseline_rows(ev, space, train, train_names, n).items():
+            base[key].append({"held_out": names[i], **row})
     median = {m: _median([r for r in folds if r["method"] == m]) for m in methods}
     baselines = {b: {"folds": rows, "median": _median(rows)} for b, rows in base.items()}
-    full = PoseSpace(dims).fit(takes)
-    latent_all = [full.transform(m) for m in takes]
-    graph: dict[str, Any] = {
-        "nodes": int(sum(len(z) for z in latent_all)),
-        "edges": {},
-        "weak_components": {},
-        "strong_components": {},
-    }
-    for method in methods:
-        c = build_graph(latent_all, method, k, names).connectivity()
-        for key in ("edges", "weak_components", "strong_components"):
-            graph[key][method] = c[key]
+    graph = _graph_summary(takes, methods, dims, k, names)
     params = {
         "methods": methods,
         "dims": dims,
@@ -357,10 +372,10 @@ def cross_validate(
         "takes": names,
         "frames": [m.n_frames for m in takes],
         "units": {
-            "error_a/error_f": "latent distance / longest side of the training points' bounding box",
+            "error_a/error_f": "latent distance / longest side of the training points' box",
             "*_deg": "RMS over the joint-angle channels, degrees",
             "*_pos": "RMS joint distance, skeleton units (root at the origin)",
-            "error_topo": "bottleneck distance of H1 barcodes (alpha radii), latent units as error_a",
+            "error_topo": "bottleneck distance of H1 barcodes (alpha radii), units of error_a",
         },
     }
     return CrossValidation(

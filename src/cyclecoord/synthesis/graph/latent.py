@@ -23,6 +23,7 @@ from ...motion import Motion
 
 __all__ = ["PoseSpace", "angle_columns", "check_takes"]
 
+
 def angle_columns(motion: Motion) -> np.ndarray:
     """Columns of the joint-angle channels: every ``r*`` channel but the root's."""
     root = set(motion.root_channels())
@@ -85,7 +86,8 @@ def check_takes(motions: Sequence[Motion], minimum: int = 2) -> list[Motion]:
             )
         if not _same_skeleton(first.skeleton, m.skeleton):
             raise ParameterError(
-                f"{_name(m, i)}: its skeleton differs from {_name(first, 0)}'s (other joints or bone "
+                f"{_name(m, i)}: its skeleton differs from {_name(first, 0)}'s "
+                "(other joints or bone "
                 "offsets); train on takes of one skeleton"
             )
         if abs(m.fps - first.fps) > 1e-9:
@@ -130,7 +132,9 @@ class PoseSpace:
         takes = list(motions)
         d = self.n_components
         if isinstance(d, bool) or not isinstance(d, (int, np.integer)) or d < 1:
-            raise ParameterError(f"the latent space needs a whole number of dimensions >= 1, got {d!r}")
+            raise ParameterError(
+                f"the latent space needs a whole number of dimensions >= 1, got {d!r}"
+            )
         self.columns_ = angle_columns(takes[0])
         self.channels_ = tuple(takes[0].channels[c] for c in self.columns_)
         first = np.unwrap(takes[0].frames[:, self.columns_], period=360.0, axis=0)
