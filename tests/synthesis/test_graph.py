@@ -247,3 +247,15 @@ def test_synth_generates_a_playable_walk(walks):
     assert 0.5 * real < travel < 1.5 * real
     with pytest.raises(ParameterError, match="start frame 500 is outside its 150 frames"):
         synth.generate(10, walks[0], 500)
+
+
+def test_target_path_keeps_to_the_data_with_squared_costs():
+    takes = [circle(60, 1.0), circle(60, 1.1, 0.05), circle(60, 0.9, 0.1)]
+    g = build_graph(takes, "delaunay")
+    start, target = g.points[0], g.points[30]  # opposite sides of the ring
+    near = lambda p: g.tree.query(p.points)[0].max()  # noqa: E731
+    p = path_to_target(g, start, target)
+    assert near(p) < 0.1
+    # along the takes' direction of travel (anticlockwise), not back against it
+    ang = np.unwrap(np.arctan2(p.points[:, 1], p.points[:, 0]))
+    assert np.all(np.diff(ang) > -0.05) and ang[-1] - ang[0] == pytest.approx(np.pi, abs=0.2)

@@ -154,10 +154,11 @@ class MotionGraph:
         """Frames Qhull left out of the triangulation (0 without one)."""
         return 0 if self.delaunay is None else int(self.delaunay.coplanar.shape[0])
 
-    def adjacency(self) -> sparse.csr_matrix:
-        """Weighted adjacency (latent edge lengths) for :mod:`scipy.sparse.csgraph`."""
+    def adjacency(self, power: float = 1.0) -> sparse.csr_matrix:
+        """Weighted adjacency for :mod:`scipy.sparse.csgraph`: latent edge lengths raised to
+        ``power`` (2 makes one long jump cost more than several short steps)."""
         a, b = self.edges[:, 0], self.edges[:, 1]
-        w = np.linalg.norm(self.points[b] - self.points[a], axis=1)
+        w = np.linalg.norm(self.points[b] - self.points[a], axis=1) ** float(power)
         w = np.maximum(w, 1e-12)  # csgraph reads an explicit 0 as "no edge"
         return sparse.csr_matrix((w, (a, b)), shape=(self.n_nodes, self.n_nodes))
 

@@ -169,8 +169,12 @@ def follow_field(
     )
 
 
-def shortest_path(graph: MotionGraph, source: int, target: int) -> np.ndarray:
+def shortest_path(graph: MotionGraph, source: int, target: int, power: float = 2.0) -> np.ndarray:
     """Graph nodes of the shortest directed path from ``source`` to ``target``.
+
+    Edge costs are latent lengths to the ``power``: with 1 (plain length) a Delaunay path
+    crosses the hole of a walk's loop on one long hull edge, through poses no take holds;
+    the default 2 prefers many short steps along the data.
 
     Raises
     ------
@@ -182,7 +186,7 @@ def shortest_path(graph: MotionGraph, source: int, target: int) -> np.ndarray:
         if not 0 <= int(v) < n:
             raise ParameterError(f"{name} node {v} is not one of the graph's {n} nodes")
     dist, pred = csgraph.dijkstra(
-        graph.adjacency(), directed=True, indices=int(source), return_predecessors=True
+        graph.adjacency(power), directed=True, indices=int(source), return_predecessors=True
     )
     if not np.isfinite(dist[int(target)]):
         t, f = graph.take[target], graph.frame[target]
@@ -198,9 +202,15 @@ def shortest_path(graph: MotionGraph, source: int, target: int) -> np.ndarray:
 
 
 def path_to_target(
-    graph: MotionGraph, start: np.ndarray, target: np.ndarray, speed: float = 1.0
+    graph: MotionGraph,
+    start: np.ndarray,
+    target: np.ndarray,
+    speed: float = 1.0,
+    power: float = 2.0,
 ) -> GraphPath:
     """Shortest graph path from the frame nearest ``start`` to the frame nearest ``target``.
+
+    Edge costs are latent lengths to the ``power`` (see :func:`shortest_path`).
 
     The node sequence is resampled by arc length with the median latent step of the
     training frames times ``speed`` (1: the captured speed); each resampled point takes its
@@ -208,7 +218,7 @@ def path_to_target(
     """
     a = int(graph.tree.query(np.asarray(start, dtype=float).reshape(-1))[1])
     b = int(graph.tree.query(np.asarray(target, dtype=float).reshape(-1))[1])
-    nodes = shortest_path(graph, a, b)
+    nodes = shortest_path(graph, a, b, power)
     p = graph.points[nodes]
     seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
     arc = np.concatenate([[0.0], np.cumsum(seg)])
