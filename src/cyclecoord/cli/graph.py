@@ -1,0 +1,266 @@
+"""``cyclecoord graph``: motion-graph synthesis (Gauch & Peters) and its cross-validation.
+
+``cyclecoord graph TRAIN... --start FILE[:FRAME] --frames N -o OUT.bvh`` follows the
+vector field of a Delaunay (or k-NN, or union) motion graph from a start pose;
+``cyclecoord graph crossval TAKE...`` prints the paper's Table II for the takes.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..errors import ParameterError
+from .main import (
+    EXIT_OK,
+    _check_output,
+    _clean,
+    _positive_float,
+    _positive_int,
+    _write_json,
+    load_input,
+)
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    p = subparsers.add_parser(
+        "graph",
+        help="generate motion along a motion graph's vector field ('graph crossval': the table)",
+        description=(
+            "Motion graph and vector-field synthesis (Gauch & Peters): PCA of the joint angles "
+            "of the training takes, a Delaunay / k-NN / union graph over their frames and the "
+            "interpolated field of their velocities. 'cyclecoord graph TRAIN...' generates a "
+            "motion from a start pose; 'cyclecoord graph crossval TAKE...' leaves each take out "
+            "in turn and prints a Table II-style table."
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=(
+            "examples:\n"
+            "  cyclecoord graph 35_16.amc 35_07.amc 35_08.amc 35_13.amc \\\n"
+            "      --start 35_16.amc:0 --frames 450 \\\n"
+            "      -o walk.bvh --report walk.json --plot figures\n"
+            "  cyclecoord graph crossval 35_16.amc 35_07.amc 35_08.amc 35_13.amc \\\n"
+            "      --report table.json\n"
+            "  cyclecoord graph crossval 35_*.amc --method delaunay --dims 3"
+        ),
+    )
+    p.add_argument(
+        "inputs",
+        nargs="+",
+        metavar="TRAIN",
+        help="training takes (one skeleton); 'crossval' first for the table",
+    )
+    p.add_argument(
+        "--method",
+        default=None,
+        help="delaunay, knn or union (generation; default delaunay); crossval takes a comma list "
+        "(default delaunay,knn,union)",
+    )
+    p.add_argument(
+        "--dims",
+        type=_positive_int,
+        default=2,
+        help="latent PCA dimensions (default 2, as the paper)",
+    )
+    p.add_argument(
+        "-k",
+        "--k",
+        type=_positive_int,
+        default=16,
+        help="neighbours of the k-NN graph and field (default 16)",
+    )
+    p.add_argument(
+        "--integrator",
+        choices=("euler", "rk4"),
+        default="euler",
+        help="field step: the paper's Euler step or fourth-order Runge-Kutta (default euler)",
+    )
+    p.add_argument(
+        "--step-scale",
+        type=_positive_float,
+        default=None,
+        help="step length in training vectors (half a frame's change): 1 is the paper's step "
+        "(about half speed; crossval default), 2 the captured speed (generation default)",
+    )
+    p.add_argument(
+        "--start",
+        default=None,
+        metavar="FILE[:FRAME]",
+        help="start pose: a take and 0-based frame (default the first training take, frame 0)",
+    )
+    p.add_argument(
+        "--target",
+        default=None,
+        metavar="FILE[:FRAME]",
+        help="instead of following the field, the shortest graph path to this pose",
+    )
+    p.add_argument(
+        "--frames", type=_positive_int, default=450, help="frames to generate (default 450)"
+    )
+    p.add_argument("-o", "--output", default=None, help="generated motion (.bvh, .amc, ...)")
+    p.add_argument("--report", default=None, help="JSON report")
+    p.add_argument("--plot", default=None, metavar="DIR", help="write figures (PNG) into DIR")
+    p.add_argument(
+        "--strict",
+        action="store_true",
+        help="write nothing when the motion fails the plausibility checks",
+    )
+    p.add_argument("--no-topo", action="store_true", help="crossval: skip the bottleneck distances")
+    p.set_defaults(func=run)
+    return p
+
+
+def _take_spec(text: str) -> tuple[str, int]:
+    """``FILE`` or ``FILE:FRAME`` (a trailing ``:N`` is a frame when N is a whole number)."""
+    if ":" in text:
+        head, tail = text.rsplit(":", 1)
+        if tail.lstrip("-").isdigit() and head:
+            return head, int(tail)
+    return text, 0
+
+
+def _find(path: str, inputs: list[str], motions: list):
+    """The motion of ``path``: a training take when it names one, else loaded."""
+    for name, m in zip(inputs, motions):
+        if (
+            Path(name).exists()
+            and Path(path).exists()
+            and Path(name).resolve() == Path(path).resolve()
+            or name == path
+        ):
+            return m
+    return load_input(path)
+
+
+def run(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
+    crossval = args.inputs[0] == "crossval" and not Path("crossval").exists()
+    inputs = args.inputs[1:] if crossval else list(args.inputs)
+    _check_output(args.report, "report")
+    if not crossval:
+        _check_output(args.output)
+        for out in (args.output, args.report):
+            if out and any(
+                Path(out).exists() and Path(out).resolve() == Path(s).resolve()
+                for s in inputs
+                if Path(s).exists()
+            ):
+                raise ParameterError(f"{out}: refusing to overwrite an input file")
+    if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
+        raise ParameterError(f"{args.plot}: exists and is not a folder")
+    motions = [
+        load_input(p) for p in tqdm(inputs, desc="loading", unit="take", disable=len(inputs) < 4)
+    ]
+    if crossval:
+        return _crossval(args, motions)
+    return _generate(args, inputs, motions)
+
+
+def _crossval(args: argparse.Namespace, motions: list) -> int:
+    from ..synthesis.graph import cross_validate
+
+    methods = [m.strip() for m in (args.method or "delaunay,knn,union").split(",") if m.strip()]
+    cv = cross_validate(
+        motions,
+        methods=methods,
+        dims=args.dims,
+        k=args.k,
+        integrator=args.integrator,
+        step_scale=args.step_scale or 1.0,
+        topo=not args.no_topo,
+        progress=True,
+    )
+    print(cv.table())
+    outside = sum(f["outside_hull_steps"] for f in cv.folds)
+    print(
+        "errors A/F: latent (/ longest side of the training box), deg (RMS over joint angles), "
+        "pos (RMS joint distance, skeleton units); topo: bottleneck of H1 barcodes; "
+        f"{outside} steps outside the hull"
+    )
+    if args.report:
+        _write_json(args.report, _clean(cv.to_report()))
+        print(f"wrote {args.report}")
+    if args.plot:
+        from ..plot.graph import save_crossval_figures
+
+        for p in save_crossval_figures(cv, motions, args.plot):
+            print(f"wrote {p}")
+    return EXIT_OK
+
+
+def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int:
+    from ..quality.plausibility import check_plausibility
+    from ..synthesis.graph import MotionGraphSynth
+    from .main import _finish
+
+    method = args.method or "delaunay"
+    if "," in method:
+        raise ParameterError(
+            f"--method {method}: generation uses one method (a list is for 'graph crossval')"
+        )
+    synth = MotionGraphSynth(
+        method=method,
+        dims=args.dims,
+        k=args.k,
+        integrator=args.integrator,
+        step_scale=args.step_scale or 2.0,
+    ).fit(motions)
+    path, frame = _take_spec(args.start) if args.start else (inputs[0], 0)
+    start = _find(path, inputs, motions)
+    if args.target:
+        tpath, tframe = _take_spec(args.target)
+        gen = synth.to_target(
+            start, frame, _find(tpath, inputs, motions), tframe, speed=(args.step_scale or 2.0) / 2
+        )
+    else:
+        gen = synth.generate(args.frames, start, frame)
+    conn = synth.graph_.connectivity()
+    print(
+        f"{synth.graph_.method} graph over {conn['nodes']} frames of {len(motions)} takes: "
+        f"{conn['edges']} edges, "
+        f"{conn['weak_components']} weak / {conn['strong_components']} strong components; "
+        f"start/end graph H {'connected' if conn['H']['connected'] else 'NOT connected'}"
+    )
+    if conn["cannot_reach"]:
+        print(
+            "  takes that cannot reach each other: "
+            + ", ".join(f"{synth.names_[i]} -> {synth.names_[j]}" for i, j in conn["cannot_reach"])
+        )
+    ev = synth.space_.explained_variance_ratio_
+    print(
+        f"latent space: {args.dims} PCA dims explain {100 * ev.sum():.1f} % "
+        "of the joint-angle variance"
+    )
+    print(
+        f"generated {gen.motion.n_frames} frames from {gen.start['take']}:{gen.start['frame']} "
+        f"({gen.path.kind}; {gen.path.outside_hull_steps} steps outside the hull)"
+    )
+    payload = {
+        "method": method,
+        "dims": args.dims,
+        "k": args.k,
+        "integrator": args.integrator,
+        "step_scale": synth.step_scale,
+        "takes": synth.names_,
+        "start": gen.start,
+        "frames": gen.motion.n_frames,
+        "outside_hull_steps": gen.path.outside_hull_steps,
+        "explained_variance_ratio": ev.tolist(),
+        "graph": {
+            key: conn[key] for key in ("nodes", "edges", "weak_components", "strong_components")
+        },
+        "connectivity": conn,
+        "root": "weighted mean of the root steps, turns, heights and tilts of the training "
+        "frames weighing on "
+        "each generated point (the field's neighbourhood), integrated from the start frame's root",
+    }
+    if args.plot:
+        from ..plot.graph import save_graph_figures
+
+        for p in save_graph_figures(synth, gen, args.plot):
+            print(f"wrote {p}")
+    report = check_plausibility(gen.motion, motions)
+    return _finish(args, gen.motion, payload, report, "generated motion")

@@ -1,0 +1,39 @@
+"""Motion graph and vector-field synthesis over a Delaunay complex (Gauch & Peters).
+
+From a few training takes: a PCA space of the joint angles (:class:`PoseSpace`), a motion
+graph over the training frames from a Delaunay triangulation, k nearest neighbours or
+both (:func:`build_graph`), the interpolated field of the takes' velocities
+(:class:`VectorField`), paths that follow it or run to a target along the graph
+(:func:`follow_field`, :func:`path_to_target`), a playable result with a root trajectory
+(:class:`MotionGraphSynth`) and the paper's leave-one-out table (:func:`cross_validate`).
+"""
+
+from .build import METHODS, MotionGraph, build_graph, training_vectors
+from .crossval import PAPER_W1, CrossValidation, bottleneck, cross_validate, h1_diagram, path_errors
+from .field import VectorField
+from .latent import PoseSpace, check_takes
+from .model import Generation, MotionGraphSynth
+from .paths import GraphPath, follow_field, path_to_target, root_trajectory, shortest_path
+
+__all__ = [
+    "METHODS",
+    "PAPER_W1",
+    "CrossValidation",
+    "Generation",
+    "GraphPath",
+    "MotionGraph",
+    "MotionGraphSynth",
+    "PoseSpace",
+    "VectorField",
+    "bottleneck",
+    "build_graph",
+    "check_takes",
+    "cross_validate",
+    "follow_field",
+    "h1_diagram",
+    "path_errors",
+    "path_to_target",
+    "root_trajectory",
+    "shortest_path",
+    "training_vectors",
+]

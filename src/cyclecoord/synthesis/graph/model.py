@@ -1,0 +1,183 @@
+"""The motion-graph synthesiser: latent space, graph and field fitted together, and playable output.
+
+>>> synth = MotionGraphSynth(method="delaunay", dims=2).fit(takes)      # doctest: +SKIP
+>>> result = synth.generate(450, start=takes[0], frame=0)              # doctest: +SKIP
+>>> cc.save(result.motion, "walk.bvh")                                 # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from ..._blas import one_blas_thread
+from ...errors import ParameterError
+from ...motion import Motion
+from .build import MotionGraph, build_graph, check_method
+from .field import VectorField
+from .latent import PoseSpace, check_takes
+from .paths import INTEGRATORS, GraphPath, follow_field, path_to_target, root_trajectory
+
+__all__ = ["MotionGraphSynth", "Generation", "take_name"]
+
+
+def take_name(m: Motion, i: int = 0) -> str:
+    """A take's short name: its file name without folder and suffix."""
+    return (
+        m.source.replace("\\", "/").rsplit("/", 1)[-1].rsplit(".", 1)[0]
+        if m.source
+        else f"take {i}"
+    )
+
+
+@dataclass
+class Generation:
+    """A generated motion.
+
+    Attributes
+    ----------
+    motion : Motion
+        Joint angles from the path (inverse PCA), root from :func:`root_trajectory`; the
+        training takes' channels and skeleton.
+    path : GraphPath
+    start : dict
+        ``take`` (name), ``frame`` and ``latent`` (the projected start pose).
+    """
+
+    motion: Motion
+    path: GraphPath
+    start: dict
+
+
+class MotionGraphSynth:
+    """Gauch & Peters' generator: PCA space, motion graph and vector field over training takes.
+
+    Parameters
+    ----------
+    method : {"delaunay", "knn", "union"}, default "delaunay"
+    dims : int, default 2
+        Latent dimensions (the paper's 2).
+    k : int, default 16
+    integrator : {"euler", "rk4"}, default "euler"
+    step_scale : float, default 1
+        1 is the paper's step (about half the captured speed); 2 about the captured speed.
+
+    Attributes
+    ----------
+    space_ : PoseSpace
+    graph_ : MotionGraph
+    field_ : VectorField
+    takes_ : list of Motion
+    names_ : list of str
+    """
+
+    def __init__(
+        self,
+        method: str = "delaunay",
+        dims: int = 2,
+        k: int = 16,
+        integrator: str = "euler",
+        step_scale: float = 1.0,
+    ) -> None:
+        self.method = method
+        self.dims = dims
+        self.k = k
+        self.integrator = integrator
+        self.step_scale = step_scale
+
+    @one_blas_thread
+    def fit(self, takes: Sequence[Motion]) -> "MotionGraphSynth":
+        check_method(self.method)
+        if self.integrator not in INTEGRATORS:
+            raise ParameterError(
+                f"unknown integrator {self.integrator!r}; choose from {', '.join(INTEGRATORS)}"
+            )
+        self.takes_ = check_takes(takes, minimum=2)
+        self.names_ = [take_name(m, i) for i, m in enumerate(self.takes_)]
+        self.space_ = PoseSpace(self.dims).fit(self.takes_)
+        latent = [self.space_.transform(m) for m in self.takes_]
+        self.graph_: MotionGraph = build_graph(latent, self.method, self.k, self.names_)
+        self.field_ = VectorField(self.graph_)
+        return self
+
+    def _start(self, start: Motion | int, frame: int) -> tuple[Motion, int, str]:
+        if isinstance(start, (int, np.integer)) and not isinstance(start, bool):
+            if not 0 <= int(start) < len(self.takes_):
+                raise ParameterError(
+                    f"start take {start} is not one of the {len(self.takes_)} training takes"
+                )
+            motion, name = self.takes_[int(start)], self.names_[int(start)]
+        elif isinstance(start, Motion):
+            motion, name = start, take_name(start)
+            check_takes([self.takes_[0], motion], minimum=2)
+        else:
+            raise ParameterError(
+                f"start must be a Motion or a training take's index, got {type(start).__name__}"
+            )
+        n = motion.n_frames
+        if (
+            isinstance(frame, bool)
+            or not isinstance(frame, (int, np.integer))
+            or not -n <= frame < n
+        ):
+            raise ParameterError(
+                f"{name}: start frame {frame} is outside its {n} frames (0 to {n - 1})"
+            )
+        return motion, int(frame) % n, name
+
+    def start_point(self, start: Motion | int = 0, frame: int = 0) -> np.ndarray:
+        """The latent point ``(d,)`` of a take's frame."""
+        motion, f, _ = self._start(start, frame)
+        return self.space_.transform(motion[f])[0]
+
+    @one_blas_thread
+    def generate(self, n_frames: int, start: Motion | int = 0, frame: int = 0) -> Generation:
+        """Follow the field for ``n_frames`` from a take's frame and make a playable motion.
+
+        Parameters
+        ----------
+        n_frames : int
+        start : Motion or int
+            A take (any take of the skeleton, trained on or not) or a training take's index.
+        frame : int
+            0-based frame of ``start`` (negative counts from the end).
+        """
+        motion, f, name = self._start(start, frame)
+        x0 = self.space_.transform(motion[f])[0]
+        path = follow_field(self.field_, x0, n_frames, self.integrator, self.step_scale)
+        return self._result(path, motion, f, name, x0)
+
+    @one_blas_thread
+    def to_target(
+        self,
+        start: Motion | int,
+        frame: int,
+        target: Motion | int,
+        target_frame: int,
+        speed: float = 1.0,
+    ) -> Generation:
+        """The shortest graph path from one take's frame to another's (paper §V-A), playable."""
+        motion, f, name = self._start(start, frame)
+        tmotion, tf, _ = self._start(target, target_frame)
+        x0 = self.space_.transform(motion[f])[0]
+        x1 = self.space_.transform(tmotion[tf])[0]
+        path = path_to_target(self.graph_, x0, x1, speed)
+        return self._result(path, motion, f, name, x0)
+
+    def _result(
+        self, path: GraphPath, motion: Motion, f: int, name: str, x0: np.ndarray
+    ) -> Generation:
+        root = root_trajectory(self.takes_, path, motion, f)
+        out = self.space_.motion(path.points, self.takes_[0], root)
+        out = out.with_frames(
+            out.frames,
+            metadata={
+                "generator": f"motion graph ({path.kind}, {self.dims} dims)",
+                "start": f"{name}:{f}",
+            },
+        )
+        return Generation(
+            motion=out, path=path, start={"take": name, "frame": f, "latent": x0.tolist()}
+        )

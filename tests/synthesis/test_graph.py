@@ -1,0 +1,261 @@
+"""The motion graph: latent space, graphs, field, paths and cross-validation on small inputs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial import Delaunay
+
+import cyclecoord as cc
+from cyclecoord.errors import ParameterError
+from cyclecoord.synthesis.graph import (
+    MotionGraphSynth,
+    PoseSpace,
+    VectorField,
+    bottleneck,
+    build_graph,
+    check_takes,
+    cross_validate,
+    follow_field,
+    h1_diagram,
+    path_errors,
+    path_to_target,
+    shortest_path,
+    training_vectors,
+)
+
+
+def circle(n: int, radius: float = 1.0, phase: float = 0.0, turns: float = 1.0) -> np.ndarray:
+    t = phase + 2 * np.pi * turns * np.arange(n) / n
+    return np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
+
+
+@pytest.fixture(scope="module")
+def walks():
+    return [
+        cc.datasets.make_periodic_capture(kind="walk", n_frames=n, period=60, random_state=s).motion
+        for s, n in ((0, 150), (1, 130), (2, 140))
+    ]
+
+
+# ---------------------------------------------------------------------- latent space
+def test_pose_space_round_trip_and_turns(walks):
+    full = PoseSpace(56).fit(walks)
+    a = full.angles(walks[0])
+    assert a.shape == (150, 56)
+    assert np.allclose(full.inverse_transform(full.transform(a)), a, atol=1e-6)
+    space = PoseSpace(2).fit(walks)
+    assert space.components_.shape == (2, 56)
+    assert np.allclose(space.components_ @ space.components_.T, np.eye(2), atol=1e-9)
+    # a take written a whole turn away in one channel is the same pose
+    frames = np.array(walks[1].frames)
+    frames[:, space.columns_[5]] += 360.0
+    shifted = walks[1].with_frames(frames)
+    assert np.allclose(space.transform(shifted), space.transform(walks[1]), atol=1e-9)
+
+
+def test_check_takes_errors(walks):
+    with pytest.raises(ParameterError, match="at least 2 training takes, got one take"):
+        check_takes(walks[:1])
+    other = walks[1].select([c for c in walks[1].channels if c != ("lfemur", "rz")])
+    with pytest.raises(ParameterError, match="channels differ"):
+        check_takes([walks[0], other])
+    with pytest.raises(ParameterError, match="at least 3 training takes"):
+        check_takes(walks[:2], minimum=3)
+
+
+# --------------------------------------------------------------------------- graphs
+def test_training_vectors_half_forward_difference_backward_at_end():
+    p = np.array([[0.0, 0], [1, 0], [3, 0], [10, 0], [10, 2]])
+    take = np.array([0, 0, 0, 1, 1])
+    v = training_vectors(p, take)
+    assert np.allclose(v, [[0.5, 0], [1, 0], [1, 0], [0, 1], [0, 1]])
+
+
+def test_delaunay_edges_are_simplex_pairs_directed_along_velocity():
+    takes = [circle(40, 1.0), circle(40, 1.3, 0.1), circle(35, 0.8, 0.2)]
+    g = build_graph(takes, "delaunay")
+    pts = np.vstack(takes)
+    tri = Delaunay(pts)
+    pairs = {
+        tuple(sorted((int(s[a]), int(s[b]))))
+        for s in tri.simplices
+        for a in range(3)
+        for b in range(a + 1, 3)
+    }
+    n_own = g.n_nodes - g.n_takes
+    got = {tuple(sorted(e)) for e in g.edges[n_own:].tolist()}
+    own = {tuple(sorted(e)) for e in g.edges[:n_own].tolist()}
+    assert got | (pairs & own) == pairs
+    v = g.velocities
+    for a, b in g.edges[n_own:]:
+        assert (v[a] + v[b]) @ (g.points[b] - g.points[a]) > 0
+    nxg = g.to_networkx()
+    assert nxg.number_of_nodes() == g.n_nodes and nxg.number_of_edges() == len(g.edges)
+    assert nxg.nodes[45]["take"] == 1 and nxg.nodes[45]["frame"] == 5
+    c = g.connectivity()
+    assert c["weak_components"] == 1 and c["strong_components"] == 1 and c["H"]["connected"]
+
+
+def test_knn_graph_reports_takes_that_cannot_reach_each_other():
+    a = np.stack([np.linspace(0, 1, 20), np.zeros(20)], axis=1)
+    b = a + [0.0, 50.0]
+    g = build_graph([a, b], "knn", k=3)
+    c = g.connectivity()
+    assert c["weak_components"] == 2
+    assert c["strong_components"] == 40  # straight lines: nothing comes back
+    assert sorted(c["cannot_reach"]) == [[0, 1], [1, 0]]
+    assert not c["H"]["connected"]
+    # every frame has its 3 nearest as neighbours (one direction or the other)
+    und = {tuple(sorted(e)) for e in g.edges.tolist()}
+    assert (0, 1) in und and (0, 3) in und
+
+
+def test_delaunay_keeps_qhull_dropped_duplicates():
+    pts = circle(30, 1.0)
+    dup = np.vstack([pts, pts[:1]])  # frame 30 repeats frame 0
+    g = build_graph([dup, circle(25, 1.4, 0.05)], "delaunay")
+    assert g.n_coplanar >= 1
+    und = {tuple(sorted(e)) for e in g.edges.tolist()}
+    assert any(30 in e for e in und - {(29, 30)})
+
+
+def test_union_contains_both():
+    takes = [circle(40, 1.0), circle(40, 1.2, 0.1)]
+    e = {
+        m: {tuple(sorted(x)) for x in build_graph(takes, m, k=4).edges.tolist()}
+        for m in ("delaunay", "knn", "union")
+    }
+    assert e["delaunay"] | e["knn"] == e["union"]
+
+
+def test_too_many_delaunay_dims_is_one_clear_line():
+    pts = np.random.default_rng(0).normal(size=(2000, 6))
+    with pytest.raises(ParameterError, match="6 dimensions would hold about .* use method 'knn'"):
+        build_graph([pts[:1000], pts[1000:]], "delaunay")
+    build_graph([pts[:1000], pts[1000:]], "knn")  # k-NN is fine
+
+
+# ---------------------------------------------------------------------------- field
+def test_field_weights_and_fallback():
+    takes = [circle(60, 1.0), circle(60, 1.3, 0.05)]
+    g = build_graph(takes, "delaunay")
+    f = VectorField(g)
+    idx, w, inside = f.neighbours(np.array([[1.1, 0.05], [5.0, 5.0]]))
+    assert np.allclose(w.sum(axis=1), 1.0)
+    assert inside.tolist() == [True, False]
+    assert (w[0] > 0).sum() == 3  # a triangle's vertices
+    knn = VectorField(build_graph(takes, "knn"))
+    assert np.allclose(f(np.array([5.0, 5.0])), knn(np.array([5.0, 5.0])))
+    # on a training frame the field is that frame's vector
+    assert np.allclose(f(g.points[7]), g.velocities[7])
+    # inverse-square weights
+    x = np.array([[1.1, 0.05]])
+    d2 = ((g.points[idx[0]] - x) ** 2).sum(axis=1)
+    expect = (1 / d2) * (w[0] > 0)
+    assert np.allclose(w[0], expect / expect.sum())
+
+
+def test_follow_field_goes_round_the_loop():
+    takes = [circle(80, 1.0), circle(80, 1.1, 0.3), circle(80, 0.9, 0.6)]
+    for method in ("delaunay", "knn", "union"):
+        f = VectorField(build_graph(takes, method))
+        for integ in ("euler", "rk4"):
+            p = follow_field(f, takes[0][0], 120, integ, step_scale=2.0)
+            r = np.linalg.norm(p.points, axis=1)
+            assert p.points.shape == (120, 2)
+            ang = np.unwrap(np.arctan2(p.points[:, 1], p.points[:, 0]))
+            assert ang[-1] - ang[0] > 2 * np.pi  # more than a full turn, anticlockwise
+            assert p.outside_hull_steps == 0
+            if integ == "euler":  # full steps along chords retrace the polygon
+                assert 0.95 < r.min() and r.max() < 1.05
+            else:  # the continuous flow of chord vectors (pointing inwards) spirals in
+                assert r[-1] < 0.9 and r.max() <= 1.0 + 1e-9
+    with pytest.raises(ParameterError, match="n_frames"):
+        follow_field(f, takes[0][0], 0)
+    with pytest.raises(ParameterError, match="integrator"):
+        follow_field(f, takes[0][0], 5, "midpoint")
+
+
+def test_shortest_path_and_target():
+    takes = [circle(40, 1.0), circle(40, 1.2, 0.1)]
+    g = build_graph(takes, "delaunay")
+    nodes = shortest_path(g, 0, 60)
+    edges = {tuple(e) for e in g.edges.tolist()}
+    assert nodes[0] == 0 and nodes[-1] == 60
+    assert all((a, b) in edges for a, b in zip(nodes[:-1], nodes[1:]))
+    p = path_to_target(g, g.points[0], g.points[60])
+    assert np.allclose(p.points[0], g.points[0]) and np.allclose(p.points[-1], g.points[60])
+    lines = build_graph(
+        [np.stack([np.linspace(0, 1, 10), np.zeros(10)], 1)] * 1
+        + [np.stack([np.linspace(0, 1, 10), np.full(10, 9.0)], 1)],
+        "knn",
+        k=2,
+    )
+    with pytest.raises(ParameterError, match="no path"):
+        shortest_path(lines, 0, 15)
+
+
+# --------------------------------------------------------------------- errors, topology
+def test_path_errors_and_bottleneck():
+    true = circle(100)
+    a, f = path_errors(np.linalg.norm(true[:, None] - true[None], axis=2))
+    assert a == 0 and f == 0
+    still = true[:1]
+    a, f = path_errors(np.linalg.norm(true[:, None] - still[None], axis=2))
+    assert f == pytest.approx(np.linalg.norm(true[-1] - true[0]))
+    d1, d2 = h1_diagram(true), h1_diagram(circle(100, 1.2))
+    assert len(d1) >= 1 and d1[:, 1].max() == pytest.approx(1.0, abs=0.01)
+    assert bottleneck(d1, d2) == pytest.approx(0.2, abs=0.02)  # deaths 1 and 1.2
+    assert bottleneck(d1, np.zeros((0, 2))) == pytest.approx(0.5 * np.ptp(d1[np.argmax(d1[:, 1])]))
+    assert bottleneck(d1, d1) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_cross_validate_report_keys(walks):
+    cv = cross_validate(walks, methods=("delaunay", "knn"), dims=2)
+    assert len(cv.folds) == 6
+    keys = {
+        "held_out",
+        "method",
+        "error_a",
+        "error_f",
+        "error_a_deg",
+        "error_f_deg",
+        "error_topo",
+        "outside_hull_steps",
+    }
+    assert all(keys <= set(f) for f in cv.folds)
+    for m in ("delaunay", "knn"):
+        assert {"error_a", "error_f", "error_a_deg", "error_f_deg", "error_topo"} <= set(
+            cv.median[m]
+        )
+        assert cv.median[m]["error_f_deg"] < cv.baselines["standing_still"]["median"]["error_f_deg"]
+    assert set(cv.baselines) == {"standing_still", "nearest_take"}
+    assert {"nodes", "edges", "weak_components", "strong_components"} <= set(cv.graph)
+    assert "paper w1: delaunay" in cv.table()
+
+
+def test_synth_generates_a_playable_walk(walks):
+    synth = MotionGraphSynth(dims=2, step_scale=2.0).fit(walks)
+    gen = synth.generate(120, walks[0], 10)
+    m = gen.motion
+    assert m.n_frames == 120 and m.channels == walks[0].channels
+    root = walks[0].frames[10, :3]
+    assert np.allclose(m.frames[0, [0, 2]], root[[0, 2]], atol=1e-6)
+    travel = np.linalg.norm(m.frames[-1, [0, 2]] - m.frames[0, [0, 2]])
+    real = np.linalg.norm(walks[0].frames[129, [0, 2]] - walks[0].frames[10, [0, 2]])
+    assert 0.5 * real < travel < 1.5 * real
+    with pytest.raises(ParameterError, match="start frame 500 is outside its 150 frames"):
+        synth.generate(10, walks[0], 500)
+
+
+def test_target_path_keeps_to_the_data_with_squared_costs():
+    takes = [circle(60, 1.0), circle(60, 1.1, 0.05), circle(60, 0.9, 0.1)]
+    g = build_graph(takes, "delaunay")
+    start, target = g.points[0], g.points[30]  # opposite sides of the ring
+    near = lambda p: g.tree.query(p.points)[0].max()  # noqa: E731
+    p = path_to_target(g, start, target)
+    assert near(p) < 0.1
+    # along the takes' direction of travel (anticlockwise), not back against it
+    ang = np.unwrap(np.arctan2(p.points[:, 1], p.points[:, 0]))
+    assert np.all(np.diff(ang) > -0.05) and ang[-1] - ang[0] == pytest.approx(np.pi, abs=0.2)

@@ -1,0 +1,163 @@
+"""`cyclecoord graph` and `graph crossval`: bad input in one line, reports, and set w1 (CMU 35)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.cli.main import main
+
+W1 = ("35_16", "35_07", "35_08", "35_13")
+
+
+@pytest.fixture(scope="module")
+def synthetic_takes(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("takes")
+    paths = []
+    for s, n in ((0, 150), (1, 130), (2, 140)):
+        m = cc.datasets.make_periodic_capture(
+            kind="walk", n_frames=n, period=60, random_state=s
+        ).motion
+        p = folder / f"walk{s}.bvh"
+        cc.save(m, p)
+        paths.append(str(p))
+    return paths
+
+
+def one_error_line(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    err = [e for e in err if e.startswith("cyclecoord: error:")]
+    assert len(err) == 1, err
+    return err[0]
+
+
+def test_generate_writes_motion_report_and_figures(synthetic_takes, tmp_path, capsys):
+    out, rep, figs = tmp_path / "gen.bvh", tmp_path / "gen.json", tmp_path / "figs"
+    rc = main(
+        [
+            "graph",
+            *synthetic_takes,
+            "--start",
+            f"{synthetic_takes[1]}:5",
+            "--frames",
+            "90",
+            "-o",
+            str(out),
+            "--report",
+            str(rep),
+            "--plot",
+            str(figs),
+        ]
+    )
+    assert rc == 0
+    m = cc.load(out)
+    assert m.n_frames == 90
+    r = json.loads(rep.read_text())
+    assert r["start"]["frame"] == 5 and r["frames"] == 90
+    assert {"nodes", "edges", "weak_components", "strong_components"} == set(r["graph"])
+    assert r["graph"]["nodes"] == 420
+    assert "plausibility" in r and "root" in r
+    assert sorted(p.name for p in figs.iterdir()) == ["field.png", "graph.png", "path.png"]
+
+
+def test_crossval_report_keys(synthetic_takes, tmp_path, capsys):
+    rep = tmp_path / "cv.json"
+    rc = main(
+        ["graph", "crossval", *synthetic_takes, "--method", "delaunay,knn", "--report", str(rep)]
+    )
+    assert rc == 0
+    out = capsys.readouterr().out
+    assert "paper w1: delaunay" in out and "baseline: standing still" in out
+    r = json.loads(rep.read_text())
+    fold_keys = {
+        "held_out",
+        "method",
+        "error_a",
+        "error_f",
+        "error_a_deg",
+        "error_f_deg",
+        "error_topo",
+        "outside_hull_steps",
+    }
+    assert len(r["folds"]) == 6 and all(fold_keys <= set(f) for f in r["folds"])
+    assert set(r["median"]) == {"delaunay", "knn"}
+    assert {"error_a", "error_f", "error_a_deg", "error_f_deg", "error_topo"} <= set(
+        r["median"]["knn"]
+    )
+    assert set(r["baselines"]) == {"standing_still", "nearest_take"}
+    assert {"nodes", "edges", "weak_components", "strong_components"} <= set(r["graph"])
+
+
+def test_bad_input_one_line_each(synthetic_takes, tmp_path, capsys):
+    a, b, _ = synthetic_takes
+    # one take only
+    assert main(["graph", a]) == 1
+    assert "at least 2 training takes, got one take" in one_error_line(capsys)
+    assert main(["graph", "crossval", a, b]) == 1
+    assert "at least 3 training takes" in one_error_line(capsys)
+    # start frame out of range
+    assert main(["graph", a, b, "--start", f"{a}:999"]) == 1
+    assert "start frame 999 is outside its 150 frames" in one_error_line(capsys)
+    # Delaunay in more dimensions than it can afford
+    assert main(["graph", a, b, "--dims", "7"]) == 1
+    assert "7 dimensions would hold about" in one_error_line(capsys)
+    # different channels
+    m = cc.load(b)
+    fewer = m.select([c for c in m.channels if c != ("lhumerus", "rz")])
+    path = tmp_path / "fewer.npz"
+    cc.save(fewer, path)
+    assert main(["graph", a, str(path)]) == 1
+    assert "channels differ" in one_error_line(capsys)
+    # bad method
+    assert main(["graph", a, b, "--method", "voronoi"]) == 1
+    assert "unknown graph method 'voronoi'" in one_error_line(capsys)
+
+
+def test_different_skeletons_one_line(cmu_dir, capsys):
+    a, b = cmu_dir / "35" / "35_16.amc", cmu_dir / "69" / "69_01.amc"
+    if not (a.is_file() and b.is_file()):
+        pytest.skip("35_16 / 69_01 not in the shared data")
+    assert main(["graph", str(a), str(b)]) == 1
+    assert "skeleton differs" in one_error_line(capsys)
+
+
+@pytest.fixture(scope="module")
+def w1(cmu_dir):
+    paths = [cmu_dir / "35" / f"{n}.amc" for n in W1]
+    if not all(p.is_file() for p in paths):
+        pytest.skip("set w1 (CMU 35_16, 35_07, 35_08, 35_13) not in the shared data")
+    return [cc.load(p) for p in paths]
+
+
+@pytest.mark.slow
+def test_w1_table_against_baselines(w1):
+    from cyclecoord.synthesis.graph import cross_validate
+
+    assert [m.n_frames for m in w1] == [443, 360, 455, 454]  # the paper's Table I
+    cv = cross_validate(w1, methods=("delaunay", "knn"), dims=3, topo=False)
+    still = cv.baselines["standing_still"]["median"]
+    for m in ("delaunay", "knn"):
+        assert cv.median[m]["error_f"] < 0.25 * still["error_f"]
+        assert cv.median[m]["error_a"] < 0.5 * still["error_a"]
+    # in 3 dimensions Delaunay is at most k-NN on both medians
+    assert cv.median["delaunay"]["error_a"] <= cv.median["knn"]["error_a"]
+    assert cv.median["delaunay"]["error_f"] <= cv.median["knn"]["error_f"]
+
+
+@pytest.mark.slow
+def test_w1_generated_walk_loops_and_is_plausible(w1):
+    from cyclecoord.quality.plausibility import check_plausibility
+    from cyclecoord.synthesis.graph import MotionGraphSynth
+
+    gen = (
+        MotionGraphSynth(method="delaunay", dims=2, step_scale=2.0).fit(w1).generate(450, w1[0], 0)
+    )
+    res = cc.extract(gen.motion)
+    assert res.cycles >= 1.5
+    assert 100 < res.period_frames < 180  # the takes' own: about 131-134 frames
+    assert check_plausibility(gen.motion, w1).clean
+    travel = np.linalg.norm(gen.motion.frames[-1, [0, 2]] - gen.motion.frames[0, [0, 2]])
+    assert travel > 50  # it walks: about 79 units (4.4 m) in 3.75 s
