@@ -118,9 +118,62 @@ def _lock_weights(planted: np.ndarray, nb: int, cyclic: bool):
     return w, label, runs, 0
 
 
-def _targets(points: np.ndarray, planted: np.ndarray, up: int, nb: int, cyclic: bool):
+def _next_loop(points: np.ndarray, loop, shift) -> np.ndarray:
+    """Positions moved by ``loop`` loops of a travelling cycle.
+
+    ``shift`` is ``(origin (3,), step (3,), turn (degrees), up)``: the next loop is this one
+    turned by ``turn`` about the vertical through ``origin`` and moved by ``step``.
+    """
+    origin, step, turn, up = shift
+    out = np.array(points, dtype=float)
+    a, b = [k for k in range(3) if k != up]
+    for c in (-1, 1):
+        rows = loop == c
+        if not rows.any():
+            continue
+        ang = np.radians(turn * c)
+        ca, sa = np.cos(ang), np.sin(ang)
+        if c == 1:
+            rel = out[rows] - origin
+            x, z = rel[:, b], rel[:, a]
+            out[rows, a] = origin[a] + sa * x + ca * z + step[a]
+            out[rows, b] = origin[b] + ca * x - sa * z + step[b]
+        else:
+            # the inverse: undo the step, then turn back
+            rel = out[rows] - origin - step
+            x, z = rel[:, b], rel[:, a]
+            out[rows, a] = origin[a] + sa * x + ca * z
+            out[rows, b] = origin[b] + ca * x - sa * z
+    return out
+
+
+def _loop_shift(root: np.ndarray, rot: np.ndarray, up: int) -> tuple:
+    """How a travelling loop's next repetition sits: ``(origin, step, turn, up)``.
+
+    Extrapolated from the root's first and last frames: the step and the heading turn
+    (about the vertical, degrees; with y up, from the root's z axis) of ``T`` frames.
+    """
+    T = root.shape[0]
+    k = T / max(T - 1, 1)
+    step = (root[-1] - root[0]) * k
+    step[up] = 0.0
+    turn = 0.0
+    if up == 1:
+        h = np.degrees(np.arctan2(rot[:, 0, 2], rot[:, 2, 2]))
+        turn = float((np.degrees(np.unwrap(np.radians(h)))[-1] - h[0]) * k)
+    return root[0].astype(float), step, turn, up
+
+
+def _targets(
+    points: np.ndarray, planted: np.ndarray, up: int, nb: int, cyclic: bool, loop_shift: tuple | None = None
+):
     """Targets ``(T, 3)`` (horizontal components eased into locks), weights ``(T,)`` and run
-    labels for one foot point."""
+    labels for one foot point.
+
+    A cyclic motion that travels moves by ``loop_shift`` from one loop to the next: a
+    contact that runs across the seam reads the frames of the neighbouring loop there
+    (its own frames shifted by it), not the far end of this one.
+    """
     T = planted.size
     horiz = [k for k in range(3) if k != up]
     w, label, runs, shift = _lock_weights(planted, nb, cyclic)
@@ -129,8 +182,15 @@ def _targets(points: np.ndarray, planted: np.ndarray, up: int, nb: int, cyclic: 
     for k in np.unique(label[label >= 0]):
         a, b = runs[k]
         frames = np.arange(a, b) - shift
-        frames = np.mod(frames, T) if cyclic else frames
-        locks[k] = points[frames][:, horiz].mean(axis=0)
+        if cyclic:
+            loop = np.floor_divide(frames, T)  # -1, 0 or 1: the loop before, this one, the next
+            frames = np.mod(frames, T)
+            pos = points[frames]
+            if loop_shift is not None:
+                pos = _next_loop(pos, loop, loop_shift)
+            locks[k] = pos[:, horiz].mean(axis=0)
+        else:
+            locks[k] = points[frames][:, horiz].mean(axis=0)
     for t in np.flatnonzero(label >= 0):
         lock = locks[label[t]]
         target[t, horiz] = points[t, horiz] + w[t] * (lock - points[t, horiz])
@@ -267,9 +327,10 @@ def _lock_once(
         weights = np.full((T, len(pts), 3), _SOFT)
         active = np.zeros(T, bool)
         horiz = [k for k in range(3) if k != contacts.up]
+        loop_shift = _loop_shift(wpos[:, 0], wrot[:, 0], contacts.up) if cyclic and T > 1 else None
         for m, i in enumerate(cols):
             tgt, _, label = _targets(
-                wpos[:, pts[m]], contacts.planted[:, i], contacts.up, nb, cyclic
+                wpos[:, pts[m]], contacts.planted[:, i], contacts.up, nb, cyclic, loop_shift
             )
             targets[:, m] = tgt
             locked = label >= 0
