@@ -104,6 +104,9 @@ class Synthesizer:
     params : ParticleParams
     bridge_threshold : float, optional
         See :func:`~.bridges.find_bridges`.
+    clamp : bool, default True
+        Clip joint angles to the training range of the model(s) making each frame (the
+        count and largest clip are kept in ``clamped``).
     """
 
     models: dict[str, LatentModel]
@@ -111,6 +114,7 @@ class Synthesizer:
     seed: int = 0
     params: ParticleParams = field(default_factory=ParticleParams)
     bridge_threshold: float | None = None
+    clamp: bool = True
 
     def __post_init__(self) -> None:
         if not self.models:
@@ -129,6 +133,14 @@ class Synthesizer:
         self._graphs: dict[str, CommandGraph] = {}
         self._bridges: dict[tuple[str, str], Bridges] = {}
         self.sim_seconds = 0.0
+        self.clamped = {"values": 0, "max_deg": 0.0}
+        self._ranges: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+    def _range(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        if name not in self._ranges:
+            a = self.models[name].angles(self.models[name].frames_)
+            self._ranges[name] = (a.min(axis=0), a.max(axis=0))
+        return self._ranges[name]
 
     # ---------------------------------------------------------------- helpers
     def model(self, name: str) -> LatentModel:
@@ -184,6 +196,18 @@ class Synthesizer:
         self.x, self.v = X[-1], V[-1]
 
     def _emit(self, name, X, angles, root) -> None:
+        if self.clamp:
+            # joint limits: the training range of the model the frames come from (a
+            # TRANSITION's blend lies between two models' poses, so their joint range)
+            lo, hi = self._range(name)
+            if self.chunks or self.current != name:
+                lo0, hi0 = self._range(self.current)
+                lo, hi = np.minimum(lo, lo0), np.maximum(hi, hi0)
+            clipped = np.clip(angles, lo, hi)
+            over = np.abs(clipped - angles)
+            self.clamped["values"] += int((over > 1e-9).sum())
+            self.clamped["max_deg"] = max(self.clamped["max_deg"], float(over.max(initial=0.0)))
+            angles = clipped
         self.chunks.append(_Chunk(name, X, angles, root, self.command))
         self.t += X.shape[0] / self.fps
 

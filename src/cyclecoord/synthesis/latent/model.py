@@ -221,19 +221,29 @@ class LatentModel:
         """GP mean in PCA space ``(T, d_pca)``."""
         return self.kernel(X) @ self.gp_.alpha_
 
-    def density(self, x: np.ndarray) -> tuple[float, np.ndarray]:
-        """Likelihood proxy ``1 - sigma^2(x) / sigma_rbf^2`` in [0, 1] and its gradient.
-
-        ``sigma^2(x) = k(x, x) - k(x)^T K^-1 k(x)`` is the predictive variance of the
-        noise-free GP (Eq. 8): 1 on the training points' manifold, 0 far from them.
-        """
+    def predictive_variance(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """Predictive variance ``k(x, x) - k(x)^T K^-1 k(x)`` of the noise-free GP (Eq. 8)
+        at latent point ``x`` (q,) and its gradient (time quadratic in the training size)."""
         diff = x[None, :] - self.X_
         k = self.gp_.variance_ * np.exp(-0.5 * (diff * diff).sum(1) / self._l2)
         u = self.gp_.kinv_ @ k
-        s = self.gp_.variance_
-        p = float(k @ u) / s
-        grad = (-2.0 / (s * self._l2)) * ((u * k) @ diff)
-        return p, grad
+        var = max(self.gp_.variance_ - float(k @ u), 0.0)
+        grad = (2.0 / self._l2) * ((u * k) @ diff)
+        return var, grad
+
+    def density(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """Likelihood proxy ``p(x|M) = s_w / (s_w + sigma^2(x))`` in (0, 1] and its gradient.
+
+        ``sigma^2(x)`` is :meth:`predictive_variance` and ``s_w`` the white noise variance: ``p`` is
+        near 1 where the GP knows the pose up to the data's own noise and falls towards
+        0 away from the training points.  (Normalising by the RBF variance instead gives
+        a proxy that stays near 1 wherever the fitted length scale exceeds the data's
+        extent, which it often does.)
+        """
+        var, grad = self.predictive_variance(x)
+        w = self.gp_.noise_
+        p = w / (w + var)
+        return p, (-w / (w + var) ** 2) * grad
 
     def nearest_frame(self, X: np.ndarray) -> np.ndarray:
         """Index of the training frame nearest each latent point ``(T, q)``."""

@@ -50,11 +50,11 @@ class ParticleParams:
         Drag towards the path's velocity (1/s).
     likelihood : float, default 8
         ``a`` of Eq. 11 (acceleration ``a * speed``).
-    threshold : float, default 0.7
-        ``v`` of Eq. 11 on the density proxy in [0, 1].
+    threshold : float, default 0.6
+        ``v`` of Eq. 11 on the density proxy in [0, 1] (``LatentModel.density``).
     width : float, default 0.05
         ``l`` of Eq. 11.
-    random : float, default 6
+    random : float, default 2
         Standard deviation of each random force component (``random * speed``).
     timescale : float, default 0.4
         Seconds: ``tau`` of the random force's covariance (``gamma = tau^2``).
@@ -64,9 +64,9 @@ class ParticleParams:
     alpha: float = 12.0
     damping: float = 3.0
     likelihood: float = 8.0
-    threshold: float = 0.7
+    threshold: float = 0.6
     width: float = 0.05
-    random: float = 6.0
+    random: float = 2.0
     timescale: float = 0.4
 
     def __post_init__(self) -> None:
