@@ -39,6 +39,19 @@ def smoothstep(n: int) -> np.ndarray:
     return u * u * (3.0 - 2.0 * u)
 
 
+def eased(n: int, ramp: int) -> np.ndarray:
+    """Arc-length fractions ``(n + 1,)`` from 0 to 1: constant speed with smooth starts and
+    stops over ``ramp`` frames (speed rising as a smoothstep), so a MOVE does not jerk the
+    particle into motion or stop it dead."""
+    k = np.arange(n, dtype=float) + 0.5
+    r = max(1e-9, min(float(ramp), n / 2.0))
+    rise = np.clip(k / r, 0, 1)
+    fall = np.clip((n - k) / r, 0, 1)
+    v = np.minimum(rise * rise * (3 - 2 * rise), fall * fall * (3 - 2 * fall))
+    c = np.concatenate([[0.0], np.cumsum(v)])
+    return c / c[-1]
+
+
 def resample(points: np.ndarray, step: float) -> np.ndarray:
     """A polyline ``(M, q)`` resampled at constant arc length ``step``; ends kept."""
     seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
@@ -104,6 +117,9 @@ class Synthesizer:
     params : ParticleParams
     bridge_threshold : float, optional
         See :func:`~.bridges.find_bridges`.
+    ease : float, default 0.25
+        Seconds over which a MOVE's path speeds up and slows down (0: the paper's
+        constant speed throughout).
     clamp : bool, default True
         Clip joint angles to the training range of the model(s) making each frame (the
         count and largest clip are kept in ``clamped``).
@@ -115,6 +131,7 @@ class Synthesizer:
     params: ParticleParams = field(default_factory=ParticleParams)
     bridge_threshold: float | None = None
     clamp: bool = True
+    ease: float = 0.25
 
     def __post_init__(self) -> None:
         if not self.models:
@@ -255,8 +272,11 @@ class Synthesizer:
             if not (isinstance(duration, (int, float)) and duration > 0):
                 raise ParameterError(f"MOVE duration must be a positive number of seconds, got {duration!r}")
             n = max(1, int(round(duration * self.fps)))
-        dense = resample(poly, max(length / n, 1e-12))
-        s = np.linspace(0, dense.shape[0] - 1, n + 1)
+        ramp = int(round(self.ease * self.fps))
+        if ramp:
+            n += ramp  # the ramps lose about half their length each
+        dense = resample(poly, max(length / (4 * n), 1e-12))
+        s = (eased(n, ramp) if ramp else np.linspace(0, 1, n + 1)) * (dense.shape[0] - 1)
         samples = np.stack([np.interp(s, np.arange(dense.shape[0]), dense[:, k]) for k in range(dense.shape[1])], 1)
         self._run(samples, radius)
 
