@@ -6,7 +6,8 @@ comes closest to it is searched (Eq. 15) from several starts: the model-2 traini
 points nearest ``z1`` in PCA space plus one drawn at random.  The search is a batched
 gradient descent with small, capped steps (the paper warns that the gradient vanishes
 away from the training points, so large steps get lost).  Pairs whose poses lie closer
-than a threshold (RMS distance of the joints' positions, root fixed) are bridges.
+than a threshold (RMS distance of the joints' positions, root fixed) and whose point in
+model 2 lies near its training points (density proxy >= ``min_density``) are bridges.
 """
 
 from __future__ import annotations
@@ -161,7 +162,7 @@ class Bridges:
 
 def find_bridges(
     m1, m2, names: tuple[str, str] = ("model1", "model2"), threshold: float | None = None,
-    n_starts: int = 3, random_state: int = 0,
+    n_starts: int = 3, random_state: int = 0, min_density: float = 0.3,
 ) -> Bridges:
     """Bridges from every training latent point of ``m1`` into ``m2`` (Eq. 13-15).
 
@@ -176,6 +177,11 @@ def find_bridges(
         ``m1``'s total bone length.
     n_starts : int
     random_state : int
+    min_density : float, default 0.3
+        A target point must have at least this density proxy in ``m2``
+        (:meth:`~.model.LatentModel.density`): far from the training points the GP mean
+        decays to the mean pose, which can match a pose of ``m1`` without being a pose
+        ``m2`` ever makes.
     """
     check_compatible(m1, m2, f"bridging {names[0]!r} to {names[1]!r}: ")
     if threshold is None:
@@ -187,8 +193,10 @@ def find_bridges(
     # Eq. 15 measures in model 2's PCA space, blind to what model 1's pose does outside
     # it: of every start's optimum, keep the one whose pose is really nearest
     S = XS.shape[1]
+    flat = XS.reshape(n1 * S, -1)
     d_all = pose_distance(m1.skeleton_, m1.channels_, np.repeat(pose1, S, axis=0),
-                          m2.pose(XS.reshape(n1 * S, -1))).reshape(n1, S)
+                          m2.pose(flat)).reshape(n1, S)
+    d_all[(m2.densities(flat) < min_density).reshape(n1, S)] = np.inf
     pick = np.argmin(d_all, axis=1)
     X2 = XS[np.arange(n1), pick]
     dist = d_all[np.arange(n1), pick]

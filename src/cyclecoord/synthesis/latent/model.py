@@ -245,6 +245,12 @@ class LatentModel:
         p = w / (w + var)
         return p, (-w / (w + var) ** 2) * grad
 
+    def densities(self, X: np.ndarray) -> np.ndarray:
+        """:meth:`density` (without gradient) of many latent points ``(T, q)`` at once."""
+        K = self.kernel(X)
+        var = np.maximum(self.gp_.variance_ - ((K @ self.gp_.kinv_) * K).sum(1), 0.0)
+        return self.gp_.noise_ / (self.gp_.noise_ + var)
+
     def nearest_frame(self, X: np.ndarray) -> np.ndarray:
         """Index of the training frame nearest each latent point ``(T, q)``."""
         return np.argmin(sqdist(np.atleast_2d(X), self.X_), axis=1)
