@@ -131,6 +131,8 @@ class Bridges:
         ``threshold``).
     threshold : float
         Skeleton units.
+    best_raw : ndarray, shape (N1,), optional
+        Best distance from every source frame before the density filter.
     """
 
     source: str
@@ -141,6 +143,7 @@ class Bridges:
     distances: np.ndarray
     best: np.ndarray
     threshold: float
+    best_raw: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.frames.size)
@@ -196,6 +199,7 @@ def find_bridges(
     flat = XS.reshape(n1 * S, -1)
     d_all = pose_distance(m1.skeleton_, m1.channels_, np.repeat(pose1, S, axis=0),
                           m2.pose(flat)).reshape(n1, S)
+    raw = d_all.min(axis=1)
     d_all[(m2.densities(flat) < min_density).reshape(n1, S)] = np.inf
     pick = np.argmin(d_all, axis=1)
     X2 = XS[np.arange(n1), pick]
@@ -204,4 +208,5 @@ def find_bridges(
     return Bridges(
         source=names[0], target=names[1], frames=keep, source_points=m1.X_[keep].copy(),
         target_points=X2[keep], distances=dist[keep], best=dist, threshold=float(threshold),
+        best_raw=raw,
     )

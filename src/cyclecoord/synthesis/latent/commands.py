@@ -310,9 +310,13 @@ class Synthesizer:
             raise ParameterError(f"TRANSITION blend must be a positive number of seconds, got {blend!r}")
         br = self.bridges(src, to)
         if not len(br):
+            near = br.best.min()
+            anywhere = br.best_raw.min() if br.best_raw is not None else near
+            detail = (f"the closest poses differ by {near:.3g}" if np.isfinite(near) else
+                      f"no pose near {to!r}'s training data comes close (best {anywhere:.3g})")
             raise ParameterError(
-                f"no bridges from {src!r} to {to!r}: the closest poses differ by "
-                f"{br.best.min():.3g} (threshold {br.threshold:.3g}); go through another model")
+                f"no bridges from {src!r} to {to!r}: {detail} (threshold {br.threshold:.3g}); "
+                "go through another model")
         b = br.nearest(self.x)
         small = 0.5 * (self.params.radius if radius is None else radius)
         self.move(_Point(br.source_points[b]), radius=small)
