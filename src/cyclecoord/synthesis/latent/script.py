@@ -150,7 +150,7 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
     if progress:
         from tqdm import tqdm
 
-        iterator = tqdm(list(enumerate(commands)), desc="commands", unit="cmd")
+        iterator = tqdm(list(enumerate(commands)), desc="commands", unit="cmd", delay=2.0)
     else:
         iterator = enumerate(commands)
     for i, c in iterator:
