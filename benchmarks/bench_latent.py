@@ -196,7 +196,7 @@ def kovar(mA: LatentModel, mB: LatentModel, thr: float):
             D[:, bad] = np.inf
     local = D == ndimage.minimum_filter(D, size=3, mode="nearest")
     hits = np.argwhere(local & (D < thr))
-    return D, hits, pa, pb, scale
+    return D, hits, local, pb, scale
 
 
 def mg_transition(mA, mB, D, hits, scale) -> tuple[cc.Motion, int, bool]:
@@ -262,13 +262,24 @@ def training_stats(models: dict, tests: dict) -> dict:
     return out
 
 
-def latent_transition(mA, mB, nA, nB):
-    syn = Synthesizer({nA: mA, nB: mB}, fps=FPS, seed=0)
+def latent_transition(models, bridges, nA, nB, p99, low):
+    """TRANSITION from A's first frame to B (through other models when no bridge joins
+    them directly); the worst blend window's statistics and the route."""
+    from cyclecoord.errors import ParameterError
+
+    syn = Synthesizer(models, fps=FPS, seed=0)
+    syn._bridges = dict(bridges)
     syn.start(nA)
-    syn.transition(nB, blend=BLEND / FPS)
+    try:
+        syn.transition(nB, blend=BLEND / FPS)
+    except ParameterError:
+        return None
     syn.idle(duration=HOLD)
-    ev = syn.events[-1]
-    return syn.motion(), ev["start_frame"], ev
+    motion = syn.motion()
+    stats = [window_stats(motion, ev["start_frame"], ev["blend_frames"], p99, low) for ev in syn.events]
+    return {"acc": max(s["acc"] for s in stats), "jerk": max(s["jerk"] for s in stats),
+            "skate": float(np.mean([s["skate"] for s in stats])),
+            "route": [syn.events[0]["transition"][0]] + [ev["transition"][1] for ev in syn.events]}
 
 
 def pair_rows(models: dict, stats: dict, progress: bool) -> list[dict]:
@@ -276,27 +287,31 @@ def pair_rows(models: dict, stats: dict, progress: bool) -> list[dict]:
 
     names = list(models)
     pairs = [(a, b) for a in names for b in names if a != b]
+    bridges = {(a, b): find_bridges(models[a], models[b], names=(a, b),
+                                    threshold=THRESHOLD * models[a].skeleton_.total_length())
+               for a, b in tqdm(pairs, desc="bridges", disable=not progress)}
     rows = []
     for a, b in tqdm(pairs, desc="pairs", disable=not progress):
         mA, mB = models[a], models[b]
         thr = THRESHOLD * mA.skeleton_.total_length()
-        br = find_bridges(mA, mB, names=(a, b), threshold=thr)
-        D, hits, _, _, scale = kovar(mA, mB, thr)
+        br = bridges[(a, b)]
+        D, hits, local, _, scale = kovar(mA, mB, thr)
+        hits2 = np.argwhere(local & (D < 2 * thr))
         p99 = (float(np.percentile(np.r_[stats[a]["acc"], stats[b]["acc"]], 99)),
                float(np.percentile(np.r_[stats[a]["jerk"], stats[b]["jerk"]], 99)))
         low = stats[a]["low"]
         row = {"from": a, "to": b, "bridges": len(br), "mg_transitions": int(len(hits)),
                "bridge_cov_play": coverage_play(mA, br.frames),
                "mg_cov_play": coverage_play(mA, hits[:, 0] if len(hits) else np.array([], int)),
-               "best_bridge": float(br.best.min()), "best_mg": float(D.min()), "threshold": thr}
+               "best_bridge": float(br.best.min()), "best_mg": float(D.min()), "threshold": thr,
+               "mg_transitions_2x": int(len(hits2)),
+               "mg_cov_play_2x": coverage_play(mA, hits2[:, 0] if len(hits2) else np.array([], int))}
         if len(br):
             d = np.sqrt(((mA.X_[:, None] - br.source_points[None]) ** 2).sum(-1)).min(1)
             row["bridge_cov_move"] = float((d / mA.speed_ <= 1.0).mean())
-            motion, start, ev = latent_transition(mA, mB, a, b)
-            row["latent"] = window_stats(motion, start, BLEND, p99, low)
         else:
             row["bridge_cov_move"] = 0.0
-            row["latent"] = None
+        row["latent"] = latent_transition(models, bridges, a, b, p99, low)
         motion, start, under = mg_transition(mA, mB, D, hits, scale)
         row["mg"] = window_stats(motion, start, BLEND, p99, low) | {"under_threshold": under}
         row["train_skate"] = stats[a]["skate"]
@@ -355,22 +370,23 @@ def main(argv=None) -> int:
     segs = load_segments(args.data, args.quick)
     models, tests, fits = fit_models(segs, args.quick)
     print("\n== models (30 fps, first 80 % of each segment) ==")
-    print(f"{'model':10} {'frames':>6} {'pca':>4} {'fit cpu s':>9} {'wall s':>7} | RMS deg: "
+    print(f"{'model':15} {'frames':>6} {'pca':>4} {'fit cpu s':>9} {'wall s':>7} | RMS deg: "
           f"{'gplvm train':>11} {'left out':>8} | {'pca3 train':>10} {'left out':>8}")
     for r in fits:
         r.update(reconstruction(models[r["model"]], tests[r["model"]]))
-        print(f"{r['model']:10} {r['frames']:6d} {r['pca']:4d} {r['fit_cpu_s']:9.1f} {r['fit_wall_s']:7.1f} |"
+        print(f"{r['model']:15} {r['frames']:6d} {r['pca']:4d} {r['fit_cpu_s']:9.1f} {r['fit_wall_s']:7.1f} |"
               f"          {r['gplvm_train']:11.2f} {r['gplvm_left_out']:8.2f} | {r['pca_train']:10.2f} "
               f"{r['pca_left_out']:8.2f}")
     stats = training_stats(models, tests)
     rows = pair_rows(models, stats, not args.no_progress)
     print("\n== transitions A -> B (threshold 1.5 % of bone length; blend 12 frames) ==")
-    print(f"{'A':10} {'B':10} {'bridges':>7} {'MG':>4} | coverage: {'br play':>7} {'br move':>7} {'MG':>5} |"
+    print(f"{'A':10} {'B':10} {'bridges':>7} {'MG':>4} {'hops':>4} | coverage: {'br play':>7} {'br move':>7} {'MG':>5} |"
           f" acc/p99: {'latent':>6} {'MG':>6} | jerk/p99: {'latent':>6} {'MG':>6} | skate: {'lat':>5} {'MG':>5} {'train':>5}")
     for r in rows:
         lt, mg = r["latent"], r["mg"]
         star = "" if mg["under_threshold"] else "*"
-        print(f"{r['from']:10} {r['to']:10} {r['bridges']:7d} {r['mg_transitions']:4d} |"
+        hops = "-" if lt is None else str(len(lt["route"]) - 1)
+        print(f"{r['from'][:10]:10} {r['to'][:10]:10} {r['bridges']:7d} {r['mg_transitions']:4d} {hops:>4} |"
               f"           {r['bridge_cov_play']:7.0%} {r['bridge_cov_move']:7.0%} {r['mg_cov_play']:5.0%} |"
               f"          {fmt(lt and lt['acc']):>6} {fmt(mg['acc']) + star:>6} |"
               f"           {fmt(lt and lt['jerk']):>6} {fmt(mg['jerk']) + star:>6} |"
@@ -378,12 +394,16 @@ def main(argv=None) -> int:
     n = len(rows)
     with_br = sum(r["bridges"] > 0 for r in rows)
     with_mg = sum(r["mg_transitions"] > 0 for r in rows)
+    with_mg2 = sum(r["mg_transitions_2x"] > 0 for r in rows)
     worst = max((r["latent"]["acc"] for r in rows if r["latent"]), default=None)
+    reached = sum(r["latent"] is not None for r in rows)
     summary = {
-        "pairs": n, "pairs_with_bridges": with_br, "pairs_with_mg": with_mg,
+        "pairs": n, "pairs_with_bridges": with_br, "pairs_with_mg": with_mg, "pairs_reached_latent": reached,
         "mean_cov_bridges_play": float(np.mean([r["bridge_cov_play"] for r in rows])),
         "mean_cov_bridges_move": float(np.mean([r["bridge_cov_move"] for r in rows])),
         "mean_cov_mg": float(np.mean([r["mg_cov_play"] for r in rows])),
+        "pairs_with_mg_2x": with_mg2,
+        "mean_cov_mg_2x": float(np.mean([r["mg_cov_play_2x"] for r in rows])),
         "latent_worst_acc_ratio": worst,
         "latent_pairs_over_1.5": sum(1 for r in rows if r["latent"] and r["latent"]["acc"] > 1.5),
         "mg_pairs_over_1.5": sum(1 for r in rows if r["mg"]["acc"] > 1.5),
@@ -391,7 +411,9 @@ def main(argv=None) -> int:
     print(f"\npairs with bridges {with_br}/{n}, with motion-graph transitions {with_mg}/{n}; mean coverage "
           f"bridges {summary['mean_cov_bridges_play']:.0%} (play) / {summary['mean_cov_bridges_move']:.0%} (move), "
           f"motion graph {summary['mean_cov_mg']:.0%}")
-    print(f"latent transitions over 1.5x p99 acceleration: {summary['latent_pairs_over_1.5']} of {with_br} "
+    print(f"motion graph at twice the threshold: {with_mg2}/{n} pairs, mean coverage {summary['mean_cov_mg_2x']:.0%}")
+    print(f"latent TRANSITION reaches {reached}/{n} pairs (through other models when needed)")
+    print(f"latent transitions over 1.5x p99 acceleration: {summary['latent_pairs_over_1.5']} of {reached} "
           f"(worst {fmt(worst)}); motion graph: {summary['mg_pairs_over_1.5']} of {n}")
     out = {"models": fits, "pairs": rows, "summary": summary}
     if not args.quick:

@@ -300,10 +300,41 @@ class Synthesizer:
             n = max(1, int(round(min(hover if len(points) > 1 else duration, end - self.t) * self.fps)))
             self._run(np.repeat(p[None, :], n + 1, axis=0), radius)
 
-    def transition(self, to: str, blend: float = 0.4, radius: float | None = None) -> None:
-        """TRANSITION: move to the nearest bridge, blend into model ``to`` while both idle."""
+    def route(self, src: str, to: str) -> list[str] | None:
+        """Models from ``src`` to ``to`` along bridges (fewest hops), or None.
+
+        The paper (Sec. 7): two models with no matching poses may be joined through a third
+        that has matching points with both.  Bridges between every pair of the script's
+        models are computed when a route is needed.
+        """
+        g = nx.DiGraph()
+        g.add_nodes_from(self.models)
+        for a in self.models:
+            for b in self.models:
+                if a != b and tuple(self.models[a].channels_) == tuple(self.models[b].channels_):
+                    if len(self.bridges(a, b)):
+                        g.add_edge(a, b)
+        try:
+            return nx.shortest_path(g, src, to)
+        except nx.NetworkXNoPath:
+            return None
+
+    def transition(self, to: str, blend: float = 0.4, radius: float | None = None, route: bool = True) -> None:
+        """TRANSITION: move to the nearest bridge, blend into model ``to`` while both idle.
+
+        Without bridges from the current model to ``to`` and with ``route`` (default), the
+        particle goes through the models of :meth:`route`, one TRANSITION each.
+        """
         self._need_start("TRANSITION")
         src = self.current
+        if route and src != to:
+            check_compatible(self.models[src], self.model(to), f"TRANSITION from {src!r} to {to!r}: ")
+            if not len(self.bridges(src, to)):
+                hops = self.route(src, to)
+                if hops is not None:
+                    for nxt in hops[1:]:
+                        self.transition(nxt, blend=blend, radius=radius, route=False)
+                    return
         m1, m2 = self.models[src], self.model(to)
         check_compatible(m1, m2, f"TRANSITION from {src!r} to {to!r}: ")
         if not (isinstance(blend, (int, float)) and blend > 0):
@@ -316,7 +347,8 @@ class Synthesizer:
                       f"no pose near {to!r}'s training data comes close (best {anywhere:.3g})")
             raise ParameterError(
                 f"no bridges from {src!r} to {to!r}: {detail} (threshold {br.threshold:.3g}); "
-                "go through another model")
+                + ("no chain of bridges through the script's other models reaches it either" if route
+                   else "go through another model (route)"))
         b = br.nearest(self.x)
         small = 0.5 * (self.params.radius if radius is None else radius)
         self.move(_Point(br.source_points[b]), radius=small)

@@ -43,7 +43,7 @@ TOP_KEYS = {"fps", "seed", "models", "start", "particle", "bridge_threshold", "c
 COMMANDS = {
     "MOVE": {"to", "path", "duration", "speed", "radius"},
     "IDLE": {"at", "duration", "radius", "hover"},
-    "TRANSITION": {"to", "blend", "radius"},
+    "TRANSITION": {"to", "blend", "radius", "route"},
     "PLAY": {"segment", "start", "stop"},
 }
 _REQUIRED = {"MOVE": {"to"}, "IDLE": {"duration"}, "TRANSITION": {"to"}, "PLAY": {"segment"}}
