@@ -48,7 +48,6 @@ sys.path.insert(0, str(ROOT / "src"))
 
 import cyclecoord as cc  # noqa: E402
 from cyclecoord.synthesis.latent import LatentModel, Synthesizer, find_bridges, project  # noqa: E402
-from cyclecoord.synthesis.latent.commands import smoothstep  # noqa: E402
 from cyclecoord.synthesis.transitions import aligned_transform, window_distances  # noqa: E402
 
 STEP = 4
@@ -69,7 +68,9 @@ def load_segments(data: Path, quick: bool = False) -> dict[str, list[tuple[str, 
     take = cc.load(cmu / "13" / "13_29.amc")
     with open(data / "labels" / "13_29.csv", newline="") as fh:
         for row in csv.DictReader(fh):
-            out[row["activity"]] = [(row["activity"], take[int(row["start_frame"]) : int(row["stop_frame"])])]
+            out[row["activity"]] = [
+                (row["activity"], take[int(row["start_frame"]) : int(row["stop_frame"])])
+            ]
     if quick:
         return {k: out[k] for k in ("JumpJack", "Twist")}
     out["Walk35"] = [(p.stem, cc.load(p)) for p in sorted((cmu / "35").glob("35_*.amc"))]
@@ -113,7 +114,8 @@ def derivatives(local: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray]:
 def toe_columns(motion: cc.Motion) -> list[int]:
     names = motion.positions().names
     return [i for i, n in enumerate(names) if n in ("ltoes/end", "rtoes/end")] or [
-        i for i, n in enumerate(names) if "toe" in n]
+        i for i, n in enumerate(names) if "toe" in n
+    ]
 
 
 def foot_skating(motion: cc.Motion, low: float) -> float:
@@ -131,8 +133,15 @@ def fit_models(segs: dict, quick: bool) -> tuple[dict, dict, list]:
         train, test = split(parts)
         t0, w0 = time.process_time(), time.perf_counter()
         m = LatentModel(gplvm={"max_iter": iters}).fit([s for _, s in train], [n for n, _ in train])
-        rows.append({"model": name, "frames": m.X_.shape[0], "pca": m.components_.shape[1],
-                     "fit_cpu_s": time.process_time() - t0, "fit_wall_s": time.perf_counter() - w0})
+        rows.append(
+            {
+                "model": name,
+                "frames": m.X_.shape[0],
+                "pca": m.components_.shape[1],
+                "fit_cpu_s": time.process_time() - t0,
+                "fit_wall_s": time.perf_counter() - w0,
+            }
+        )
         models[name] = m
         tests[name] = [s for _, s in test]
     return models, tests, rows
@@ -148,8 +157,12 @@ def reconstruction(m: LatentModel, tests: list) -> dict:
     _, _, Vt = np.linalg.svd(train - mu, full_matrices=False)
     V = Vt[:q].T
     pca = lambda a: mu + (a - mu) @ V @ V.T  # noqa: E731
-    return {"gplvm_train": rms(m.pose(m.X_), train), "gplvm_left_out": rms(m.pose(X), left),
-            "pca_train": rms(pca(train), train), "pca_left_out": rms(pca(left), left)}
+    return {
+        "gplvm_train": rms(m.pose(m.X_), train),
+        "gplvm_left_out": rms(m.pose(X), left),
+        "pca_train": rms(pca(train), train),
+        "pca_left_out": rms(pca(left), left),
+    }
 
 
 def seg_bounds(m: LatentModel) -> list[tuple[int, int]]:
@@ -175,7 +188,9 @@ def motion_of(m: LatentModel, frames: np.ndarray, skeleton=None, scale: float = 
     for j, d in m.root_channels_:
         if d.startswith("t"):
             fr[:, m.all_channels_.index((j, d))] *= scale
-    return cc.Motion(frames=fr, channels=m.all_channels_, fps=m.fps_, skeleton=skeleton or m.skeleton_)
+    return cc.Motion(
+        frames=fr, channels=m.all_channels_, fps=m.fps_, skeleton=skeleton or m.skeleton_
+    )
 
 
 def kovar(mA: LatentModel, mB: LatentModel, thr: float):
@@ -204,7 +219,11 @@ def mg_transition(mA, mB, D, hits, scale) -> tuple[cc.Motion, int, bool]:
     from cyclecoord.synthesis.interpolate import _continuous_euler, _root_rotation
 
     under = len(hits) > 0
-    i, j = (hits[np.argmin(D[hits[:, 0], hits[:, 1]])] if under else np.unravel_index(np.argmin(D), D.shape))
+    i, j = (
+        hits[np.argmin(D[hits[:, 0], hits[:, 1]])]
+        if under
+        else np.unravel_index(np.argmin(D), D.shape)
+    )
     A = motion_of(mA, mA.frames_)
     B = motion_of(mB, mB.frames_, mA.skeleton_, scale)
     pre = int(HOLD * FPS)
@@ -223,7 +242,9 @@ def mg_transition(mA, mB, D, hits, scale) -> tuple[cc.Motion, int, bool]:
     fb[:, tcols] = fb[:, tcols] @ Ry.T + t
     ra, _, _ = _root_rotation(A.with_frames(fa))
     n_pre = i - a0
-    w = 1.0 - (2 * ((np.arange(BLEND) + 1) / BLEND) ** 3 - 3 * ((np.arange(BLEND) + 1) / BLEND) ** 2 + 1)
+    w = 1.0 - (
+        2 * ((np.arange(BLEND) + 1) / BLEND) ** 3 - 3 * ((np.arange(BLEND) + 1) / BLEND) ** 2 + 1
+    )
     out = np.concatenate([fa[:n_pre], np.zeros((BLEND, fa.shape[1])), fb[BLEND:]])
     mats = np.concatenate([ra[:n_pre], np.zeros((BLEND, 3, 3)), rb[BLEND:]])
     for k in range(BLEND):
@@ -234,31 +255,41 @@ def mg_transition(mA, mB, D, hits, scale) -> tuple[cc.Motion, int, bool]:
     return A.with_frames(out), n_pre, bool(under)
 
 
-def window_stats(motion: cc.Motion, start: int, n: int, p99: tuple[float, float], low: float) -> dict:
+def window_stats(
+    motion: cc.Motion, start: int, n: int, p99: tuple[float, float], low: float
+) -> dict:
     acc, jerk = derivatives(local_positions(motion), motion.fps)
     a = max(0, start - 2)
     b = start + n + 2
     # acc[k] is centred on frame k+1, jerk[k] spans k..k+3
-    return {"acc": float(acc[max(0, a - 1) : b].max() / p99[0]),
-            "jerk": float(jerk[max(0, a - 2) : b].max() / p99[1]),
-            "skate": foot_skating(motion[max(0, a) : b + 1], low)}
+    return {
+        "acc": float(acc[max(0, a - 1) : b].max() / p99[0]),
+        "jerk": float(jerk[max(0, a - 2) : b].max() / p99[1]),
+        "skate": foot_skating(motion[max(0, a) : b + 1], low),
+    }
 
 
 def training_stats(models: dict, tests: dict) -> dict:
     out = {}
     for k, m in models.items():
-        accs, jerks, toes, skates = [], [], [], []
+        accs, jerks, toes = [], [], []
         for a, b in seg_bounds(m):
             mo = motion_of(m, m.frames_[a:b])
             ac, je = derivatives(local_positions(mo), FPS)
             accs.append(ac)
             jerks.append(je)
             toes.append(mo.positions().positions[:, toe_columns(mo), 1].ravel())
-        out[k] = {"acc": np.concatenate(accs), "jerk": np.concatenate(jerks), "toe": np.concatenate(toes)}
+        out[k] = {
+            "acc": np.concatenate(accs),
+            "jerk": np.concatenate(jerks),
+            "toe": np.concatenate(toes),
+        }
     for k, m in models.items():
         low = float(np.percentile(out[k]["toe"], 5) + 1.5)
         out[k]["low"] = low
-        out[k]["skate"] = float(np.mean([foot_skating(motion_of(m, m.frames_[a:b]), low) for a, b in seg_bounds(m)]))
+        out[k]["skate"] = float(
+            np.mean([foot_skating(motion_of(m, m.frames_[a:b]), low) for a, b in seg_bounds(m)])
+        )
     return out
 
 
@@ -276,10 +307,15 @@ def latent_transition(models, bridges, nA, nB, p99, low):
         return None
     syn.idle(duration=HOLD)
     motion = syn.motion()
-    stats = [window_stats(motion, ev["start_frame"], ev["blend_frames"], p99, low) for ev in syn.events]
-    return {"acc": max(s["acc"] for s in stats), "jerk": max(s["jerk"] for s in stats),
-            "skate": float(np.mean([s["skate"] for s in stats])),
-            "route": [syn.events[0]["transition"][0]] + [ev["transition"][1] for ev in syn.events]}
+    stats = [
+        window_stats(motion, ev["start_frame"], ev["blend_frames"], p99, low) for ev in syn.events
+    ]
+    return {
+        "acc": max(s["acc"] for s in stats),
+        "jerk": max(s["jerk"] for s in stats),
+        "skate": float(np.mean([s["skate"] for s in stats])),
+        "route": [syn.events[0]["transition"][0]] + [ev["transition"][1] for ev in syn.events],
+    }
 
 
 def pair_rows(models: dict, stats: dict, progress: bool) -> list[dict]:
@@ -287,9 +323,15 @@ def pair_rows(models: dict, stats: dict, progress: bool) -> list[dict]:
 
     names = list(models)
     pairs = [(a, b) for a in names for b in names if a != b]
-    bridges = {(a, b): find_bridges(models[a], models[b], names=(a, b),
-                                    threshold=THRESHOLD * models[a].skeleton_.total_length())
-               for a, b in tqdm(pairs, desc="bridges", disable=not progress)}
+    bridges = {
+        (a, b): find_bridges(
+            models[a],
+            models[b],
+            names=(a, b),
+            threshold=THRESHOLD * models[a].skeleton_.total_length(),
+        )
+        for a, b in tqdm(pairs, desc="bridges", disable=not progress)
+    }
     rows = []
     for a, b in tqdm(pairs, desc="pairs", disable=not progress):
         mA, mB = models[a], models[b]
@@ -297,15 +339,24 @@ def pair_rows(models: dict, stats: dict, progress: bool) -> list[dict]:
         br = bridges[(a, b)]
         D, hits, local, _, scale = kovar(mA, mB, thr)
         hits2 = np.argwhere(local & (D < 2 * thr))
-        p99 = (float(np.percentile(np.r_[stats[a]["acc"], stats[b]["acc"]], 99)),
-               float(np.percentile(np.r_[stats[a]["jerk"], stats[b]["jerk"]], 99)))
+        p99 = (
+            float(np.percentile(np.r_[stats[a]["acc"], stats[b]["acc"]], 99)),
+            float(np.percentile(np.r_[stats[a]["jerk"], stats[b]["jerk"]], 99)),
+        )
         low = stats[a]["low"]
-        row = {"from": a, "to": b, "bridges": len(br), "mg_transitions": int(len(hits)),
-               "bridge_cov_play": coverage_play(mA, br.frames),
-               "mg_cov_play": coverage_play(mA, hits[:, 0] if len(hits) else np.array([], int)),
-               "best_bridge": float(br.best.min()), "best_mg": float(D.min()), "threshold": thr,
-               "mg_transitions_2x": int(len(hits2)),
-               "mg_cov_play_2x": coverage_play(mA, hits2[:, 0] if len(hits2) else np.array([], int))}
+        row = {
+            "from": a,
+            "to": b,
+            "bridges": len(br),
+            "mg_transitions": len(hits),
+            "bridge_cov_play": coverage_play(mA, br.frames),
+            "mg_cov_play": coverage_play(mA, hits[:, 0] if len(hits) else np.array([], int)),
+            "best_bridge": float(br.best.min()),
+            "best_mg": float(D.min()),
+            "threshold": thr,
+            "mg_transitions_2x": len(hits2),
+            "mg_cov_play_2x": coverage_play(mA, hits2[:, 0] if len(hits2) else np.array([], int)),
+        }
         if len(br):
             d = np.sqrt(((mA.X_[:, None] - br.source_points[None]) ** 2).sum(-1)).min(1)
             row["bridge_cov_move"] = float((d / mA.speed_ <= 1.0).mean())
@@ -334,8 +385,14 @@ def fit_timing(data: Path, sizes=(100, 400, 800)) -> list[dict]:
             names.append(f"s{k}")
         t0, w0 = time.process_time(), time.perf_counter()
         m = LatentModel().fit(parts, names)
-        out.append({"frames": m.X_.shape[0], "cpu_s": time.process_time() - t0,
-                    "wall_s": time.perf_counter() - w0, "iterations": m.gp_.n_iter_})
+        out.append(
+            {
+                "frames": m.X_.shape[0],
+                "cpu_s": time.process_time() - t0,
+                "wall_s": time.perf_counter() - w0,
+                "iterations": m.gp_.n_iter_,
+            }
+        )
     return out
 
 
@@ -346,8 +403,14 @@ def synthesis_speed(m: LatentModel, name: str, seconds: float = 60.0) -> dict:
     while syn.t < seconds:
         syn.move({"frame": int(rng.integers(m.X_.shape[0]))}, path="line")
         syn.idle(duration=1.0)
-    return {"frames": syn.n_frames, "seconds": syn.sim_seconds, "fps": syn.n_frames / syn.sim_seconds,
-            "training_frames": int(m.X_.shape[0])}
+    return {
+        "frames": syn.n_frames,
+        "seconds": syn.sim_seconds,
+        "fps": syn.n_frames / syn.sim_seconds,
+        "cpu_seconds": syn.sim_cpu_seconds,
+        "cpu_fps": syn.n_frames / syn.sim_cpu_seconds,
+        "training_frames": int(m.X_.shape[0]),
+    }
 
 
 def fmt(x, spec=".2f"):
@@ -356,7 +419,9 @@ def fmt(x, spec=".2f"):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--quick", action="store_true", help="two 13_29 models, short fits, no timing part")
+    ap.add_argument(
+        "--quick", action="store_true", help="two 13_29 models, short fits, no timing part"
+    )
     ap.add_argument("--data", type=Path, default=default_data())
     ap.add_argument("--json", type=Path)
     ap.add_argument("--no-progress", action="store_true")
@@ -370,27 +435,42 @@ def main(argv=None) -> int:
     segs = load_segments(args.data, args.quick)
     models, tests, fits = fit_models(segs, args.quick)
     print("\n== models (30 fps, first 80 % of each segment) ==")
-    print(f"{'model':15} {'frames':>6} {'pca':>4} {'fit cpu s':>9} {'wall s':>7} | RMS deg: "
-          f"{'gplvm train':>11} {'left out':>8} | {'pca3 train':>10} {'left out':>8}")
+    print(
+        f"{'model':15} {'frames':>6} {'pca':>4} {'fit cpu s':>9} {'wall s':>7} | RMS deg: "
+        f"{'gplvm train':>11} {'left out':>8} | {'pca3 train':>10} {'left out':>8}"
+    )
     for r in fits:
         r.update(reconstruction(models[r["model"]], tests[r["model"]]))
-        print(f"{r['model']:15} {r['frames']:6d} {r['pca']:4d} {r['fit_cpu_s']:9.1f} {r['fit_wall_s']:7.1f} |"
-              f"          {r['gplvm_train']:11.2f} {r['gplvm_left_out']:8.2f} | {r['pca_train']:10.2f} "
-              f"{r['pca_left_out']:8.2f}")
+        print(
+            f"{r['model']:15} {r['frames']:6d} {r['pca']:4d} {r['fit_cpu_s']:9.1f} "
+            f"{r['fit_wall_s']:7.1f} |"
+            f"          {r['gplvm_train']:11.2f} {r['gplvm_left_out']:8.2f} | "
+            f"{r['pca_train']:10.2f} "
+            f"{r['pca_left_out']:8.2f}"
+        )
     stats = training_stats(models, tests)
     rows = pair_rows(models, stats, not args.no_progress)
     print("\n== transitions A -> B (threshold 1.5 % of bone length; blend 12 frames) ==")
-    print(f"{'A':10} {'B':10} {'bridges':>7} {'MG':>4} {'hops':>4} | coverage: {'br play':>7} {'br move':>7} {'MG':>5} |"
-          f" acc/p99: {'latent':>6} {'MG':>6} | jerk/p99: {'latent':>6} {'MG':>6} | skate: {'lat':>5} {'MG':>5} {'train':>5}")
+    print(
+        f"{'A':10} {'B':10} {'bridges':>7} {'MG':>4} {'hops':>4} | coverage: {'br play':>7} "
+        f"{'br move':>7} {'MG':>5} |"
+        f" acc/p99: {'latent':>6} {'MG':>6} | jerk/p99: {'latent':>6} {'MG':>6} | skate: "
+        f"{'lat':>5} {'MG':>5} {'train':>5}"
+    )
     for r in rows:
         lt, mg = r["latent"], r["mg"]
         star = "" if mg["under_threshold"] else "*"
         hops = "-" if lt is None else str(len(lt["route"]) - 1)
-        print(f"{r['from'][:10]:10} {r['to'][:10]:10} {r['bridges']:7d} {r['mg_transitions']:4d} {hops:>4} |"
-              f"           {r['bridge_cov_play']:7.0%} {r['bridge_cov_move']:7.0%} {r['mg_cov_play']:5.0%} |"
-              f"          {fmt(lt and lt['acc']):>6} {fmt(mg['acc']) + star:>6} |"
-              f"           {fmt(lt and lt['jerk']):>6} {fmt(mg['jerk']) + star:>6} |"
-              f"        {fmt(lt and lt['skate'], '.1f'):>5} {fmt(mg['skate'], '.1f') + star:>5} {r['train_skate']:5.1f}")
+        print(
+            f"{r['from'][:10]:10} {r['to'][:10]:10} {r['bridges']:7d} {r['mg_transitions']:4d} "
+            f"{hops:>4} |"
+            f"           {r['bridge_cov_play']:7.0%} {r['bridge_cov_move']:7.0%} "
+            f"{r['mg_cov_play']:5.0%} |"
+            f"          {fmt(lt and lt['acc']):>6} {fmt(mg['acc']) + star:>6} |"
+            f"           {fmt(lt and lt['jerk']):>6} {fmt(mg['jerk']) + star:>6} |"
+            f"        {fmt(lt and lt['skate'], '.1f'):>5} {fmt(mg['skate'], '.1f') + star:>5} "
+            f"{r['train_skate']:5.1f}"
+        )
     n = len(rows)
     with_br = sum(r["bridges"] > 0 for r in rows)
     with_mg = sum(r["mg_transitions"] > 0 for r in rows)
@@ -398,7 +478,10 @@ def main(argv=None) -> int:
     worst = max((r["latent"]["acc"] for r in rows if r["latent"]), default=None)
     reached = sum(r["latent"] is not None for r in rows)
     summary = {
-        "pairs": n, "pairs_with_bridges": with_br, "pairs_with_mg": with_mg, "pairs_reached_latent": reached,
+        "pairs": n,
+        "pairs_with_bridges": with_br,
+        "pairs_with_mg": with_mg,
+        "pairs_reached_latent": reached,
         "mean_cov_bridges_play": float(np.mean([r["bridge_cov_play"] for r in rows])),
         "mean_cov_bridges_move": float(np.mean([r["bridge_cov_move"] for r in rows])),
         "mean_cov_mg": float(np.mean([r["mg_cov_play"] for r in rows])),
@@ -408,23 +491,41 @@ def main(argv=None) -> int:
         "latent_pairs_over_1.5": sum(1 for r in rows if r["latent"] and r["latent"]["acc"] > 1.5),
         "mg_pairs_over_1.5": sum(1 for r in rows if r["mg"]["acc"] > 1.5),
     }
-    print(f"\npairs with bridges {with_br}/{n}, with motion-graph transitions {with_mg}/{n}; mean coverage "
-          f"bridges {summary['mean_cov_bridges_play']:.0%} (play) / {summary['mean_cov_bridges_move']:.0%} (move), "
-          f"motion graph {summary['mean_cov_mg']:.0%}")
-    print(f"motion graph at twice the threshold: {with_mg2}/{n} pairs, mean coverage {summary['mean_cov_mg_2x']:.0%}")
+    print(
+        f"\npairs with bridges {with_br}/{n}, with motion-graph transitions {with_mg}/{n}; mean "
+        "coverage "
+        f"bridges {summary['mean_cov_bridges_play']:.0%} (play) / "
+        f"{summary['mean_cov_bridges_move']:.0%} (move), "
+        f"motion graph {summary['mean_cov_mg']:.0%}"
+    )
+    print(
+        f"motion graph at twice the threshold: {with_mg2}/{n} pairs, mean coverage "
+        f"{summary['mean_cov_mg_2x']:.0%}"
+    )
     print(f"latent TRANSITION reaches {reached}/{n} pairs (through other models when needed)")
-    print(f"latent transitions over 1.5x p99 acceleration: {summary['latent_pairs_over_1.5']} of {reached} "
-          f"(worst {fmt(worst)}); motion graph: {summary['mg_pairs_over_1.5']} of {n}")
+    print(
+        f"latent transitions over 1.5x p99 acceleration: {summary['latent_pairs_over_1.5']} of "
+        f"{reached} "
+        f"(worst {fmt(worst)}); motion graph: {summary['mg_pairs_over_1.5']} of {n}"
+    )
     out = {"models": fits, "pairs": rows, "summary": summary}
     if not args.quick:
         out["fit_timing"] = fit_timing(args.data)
         print("\n== fitting time (13_29 frames, 30 fps; target: 800 frames < 60 s) ==")
         for r in out["fit_timing"]:
-            print(f"{r['frames']:5d} frames: {r['cpu_s']:6.1f} s CPU, {r['wall_s']:6.1f} s wall, {r['iterations']} iterations")
+            print(
+                f"{r['frames']:5d} frames: {r['cpu_s']:6.1f} s CPU, {r['wall_s']:6.1f} s wall, "
+                f"{r['iterations']} iterations"
+            )
         out["synthesis"] = synthesis_speed(models["Walk35"], "Walk35")
         s = out["synthesis"]
-        print(f"\n== synthesis: {s['frames']} frames on the walk model ({s['training_frames']} training frames) in "
-              f"{s['seconds']:.2f} s: {s['fps']:,.0f} frames/s (target 1,000) ==")
+        print(
+            f"\n== synthesis: {s['frames']} frames on the walk model ({s['training_frames']} "
+            "training frames): "
+            f"{s['cpu_seconds']:.2f} s CPU = {s['cpu_fps']:,.0f} frames per CPU second (target "
+            "1,000); "
+            f"{s['seconds']:.2f} s wall = {s['fps']:,.0f} frames/s on this shared machine =="
+        )
     if args.json:
         from cyclecoord.io._atomic import atomic_write
 

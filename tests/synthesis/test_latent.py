@@ -13,7 +13,11 @@ from cyclecoord.synthesis.latent.commands import CommandGraph, eased, resample
 from cyclecoord.synthesis.latent.gplvm import GPLVM, objective
 from cyclecoord.synthesis.latent.influence import influence_weights
 from cyclecoord.synthesis.latent.particle import ParticleParams, RandomForce, simulate
-from cyclecoord.synthesis.transitions import aligned_transform, transition_points, window_distances
+from cyclecoord.synthesis.transitions import (
+    aligned_transform,
+    transition_points,
+    window_distances,
+)
 
 
 def _capture(kind: str, seed: int = 0, n: int = 240):
@@ -105,9 +109,12 @@ def test_model_rebuilds_training_frames_and_round_trips(walk_model, tmp_path):
 
 def test_density_gradient_matches_finite_differences(walk_model):
     x = walk_model.X_[5] + 0.05
-    p, g = walk_model.density(x)
+    _, g = walk_model.density(x)
     h = 1e-3  # central differences: the variance is a small difference of large numbers
-    num = [(walk_model.density(x + h * e)[0] - walk_model.density(x - h * e)[0]) / (2 * h) for e in np.eye(3)]
+    num = [
+        (walk_model.density(x + h * e)[0] - walk_model.density(x - h * e)[0]) / (2 * h)
+        for e in np.eye(3)
+    ]
     np.testing.assert_allclose(g, num, rtol=1e-3, atol=1e-4)
 
 
@@ -123,8 +130,12 @@ def test_particle_stays_near_its_path_and_is_seeded(walk_model):
     m = walk_model
     path = np.linspace(m.X_[0], m.X_[20], 61)
     params = ParticleParams(random=6.0)
-    runs = [simulate(m, path, m.X_[0], np.zeros(3), 30.0, params, RandomForce(3, 0.4, random_state=s))[0]
-            for s in (0, 0, 1)]
+    runs = [
+        simulate(m, path, m.X_[0], np.zeros(3), 30.0, params, RandomForce(3, 0.4, random_state=s))[
+            0
+        ]
+        for s in (0, 0, 1)
+    ]
     np.testing.assert_array_equal(runs[0], runs[1])
     assert not np.allclose(runs[0], runs[2])
     r = params.radius * m.speed_
@@ -178,8 +189,11 @@ def test_synthesizer_transition_and_output(walk_model, jog_model):
     assert syn.events and syn.events[0]["transition"] == ["walk", "jog"]
     assert np.isfinite(motion.frames).all()
     # walking moves the root forward
-    assert np.ptp(motion.frames[:, motion.channel_index("root", "tz")]) + np.ptp(
-        motion.frames[:, motion.channel_index("root", "tx")]) > 1.0
+    assert (
+        np.ptp(motion.frames[:, motion.channel_index("root", "tz")])
+        + np.ptp(motion.frames[:, motion.channel_index("root", "tx")])
+        > 1.0
+    )
     again = Synthesizer({"walk": walk_model, "jog": jog_model}, fps=30, seed=3)
     again.start("walk")
     again.idle(duration=0.5)

@@ -19,16 +19,44 @@ def workdir(tmp_path_factory) -> Path:
     walk2 = cc.datasets.make_periodic_capture(kind="walk", n_frames=160, random_state=5).motion
     cc.save(walk, d / "walk.bvh")
     cc.save(walk2, d / "walk2.bvh")
-    assert main(["latent", "fit", f"{d / 'walk.bvh'}:0:120=a", f"{d / 'walk.bvh'}:120:240=b",
-                 "-o", str(d / "walk.npz"), "--max-iter", "40", "--report", str(d / "fit.json")]) == 0
-    assert main(["latent", "fit", str(d / "walk2.bvh") + "=w2", "-o", str(d / "walk2.npz"),
-                 "--max-iter", "40"]) == 0
+    assert (
+        main(
+            [
+                "latent",
+                "fit",
+                f"{d / 'walk.bvh'}:0:120=a",
+                f"{d / 'walk.bvh'}:120:240=b",
+                "-o",
+                str(d / "walk.npz"),
+                "--max-iter",
+                "40",
+                "--report",
+                str(d / "fit.json"),
+            ]
+        )
+        == 0
+    )
+    assert (
+        main(
+            [
+                "latent",
+                "fit",
+                str(d / "walk2.bvh") + "=w2",
+                "-o",
+                str(d / "walk2.npz"),
+                "--max-iter",
+                "40",
+            ]
+        )
+        == 0
+    )
     return d
 
 
 def _script(d: Path, name: str, **changes) -> Path:
     spec = {
-        "fps": 30, "seed": 1,
+        "fps": 30,
+        "seed": 1,
         "models": {"walk": "walk.npz", "other": "walk2.npz"},
         "start": {"model": "walk"},
         "commands": [
@@ -73,11 +101,23 @@ def test_animate_writes_bvh_and_report_reproducibly(workdir):
     [
         ({"models": {"walk": "walk.npz", "other": "missing.npz"}}, "models.other"),
         ({"commands": [{"command": "JUMP"}]}, r"commands\[0\] \(JUMP\): unknown command"),
-        ({"commands": [{"command": "TRANSITION", "to": "nope"}]}, r"commands\[0\] \(TRANSITION\): unknown model"),
-        ({"commands": [{"command": "MOVE", "to": [40, 40, 40]}]}, r"commands\[0\] \(MOVE\): .*outside model"),
-        ({"commands": [{"command": "IDLE", "duration": 1, "speed": 2}]}, r"commands\[0\] \(IDLE\): unknown key"),
+        (
+            {"commands": [{"command": "TRANSITION", "to": "nope"}]},
+            r"commands\[0\] \(TRANSITION\): unknown model",
+        ),
+        (
+            {"commands": [{"command": "MOVE", "to": [40, 40, 40]}]},
+            r"commands\[0\] \(MOVE\): .*outside model",
+        ),
+        (
+            {"commands": [{"command": "IDLE", "duration": 1, "speed": 2}]},
+            r"commands\[0\] \(IDLE\): unknown key",
+        ),
         ({"start": {"model": "ghost"}}, "start: unknown model"),
-        ({"commands": [{"command": "PLAY", "segment": "zz"}]}, r"commands\[0\] \(PLAY\): model 'walk' has no segment"),
+        (
+            {"commands": [{"command": "PLAY", "segment": "zz"}]},
+            r"commands\[0\] \(PLAY\): model 'walk' has no segment",
+        ),
     ],
 )
 def test_bad_scripts_fail_with_one_line_and_no_output(workdir, capsys, changes, message):
@@ -85,7 +125,9 @@ def test_bad_scripts_fail_with_one_line_and_no_output(workdir, capsys, changes, 
     out = workdir / "bad.bvh"
     rep = workdir / "bad_report.json"
     assert main(["animate", str(s), "-o", str(out), "--report", str(rep)]) == 1
-    err = [ln for ln in capsys.readouterr().err.strip().splitlines() if "cmd/s" not in ln]  # no tqdm bar
+    err = [
+        ln for ln in capsys.readouterr().err.strip().splitlines() if "cmd/s" not in ln
+    ]  # no tqdm bar
     assert len(err) == 1 and err[0].startswith("cyclecoord: error:")
     import re
 
@@ -97,8 +139,20 @@ def test_models_of_different_skeletons_cannot_transition(workdir, capsys):
     m = cc.load(workdir / "walk2.bvh")
     keep = [c for c in m.channels if c[0] not in ("lhand", "lfingers", "lthumb")]
     cc.save(m.select(keep), workdir / "cut.npz")
-    assert main(["latent", "fit", str(workdir / "cut.npz"), "-o", str(workdir / "cut_model.npz"),
-                 "--max-iter", "20"]) == 0
+    assert (
+        main(
+            [
+                "latent",
+                "fit",
+                str(workdir / "cut.npz"),
+                "-o",
+                str(workdir / "cut_model.npz"),
+                "--max-iter",
+                "20",
+            ]
+        )
+        == 0
+    )
     s = _script(workdir, "skel.json", models={"walk": "walk.npz", "other": "cut_model.npz"})
     out = workdir / "skel.bvh"
     assert main(["animate", str(s), "-o", str(out)]) == 1

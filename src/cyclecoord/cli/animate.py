@@ -21,7 +21,9 @@ def add_parser(subparsers) -> None:
     )
     p.add_argument("script", metavar="SCRIPT.json")
     p.add_argument("-o", "--output", required=True, metavar="OUT.bvh")
-    p.add_argument("--report", metavar="R.json", help="write a JSON report (commands, bridges, timing, checks)")
+    p.add_argument(
+        "--report", metavar="R.json", help="write a JSON report (commands, bridges, timing, checks)"
+    )
     p.add_argument("--no-check", action="store_true", help="skip the plausibility checks")
     p.set_defaults(func=run)
 
@@ -36,7 +38,9 @@ def run(args: argparse.Namespace) -> int:
 
     out = Path(args.output)
     script = Path(args.script)
-    if out.resolve() == script.resolve() or (args.report and Path(args.report).resolve() == script.resolve()):
+    if out.resolve() == script.resolve() or (
+        args.report and Path(args.report).resolve() == script.resolve()
+    ):
         raise ParameterError(f"an output would overwrite the script {script}")
     for target in [out] + ([Path(args.report)] if args.report else []):
         if not (target.parent if str(target.parent) else Path(".")).is_dir():
@@ -60,8 +64,11 @@ def run(args: argparse.Namespace) -> int:
     t = report["timing"]
     fps = t["frames_per_second"]
     speed = f", synthesis {fps:,.0f} frames/s" if fps else ""
-    print(f"{out}: {report['frames']} frames ({report['duration_s']:.1f} s at {report['fps']:g} fps), "
-          f"{len(report['transitions'])} transitions{speed}")
+    print(
+        f"{out}: {report['frames']} frames ({report['duration_s']:.1f} s at {report['fps']:g} "
+        "fps), "
+        f"{len(report['transitions'])} transitions{speed}"
+    )
     if "plausibility" in report:
         pl = report["plausibility"]
         print("plausibility: " + ("clean" if pl["clean"] else "; ".join(pl["notes"])))

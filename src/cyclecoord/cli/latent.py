@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-__all__ = ["add_parser", "run", "parse_take"]
+__all__ = ["add_parser", "parse_take", "run"]
 
 
 def parse_take(text: str) -> tuple[str, int | None, int | None, str | None]:
@@ -20,7 +20,9 @@ def parse_take(text: str) -> tuple[str, int | None, int | None, str | None]:
     if len(parts) == 1:
         return parts[0], None, None, name
     if len(parts) != 3:
-        raise ParameterError(f"take {text!r}: expected PATH or PATH:A:B (0-based, half-open frames)")
+        raise ParameterError(
+            f"take {text!r}: expected PATH or PATH:A:B (0-based, half-open frames)"
+        )
     try:
         a = int(parts[1]) if parts[1] else None
         b = int(parts[2]) if parts[2] else None
@@ -33,7 +35,7 @@ def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
         "latent",
         help="train latent-space (GPLVM) motion models",
-        description="Latent-space models for synthesis (Bailey et al.): influence scaling, PCA, GPLVM.",
+        description="Latent-space models (Bailey et al.): influence scaling, PCA, GPLVM.",
     )
     sub = p.add_subparsers(dest="latent_command", metavar="ACTION")
     f = sub.add_parser(
@@ -48,10 +50,18 @@ def add_parser(subparsers) -> None:
     f.add_argument("takes", nargs="+", metavar="TAKE[:A:B][=NAME]")
     f.add_argument("-o", "--output", required=True, metavar="MODEL.npz")
     f.add_argument("--dims", type=int, default=3, help="latent dimensions (default 3)")
-    f.add_argument("--variance", type=float, default=0.85,
-                   help="variance the PCA keeps, in (0, 1] (default 0.85)")
-    f.add_argument("--step", type=int, default=4,
-                   help="keep every STEP-th frame (default 4: 120 fps captures train at 30 fps)")
+    f.add_argument(
+        "--variance",
+        type=float,
+        default=0.85,
+        help="variance the PCA keeps, in (0, 1] (default 0.85)",
+    )
+    f.add_argument(
+        "--step",
+        type=int,
+        default=4,
+        help="keep every STEP-th frame (default 4: 120 fps captures train at 30 fps)",
+    )
     f.add_argument("--max-iter", type=int, default=200, help="optimiser iterations (default 200)")
     f.add_argument("--report", metavar="R.json", help="also write the model's summary as JSON")
     f.set_defaults(func=run)
@@ -86,10 +96,15 @@ def run(args: argparse.Namespace) -> int:
         motion = load(path).window((a, b))
         seg = motion[:: args.step]
         if seg.n_frames < 3:
-            raise ParameterError(f"take {text!r} has only {seg.n_frames} frames after --step {args.step}")
+            raise ParameterError(
+                f"take {text!r} has only {seg.n_frames} frames after --step {args.step}"
+            )
         segments.append(seg)
-        label = name or Path(path).stem + (f"[{a or 0}:{b if b is not None else motion.n_frames + (a or 0)}]"
-                                           if a is not None or b is not None else "")
+        label = name or Path(path).stem + (
+            f"[{a or 0}:{b if b is not None else motion.n_frames + (a or 0)}]"
+            if a is not None or b is not None
+            else ""
+        )
         names.append(label)
     if out.resolve() in inputs:
         raise ParameterError(f"output {out} is one of the inputs")
@@ -97,15 +112,22 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"segment names repeat: {names}; name them with =NAME")
     t0 = time.process_time()
     w0 = time.perf_counter()
-    model = LatentModel(n_components=args.dims, variance=args.variance,
-                        gplvm={"max_iter": args.max_iter}).fit(segments, names)
-    summary = model.describe() | {"fit_cpu_s": time.process_time() - t0, "fit_wall_s": time.perf_counter() - w0,
-                                  "iterations": model.gp_.n_iter_}
+    model = LatentModel(
+        n_components=args.dims, variance=args.variance, gplvm={"max_iter": args.max_iter}
+    ).fit(segments, names)
+    summary = model.describe() | {
+        "fit_cpu_s": time.process_time() - t0,
+        "fit_wall_s": time.perf_counter() - w0,
+        "iterations": model.gp_.n_iter_,
+    }
     model.save(out)
     if args.report:
         with atomic_write(args.report) as fh:
             json.dump(summary, fh, indent=2)
-    print(f"{out}: {summary['frames']} frames in {len(names)} segments, {summary['pca_components']} PCA "
-          f"components ({summary['explained_variance']:.0%}), {args.dims}-D latent, fitted in "
-          f"{summary['fit_wall_s']:.1f} s ({summary['fit_cpu_s']:.1f} s CPU)")
+    print(
+        f"{out}: {summary['frames']} frames in {len(names)} segments, {summary['pca_components']} "
+        "PCA "
+        f"components ({summary['explained_variance']:.0%}), {args.dims}-D latent, fitted in "
+        f"{summary['fit_wall_s']:.1f} s ({summary['fit_cpu_s']:.1f} s CPU)"
+    )
     return 0

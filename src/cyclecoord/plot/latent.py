@@ -3,11 +3,11 @@ bridges between two models, and a strip of poses from a synthesised motion."""
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["plot_latent", "plot_bridges", "plot_pose_strip", "plot_transition_profile"]
+__all__ = ["plot_bridges", "plot_latent", "plot_pose_strip", "plot_transition_profile"]
 
 
 def _axes3d(ax, fig=None, pos=111):
@@ -19,8 +19,13 @@ def _axes3d(ax, fig=None, pos=111):
     return fig, fig.add_subplot(pos, projection="3d")
 
 
-def plot_latent(model, ax=None, path: np.ndarray | None = None, title: str | None = None,
-                bridges: np.ndarray | None = None):
+def plot_latent(
+    model,
+    ax=None,
+    path: np.ndarray | None = None,
+    title: str | None = None,
+    bridges: np.ndarray | None = None,
+):
     """A model's training latent points, coloured by time, one line per segment.
 
     Parameters
@@ -47,10 +52,20 @@ def plot_latent(model, ax=None, path: np.ndarray | None = None, title: str | Non
         idx = np.flatnonzero(model.segments_ == s)
         t = model.times_[idx] / max(model.times_[idx].max(), 1e-9)
         ax.plot(X[idx, 0], X[idx, 1], X[idx, 2], color="0.7", lw=0.6)
-        ax.scatter(X[idx, 0], X[idx, 1], X[idx, 2], c=cmap(t), s=10, marker=markers[s % len(markers)],
-                   label=name, depthshade=False)
+        ax.scatter(
+            X[idx, 0],
+            X[idx, 1],
+            X[idx, 2],
+            c=cmap(t),
+            s=10,
+            marker=markers[s % len(markers)],
+            label=name,
+            depthshade=False,
+        )
     if bridges is not None and len(bridges):
-        ax.scatter(*np.asarray(bridges)[:, :3].T, s=60, facecolors="none", edgecolors="C3", label="bridges")
+        ax.scatter(
+            *np.asarray(bridges)[:, :3].T, s=60, facecolors="none", edgecolors="C3", label="bridges"
+        )
     if path is not None:
         ax.plot(path[:, 0], path[:, 1], path[:, 2], color="C1", lw=1.5, label="particle")
         ax.scatter(*path[0, :3], color="C1", s=40, marker=">")
@@ -69,14 +84,19 @@ def plot_bridges(m1, m2, bridges, names: Sequence[str] = ("model 1", "model 2"))
 
     fig = plt.figure(figsize=(10, 4.5))
     cols = plt.get_cmap("turbo")(np.linspace(0, 1, max(len(bridges), 1)))
-    for k, (m, pts, name) in enumerate(((m1, bridges.source_points, names[0]),
-                                         (m2, bridges.target_points, names[1]))):
+    for k, (m, pts, name) in enumerate(
+        ((m1, bridges.source_points, names[0]), (m2, bridges.target_points, names[1]))
+    ):
         ax = fig.add_subplot(1, 2, k + 1, projection="3d")
         ax.scatter(*m.X_[:, :3].T, s=5, color="0.6", depthshade=False)
         if len(bridges):
-            ax.scatter(*pts[:, :3].T, s=40, c=cols, edgecolors="k", linewidths=0.4, depthshade=False)
+            ax.scatter(
+                *pts[:, :3].T, s=40, c=cols, edgecolors="k", linewidths=0.4, depthshade=False
+            )
         ax.set_title(f"{name}: {len(bridges)} bridge points", fontsize=9)
-    fig.suptitle(f"bridges {names[0]} -> {names[1]} (pose RMS < {bridges.threshold:.2g} units)", fontsize=10)
+    fig.suptitle(
+        f"bridges {names[0]} -> {names[1]} (pose RMS < {bridges.threshold:.2g} units)", fontsize=10
+    )
     return fig
 
 
@@ -96,8 +116,19 @@ def plot_pose_strip(motion, frames: Sequence[int], labels: Sequence[str] | None 
         p = P[f] - P[f, 0] * np.array([1, 0, 1])
         for i, par in enumerate(jp.parents):
             if par >= 0:
-                ax.plot([p[i, 0] + k * gap, p[par, 0] + k * gap], [p[i, 1], p[par, 1]], color="C0", lw=1.2)
-        ax.text(k * gap, P[:, :, 1].max() + 0.05 * size, labels[k] if labels else str(f), ha="center", fontsize=7)
+                ax.plot(
+                    [p[i, 0] + k * gap, p[par, 0] + k * gap],
+                    [p[i, 1], p[par, 1]],
+                    color="C0",
+                    lw=1.2,
+                )
+        ax.text(
+            k * gap,
+            P[:, :, 1].max() + 0.05 * size,
+            labels[k] if labels else str(f),
+            ha="center",
+            fontsize=7,
+        )
     ax.set_aspect("equal")
     ax.axis("off")
     return fig

@@ -22,11 +22,12 @@ from scipy import ndimage
 
 from ..errors import ParameterError
 
-__all__ = ["window_distances", "transition_points", "Transitions", "aligned_transform"]
+__all__ = ["Transitions", "aligned_transform", "transition_points", "window_distances"]
 
 
 def _window_sum(M: np.ndarray, k: int) -> np.ndarray:
-    """``S[i, j] = sum_m M[i + m, j + m]`` for the windows that fit, ``(n_a - k + 1, n_b - k + 1)``."""
+    """``S[i, j] = sum_m M[i + m, j + m]`` for the windows that fit, ``(n_a - k + 1, n_b - k + "
+    "1)``."""
     na, nb = M.shape[0] - k + 1, M.shape[1] - k + 1
     out = np.zeros((na, nb))
     for m in range(k):
@@ -58,14 +59,16 @@ def window_distances(pa: np.ndarray, pb: np.ndarray, k: int, up: int = 1) -> np.
     if pa.shape[1:] != pb.shape[1:]:
         raise ParameterError(f"point clouds differ: {pa.shape[1:]} and {pb.shape[1:]}")
     if k < 1 or k > min(len(pa), len(pb)):
-        raise ParameterError(f"window of {k} frames does not fit motions of {len(pa)} and {len(pb)} frames")
+        raise ParameterError(
+            f"window of {k} frames does not fit motions of {len(pa)} and {len(pb)} frames"
+        )
     h1, h2 = [i for i in range(3) if i != up]
     P = pa.shape[1]
     n = k * P
     xa, za, ya = pa[..., h1], pa[..., h2], pa[..., up]
     xb, zb, yb = pb[..., h1], pb[..., h2], pb[..., up]
-    dot = _window_sum(xa @ xb.T + za @ zb.T, k)       # sum x x' + z z'
-    cross = _window_sum(xa @ zb.T - za @ xb.T, k)     # sum x z' - z x'
+    dot = _window_sum(xa @ xb.T + za @ zb.T, k)  # sum x x' + z z'
+    cross = _window_sum(xa @ zb.T - za @ xb.T, k)  # sum x z' - z x'
     yy = _window_sum(ya @ yb.T, k)
     sxa, sza = _frame_sum(xa.sum(1), k), _frame_sum(za.sum(1), k)
     sxb, szb = _frame_sum(xb.sum(1), k), _frame_sum(zb.sum(1), k)
@@ -120,8 +123,13 @@ class Transitions:
 
 
 def transition_points(
-    pa: np.ndarray, pb: np.ndarray, window: int, threshold: float, up: int = 1,
-    valid_a: np.ndarray | None = None, valid_b: np.ndarray | None = None,
+    pa: np.ndarray,
+    pb: np.ndarray,
+    window: int,
+    threshold: float,
+    up: int = 1,
+    valid_a: np.ndarray | None = None,
+    valid_b: np.ndarray | None = None,
 ) -> Transitions:
     """Local minima of the window distance under ``threshold`` (Kovar et al. Sec. 3.2).
 
@@ -143,5 +151,6 @@ def transition_points(
         D[:, ~np.asarray(valid_b)[: D.shape[1]]] = np.inf
     local = D == ndimage.minimum_filter(D, size=3, mode="nearest")
     hit = np.argwhere(local & (D < threshold))
-    return Transitions(pairs=hit, distances=D[hit[:, 0], hit[:, 1]], window=int(window),
-                       threshold=float(threshold))
+    return Transitions(
+        pairs=hit, distances=D[hit[:, 0], hit[:, 1]], window=int(window), threshold=float(threshold)
+    )

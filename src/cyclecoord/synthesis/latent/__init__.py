@@ -1,4 +1,5 @@
-"""Latent-space synthesis (Bailey et al., "Repurposing hand animation for interactive applications").
+"""Latent-space synthesis after Bailey et al., "Repurposing hand animation for interactive
+applications".
 
 One GPLVM per kind of motion (:mod:`.model`, :mod:`.gplvm`, :mod:`.influence`), a particle
 steered through a model's latent space (:mod:`.particle`), bridges between models
@@ -12,6 +13,14 @@ from .model import LatentModel
 from .particle import ParticleParams, RandomForce, simulate
 
 __all__ = [
-    "Bridges", "find_bridges", "project", "CommandGraph", "Synthesizer", "GPLVM",
-    "LatentModel", "ParticleParams", "RandomForce", "simulate",
+    "GPLVM",
+    "Bridges",
+    "CommandGraph",
+    "LatentModel",
+    "ParticleParams",
+    "RandomForce",
+    "Synthesizer",
+    "find_bridges",
+    "project",
+    "simulate",
 ]

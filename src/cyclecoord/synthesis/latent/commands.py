@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any
 
 import networkx as nx
 import numpy as np
@@ -150,6 +150,7 @@ class Synthesizer:
         self._graphs: dict[str, CommandGraph] = {}
         self._bridges: dict[tuple[str, str], Bridges] = {}
         self.sim_seconds = 0.0
+        self.sim_cpu_seconds = 0.0
         self.clamped = {"values": 0, "max_deg": 0.0}
         self._ranges: dict[str, tuple[np.ndarray, np.ndarray]] = {}
 
@@ -162,7 +163,9 @@ class Synthesizer:
     # ---------------------------------------------------------------- helpers
     def model(self, name: str) -> LatentModel:
         if name not in self.models:
-            raise ParameterError(f"unknown model {name!r}; the script defines {sorted(self.models)}")
+            raise ParameterError(
+                f"unknown model {name!r}; the script defines {sorted(self.models)}"
+            )
         return self.models[name]
 
     def target(self, spec: Any, name: str | None = None) -> np.ndarray:
@@ -176,40 +179,55 @@ class Synthesizer:
         if isinstance(spec, dict):
             unknown = sorted(set(spec) - {"frame", "segment", "time"})
             if unknown:
-                raise ParameterError(f"unknown target key(s) {unknown}; use frame, or segment and time")
+                raise ParameterError(
+                    f"unknown target key(s) {unknown}; use frame, or segment and time"
+                )
             if "frame" in spec:
                 k = spec["frame"]
                 if not isinstance(k, int) or isinstance(k, bool) or not 0 <= k < m.X_.shape[0]:
-                    raise ParameterError(f"target frame {k!r} is not a training frame of {name!r} (0..{m.X_.shape[0] - 1})")
+                    raise ParameterError(
+                        f"target frame {k!r} is not a training frame of {name!r} "
+                        f"(0..{m.X_.shape[0] - 1})"
+                    )
                 return m.X_[k].copy()
             if "segment" in spec:
                 try:
                     s = m.segment_index(str(spec["segment"]))
                 except KeyError:
-                    raise ParameterError(f"model {name!r} has no segment {spec['segment']!r}; it has {m.segment_names_}") from None
+                    raise ParameterError(
+                        f"model {name!r} has no segment {spec['segment']!r}; it has "
+                        f"{m.segment_names_}"
+                    ) from None
                 idx = np.flatnonzero(m.segments_ == s)
                 t = float(spec.get("time", 0.0))
                 return m.X_[idx[np.argmin(np.abs(m.times_[idx] - t))]].copy()
             raise ParameterError("a target needs frame, or segment (and time)")
         arr = np.asarray(spec, dtype=float) if isinstance(spec, (list, tuple)) else None
         if arr is None or arr.shape != (q,) or not np.isfinite(arr).all():
-            raise ParameterError(f"a latent target of {name!r} must be {q} numbers or a frame/segment, got {spec!r}")
+            raise ParameterError(
+                f"a latent target of {name!r} must be {q} numbers or a frame/segment, got {spec!r}"
+            )
         if m.density(arr)[0] < OUTSIDE_DENSITY:
-            raise ParameterError(f"target {spec} lies outside model {name!r} (no training frame near it)")
+            raise ParameterError(
+                f"target {spec} lies outside model {name!r} (no training frame near it)"
+            )
         return arr
 
     def _need_start(self, what: str) -> LatentModel:
         if self.current is None:
-            raise ParameterError(f"{what} before the particle was placed (start it in a model first)")
+            raise ParameterError(
+                f"{what} before the particle was placed (start it in a model first)"
+            )
         return self.models[self.current]
 
     def _run(self, path: np.ndarray, radius: float | None = None) -> None:
         m = self._need_start("moving")
         params = self.params if radius is None else self.params.replace(radius=radius)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         X, V = simulate(m, path, self.x, self.v, self.fps, params, self.force, self.t)
         self._emit(self.current, X, m.pose(X), self._root(m, X))
         self.sim_seconds += time.perf_counter() - t0
+        self.sim_cpu_seconds += time.process_time() - c0
         self.x, self.v = X[-1], V[-1]
 
     def _emit(self, name, X, angles, root) -> None:
@@ -232,14 +250,23 @@ class Synthesizer:
     def _root(m: LatentModel, X: np.ndarray) -> dict[str, np.ndarray]:
         w = m.root_weights(X)
         r = m.root_
-        return {"height": w @ r.height, "velocity": w @ r.velocity, "turn": w @ r.turn,
-                "tilt": np.einsum("tn,nab->tab", w, r.tilt)}
+        return {
+            "height": w @ r.height,
+            "velocity": w @ r.velocity,
+            "turn": w @ r.turn,
+            "tilt": np.einsum("tn,nab->tab", w, r.tilt),
+        }
 
     def bridges(self, a: str, b: str) -> Bridges:
         key = (a, b)
         if key not in self._bridges:
-            self._bridges[key] = find_bridges(self.model(a), self.model(b), names=key,
-                                              threshold=self.bridge_threshold, random_state=self.seed)
+            self._bridges[key] = find_bridges(
+                self.model(a),
+                self.model(b),
+                names=key,
+                threshold=self.bridge_threshold,
+                random_state=self.seed,
+            )
         return self._bridges[key]
 
     # --------------------------------------------------------------- commands
@@ -250,8 +277,14 @@ class Synthesizer:
         self.x = self.target(at, model) if at is not None else m.X_[0].copy()
         self.v = np.zeros_like(self.x)
 
-    def move(self, to: Any, path: str = "line", duration: float | None = None, speed: float = 1.0,
-             radius: float | None = None) -> None:
+    def move(
+        self,
+        to: Any,
+        path: str = "line",
+        duration: float | None = None,
+        speed: float = 1.0,
+        radius: float | None = None,
+    ) -> None:
         """MOVE to a target along a line or the command graph's shortest path."""
         m = self._need_start("MOVE")
         goal = self.target(to)
@@ -270,24 +303,35 @@ class Synthesizer:
             n = max(1, int(np.ceil(length / (m.speed_ * speed) * self.fps)))
         else:
             if not (isinstance(duration, (int, float)) and duration > 0):
-                raise ParameterError(f"MOVE duration must be a positive number of seconds, got {duration!r}")
+                raise ParameterError(
+                    f"MOVE duration must be a positive number of seconds, got {duration!r}"
+                )
             n = max(1, int(round(duration * self.fps)))
         ramp = int(round(self.ease * self.fps))
         if ramp:
             n += ramp  # the ramps lose about half their length each
         dense = resample(poly, max(length / (4 * n), 1e-12))
         s = (eased(n, ramp) if ramp else np.linspace(0, 1, n + 1)) * (dense.shape[0] - 1)
-        samples = np.stack([np.interp(s, np.arange(dense.shape[0]), dense[:, k]) for k in range(dense.shape[1])], 1)
+        samples = np.stack(
+            [np.interp(s, np.arange(dense.shape[0]), dense[:, k]) for k in range(dense.shape[1])], 1
+        )
         self._run(samples, radius)
 
-    def idle(self, at: Any = None, duration: float = 1.0, radius: float | None = None,
-             hover: float = 1.0) -> None:
+    def idle(
+        self, at: Any = None, duration: float = 1.0, radius: float | None = None, hover: float = 1.0
+    ) -> None:
         """IDLE within ``radius`` of one point (default: where the particle is) or several."""
         self._need_start("IDLE")
         if not (isinstance(duration, (int, float)) and duration > 0):
-            raise ParameterError(f"IDLE duration must be a positive number of seconds, got {duration!r}")
+            raise ParameterError(
+                f"IDLE duration must be a positive number of seconds, got {duration!r}"
+            )
         many = isinstance(at, list) and at and all(isinstance(a, (dict, list)) for a in at)
-        points = [self.target(a) for a in at] if many else [self.target(at) if at is not None else self.x.copy()]
+        points = (
+            [self.target(a) for a in at]
+            if many
+            else [self.target(at) if at is not None else self.x.copy()]
+        )
         end = self.t + duration
         while self.t < end - 0.5 / self.fps:
             p = points[int(self.rng.integers(len(points)))] if len(points) > 1 else points[0]
@@ -297,7 +341,9 @@ class Synthesizer:
                 self.move(_Point(p), radius=radius)
                 if self.t >= end:
                     break
-            n = max(1, int(round(min(hover if len(points) > 1 else duration, end - self.t) * self.fps)))
+            n = max(
+                1, int(round(min(hover if len(points) > 1 else duration, end - self.t) * self.fps))
+            )
             self._run(np.repeat(p[None, :], n + 1, axis=0), radius)
 
     def route(self, src: str, to: str) -> list[str] | None:
@@ -319,7 +365,9 @@ class Synthesizer:
         except nx.NetworkXNoPath:
             return None
 
-    def transition(self, to: str, blend: float = 0.4, radius: float | None = None, route: bool = True) -> None:
+    def transition(
+        self, to: str, blend: float = 0.4, radius: float | None = None, route: bool = True
+    ) -> None:
         """TRANSITION: move to the nearest bridge, blend into model ``to`` while both idle.
 
         Without bridges from the current model to ``to`` and with ``route`` (default), the
@@ -328,7 +376,9 @@ class Synthesizer:
         self._need_start("TRANSITION")
         src = self.current
         if route and src != to:
-            check_compatible(self.models[src], self.model(to), f"TRANSITION from {src!r} to {to!r}: ")
+            check_compatible(
+                self.models[src], self.model(to), f"TRANSITION from {src!r} to {to!r}: "
+            )
             if not len(self.bridges(src, to)):
                 hops = self.route(src, to)
                 if hops is not None:
@@ -338,17 +388,26 @@ class Synthesizer:
         m1, m2 = self.models[src], self.model(to)
         check_compatible(m1, m2, f"TRANSITION from {src!r} to {to!r}: ")
         if not (isinstance(blend, (int, float)) and blend > 0):
-            raise ParameterError(f"TRANSITION blend must be a positive number of seconds, got {blend!r}")
+            raise ParameterError(
+                f"TRANSITION blend must be a positive number of seconds, got {blend!r}"
+            )
         br = self.bridges(src, to)
         if not len(br):
             near = br.best.min()
             anywhere = br.best_raw.min() if br.best_raw is not None else near
-            detail = (f"the closest poses differ by {near:.3g}" if np.isfinite(near) else
-                      f"no pose near {to!r}'s training data comes close (best {anywhere:.3g})")
+            detail = (
+                f"the closest poses differ by {near:.3g}"
+                if np.isfinite(near)
+                else f"no pose near {to!r}'s training data comes close (best {anywhere:.3g})"
+            )
             raise ParameterError(
                 f"no bridges from {src!r} to {to!r}: {detail} (threshold {br.threshold:.3g}); "
-                + ("no chain of bridges through the script's other models reaches it either" if route
-                   else "go through another model (route)"))
+                + (
+                    "no chain of bridges through the script's other models reaches it either"
+                    if route
+                    else "go through another model (route)"
+                )
+            )
         b = br.nearest(self.x)
         small = 0.5 * (self.params.radius if radius is None else radius)
         self.move(_Point(br.source_points[b]), radius=small)
@@ -357,16 +416,35 @@ class Synthesizer:
         p1 = self.params.replace(radius=small)
         X1, _ = simulate(m1, still, self.x, self.v, self.fps, p1, self.force, self.t)
         x2 = br.target_points[b]
-        X2, V2 = simulate(m2, np.repeat(x2[None, :], n + 1, axis=0), x2, np.zeros_like(x2), self.fps, p1,
-                          self.force, self.t)
+        X2, V2 = simulate(
+            m2,
+            np.repeat(x2[None, :], n + 1, axis=0),
+            x2,
+            np.zeros_like(x2),
+            self.fps,
+            p1,
+            self.force,
+            self.t,
+        )
         w = smoothstep(n)[:, None]
         r1, r2 = self._root(m1, X1), self._root(m2, X2)
-        root = {k: (1 - w.reshape((-1,) + (1,) * (r1[k].ndim - 1))) * r1[k]
-                + w.reshape((-1,) + (1,) * (r1[k].ndim - 1)) * r2[k] for k in r1}
+        root = {
+            k: (1 - w.reshape((-1,) + (1,) * (r1[k].ndim - 1))) * r1[k]
+            + w.reshape((-1,) + (1,) * (r1[k].ndim - 1)) * r2[k]
+            for k in r1
+        }
         self._emit(to, X2, (1 - w) * m1.pose(X1) + w * m2.pose(X2), root)
-        self.events.append({"command": self.command, "transition": [src, to], "bridge_frame": int(br.frames[b]),
-                            "bridge_distance": float(br.distances[b]), "bridges": len(br),
-                            "blend_frames": n, "start_frame": self.n_frames - n})
+        self.events.append(
+            {
+                "command": self.command,
+                "transition": [src, to],
+                "bridge_frame": int(br.frames[b]),
+                "bridge_distance": float(br.distances[b]),
+                "bridges": len(br),
+                "blend_frames": n,
+                "start_frame": self.n_frames - n,
+            }
+        )
         self.current, self.x, self.v = to, X2[-1], V2[-1]
 
     def play(self, segment: str, start: float = 0.0, stop: float | None = None) -> None:
@@ -375,12 +453,17 @@ class Synthesizer:
         try:
             s = m.segment_index(str(segment))
         except KeyError:
-            raise ParameterError(f"model {self.current!r} has no segment {segment!r}; it has {m.segment_names_}") from None
+            raise ParameterError(
+                f"model {self.current!r} has no segment {segment!r}; it has {m.segment_names_}"
+            ) from None
         idx = np.flatnonzero(m.segments_ == s)
         length = m.times_[idx][-1]
         stop = length if stop is None else float(stop)
         if not 0 <= float(start) < stop <= length + 1e-9:
-            raise ParameterError(f"PLAY times {start}..{stop} s are not inside segment {segment!r} (0..{length:.3g} s)")
+            raise ParameterError(
+                f"PLAY times {start}..{stop} s are not inside segment {segment!r} (0..{length:.3g} "
+                "s)"
+            )
         first = idx[np.argmin(np.abs(m.times_[idx] - start))]
         self.move(_Point(m.X_[first]), radius=0.25 * self.params.radius)
         t = np.arange(float(start), stop, 1.0 / self.fps)
@@ -391,8 +474,12 @@ class Synthesizer:
 
         X = interp(m.X_[idx])
         r = m.root_
-        root = {"height": interp(r.height[idx])[:, 0], "velocity": interp(r.velocity[idx]),
-                "turn": interp(r.turn[idx])[:, 0], "tilt": interp(r.tilt[idx]).reshape(-1, 3, 3)}
+        root = {
+            "height": interp(r.height[idx])[:, 0],
+            "velocity": interp(r.velocity[idx]),
+            "turn": interp(r.turn[idx])[:, 0],
+            "tilt": interp(r.tilt[idx]).reshape(-1, 3, 3),
+        }
         self._emit(self.current, X, interp(m.angles(m.frames_[idx])), root)
         self.x = X[-1]
         self.v = (X[-1] - X[-2]) * self.fps if len(X) > 1 else np.zeros_like(self.x)
@@ -436,8 +523,13 @@ class Synthesizer:
             frames[:, col[(rj.name, "r" + ax)]] = euler[:, k]
         for k, c in enumerate(first.channels_):
             frames[:, col[c]] = angles[:, k]
-        return Motion(frames=frames, channels=channels, fps=self.fps, skeleton=first.skeleton_,
-                      source="synthetic:latent")
+        return Motion(
+            frames=frames,
+            channels=channels,
+            fps=self.fps,
+            skeleton=first.skeleton_,
+            source="synthetic:latent",
+        )
 
     def segments(self) -> list[dict[str, Any]]:
         """Which frames each command made and in which model."""
@@ -447,7 +539,9 @@ class Synthesizer:
             if out and out[-1]["command"] == c.command and out[-1]["model"] == c.model:
                 out[-1]["stop"] += n
             else:
-                out.append({"command": c.command, "model": c.model, "start": start, "stop": start + n})
+                out.append(
+                    {"command": c.command, "model": c.model, "start": start, "stop": start + n}
+                )
             start += n
         return out
 

@@ -25,18 +25,17 @@ here with NumPy and SciPy.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 from scipy import linalg, optimize
 from scipy.linalg import lapack
 
 from ..._blas import one_blas_thread
-
 from ...errors import ParameterError
 
-__all__ = ["GPLVM", "rbf", "sqdist", "objective", "dynamics_precision", "ObjectiveSettings"]
+__all__ = ["GPLVM", "ObjectiveSettings", "dynamics_precision", "objective", "rbf", "sqdist"]
 
 
 def sqdist(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -247,7 +246,9 @@ class GPLVM:
         self.max_iter = max_iter
         self.random_state = random_state
 
-    def settings(self, Y: np.ndarray, segments: np.ndarray, times: np.ndarray, X0: np.ndarray) -> ObjectiveSettings:
+    def settings(
+        self, Y: np.ndarray, segments: np.ndarray, times: np.ndarray, X0: np.ndarray
+    ) -> ObjectiveSettings:
         """The fixed parts of the objective for data ``Y`` (also used by the tests)."""
         n = Y.shape[0]
         m = min(n, int(self.connectivity_points))
@@ -256,7 +257,9 @@ class GPLVM:
         eps = float(max(np.median(nn), 1e-6) ** 2)
         return ObjectiveSettings(
             Y=Y,
-            dyn_precision=dynamics_precision(segments, times, self.dynamics_lengthscale, self.dynamics_noise),
+            dyn_precision=dynamics_precision(
+                segments, times, self.dynamics_lengthscale, self.dynamics_noise
+            ),
             conn_index=idx,
             conn_weight=float(self.connectivity_weight) * n / idx.size**2,
             conn_beta=float(self.connectivity_beta),
@@ -265,7 +268,7 @@ class GPLVM:
         )
 
     @one_blas_thread
-    def fit(self, Y: np.ndarray, segments: Sequence[int], times: Sequence[float]) -> "GPLVM":
+    def fit(self, Y: np.ndarray, segments: Sequence[int], times: Sequence[float]) -> GPLVM:
         """Fit to ``Y`` (N, d), centred PCA coordinates, with each frame's segment and time (s)."""
         Y = np.asarray(Y, dtype=float)
         seg = np.asarray(segments, dtype=int)
@@ -273,7 +276,9 @@ class GPLVM:
         n, d = Y.shape
         q = int(self.n_components)
         if q < 1 or q > d:
-            raise ParameterError(f"latent dimension {q} must be between 1 and the {d} PCA components")
+            raise ParameterError(
+                f"latent dimension {q} must be between 1 and the {d} PCA components"
+            )
         if n < q + 2:
             raise ParameterError(f"a GPLVM needs more than {q + 1} training frames, got {n}")
         if seg.shape != (n,) or t.shape != (n,):
@@ -288,7 +293,12 @@ class GPLVM:
             (np.log(1e-4 * s0), np.log(s0)),
         ]
         res = optimize.minimize(
-            objective, theta0, args=(st, q), jac=True, method="L-BFGS-B", bounds=bounds,
+            objective,
+            theta0,
+            args=(st, q),
+            jac=True,
+            method="L-BFGS-B",
+            bounds=bounds,
             options={"maxiter": int(self.max_iter)},
         )
         theta = res.x
@@ -301,7 +311,9 @@ class GPLVM:
         return self
 
     def _finish(self, Y: np.ndarray) -> None:
-        K = rbf(self.X_, self.X_, self.variance_, self.lengthscale_**2) + self.noise_ * np.eye(len(Y))
+        K = rbf(self.X_, self.X_, self.variance_, self.lengthscale_**2) + self.noise_ * np.eye(
+            len(Y)
+        )
         kinv, _ = _inverse(K)
         if kinv is None:
             raise ParameterError("the fitted kernel matrix is not positive definite")
@@ -309,7 +321,7 @@ class GPLVM:
         self.alpha_ = self.kinv_ @ Y
 
     @classmethod
-    def from_arrays(cls, X, variance, lengthscale, noise, Y) -> "GPLVM":
+    def from_arrays(cls, X, variance, lengthscale, noise, Y) -> GPLVM:
         """A fitted model from stored values (``K^-1`` is recomputed)."""
         g = cls(n_components=np.asarray(X).shape[1])
         g.X_ = np.asarray(X, dtype=float)

@@ -10,7 +10,7 @@ not spend components on channels that vary a lot but hardly move anything (Eq. 1
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -18,7 +18,7 @@ from ...errors import ParameterError
 from ...motion import Motion
 from ...skeleton import Skeleton, forward_kinematics
 
-__all__ = ["pose_points", "influence_weights", "STEPS"]
+__all__ = ["STEPS", "influence_weights", "pose_points"]
 
 #: Multiples of a channel's standard deviation probed around the mean pose (Eq. 3).
 STEPS = (-2, -1, 0, 1, 2)

@@ -13,9 +13,9 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
@@ -25,7 +25,7 @@ from ...skeleton import Skeleton
 from .gplvm import GPLVM, rbf, sqdist
 from .influence import influence_weights
 
-__all__ = ["LatentModel", "RootTrack", "root_track", "heading_matrix"]
+__all__ = ["LatentModel", "RootTrack", "heading_matrix", "root_track"]
 
 _FORMAT = "cyclecoord-latent-model"
 _VERSION = 1
@@ -66,7 +66,9 @@ def root_track(motion: Motion) -> RootTrack:
     from ..interpolate import _root_rotation
 
     mats, _, _ = _root_rotation(motion)
-    pos = motion.frames[:, [motion.channel_index(motion.skeleton.joints[0].name, d) for d in ("tx", "ty", "tz")]]
+    pos = motion.frames[
+        :, [motion.channel_index(motion.skeleton.joints[0].name, d) for d in ("tx", "ty", "tz")]
+    ]
     fwd = mats[:, :, 2]
     theta = np.arctan2(fwd[:, 0], fwd[:, 2])
     head = heading_matrix(theta)
@@ -74,7 +76,10 @@ def root_track(motion: Motion) -> RootTrack:
     n = motion.n_frames
     step = np.diff(pos, axis=0, append=pos[-1:] + (pos[-1:] - pos[-2:-1] if n > 1 else 0))
     local = np.einsum("tba,tb->ta", head, step)  # head^T @ step
-    dth = np.diff(np.unwrap(theta), append=np.unwrap(theta)[-1] if n < 2 else 2 * np.unwrap(theta)[-1] - np.unwrap(theta)[-2])
+    dth = np.diff(
+        np.unwrap(theta),
+        append=np.unwrap(theta)[-1] if n < 2 else 2 * np.unwrap(theta)[-1] - np.unwrap(theta)[-2],
+    )
     return RootTrack(
         height=pos[:, 1].copy(),
         velocity=local[:, [0, 2]] * motion.fps,
@@ -122,15 +127,20 @@ class LatentModel:
     root_ : RootTrack
     """
 
-    def __init__(self, n_components: int = 3, variance: float = 0.85, gplvm: dict | None = None,
-                 random_state: int = 0) -> None:
+    def __init__(
+        self,
+        n_components: int = 3,
+        variance: float = 0.85,
+        gplvm: dict | None = None,
+        random_state: int = 0,
+    ) -> None:
         self.n_components = n_components
         self.variance = variance
         self.gplvm = gplvm
         self.random_state = random_state
 
     # ------------------------------------------------------------------ fitting
-    def fit(self, motions: Sequence[Motion], names: Sequence[str] | None = None) -> "LatentModel":
+    def fit(self, motions: Sequence[Motion], names: Sequence[str] | None = None) -> LatentModel:
         """Fit to training segments (each a contiguous capture; same channels and rate).
 
         Parameters
@@ -145,14 +155,20 @@ class LatentModel:
             raise ParameterError("a latent model needs at least one training segment")
         first = motions[0]
         if first.skeleton is None:
-            raise ParameterError("a latent model needs motions with a skeleton (forward kinematics)")
+            raise ParameterError(
+                "a latent model needs motions with a skeleton (forward kinematics)"
+            )
         for i, m in enumerate(motions):
             if m.channels != first.channels:
                 raise ParameterError(f"training segment {i} has different channels from segment 0")
             if abs(m.fps - first.fps) > 1e-9:
-                raise ParameterError(f"training segment {i} is at {m.fps:g} fps, segment 0 at {first.fps:g}")
+                raise ParameterError(
+                    f"training segment {i} is at {m.fps:g} fps, segment 0 at {first.fps:g}"
+                )
             if m.n_frames < 3:
-                raise ParameterError(f"training segment {i} has {m.n_frames} frames; at least 3 are needed")
+                raise ParameterError(
+                    f"training segment {i} has {m.n_frames} frames; at least 3 are needed"
+                )
         if not 0 < self.variance <= 1:
             raise ParameterError(f"variance must be in (0, 1], got {self.variance}")
         root = set(first.root_channels())
@@ -161,20 +177,26 @@ class LatentModel:
         self.all_channels_ = first.channels
         self.skeleton_ = first.skeleton
         self.fps_ = float(first.fps)
-        self.segment_names_ = list(names) if names is not None else [f"segment{i}" for i in range(len(motions))]
+        self.segment_names_ = (
+            list(names) if names is not None else [f"segment{i}" for i in range(len(motions))]
+        )
         if len(self.segment_names_) != len(motions):
             raise ParameterError(f"{len(self.segment_names_)} names for {len(motions)} segments")
         self.frames_ = np.concatenate([m.frames for m in motions])
         self.segments_ = np.concatenate([np.full(m.n_frames, i) for i, m in enumerate(motions)])
         self.times_ = np.concatenate([np.arange(m.n_frames) / m.fps for m in motions])
         tracks = [root_track(m) for m in motions]
-        self.root_ = RootTrack(*(np.concatenate([getattr(t, f) for t in tracks]) for f in
-                                 ("height", "velocity", "turn", "tilt")))
+        self.root_ = RootTrack(
+            *(
+                np.concatenate([getattr(t, f) for t in tracks])
+                for f in ("height", "velocity", "turn", "tilt")
+            )
+        )
         angles = self.angles(self.frames_)
         self.mean_ = angles.mean(axis=0)
         self.weights_ = influence_weights(angles, self.channels_, self.skeleton_)
         Z = (angles - self.mean_) * self.weights_
-        U, S, Vt = np.linalg.svd(Z, full_matrices=False)
+        _, S, Vt = np.linalg.svd(Z, full_matrices=False)
         ratio = np.cumsum(S**2) / max((S**2).sum(), 1e-300)
         d_pca = int(np.searchsorted(ratio, self.variance - 1e-12) + 1)
         d_pca = max(d_pca, int(self.n_components) + 1)
@@ -182,14 +204,17 @@ class LatentModel:
         self.explained_variance_ = float(ratio[d_pca - 1])
         self.components_ = Vt[:d_pca].T
         self.Y_ = Z @ self.components_
-        self.gp_ = GPLVM(n_components=self.n_components, random_state=self.random_state,
-                         **(self.gplvm or {})).fit(self.Y_, self.segments_, self.times_)
+        self.gp_ = GPLVM(
+            n_components=self.n_components, random_state=self.random_state, **(self.gplvm or {})
+        ).fit(self.Y_, self.segments_, self.times_)
         self._precompute()
         return self
 
     def _precompute(self) -> None:
         self.X_ = self.gp_.X_
-        inv_w = np.where(self.weights_ > 0, 1.0 / np.where(self.weights_ > 0, self.weights_, 1.0), 0.0)
+        inv_w = np.where(
+            self.weights_ > 0, 1.0 / np.where(self.weights_ > 0, self.weights_, 1.0), 0.0
+        )
         # pose(x) = mean + k(x) @ B: Eq. 8's mean taken back through PCA and the scaling
         self._B = (self.gp_.alpha_ @ self.components_.T) * inv_w
         self._l2 = self.gp_.lengthscale_**2
@@ -270,40 +295,65 @@ class LatentModel:
     def describe(self) -> dict:
         """Sizes and hyperparameters for reports."""
         return {
-            "frames": int(self.X_.shape[0]), "segments": list(self.segment_names_),
-            "fps": self.fps_, "channels": len(self.channels_), "pca_components": int(self.components_.shape[1]),
-            "explained_variance": self.explained_variance_, "latent_dims": int(self.X_.shape[1]),
-            "rbf_variance": self.gp_.variance_, "lengthscale": self.gp_.lengthscale_,
-            "white_variance": self.gp_.noise_, "latent_speed_per_s": self.speed_,
+            "frames": int(self.X_.shape[0]),
+            "segments": list(self.segment_names_),
+            "fps": self.fps_,
+            "channels": len(self.channels_),
+            "pca_components": int(self.components_.shape[1]),
+            "explained_variance": self.explained_variance_,
+            "latent_dims": int(self.X_.shape[1]),
+            "rbf_variance": self.gp_.variance_,
+            "lengthscale": self.gp_.lengthscale_,
+            "white_variance": self.gp_.noise_,
+            "latent_speed_per_s": self.speed_,
         }
 
     # --------------------------------------------------------------- storage
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the model and its training frames to ``path`` (``.npz``, atomic)."""
         from ...io._atomic import atomic_write
-        from ...io.tabular import write_npz, read_npz  # noqa: F401
+        from ...io.tabular import read_npz, write_npz  # noqa: F401
 
-        train = Motion(frames=self.frames_, channels=self.all_channels_, fps=self.fps_, skeleton=self.skeleton_)
+        train = Motion(
+            frames=self.frames_, channels=self.all_channels_, fps=self.fps_, skeleton=self.skeleton_
+        )
         with tempfile.TemporaryDirectory() as tmp:
             write_npz(train, Path(tmp) / "train.npz")
             with np.load(Path(tmp) / "train.npz", allow_pickle=False) as data:
                 arrays = {f"motion_{k}": data[k] for k in data.files}
-        arrays.update({
-            "format": np.array(_FORMAT), "version": np.array(_VERSION),
-            "segments": self.segments_, "times": self.times_,
-            "segment_names": np.array(json.dumps(self.segment_names_)),
-            "n_modelled": np.array(len(self.channels_)), "n_root": np.array(len(self.root_channels_)),
-            "mean": self.mean_, "weights": self.weights_, "components": self.components_,
-            "Y": self.Y_, "X": self.X_, "explained_variance": np.array(self.explained_variance_),
-            "hyper": np.array([self.gp_.variance_, self.gp_.lengthscale_, self.gp_.noise_]),
-            "params": np.array(json.dumps({"n_components": self.n_components, "variance": self.variance,
-                                           "gplvm": self.gplvm, "random_state": self.random_state})),
-        })
+        arrays.update(
+            {
+                "format": np.array(_FORMAT),
+                "version": np.array(_VERSION),
+                "segments": self.segments_,
+                "times": self.times_,
+                "segment_names": np.array(json.dumps(self.segment_names_)),
+                "n_modelled": np.array(len(self.channels_)),
+                "n_root": np.array(len(self.root_channels_)),
+                "mean": self.mean_,
+                "weights": self.weights_,
+                "components": self.components_,
+                "Y": self.Y_,
+                "X": self.X_,
+                "explained_variance": np.array(self.explained_variance_),
+                "hyper": np.array([self.gp_.variance_, self.gp_.lengthscale_, self.gp_.noise_]),
+                "params": np.array(
+                    json.dumps(
+                        {
+                            "n_components": self.n_components,
+                            "variance": self.variance,
+                            "gplvm": self.gplvm,
+                            "random_state": self.random_state,
+                        }
+                    )
+                ),
+            }
+        )
         with atomic_write(path, "wb") as fh:
             np.savez_compressed(fh, **arrays)
 
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> "LatentModel":
+    def load(cls, path: str | os.PathLike[str]) -> LatentModel:
         """Read a model written by :meth:`save`."""
         from ...io.tabular import read_npz
 
@@ -316,7 +366,10 @@ class LatentModel:
         if str(arrays.get("format", "")) != _FORMAT:
             raise ParseError(f"not a latent model (no format '{_FORMAT}')", p)
         with tempfile.TemporaryDirectory() as tmp:
-            np.savez(Path(tmp) / "train.npz", **{k[7:]: v for k, v in arrays.items() if k.startswith("motion_")})
+            np.savez(
+                Path(tmp) / "train.npz",
+                **{k[7:]: v for k, v in arrays.items() if k.startswith("motion_")},
+            )
             train = read_npz(Path(tmp) / "train.npz")
         params = json.loads(str(arrays["params"]))
         m = cls(**params)
@@ -336,8 +389,12 @@ class LatentModel:
         starts = np.flatnonzero(np.r_[True, m.segments_[1:] != m.segments_[:-1]])
         stops = np.r_[starts[1:], len(m.segments_)]
         tracks = [root_track(train[a:b]) for a, b in zip(starts, stops)]
-        m.root_ = RootTrack(*(np.concatenate([getattr(t, f) for t in tracks]) for f in
-                              ("height", "velocity", "turn", "tilt")))
+        m.root_ = RootTrack(
+            *(
+                np.concatenate([getattr(t, f) for t in tracks])
+                for f in ("height", "velocity", "turn", "tilt")
+            )
+        )
         m._precompute()
         return m
 

@@ -24,6 +24,7 @@ particle at rest outside the circle would not be pulled back.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -77,7 +78,7 @@ class ParticleParams:
             if v < 0 or (f.name in ("width", "timescale", "alpha") and v == 0):
                 raise ParameterError(f"particle parameter {f.name} must be positive, got {v!r}")
 
-    def replace(self, **changes) -> "ParticleParams":
+    def replace(self, **changes) -> ParticleParams:
         known = {f.name for f in fields(self)}
         unknown = sorted(set(changes) - known)
         if unknown:
@@ -100,7 +101,9 @@ class RandomForce:
     random_state : int, default 0
     """
 
-    def __init__(self, dims: int, timescale: float, n_features: int = 64, random_state: int = 0) -> None:
+    def __init__(
+        self, dims: int, timescale: float, n_features: int = 64, random_state: int = 0
+    ) -> None:
         rng = np.random.default_rng(random_state)
         self.omega = rng.normal(0.0, 1.0 / timescale, size=n_features)
         self.phase = rng.uniform(0.0, 2 * np.pi, size=n_features)
@@ -159,10 +162,10 @@ def simulate(
         F = -params.damping * (vv - pd)
         if a_lik > 0:
             p, grad = model.density(xx)
-            gn = np.sqrt(grad @ grad)
+            gn = math.sqrt(grad @ grad)
             if gn > 1e-12:
-                z = np.clip((p - params.threshold) / params.width, -50.0, 50.0)
-                F = F + (a_lik / (1.0 + np.exp(z))) * grad / gn
+                z = min(50.0, max(-50.0, (p - params.threshold) / params.width))
+                F = F + (a_lik / (1.0 + math.exp(z)) / gn) * grad
         if force is not None and a_rand > 0:
             F = F + a_rand * force(t)
         g = xx - pp
@@ -180,8 +183,14 @@ def simulate(
         t = t0 + k * dt
         pm = 0.5 * (p0 + p1)
         k1x, k1v = v, accel(x, v, p0, pd, t)
-        k2x, k2v = v + 0.5 * dt * k1v, accel(x + 0.5 * dt * k1x, v + 0.5 * dt * k1v, pm, pd, t + 0.5 * dt)
-        k3x, k3v = v + 0.5 * dt * k2v, accel(x + 0.5 * dt * k2x, v + 0.5 * dt * k2v, pm, pd, t + 0.5 * dt)
+        k2x, k2v = (
+            v + 0.5 * dt * k1v,
+            accel(x + 0.5 * dt * k1x, v + 0.5 * dt * k1v, pm, pd, t + 0.5 * dt),
+        )
+        k3x, k3v = (
+            v + 0.5 * dt * k2v,
+            accel(x + 0.5 * dt * k2x, v + 0.5 * dt * k2v, pm, pd, t + 0.5 * dt),
+        )
         k4x, k4v = v + dt * k3v, accel(x + dt * k3x, v + dt * k3v, p1, pd, t + dt)
         x = x + dt / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x)
         v = v + dt / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)

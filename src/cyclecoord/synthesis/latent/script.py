@@ -36,7 +36,7 @@ from .commands import Synthesizer
 from .model import LatentModel
 from .particle import ParticleParams
 
-__all__ = ["load_script", "run_script", "COMMANDS", "TOP_KEYS"]
+__all__ = ["COMMANDS", "TOP_KEYS", "load_script", "run_script"]
 
 TOP_KEYS = {"fps", "seed", "models", "start", "particle", "bridge_threshold", "commands"}
 #: Each command's allowed keys (besides "command").
@@ -70,7 +70,12 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
     if unknown:
         raise _fail(p, "top level", f"unknown key(s) {unknown}; known: {sorted(TOP_KEYS)}")
     fps = spec.get("fps", 30)
-    if not isinstance(fps, (int, float)) or isinstance(fps, bool) or not np.isfinite(fps) or fps <= 0:
+    if (
+        not isinstance(fps, (int, float))
+        or isinstance(fps, bool)
+        or not np.isfinite(fps)
+        or fps <= 0
+    ):
         raise _fail(p, "fps", f"must be a positive number, got {fps!r}")
     seed = spec.get("seed", 0)
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
@@ -93,21 +98,27 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
     if not isinstance(start, dict) or "model" not in start or set(start) - {"model", "at"}:
         raise _fail(p, "start", 'must be {"model": NAME} with an optional "at" target')
     if start["model"] not in models:
-        raise _fail(p, "start", f"unknown model {start['model']!r}; the script defines {sorted(models)}")
+        raise _fail(
+            p, "start", f"unknown model {start['model']!r}; the script defines {sorted(models)}"
+        )
     try:
         ParticleParams().replace(**(spec.get("particle") or {}))
     except (ParameterError, TypeError) as exc:
         raise _fail(p, "particle", str(exc)) from None
     thr = spec.get("bridge_threshold")
     if thr is not None and (not isinstance(thr, (int, float)) or isinstance(thr, bool) or thr <= 0):
-        raise _fail(p, "bridge_threshold", f"must be a positive number of skeleton units, got {thr!r}")
+        raise _fail(
+            p, "bridge_threshold", f"must be a positive number of skeleton units, got {thr!r}"
+        )
     commands = spec.get("commands")
     if not isinstance(commands, list) or not commands:
         raise _fail(p, "commands", "must be a non-empty list")
     for i, c in enumerate(commands):
         where = f"commands[{i}]"
         if not isinstance(c, dict) or not isinstance(c.get("command"), str):
-            raise _fail(p, where, 'each command is an object with "command": MOVE, IDLE, TRANSITION or PLAY')
+            raise _fail(
+                p, where, 'each command is an object with "command": MOVE, IDLE, TRANSITION or PLAY'
+            )
         kind = c["command"].upper()
         where = f"commands[{i}] ({c['command']})"
         if kind not in COMMANDS:
@@ -138,8 +149,13 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
     p = Path(path)
     spec, models = load_script(p)
     params = ParticleParams().replace(**(spec.get("particle") or {}))
-    syn = Synthesizer(models, fps=float(spec.get("fps", 30)), seed=int(spec.get("seed", 0)), params=params,
-                      bridge_threshold=spec.get("bridge_threshold"))
+    syn = Synthesizer(
+        models,
+        fps=float(spec.get("fps", 30)),
+        seed=int(spec.get("seed", 0)),
+        params=params,
+        bridge_threshold=spec.get("bridge_threshold"),
+    )
     start = spec.get("start", {"model": next(iter(models))})
     t0 = time.perf_counter()
     try:
@@ -171,7 +187,10 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
     total = time.perf_counter() - t0
     motion = syn.motion()
     report: dict[str, Any] = {
-        "script": str(p), "fps": syn.fps, "seed": syn.seed, "frames": motion.n_frames,
+        "script": str(p),
+        "fps": syn.fps,
+        "seed": syn.seed,
+        "frames": motion.n_frames,
         "duration_s": motion.duration,
         "models": {k: m.describe() for k, m in models.items()},
         "output_skeleton_from": syn.chunks[0].model,
@@ -180,20 +199,34 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
         "clamped_to_training_range": syn.clamped,
         "bridges": {f"{a}->{b}": br.to_dict() for (a, b), br in syn._bridges.items()},
         "timing": {
-            "total_s": total, "particle_and_pose_s": syn.sim_seconds,
+            "total_s": total,
+            "particle_and_pose_s": syn.sim_seconds,
+            "particle_and_pose_cpu_s": syn.sim_cpu_seconds,
             "frames_per_second": motion.n_frames / syn.sim_seconds if syn.sim_seconds > 0 else None,
+            "frames_per_cpu_second": motion.n_frames / syn.sim_cpu_seconds
+            if syn.sim_cpu_seconds > 0
+            else None,
         },
     }
     sizes = {round(m.skeleton_.total_length(), 6) for m in models.values()}
     if len(sizes) > 1:
-        report["notes"] = ["the models' skeletons have the same joints but different bone lengths; "
-                           f"the output uses {syn.chunks[0].model!r}'s"]
+        report["notes"] = [
+            "the models' skeletons have the same joints but different bone lengths; "
+            f"the output uses {syn.chunks[0].model!r}'s"
+        ]
     if check:
         from ...motion import Motion
         from ...quality.plausibility import check_plausibility
 
         used = {c.model for c in syn.chunks}
-        refs = [Motion(frames=models[k].frames_, channels=models[k].all_channels_, fps=models[k].fps_,
-                       skeleton=models[k].skeleton_) for k in sorted(used)]
+        refs = [
+            Motion(
+                frames=models[k].frames_,
+                channels=models[k].all_channels_,
+                fps=models[k].fps_,
+                skeleton=models[k].skeleton_,
+            )
+            for k in sorted(used)
+        ]
         report["plausibility"] = check_plausibility(motion, refs).to_dict()
     return motion, report
