@@ -63,7 +63,10 @@ def run(args: argparse.Namespace) -> int:
         staged.replace(out)
     t = report["timing"]
     fps = t["frames_per_second"]
+    cpu = t.get("frames_per_cpu_second")
     speed = f", synthesis {fps:,.0f} frames/s" if fps else ""
+    if cpu:
+        speed += f" ({cpu:,.0f} per CPU second)"
     print(
         f"{out}: {report['frames']} frames ({report['duration_s']:.1f} s at {report['fps']:g} "
         "fps), "

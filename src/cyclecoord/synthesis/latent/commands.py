@@ -199,7 +199,12 @@ class Synthesizer:
                         f"{m.segment_names_}"
                     ) from None
                 idx = np.flatnonzero(m.segments_ == s)
-                t = float(spec.get("time", 0.0))
+                t = spec.get("time", 0.0)
+                end = float(m.times_[idx][-1])
+                if not isinstance(t, (int, float)) or isinstance(t, bool) or not 0 <= t <= end + 1e-9:
+                    raise ParameterError(
+                        f"time {t!r} is not inside segment {spec['segment']!r} (0..{end:.3g} s)"
+                    )
                 return m.X_[idx[np.argmin(np.abs(m.times_[idx] - t))]].copy()
             raise ParameterError("a target needs frame, or segment (and time)")
         arr = np.asarray(spec, dtype=float) if isinstance(spec, (list, tuple)) else None
