@@ -235,19 +235,20 @@ class Synthesizer:
         self.sim_cpu_seconds += time.process_time() - c0
         self.x, self.v = X[-1], V[-1]
 
-    def _emit(self, name, X, angles, root) -> None:
-        if self.clamp:
-            # joint limits: the training range of the model the frames come from (a
-            # TRANSITION's blend lies between two models' poses, so their joint range)
-            lo, hi = self._range(name)
-            if self.chunks or self.current != name:
-                lo0, hi0 = self._range(self.current)
-                lo, hi = np.minimum(lo, lo0), np.maximum(hi, hi0)
-            clipped = np.clip(angles, lo, hi)
-            over = np.abs(clipped - angles)
-            self.clamped["values"] += int((over > 1e-9).sum())
-            self.clamped["max_deg"] = max(self.clamped["max_deg"], float(over.max(initial=0.0)))
-            angles = clipped
+    def _clip(self, name: str, angles: np.ndarray) -> np.ndarray:
+        """Joint limits: clip to the training range of model ``name`` (counted)."""
+        if not self.clamp:
+            return angles
+        lo, hi = self._range(name)
+        clipped = np.clip(angles, lo, hi)
+        over = np.abs(clipped - angles)
+        self.clamped["values"] += int((over > 1e-9).sum())
+        self.clamped["max_deg"] = max(self.clamped["max_deg"], float(over.max(initial=0.0)))
+        return clipped
+
+    def _emit(self, name, X, angles, root, clip: bool = True) -> None:
+        if clip:
+            angles = self._clip(name, angles)
         self.chunks.append(_Chunk(name, X, angles, root, self.command))
         self.t += X.shape[0] / self.fps
 
@@ -438,7 +439,10 @@ class Synthesizer:
             + w.reshape((-1,) + (1,) * (r1[k].ndim - 1)) * r2[k]
             for k in r1
         }
-        self._emit(to, X2, (1 - w) * m1.pose(X1) + w * m2.pose(X2), root)
+        # each model's pose is clipped to its own range before the blend, so the frames
+        # after the blend continue without a jump
+        blended = (1 - w) * self._clip(src, m1.pose(X1)) + w * self._clip(to, m2.pose(X2))
+        self._emit(to, X2, blended, root, clip=False)
         self.events.append(
             {
                 "command": self.command,
