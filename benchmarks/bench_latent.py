@@ -355,6 +355,8 @@ def pair_rows(models: dict, stats: dict, progress: bool) -> list[dict]:
             "best_mg": float(D.min()),
             "threshold": thr,
             "mg_transitions_2x": len(hits2),
+            "bridges_2x": int((br.best < 2 * thr).sum()),
+            "bridge_cov_play_2x": coverage_play(mA, np.flatnonzero(br.best < 2 * thr)),
             "mg_cov_play_2x": coverage_play(mA, hits2[:, 0] if len(hits2) else np.array([], int)),
         }
         if len(br):
@@ -475,6 +477,7 @@ def main(argv=None) -> int:
     with_br = sum(r["bridges"] > 0 for r in rows)
     with_mg = sum(r["mg_transitions"] > 0 for r in rows)
     with_mg2 = sum(r["mg_transitions_2x"] > 0 for r in rows)
+    with_br2 = sum(r["bridges_2x"] > 0 for r in rows)
     worst = max((r["latent"]["acc"] for r in rows if r["latent"]), default=None)
     reached = sum(r["latent"] is not None for r in rows)
     summary = {
@@ -486,6 +489,8 @@ def main(argv=None) -> int:
         "mean_cov_bridges_move": float(np.mean([r["bridge_cov_move"] for r in rows])),
         "mean_cov_mg": float(np.mean([r["mg_cov_play"] for r in rows])),
         "pairs_with_mg_2x": with_mg2,
+        "pairs_with_bridges_2x": with_br2,
+        "mean_cov_bridges_play_2x": float(np.mean([r["bridge_cov_play_2x"] for r in rows])),
         "mean_cov_mg_2x": float(np.mean([r["mg_cov_play_2x"] for r in rows])),
         "latent_worst_acc_ratio": worst,
         "latent_pairs_over_1.5": sum(1 for r in rows if r["latent"] and r["latent"]["acc"] > 1.5),
@@ -501,6 +506,10 @@ def main(argv=None) -> int:
     print(
         f"motion graph at twice the threshold: {with_mg2}/{n} pairs, mean coverage "
         f"{summary['mean_cov_mg_2x']:.0%}"
+    )
+    print(
+        f"bridges at twice the threshold: {with_br2}/{n} pairs, mean coverage (play) "
+        f"{summary['mean_cov_bridges_play_2x']:.0%}"
     )
     print(f"latent TRANSITION reaches {reached}/{n} pairs (through other models when needed)")
     print(
