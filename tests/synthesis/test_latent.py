@@ -242,3 +242,23 @@ def test_window_distance_is_invariant_to_turns_and_floor_moves():
     assert D[i, j] == pytest.approx(best, abs=1e-4)
     tr = transition_points(pa, pb, 5, threshold=1e-3)
     assert len(tr) >= 1 and np.all(tr.pairs[:, 0] == tr.pairs[:, 1])
+
+
+def test_figures(walk_model, jog_model):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from cyclecoord.plot.latent import plot_bridges, plot_latent, plot_pose_strip
+
+    fig = plot_latent(walk_model, path=walk_model.X_[:10] + 0.01)
+    assert len(fig.axes) == 1
+    br = find_bridges(walk_model, jog_model, names=("w", "j"))
+    fig2 = plot_bridges(walk_model, jog_model, br, ("w", "j"))
+    assert len(fig2.axes) == 2
+    motion = cc.Motion(frames=walk_model.frames_[:20], channels=walk_model.all_channels_,
+                       skeleton=walk_model.skeleton_)
+    fig3 = plot_pose_strip(motion, [0, 10, 19])
+    assert fig3.axes
+    plt.close("all")
