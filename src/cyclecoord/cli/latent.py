@@ -88,6 +88,10 @@ def run(args: argparse.Namespace) -> int:
     if args.step < 1 or args.max_iter < 1:
         raise ParameterError("--step and --max-iter must be >= 1")
     out = Path(args.output)
+    for target in [out] + ([Path(args.report)] if args.report else []):
+        folder = target.parent if str(target.parent) else Path(".")
+        if not folder.is_dir():
+            raise ParameterError(f"{target}: folder {folder} does not exist")
     inputs = set()
     segments, names = [], []
     for i, text in enumerate(args.takes):
@@ -120,10 +124,16 @@ def run(args: argparse.Namespace) -> int:
         "fit_wall_s": time.perf_counter() - w0,
         "iterations": model.gp_.n_iter_,
     }
+    existed = out.exists()
     model.save(out)
     if args.report:
-        with atomic_write(args.report) as fh:
-            json.dump(summary, fh, indent=2)
+        try:
+            with atomic_write(args.report) as fh:
+                json.dump(summary, fh, indent=2)
+        except BaseException:
+            if not existed:
+                out.unlink(missing_ok=True)  # no partial output
+            raise
     print(
         f"{out}: {summary['frames']} frames in {len(names)} segments, {summary['pca_components']} "
         "PCA "
