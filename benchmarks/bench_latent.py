@@ -419,6 +419,31 @@ def fmt(x, spec=".2f"):
     return "n/a" if x is None else format(x, spec)
 
 
+def print_pairs(rows: list[dict]) -> None:
+    """The pair table."""
+    print("\n== transitions A -> B (threshold 1.5 % of bone length; blend 12 frames) ==")
+    print(
+        f"{'A':10} {'B':10} {'bridges':>7} {'MG':>4} {'hops':>4} | coverage: {'br play':>7} "
+        f"{'br move':>7} {'MG':>5} |"
+        f" acc/p99: {'latent':>6} {'MG':>6} | jerk/p99: {'latent':>6} {'MG':>6} | skate: "
+        f"{'lat':>5} {'MG':>5} {'train':>5}"
+    )
+    for r in rows:
+        lt, mg = r["latent"], r["mg"]
+        star = "" if mg["under_threshold"] else "*"
+        hops = "-" if lt is None else str(len(lt["route"]) - 1)
+        print(
+            f"{r['from'][:10]:10} {r['to'][:10]:10} {r['bridges']:7d} {r['mg_transitions']:4d} "
+            f"{hops:>4} |"
+            f"           {r['bridge_cov_play']:7.0%} {r['bridge_cov_move']:7.0%} "
+            f"{r['mg_cov_play']:5.0%} |"
+            f"          {fmt(lt and lt['acc']):>6} {fmt(mg['acc']) + star:>6} |"
+            f"           {fmt(lt and lt['jerk']):>6} {fmt(mg['jerk']) + star:>6} |"
+            f"        {fmt(lt and lt['skate'], '.1f'):>5} {fmt(mg['skate'], '.1f') + star:>5} "
+            f"{r['train_skate']:5.1f}"
+        )
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument(
@@ -452,27 +477,7 @@ def main(argv=None) -> int:
         )
     stats = training_stats(models, tests)
     rows = pair_rows(models, stats, not args.no_progress)
-    print("\n== transitions A -> B (threshold 1.5 % of bone length; blend 12 frames) ==")
-    print(
-        f"{'A':10} {'B':10} {'bridges':>7} {'MG':>4} {'hops':>4} | coverage: {'br play':>7} "
-        f"{'br move':>7} {'MG':>5} |"
-        f" acc/p99: {'latent':>6} {'MG':>6} | jerk/p99: {'latent':>6} {'MG':>6} | skate: "
-        f"{'lat':>5} {'MG':>5} {'train':>5}"
-    )
-    for r in rows:
-        lt, mg = r["latent"], r["mg"]
-        star = "" if mg["under_threshold"] else "*"
-        hops = "-" if lt is None else str(len(lt["route"]) - 1)
-        print(
-            f"{r['from'][:10]:10} {r['to'][:10]:10} {r['bridges']:7d} {r['mg_transitions']:4d} "
-            f"{hops:>4} |"
-            f"           {r['bridge_cov_play']:7.0%} {r['bridge_cov_move']:7.0%} "
-            f"{r['mg_cov_play']:5.0%} |"
-            f"          {fmt(lt and lt['acc']):>6} {fmt(mg['acc']) + star:>6} |"
-            f"           {fmt(lt and lt['jerk']):>6} {fmt(mg['jerk']) + star:>6} |"
-            f"        {fmt(lt and lt['skate'], '.1f'):>5} {fmt(mg['skate'], '.1f') + star:>5} "
-            f"{r['train_skate']:5.1f}"
-        )
+    print_pairs(rows)
     n = len(rows)
     with_br = sum(r["bridges"] > 0 for r in rows)
     with_mg = sum(r["mg_transitions"] > 0 for r in rows)

@@ -96,7 +96,8 @@ class LatentModel:
     n_components : int, default 3
         Latent dimension.
     variance : float, default 0.85
-        Fraction of the scaled data's variance the PCA keeps.
+        Fraction of the scaled data's variance the PCA keeps (at least ``n_components + 1``
+        components are kept, as the GPLVM reduces the PCA space further).
     gplvm : dict, optional
         Further :class:`~.gplvm.GPLVM` parameters.
     random_state : int, default 0
