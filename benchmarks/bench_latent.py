@@ -262,11 +262,26 @@ def window_stats(
     a = max(0, start - 2)
     b = start + n + 2
     # acc[k] is centred on frame k+1, jerk[k] spans k..k+3
-    return {
+    out = {
         "acc": float(acc[max(0, a - 1) : b].max() / p99[0]),
         "jerk": float(jerk[max(0, a - 2) : b].max() / p99[1]),
         "skate": foot_skating(motion[max(0, a) : b + 1], low),
     }
+    contacts = contacts_skating(motion)
+    if contacts is not None:
+        # quality.contacts (when present): fraction of the window's frames on which a
+        # planted foot point slides, contacts found on the whole synthesised motion
+        out["skating_frames_contacts"] = float(contacts.skating[a : b + 1].any(axis=1).mean())
+    return out
+
+
+def contacts_skating(motion: cc.Motion):
+    """``cyclecoord.quality.contacts.foot_skating(motion)`` when that module exists, else None."""
+    try:
+        from cyclecoord.quality.contacts import foot_skating as skating
+    except ImportError:
+        return None
+    return skating(motion)
 
 
 def training_stats(models: dict, tests: dict) -> dict:
@@ -310,12 +325,17 @@ def latent_transition(models, bridges, nA, nB, p99, low):
     stats = [
         window_stats(motion, ev["start_frame"], ev["blend_frames"], p99, low) for ev in syn.events
     ]
-    return {
+    out = {
         "acc": max(s["acc"] for s in stats),
         "jerk": max(s["jerk"] for s in stats),
         "skate": float(np.mean([s["skate"] for s in stats])),
         "route": [syn.events[0]["transition"][0]] + [ev["transition"][1] for ev in syn.events],
     }
+    if "skating_frames_contacts" in stats[0]:
+        out["skating_frames_contacts"] = float(
+            np.mean([s["skating_frames_contacts"] for s in stats])
+        )
+    return out
 
 
 def pair_rows(models: dict, stats: dict, progress: bool) -> list[dict]:
@@ -516,6 +536,20 @@ def main(argv=None) -> int:
         f"bridges at twice the threshold: {with_br2}/{n} pairs, mean coverage (play) "
         f"{summary['mean_cov_bridges_play_2x']:.0%}"
     )
+    lat_c = [r["latent"]["skating_frames_contacts"] for r in rows
+             if r["latent"] and "skating_frames_contacts" in r["latent"]]
+    if lat_c:
+        mg_c = [r["mg"]["skating_frames_contacts"] for r in rows if r["latent"]]
+        summary["skating_frames_contacts"] = {
+            "latent": float(np.mean(lat_c)),
+            "mg": float(np.mean(mg_c)),
+        }
+        print(
+            f"quality.contacts: planted feet skate on {np.mean(lat_c):.0%} of the latent blend "
+            f"windows' frames, {np.mean(mg_c):.0%} of the motion graph's (same pairs)"
+        )
+    else:
+        print("quality.contacts not available: foot skating is the minimal toe measure only")
     print(f"latent TRANSITION reaches {reached}/{n} pairs (through other models when needed)")
     print(
         f"latent transitions over 1.5x p99 acceleration: {summary['latent_pairs_over_1.5']} of "
