@@ -47,7 +47,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 import cyclecoord as cc  # noqa: E402
-from cyclecoord.synthesis.latent import LatentModel, Synthesizer, find_bridges, project  # noqa: E402
+from cyclecoord.synthesis.latent import (  # noqa: E402
+    LatentModel,
+    Synthesizer,
+    find_bridges,
+    project,
+)
 from cyclecoord.synthesis.transitions import aligned_transform, window_distances  # noqa: E402
 
 STEP = 4
