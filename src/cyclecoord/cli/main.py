@@ -784,7 +784,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
 #: ``add_parser(subparsers)``, which adds its parser and sets ``func`` to the function that
 #: runs it (taking the parsed arguments, returning the exit code).  Modules must import
 #: their heavy dependencies inside that function so ``cyclecoord --help`` stays fast.
-COMMAND_MODULES: tuple[str, ...] = ("view", "feet", "graph")
+COMMAND_MODULES: tuple[str, ...] = ("view", "feet", "graph", "latent", "animate")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,78 @@
+"""``cyclecoord animate``: run a JSON script of latent-synthesis commands into a motion file."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(subparsers) -> None:
+    p = subparsers.add_parser(
+        "animate",
+        help="synthesise a motion from a script of latent-space commands",
+        description=(
+            "Run SCRIPT.json (models by name, MOVE/IDLE/TRANSITION/PLAY commands, fps, seed; see "
+            "the README) and write the motion (.bvh, .amc, .npz or .csv). Nothing is written if "
+            "the script fails."
+        ),
+    )
+    p.add_argument("script", metavar="SCRIPT.json")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.bvh")
+    p.add_argument(
+        "--report", metavar="R.json", help="write a JSON report (commands, bridges, timing, checks)"
+    )
+    p.add_argument("--no-check", action="store_true", help="skip the plausibility checks")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import tempfile
+
+    from .. import save
+    from ..errors import ParameterError
+    from ..io._atomic import atomic_write
+    from ..synthesis.latent.script import run_script
+
+    out = Path(args.output)
+    script = Path(args.script)
+    if out.resolve() == script.resolve() or (
+        args.report and Path(args.report).resolve() == script.resolve()
+    ):
+        raise ParameterError(f"an output would overwrite the script {script}")
+    for target in [out] + ([Path(args.report)] if args.report else []):
+        if not (target.parent if str(target.parent) else Path(".")).is_dir():
+            raise ParameterError(f"{target}: folder {target.parent} does not exist")
+    motion, report = run_script(script, check=not args.no_check, progress=True)
+    # write both outputs to temporary files first, so a failure leaves neither
+    with tempfile.TemporaryDirectory(dir=out.parent if str(out.parent) else ".") as tmp:
+        staged = Path(tmp) / ("motion" + out.suffix)
+        asf = None
+        if out.suffix.lower() == ".amc":
+            asf = Path(tmp) / "motion.asf"
+            save(motion, staged, asf_path=asf)
+        else:
+            save(motion, staged)
+        if args.report:
+            with atomic_write(args.report) as fh:
+                json.dump(report, fh, indent=2, default=float)
+        if asf is not None:
+            asf.replace(out.with_suffix(".asf"))
+        staged.replace(out)
+    t = report["timing"]
+    fps = t["frames_per_second"]
+    cpu = t.get("frames_per_cpu_second")
+    speed = f", synthesis {fps:,.0f} frames/s" if fps else ""
+    if cpu:
+        speed += f" ({cpu:,.0f} per CPU second)"
+    print(
+        f"{out}: {report['frames']} frames ({report['duration_s']:.1f} s at {report['fps']:g} "
+        "fps), "
+        f"{len(report['transitions'])} transitions{speed}"
+    )
+    if "plausibility" in report:
+        pl = report["plausibility"]
+        print("plausibility: " + ("clean" if pl["clean"] else "; ".join(pl["notes"])))
+    return 0

@@ -1,0 +1,143 @@
+"""``cyclecoord latent fit``: train a latent (GPLVM) model on takes or labelled segments."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+__all__ = ["add_parser", "parse_take", "run"]
+
+
+def parse_take(text: str) -> tuple[str, int | None, int | None, str | None]:
+    """``PATH[:A:B][=NAME]`` -> (path, start, stop, name); A, B 0-based half-open frames."""
+    from ..errors import ParameterError
+
+    name = None
+    if "=" in text:
+        text, name = text.rsplit("=", 1)
+    parts = text.split(":")
+    if len(parts) == 1:
+        return parts[0], None, None, name
+    if len(parts) != 3:
+        raise ParameterError(
+            f"take {text!r}: expected PATH or PATH:A:B (0-based, half-open frames)"
+        )
+    try:
+        a = int(parts[1]) if parts[1] else None
+        b = int(parts[2]) if parts[2] else None
+    except ValueError:
+        raise ParameterError(f"take {text!r}: frames A:B must be whole numbers") from None
+    return parts[0], a, b, name
+
+
+def add_parser(subparsers) -> None:
+    p = subparsers.add_parser(
+        "latent",
+        help="train latent-space (GPLVM) motion models",
+        description="Latent-space models (Bailey et al.): influence scaling, PCA, GPLVM.",
+    )
+    sub = p.add_subparsers(dest="latent_command", metavar="ACTION")
+    f = sub.add_parser(
+        "fit",
+        help="train one model on takes or labelled segments",
+        description=(
+            "Train one GPLVM model on one or several training segments, each TAKE[:A:B][=NAME] "
+            "(an .amc/.bvh/.npz capture, optionally frames A..B-1, optionally named), e.g. "
+            "13_29.amc:0:456=JumpJack. All segments need the same channels."
+        ),
+    )
+    f.add_argument("takes", nargs="+", metavar="TAKE[:A:B][=NAME]")
+    f.add_argument("-o", "--output", required=True, metavar="MODEL.npz")
+    f.add_argument("--dims", type=int, default=3, help="latent dimensions (default 3)")
+    f.add_argument(
+        "--variance",
+        type=float,
+        default=0.85,
+        help="variance the PCA keeps, in (0, 1] (default 0.85)",
+    )
+    f.add_argument(
+        "--step",
+        type=int,
+        default=4,
+        help="keep every STEP-th frame (default 4: 120 fps captures train at 30 fps)",
+    )
+    f.add_argument("--max-iter", type=int, default=200, help="optimiser iterations (default 200)")
+    f.add_argument("--report", metavar="R.json", help="also write the model's summary as JSON")
+    f.set_defaults(func=run)
+    p.set_defaults(func=lambda args: _usage(p))
+
+
+def _usage(parser) -> int:
+    parser.print_help()
+    return 2
+
+
+def run(args: argparse.Namespace) -> int:
+    import time
+
+    from .. import load
+    from ..errors import ParameterError
+    from ..io._atomic import atomic_write
+    from ..synthesis.latent.model import LatentModel
+
+    if args.dims < 1:
+        raise ParameterError(f"--dims must be >= 1, got {args.dims}")
+    if not 0 < args.variance <= 1:
+        raise ParameterError(f"--variance must be in (0, 1], got {args.variance}")
+    if args.step < 1 or args.max_iter < 1:
+        raise ParameterError("--step and --max-iter must be >= 1")
+    out = Path(args.output)
+    for target in [out] + ([Path(args.report)] if args.report else []):
+        folder = target.parent if str(target.parent) else Path(".")
+        if not folder.is_dir():
+            raise ParameterError(f"{target}: folder {folder} does not exist")
+    inputs = set()
+    segments, names = [], []
+    for i, text in enumerate(args.takes):
+        path, a, b, name = parse_take(text)
+        inputs.add(Path(path).resolve())
+        motion = load(path).window((a, b))
+        seg = motion[:: args.step]
+        if seg.n_frames < 3:
+            raise ParameterError(
+                f"take {text!r} has only {seg.n_frames} frames after --step {args.step}"
+            )
+        segments.append(seg)
+        label = name or Path(path).stem + (
+            f"[{a or 0}:{b if b is not None else motion.n_frames + (a or 0)}]"
+            if a is not None or b is not None
+            else ""
+        )
+        names.append(label)
+    if out.resolve() in inputs:
+        raise ParameterError(f"output {out} is one of the inputs")
+    if len(set(names)) != len(names):
+        raise ParameterError(f"segment names repeat: {names}; name them with =NAME")
+    t0 = time.process_time()
+    w0 = time.perf_counter()
+    model = LatentModel(
+        n_components=args.dims, variance=args.variance, gplvm={"max_iter": args.max_iter}
+    ).fit(segments, names)
+    summary = model.describe() | {
+        "fit_cpu_s": time.process_time() - t0,
+        "fit_wall_s": time.perf_counter() - w0,
+        "iterations": model.gp_.n_iter_,
+    }
+    existed = out.exists()
+    model.save(out)
+    if args.report:
+        try:
+            with atomic_write(args.report) as fh:
+                json.dump(summary, fh, indent=2)
+        except BaseException:
+            if not existed:
+                out.unlink(missing_ok=True)  # no partial output
+            raise
+    print(
+        f"{out}: {summary['frames']} frames in {len(names)} segments, {summary['pca_components']} "
+        "PCA "
+        f"components ({summary['explained_variance']:.0%}), {args.dims}-D latent, fitted in "
+        f"{summary['fit_wall_s']:.1f} s ({summary['fit_cpu_s']:.1f} s CPU)"
+    )
+    return 0

@@ -1,0 +1,566 @@
+"""Commands that steer the particle (Bailey et al. Sec. 5.3): MOVE, IDLE, TRANSITION, PLAY.
+
+:class:`Synthesizer` holds the named models, the particle's state and the frames made
+so far.  MOVE follows a straight line or the shortest path through the command graph
+(the training latent points, complete, edge cost ``||x_i - x_j||^p`` with ``p = 4``),
+resampled to constant speed.  The paper writes the weight as ``||x_i - x_j||^-p``, the
+affinity of the connectivity prior; as a shortest-path *cost* that would favour the
+longest jumps, so the cost here is its reciprocal, which keeps paths on the data.
+IDLE hovers within ``r`` of one or several poses, TRANSITION moves to the nearest bridge
+and blends into the other model while both particles idle, PLAY replays a training
+segment as it was.  Root motion comes from the training frames nearest the particle.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import networkx as nx
+import numpy as np
+
+from ...errors import ParameterError
+from ...motion import Motion
+from .bridges import Bridges, check_compatible, find_bridges
+from .gplvm import sqdist
+from .model import LatentModel, heading_matrix
+from .particle import ParticleParams, RandomForce, simulate
+
+__all__ = ["CommandGraph", "Synthesizer", "resample", "smoothstep"]
+
+#: A latent target whose density proxy is below this lies outside the model.
+OUTSIDE_DENSITY = 0.05
+
+
+def smoothstep(n: int) -> np.ndarray:
+    """Blend weights rising smoothly from 0 to 1 over ``n`` frames (ends excluded)."""
+    u = (np.arange(n) + 1.0) / (n + 1.0)
+    return u * u * (3.0 - 2.0 * u)
+
+
+def eased(n: int, ramp: int) -> np.ndarray:
+    """Arc-length fractions ``(n + 1,)`` from 0 to 1: constant speed with smooth starts and
+    stops over ``ramp`` frames (speed rising as a smoothstep), so a MOVE does not jerk the
+    particle into motion or stop it dead."""
+    k = np.arange(n, dtype=float) + 0.5
+    r = max(1e-9, min(float(ramp), n / 2.0))
+    rise = np.clip(k / r, 0, 1)
+    fall = np.clip((n - k) / r, 0, 1)
+    v = np.minimum(rise * rise * (3 - 2 * rise), fall * fall * (3 - 2 * fall))
+    c = np.concatenate([[0.0], np.cumsum(v)])
+    return c / c[-1]
+
+
+def resample(points: np.ndarray, step: float) -> np.ndarray:
+    """A polyline ``(M, q)`` resampled at constant arc length ``step``; ends kept."""
+    seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    total = s[-1]
+    if total <= 1e-12:
+        return points[:1].copy()
+    n = max(1, int(np.ceil(total / step)))
+    u = np.linspace(0.0, total, n + 1)
+    return np.stack([np.interp(u, s, points[:, k]) for k in range(points.shape[1])], axis=1)
+
+
+class CommandGraph:
+    """Shortest paths over a model's training latent points (complete graph, cost ``d^p``)."""
+
+    def __init__(self, model: LatentModel, power: float = 4.0) -> None:
+        self.model = model
+        self.power = power
+        X = model.X_
+        n = X.shape[0]
+        i, j = np.triu_indices(n, 1)
+        cost = np.sqrt(sqdist(X, X))[i, j] ** power
+        self.graph = nx.Graph()
+        self.graph.add_weighted_edges_from(zip(i.tolist(), j.tolist(), cost.tolist()))
+
+    def path(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Polyline from ``a`` to ``b`` through training points, ``(M, q)``."""
+        X = self.model.X_
+        g = self.graph
+        da = np.sqrt(((X - a) ** 2).sum(1)) ** self.power
+        db = np.sqrt(((X - b) ** 2).sum(1)) ** self.power
+        g.add_weighted_edges_from(("a", k, float(c)) for k, c in enumerate(da))
+        g.add_weighted_edges_from(("b", k, float(c)) for k, c in enumerate(db))
+        g.add_edge("a", "b", weight=float(np.linalg.norm(a - b) ** self.power))
+        try:
+            nodes = nx.dijkstra_path(g, "a", "b")
+        finally:
+            g.remove_nodes_from(["a", "b"])
+        return np.vstack([a] + [X[k] for k in nodes[1:-1]] + [b])
+
+
+@dataclass
+class _Chunk:
+    model: str
+    X: np.ndarray
+    angles: np.ndarray
+    root: dict[str, np.ndarray]
+    command: int
+
+
+@dataclass
+class Synthesizer:
+    """Runs commands over named latent models and collects the frames.
+
+    Parameters
+    ----------
+    models : dict of str to LatentModel
+        Same joint-angle channels for any two models a TRANSITION joins.
+    fps : float
+        Output frame rate (one particle step a frame).
+    seed : int
+        Seeds the random force and IDLE's choice of poses.
+    params : ParticleParams
+    bridge_threshold : float, optional
+        See :func:`~.bridges.find_bridges`.
+    ease : float, default 0.25
+        Seconds over which a MOVE's path speeds up and slows down (0: the paper's
+        constant speed throughout).
+    clamp : bool, default True
+        Clip joint angles to the training range of the model(s) making each frame (the
+        count and largest clip are kept in ``clamped``).
+    """
+
+    models: dict[str, LatentModel]
+    fps: float = 30.0
+    seed: int = 0
+    params: ParticleParams = field(default_factory=ParticleParams)
+    bridge_threshold: float | None = None
+    clamp: bool = True
+    ease: float = 0.25
+
+    def __post_init__(self) -> None:
+        if not self.models:
+            raise ParameterError("no models")
+        if not np.isfinite(self.fps) or self.fps <= 0:
+            raise ParameterError(f"fps must be positive, got {self.fps}")
+        dims = {m.X_.shape[1] for m in self.models.values()}
+        self.force = RandomForce(max(dims), self.params.timescale, random_state=self.seed)
+        self.rng = np.random.default_rng(self.seed)
+        self.chunks: list[_Chunk] = []
+        self.current: str | None = None
+        self.x = self.v = None
+        self.t = 0.0
+        self.command = -1
+        self.events: list[dict[str, Any]] = []
+        self._graphs: dict[str, CommandGraph] = {}
+        self._bridges: dict[tuple[str, str], Bridges] = {}
+        self.sim_seconds = 0.0
+        self.sim_cpu_seconds = 0.0
+        self.clamped = {"values": 0, "max_deg": 0.0}
+        self._ranges: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+    def _range(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        if name not in self._ranges:
+            a = self.models[name].angles(self.models[name].frames_)
+            self._ranges[name] = (a.min(axis=0), a.max(axis=0))
+        return self._ranges[name]
+
+    # ---------------------------------------------------------------- helpers
+    def model(self, name: str) -> LatentModel:
+        if name not in self.models:
+            raise ParameterError(
+                f"unknown model {name!r}; the script defines {sorted(self.models)}"
+            )
+        return self.models[name]
+
+    def target(self, spec: Any, name: str | None = None) -> np.ndarray:
+        """A latent point of model ``name`` from a spec: ``[x, y, z]``, ``{"frame": k}`` or
+        ``{"segment": s, "time": seconds}``."""
+        name = name or self.current
+        m = self.model(name)
+        if isinstance(spec, _Point):
+            return np.asarray(spec, dtype=float)
+        q = m.X_.shape[1]
+        if isinstance(spec, dict):
+            unknown = sorted(set(spec) - {"frame", "segment", "time"})
+            if unknown:
+                raise ParameterError(
+                    f"unknown target key(s) {unknown}; use frame, or segment and time"
+                )
+            if "frame" in spec:
+                k = spec["frame"]
+                if not isinstance(k, int) or isinstance(k, bool) or not 0 <= k < m.X_.shape[0]:
+                    raise ParameterError(
+                        f"target frame {k!r} is not a training frame of {name!r} "
+                        f"(0..{m.X_.shape[0] - 1})"
+                    )
+                return m.X_[k].copy()
+            if "segment" in spec:
+                try:
+                    s = m.segment_index(str(spec["segment"]))
+                except KeyError:
+                    raise ParameterError(
+                        f"model {name!r} has no segment {spec['segment']!r}; it has "
+                        f"{m.segment_names_}"
+                    ) from None
+                idx = np.flatnonzero(m.segments_ == s)
+                t = spec.get("time", 0.0)
+                end = float(m.times_[idx][-1])
+                if not isinstance(t, (int, float)) or isinstance(t, bool) or not 0 <= t <= end + 1e-9:
+                    raise ParameterError(
+                        f"time {t!r} is not inside segment {spec['segment']!r} (0..{end:.3g} s)"
+                    )
+                return m.X_[idx[np.argmin(np.abs(m.times_[idx] - t))]].copy()
+            raise ParameterError("a target needs frame, or segment (and time)")
+        arr = np.asarray(spec, dtype=float) if isinstance(spec, (list, tuple)) else None
+        if arr is None or arr.shape != (q,) or not np.isfinite(arr).all():
+            raise ParameterError(
+                f"a latent target of {name!r} must be {q} numbers or a frame/segment, got {spec!r}"
+            )
+        if m.density(arr)[0] < OUTSIDE_DENSITY:
+            raise ParameterError(
+                f"target {spec} lies outside model {name!r} (no training frame near it)"
+            )
+        return arr
+
+    def _need_start(self, what: str) -> LatentModel:
+        if self.current is None:
+            raise ParameterError(
+                f"{what} before the particle was placed (start it in a model first)"
+            )
+        return self.models[self.current]
+
+    def _run(self, path: np.ndarray, radius: float | None = None) -> None:
+        m = self._need_start("moving")
+        params = self.params if radius is None else self.params.replace(radius=radius)
+        t0, c0 = time.perf_counter(), time.process_time()
+        X, V = simulate(m, path, self.x, self.v, self.fps, params, self.force, self.t)
+        self._emit(self.current, X, m.pose(X), self._root(m, X))
+        self.sim_seconds += time.perf_counter() - t0
+        self.sim_cpu_seconds += time.process_time() - c0
+        self.x, self.v = X[-1], V[-1]
+
+    def _clip(self, name: str, angles: np.ndarray) -> np.ndarray:
+        """Joint limits: clip to the training range of model ``name`` (counted)."""
+        if not self.clamp:
+            return angles
+        lo, hi = self._range(name)
+        clipped = np.clip(angles, lo, hi)
+        over = np.abs(clipped - angles)
+        self.clamped["values"] += int((over > 1e-9).sum())
+        self.clamped["max_deg"] = max(self.clamped["max_deg"], float(over.max(initial=0.0)))
+        return clipped
+
+    def _emit(self, name, X, angles, root, clip: bool = True) -> None:
+        if clip:
+            angles = self._clip(name, angles)
+        self.chunks.append(_Chunk(name, X, angles, root, self.command))
+        self.t += X.shape[0] / self.fps
+
+    @staticmethod
+    def _root(m: LatentModel, X: np.ndarray) -> dict[str, np.ndarray]:
+        w = m.root_weights(X)
+        r = m.root_
+        return {
+            "height": w @ r.height,
+            "velocity": w @ r.velocity,
+            "turn": w @ r.turn,
+            "tilt": np.einsum("tn,nab->tab", w, r.tilt),
+        }
+
+    def bridges(self, a: str, b: str) -> Bridges:
+        key = (a, b)
+        if key not in self._bridges:
+            self._bridges[key] = find_bridges(
+                self.model(a),
+                self.model(b),
+                names=key,
+                threshold=self.bridge_threshold,
+                random_state=self.seed,
+            )
+        return self._bridges[key]
+
+    # --------------------------------------------------------------- commands
+    def start(self, model: str, at: Any = None) -> None:
+        """Place the particle in ``model`` (at a target, default its first training frame)."""
+        m = self.model(model)
+        self.current = model
+        self.x = self.target(at, model) if at is not None else m.X_[0].copy()
+        self.v = np.zeros_like(self.x)
+
+    def move(
+        self,
+        to: Any,
+        path: str = "line",
+        duration: float | None = None,
+        speed: float = 1.0,
+        radius: float | None = None,
+    ) -> None:
+        """MOVE to a target along a line or the command graph's shortest path."""
+        m = self._need_start("MOVE")
+        goal = self.target(to)
+        if path == "line":
+            poly = np.vstack([self.x, goal])
+        elif path == "graph":
+            if self.current not in self._graphs:
+                self._graphs[self.current] = CommandGraph(m)
+            poly = self._graphs[self.current].path(self.x, goal)
+        else:
+            raise ParameterError(f"MOVE path must be 'line' or 'graph', got {path!r}")
+        if not (isinstance(speed, (int, float)) and speed > 0):
+            raise ParameterError(f"MOVE speed must be a positive number, got {speed!r}")
+        length = float(np.linalg.norm(np.diff(poly, axis=0), axis=1).sum())
+        if duration is None:
+            n = max(1, int(np.ceil(length / (m.speed_ * speed) * self.fps)))
+        else:
+            if not (isinstance(duration, (int, float)) and duration > 0):
+                raise ParameterError(
+                    f"MOVE duration must be a positive number of seconds, got {duration!r}"
+                )
+            n = max(1, int(round(duration * self.fps)))
+        ramp = int(round(self.ease * self.fps))
+        if ramp:
+            n += ramp  # the ramps lose about half their length each
+        dense = resample(poly, max(length / (4 * n), 1e-12))
+        s = (eased(n, ramp) if ramp else np.linspace(0, 1, n + 1)) * (dense.shape[0] - 1)
+        samples = np.stack(
+            [np.interp(s, np.arange(dense.shape[0]), dense[:, k]) for k in range(dense.shape[1])], 1
+        )
+        self._run(samples, radius)
+
+    def idle(
+        self, at: Any = None, duration: float = 1.0, radius: float | None = None, hover: float = 1.0
+    ) -> None:
+        """IDLE within ``radius`` of one point (default: where the particle is) or several."""
+        self._need_start("IDLE")
+        if not (isinstance(duration, (int, float)) and duration > 0):
+            raise ParameterError(
+                f"IDLE duration must be a positive number of seconds, got {duration!r}"
+            )
+        many = isinstance(at, list) and at and all(isinstance(a, (dict, list)) for a in at)
+        points = (
+            [self.target(a) for a in at]
+            if many
+            else [self.target(at) if at is not None else self.x.copy()]
+        )
+        end = self.t + duration
+        while self.t < end - 0.5 / self.fps:
+            p = points[int(self.rng.integers(len(points)))] if len(points) > 1 else points[0]
+            m = self.models[self.current]
+            gap = float(np.linalg.norm(p - self.x))
+            if gap > self.params.radius * m.speed_:
+                self.move(_Point(p), radius=radius)
+                if self.t >= end:
+                    break
+            n = max(
+                1, int(round(min(hover if len(points) > 1 else duration, end - self.t) * self.fps))
+            )
+            self._run(np.repeat(p[None, :], n + 1, axis=0), radius)
+
+    def route(self, src: str, to: str) -> list[str] | None:
+        """Models from ``src`` to ``to`` along bridges (fewest hops), or None.
+
+        The paper (Sec. 7): two models with no matching poses may be joined through a third
+        that has matching points with both.  Bridges between every pair of the script's
+        models are computed when a route is needed.
+        """
+        g = nx.DiGraph()
+        g.add_nodes_from(self.models)
+        for a in self.models:
+            for b in self.models:
+                if a != b and tuple(self.models[a].channels_) == tuple(self.models[b].channels_):
+                    if len(self.bridges(a, b)):
+                        g.add_edge(a, b)
+        try:
+            return nx.shortest_path(g, src, to)
+        except nx.NetworkXNoPath:
+            return None
+
+    def transition(
+        self, to: str, blend: float = 0.4, radius: float | None = None, route: bool = True
+    ) -> None:
+        """TRANSITION: move to the nearest bridge, blend into model ``to`` while both idle.
+
+        Without bridges from the current model to ``to`` and with ``route`` (default), the
+        particle goes through the models of :meth:`route`, one TRANSITION each.
+        """
+        self._need_start("TRANSITION")
+        src = self.current
+        if route and src != to:
+            check_compatible(
+                self.models[src], self.model(to), f"TRANSITION from {src!r} to {to!r}: "
+            )
+            if not len(self.bridges(src, to)):
+                hops = self.route(src, to)
+                if hops is not None:
+                    for nxt in hops[1:]:
+                        self.transition(nxt, blend=blend, radius=radius, route=False)
+                    return
+        m1, m2 = self.models[src], self.model(to)
+        check_compatible(m1, m2, f"TRANSITION from {src!r} to {to!r}: ")
+        if not (isinstance(blend, (int, float)) and blend > 0):
+            raise ParameterError(
+                f"TRANSITION blend must be a positive number of seconds, got {blend!r}"
+            )
+        br = self.bridges(src, to)
+        if not len(br):
+            near = br.best.min()
+            anywhere = br.best_raw.min() if br.best_raw is not None else near
+            detail = (
+                f"the closest poses differ by {near:.3g}"
+                if np.isfinite(near)
+                else f"no pose near {to!r}'s training data comes close (best {anywhere:.3g})"
+            )
+            raise ParameterError(
+                f"no bridges from {src!r} to {to!r}: {detail} (threshold {br.threshold:.3g}); "
+                + (
+                    "no chain of bridges through the script's other models reaches it either"
+                    if route
+                    else "go through another model (route)"
+                )
+            )
+        b = br.nearest(self.x)
+        small = 0.5 * (self.params.radius if radius is None else radius)
+        self.move(_Point(br.source_points[b]), radius=small)
+        n = max(1, int(round(blend * self.fps)))
+        still = np.repeat(br.source_points[b][None, :], n + 1, axis=0)
+        p1 = self.params.replace(radius=small)
+        X1, _ = simulate(m1, still, self.x, self.v, self.fps, p1, self.force, self.t)
+        x2 = br.target_points[b]
+        X2, V2 = simulate(
+            m2,
+            np.repeat(x2[None, :], n + 1, axis=0),
+            x2,
+            np.zeros_like(x2),
+            self.fps,
+            p1,
+            self.force,
+            self.t,
+        )
+        w = smoothstep(n)[:, None]
+        r1, r2 = self._root(m1, X1), self._root(m2, X2)
+        root = {
+            k: (1 - w.reshape((-1,) + (1,) * (r1[k].ndim - 1))) * r1[k]
+            + w.reshape((-1,) + (1,) * (r1[k].ndim - 1)) * r2[k]
+            for k in r1
+        }
+        # each model's pose is clipped to its own range before the blend, so the frames
+        # after the blend continue without a jump
+        blended = (1 - w) * self._clip(src, m1.pose(X1)) + w * self._clip(to, m2.pose(X2))
+        self._emit(to, X2, blended, root, clip=False)
+        self.events.append(
+            {
+                "command": self.command,
+                "transition": [src, to],
+                "bridge_frame": int(br.frames[b]),
+                "bridge_distance": float(br.distances[b]),
+                "bridges": len(br),
+                "blend_frames": n,
+                "start_frame": self.n_frames - n,
+            }
+        )
+        self.current, self.x, self.v = to, X2[-1], V2[-1]
+
+    def play(self, segment: str, start: float = 0.0, stop: float | None = None) -> None:
+        """PLAY a training segment of the current model as it was (seconds ``start..stop``)."""
+        m = self._need_start("PLAY")
+        try:
+            s = m.segment_index(str(segment))
+        except KeyError:
+            raise ParameterError(
+                f"model {self.current!r} has no segment {segment!r}; it has {m.segment_names_}"
+            ) from None
+        idx = np.flatnonzero(m.segments_ == s)
+        length = m.times_[idx][-1]
+        stop = length if stop is None else float(stop)
+        if not 0 <= float(start) < stop <= length + 1e-9:
+            raise ParameterError(
+                f"PLAY times {start}..{stop} s are not inside segment {segment!r} (0..{length:.3g} "
+                "s)"
+            )
+        first = idx[np.argmin(np.abs(m.times_[idx] - start))]
+        self.move(_Point(m.X_[first]), radius=0.25 * self.params.radius)
+        t = np.arange(float(start), stop, 1.0 / self.fps)
+        tt = m.times_[idx]
+
+        def interp(a: np.ndarray) -> np.ndarray:
+            return np.stack([np.interp(t, tt, col) for col in a.reshape(len(idx), -1).T], 1)
+
+        X = interp(m.X_[idx])
+        r = m.root_
+        root = {
+            "height": interp(r.height[idx])[:, 0],
+            "velocity": interp(r.velocity[idx]),
+            "turn": interp(r.turn[idx])[:, 0],
+            "tilt": interp(r.tilt[idx]).reshape(-1, 3, 3),
+        }
+        self._emit(self.current, X, interp(m.angles(m.frames_[idx])), root)
+        self.x = X[-1]
+        self.v = (X[-1] - X[-2]) * self.fps if len(X) > 1 else np.zeros_like(self.x)
+
+    # ----------------------------------------------------------------- output
+    @property
+    def n_frames(self) -> int:
+        return sum(c.X.shape[0] for c in self.chunks)
+
+    def motion(self) -> Motion:
+        """The frames so far as a motion on the first model's skeleton (root integrated)."""
+        from ..interpolate import _continuous_euler
+
+        if not self.chunks:
+            raise ParameterError("the script made no frames")
+        first = self.models[self.chunks[0].model]
+        angles = np.concatenate([c.angles for c in self.chunks])
+        keys = ("height", "velocity", "turn", "tilt")
+        root = {k: np.concatenate([c.root[k] for c in self.chunks]) for k in keys}
+        T = angles.shape[0]
+        theta = np.concatenate([[0.0], np.cumsum(root["turn"][:-1]) / self.fps])
+        head = heading_matrix(theta)
+        step = np.zeros((T, 3))
+        step[:, 0], step[:, 2] = root["velocity"][:, 0], root["velocity"][:, 1]
+        world = np.einsum("tab,tb->ta", head, step) / self.fps
+        pos = np.concatenate([np.zeros((1, 3)), np.cumsum(world[:-1], axis=0)])
+        pos[:, 1] = root["height"]
+        U, _, Vt = np.linalg.svd(root["tilt"])
+        tilt = U @ Vt
+        mats = head @ tilt
+        rj = first.skeleton_.joints[0]
+        if not np.allclose(rj.axis, np.eye(3)):
+            mats = rj.axis.T @ mats @ rj.axis
+        euler = _continuous_euler(mats, rj.rotation_order, None)
+        channels = first.all_channels_
+        frames = np.zeros((T, len(channels)))
+        col = {c: i for i, c in enumerate(channels)}
+        for k, d in enumerate(("tx", "ty", "tz")):
+            frames[:, col[(rj.name, d)]] = pos[:, k]
+        for k, ax in enumerate(rj.rotation_order.lower()):
+            frames[:, col[(rj.name, "r" + ax)]] = euler[:, k]
+        for k, c in enumerate(first.channels_):
+            frames[:, col[c]] = angles[:, k]
+        return Motion(
+            frames=frames,
+            channels=channels,
+            fps=self.fps,
+            skeleton=first.skeleton_,
+            source="synthetic:latent",
+        )
+
+    def segments(self) -> list[dict[str, Any]]:
+        """Which frames each command made and in which model."""
+        out, start = [], 0
+        for c in self.chunks:
+            n = c.X.shape[0]
+            if out and out[-1]["command"] == c.command and out[-1]["model"] == c.model:
+                out[-1]["stop"] += n
+            else:
+                out.append(
+                    {"command": c.command, "model": c.model, "start": start, "stop": start + n}
+                )
+            start += n
+        return out
+
+    def latent_path(self) -> list[tuple[str, np.ndarray]]:
+        """The particle's path per chunk: ``(model, X)``."""
+        return [(c.model, c.X) for c in self.chunks]
+
+
+class _Point(list):
+    """A latent point already resolved (skips the target checks)."""
+
+    def __init__(self, x: np.ndarray) -> None:
+        super().__init__(np.asarray(x, dtype=float).tolist())

@@ -1,0 +1,405 @@
+"""A latent motion model: influence scaling, PCA and a GPLVM over one kind of motion.
+
+:class:`LatentModel` chains the paper's Sec. 4: joint angles scaled by influence
+(:mod:`.influence`), PCA to the components explaining 85 % of the variance, and the
+GPLVM (:mod:`.gplvm`).  It maps latent points to poses (Eq. 8, linear in the number of
+training frames), gives the predictive variance and its gradient (the particle's
+likelihood force) and keeps the training frames, their segments and the root motion
+per frame, so a synthesised walk can walk.  Models are saved to and loaded from ``.npz``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import ParameterError, ParseError
+from ...motion import Motion
+from ...skeleton import Skeleton
+from .gplvm import GPLVM, rbf, sqdist
+from .influence import influence_weights
+
+__all__ = ["LatentModel", "RootTrack", "heading_matrix", "root_track"]
+
+_FORMAT = "cyclecoord-latent-model"
+_VERSION = 1
+
+
+def heading_matrix(theta: np.ndarray) -> np.ndarray:
+    """Rotations ``(T, 3, 3)`` by ``theta`` (radians) about the vertical y axis (z -> x)."""
+    c, s = np.cos(theta), np.sin(theta)
+    m = np.zeros(np.shape(theta) + (3, 3))
+    m[..., 0, 0], m[..., 0, 2], m[..., 1, 1], m[..., 2, 0], m[..., 2, 2] = c, s, 1.0, -s, c
+    return m
+
+
+@dataclass(frozen=True)
+class RootTrack:
+    """Root motion per training frame, free of where and which way the capture went.
+
+    Attributes
+    ----------
+    height : ndarray, shape (N,)
+        Root height (y), length units.
+    velocity : ndarray, shape (N, 2)
+        Horizontal velocity (x, z) in the root's heading frame, units per second.
+    turn : ndarray, shape (N,)
+        Heading rate about the vertical, radians per second.
+    tilt : ndarray, shape (N, 3, 3)
+        Root rotation with the heading removed.
+    """
+
+    height: np.ndarray
+    velocity: np.ndarray
+    turn: np.ndarray
+    tilt: np.ndarray
+
+
+def root_track(motion: Motion) -> RootTrack:
+    """The :class:`RootTrack` of one contiguous capture (y up, CMU facing +z at rest)."""
+    from ..interpolate import _root_rotation
+
+    mats, _, _ = _root_rotation(motion)
+    pos = motion.frames[
+        :, [motion.channel_index(motion.skeleton.joints[0].name, d) for d in ("tx", "ty", "tz")]
+    ]
+    fwd = mats[:, :, 2]
+    theta = np.arctan2(fwd[:, 0], fwd[:, 2])
+    head = heading_matrix(theta)
+    tilt = np.transpose(head, (0, 2, 1)) @ mats
+    n = motion.n_frames
+    step = np.diff(pos, axis=0, append=pos[-1:] + (pos[-1:] - pos[-2:-1] if n > 1 else 0))
+    local = np.einsum("tba,tb->ta", head, step)  # head^T @ step
+    dth = np.diff(
+        np.unwrap(theta),
+        append=np.unwrap(theta)[-1] if n < 2 else 2 * np.unwrap(theta)[-1] - np.unwrap(theta)[-2],
+    )
+    return RootTrack(
+        height=pos[:, 1].copy(),
+        velocity=local[:, [0, 2]] * motion.fps,
+        turn=dth * motion.fps,
+        tilt=tilt,
+    )
+
+
+class LatentModel:
+    """One kind of motion as a low-dimensional latent space (Bailey et al. Sec. 4).
+
+    Parameters
+    ----------
+    n_components : int, default 3
+        Latent dimension.
+    variance : float, default 0.85
+        Fraction of the scaled data's variance the PCA keeps (at least ``n_components + 1``
+        components are kept, as the GPLVM reduces the PCA space further).
+    gplvm : dict, optional
+        Further :class:`~.gplvm.GPLVM` parameters.
+    random_state : int, default 0
+
+    Attributes
+    ----------
+    channels_ : tuple of (joint, dof)
+        The modelled joint-angle channels (every channel but the root's).
+    root_channels_ : tuple of (joint, dof)
+    all_channels_ : tuple of (joint, dof)
+        Every channel of the training frames, in their order.
+    skeleton_ : Skeleton
+    fps_ : float
+        Rate of the training frames.
+    frames_ : ndarray, shape (N, D)
+        Training frames, every channel (root first as in the capture).
+    segments_ : ndarray of int, shape (N,)
+    segment_names_ : list of str
+    times_ : ndarray, shape (N,)
+        Seconds from each segment's start.
+    mean_, weights_ : ndarray, shape (C,)
+        Mean pose and influence weights (Eq. 3).
+    components_ : ndarray, shape (C, d_pca)
+        ``T_pca``.
+    Y_ : ndarray, shape (N, d_pca)
+    gp_ : GPLVM
+    X_ : ndarray, shape (N, q)
+    root_ : RootTrack
+    """
+
+    def __init__(
+        self,
+        n_components: int = 3,
+        variance: float = 0.85,
+        gplvm: dict | None = None,
+        random_state: int = 0,
+    ) -> None:
+        self.n_components = n_components
+        self.variance = variance
+        self.gplvm = gplvm
+        self.random_state = random_state
+
+    # ------------------------------------------------------------------ fitting
+    def fit(self, motions: Sequence[Motion], names: Sequence[str] | None = None) -> LatentModel:
+        """Fit to training segments (each a contiguous capture; same channels and rate).
+
+        Parameters
+        ----------
+        motions : sequence of Motion
+            With skeletons; their root channels drive :attr:`root_`, every other
+            channel is modelled.
+        names : sequence of str, optional
+            One name per segment (default ``"segment0"``, ...).
+        """
+        if not motions:
+            raise ParameterError("a latent model needs at least one training segment")
+        first = motions[0]
+        if first.skeleton is None:
+            raise ParameterError(
+                "a latent model needs motions with a skeleton (forward kinematics)"
+            )
+        for i, m in enumerate(motions):
+            if m.channels != first.channels:
+                raise ParameterError(f"training segment {i} has different channels from segment 0")
+            if abs(m.fps - first.fps) > 1e-9:
+                raise ParameterError(
+                    f"training segment {i} is at {m.fps:g} fps, segment 0 at {first.fps:g}"
+                )
+            if m.n_frames < 3:
+                raise ParameterError(
+                    f"training segment {i} has {m.n_frames} frames; at least 3 are needed"
+                )
+        if not 0 < self.variance <= 1:
+            raise ParameterError(f"variance must be in (0, 1], got {self.variance}")
+        root = set(first.root_channels())
+        self.root_channels_ = tuple(first.channels[i] for i in sorted(root))
+        self.channels_ = tuple(c for i, c in enumerate(first.channels) if i not in root)
+        self.all_channels_ = first.channels
+        self.skeleton_ = first.skeleton
+        self.fps_ = float(first.fps)
+        self.segment_names_ = (
+            list(names) if names is not None else [f"segment{i}" for i in range(len(motions))]
+        )
+        if len(self.segment_names_) != len(motions):
+            raise ParameterError(f"{len(self.segment_names_)} names for {len(motions)} segments")
+        self.frames_ = np.concatenate([m.frames for m in motions])
+        self.segments_ = np.concatenate([np.full(m.n_frames, i) for i, m in enumerate(motions)])
+        self.times_ = np.concatenate([np.arange(m.n_frames) / m.fps for m in motions])
+        tracks = [root_track(m) for m in motions]
+        self.root_ = RootTrack(
+            *(
+                np.concatenate([getattr(t, f) for t in tracks])
+                for f in ("height", "velocity", "turn", "tilt")
+            )
+        )
+        angles = self.angles(self.frames_)
+        self.mean_ = angles.mean(axis=0)
+        self.weights_ = influence_weights(angles, self.channels_, self.skeleton_)
+        Z = (angles - self.mean_) * self.weights_
+        _, S, Vt = np.linalg.svd(Z, full_matrices=False)
+        ratio = np.cumsum(S**2) / max((S**2).sum(), 1e-300)
+        d_pca = int(np.searchsorted(ratio, self.variance - 1e-12) + 1)
+        d_pca = max(d_pca, int(self.n_components) + 1)
+        d_pca = min(d_pca, Vt.shape[0])
+        self.explained_variance_ = float(ratio[d_pca - 1])
+        self.components_ = Vt[:d_pca].T
+        self.Y_ = Z @ self.components_
+        self.gp_ = GPLVM(
+            n_components=self.n_components, random_state=self.random_state, **(self.gplvm or {})
+        ).fit(self.Y_, self.segments_, self.times_)
+        self._precompute()
+        return self
+
+    def _precompute(self) -> None:
+        self.X_ = self.gp_.X_
+        inv_w = np.where(
+            self.weights_ > 0, 1.0 / np.where(self.weights_ > 0, self.weights_, 1.0), 0.0
+        )
+        # pose(x) = mean + k(x) @ B: Eq. 8's mean taken back through PCA and the scaling
+        self._B = (self.gp_.alpha_ @ self.components_.T) * inv_w
+        self._l2 = self.gp_.lengthscale_**2
+        steps = np.linalg.norm(np.diff(self.X_, axis=0), axis=1)
+        same = self.segments_[1:] == self.segments_[:-1]
+        self.speed_ = float(np.median(steps[same]) * self.fps_) if same.any() else 1.0
+        self._root_h2 = float((2.0 * np.median(steps[same]) if same.any() else 0.1) ** 2)
+
+    # -------------------------------------------------------------- mappings
+    def angles(self, frames: np.ndarray) -> np.ndarray:
+        """The modelled joint-angle columns of full frames ``(T, D)``."""
+        modelled = set(self.channels_)
+        cols = [i for i, c in enumerate(self.all_channels_) if c in modelled]
+        return np.asarray(frames, dtype=float)[:, cols]
+
+    def kernel(self, X: np.ndarray) -> np.ndarray:
+        """``k(x)`` for latent points ``(T, q)``: ``(T, N)``."""
+        return rbf(np.atleast_2d(X), self.X_, self.gp_.variance_, self._l2)
+
+    def pose(self, X: np.ndarray) -> np.ndarray:
+        """Joint angles (degrees) ``(T, C)`` of latent points ``(T, q)`` (Eq. 8's mean)."""
+        return self.mean_ + self.kernel(X) @ self._B
+
+    def pca_coordinates(self, angles: np.ndarray) -> np.ndarray:
+        """Eq. 13: joint angles ``(T, C)`` into this model's PCA space ``(T, d_pca)``."""
+        return ((np.atleast_2d(angles) - self.mean_) * self.weights_) @ self.components_
+
+    def mean_y(self, X: np.ndarray) -> np.ndarray:
+        """GP mean in PCA space ``(T, d_pca)``."""
+        return self.kernel(X) @ self.gp_.alpha_
+
+    def predictive_variance(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """Predictive variance ``k(x, x) - k(x)^T K^-1 k(x)`` of the noise-free GP (Eq. 8)
+        at latent point ``x`` (q,) and its gradient (time quadratic in the training size)."""
+        diff = x[None, :] - self.X_
+        k = self.gp_.variance_ * np.exp(-0.5 * (diff * diff).sum(1) / self._l2)
+        u = self.gp_.kinv_ @ k
+        var = max(self.gp_.variance_ - float(k @ u), 0.0)
+        grad = (2.0 / self._l2) * ((u * k) @ diff)
+        return var, grad
+
+    def density(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """Likelihood proxy ``p(x|M) = s_w / (s_w + sigma^2(x))`` in (0, 1] and its gradient.
+
+        ``sigma^2(x)`` is :meth:`predictive_variance` and ``s_w`` the white noise variance: ``p`` is
+        near 1 where the GP knows the pose up to the data's own noise and falls towards
+        0 away from the training points.  (Normalising by the RBF variance instead gives
+        a proxy that stays near 1 wherever the fitted length scale exceeds the data's
+        extent, which it often does.)
+        """
+        var, grad = self.predictive_variance(x)
+        w = self.gp_.noise_
+        p = w / (w + var)
+        return p, (-w / (w + var) ** 2) * grad
+
+    def densities(self, X: np.ndarray) -> np.ndarray:
+        """:meth:`density` (without gradient) of many latent points ``(T, q)`` at once."""
+        K = self.kernel(X)
+        var = np.maximum(self.gp_.variance_ - ((K @ self.gp_.kinv_) * K).sum(1), 0.0)
+        return self.gp_.noise_ / (self.gp_.noise_ + var)
+
+    def nearest_frame(self, X: np.ndarray) -> np.ndarray:
+        """Index of the training frame nearest each latent point ``(T, q)``."""
+        return np.argmin(sqdist(np.atleast_2d(X), self.X_), axis=1)
+
+    def root_weights(self, X: np.ndarray) -> np.ndarray:
+        """Normalised weights ``(T, N)`` of the training frames near each latent point."""
+        d2 = sqdist(np.atleast_2d(X), self.X_)
+        w = np.exp(-0.5 * (d2 - d2.min(axis=1, keepdims=True)) / self._root_h2)
+        return w / w.sum(axis=1, keepdims=True)
+
+    def segment_index(self, name: str) -> int:
+        try:
+            return self.segment_names_.index(name)
+        except ValueError:
+            raise KeyError(name) from None
+
+    def describe(self) -> dict:
+        """Sizes and hyperparameters for reports."""
+        return {
+            "frames": int(self.X_.shape[0]),
+            "segments": list(self.segment_names_),
+            "fps": self.fps_,
+            "channels": len(self.channels_),
+            "pca_components": int(self.components_.shape[1]),
+            "explained_variance": self.explained_variance_,
+            "latent_dims": int(self.X_.shape[1]),
+            "rbf_variance": self.gp_.variance_,
+            "lengthscale": self.gp_.lengthscale_,
+            "white_variance": self.gp_.noise_,
+            "latent_speed_per_s": self.speed_,
+        }
+
+    # --------------------------------------------------------------- storage
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Write the model and its training frames to ``path`` (``.npz``, atomic)."""
+        from ...io._atomic import atomic_write
+        from ...io.tabular import read_npz, write_npz  # noqa: F401
+
+        train = Motion(
+            frames=self.frames_, channels=self.all_channels_, fps=self.fps_, skeleton=self.skeleton_
+        )
+        with tempfile.TemporaryDirectory() as tmp:
+            write_npz(train, Path(tmp) / "train.npz")
+            with np.load(Path(tmp) / "train.npz", allow_pickle=False) as data:
+                arrays = {f"motion_{k}": data[k] for k in data.files}
+        arrays.update(
+            {
+                "format": np.array(_FORMAT),
+                "version": np.array(_VERSION),
+                "segments": self.segments_,
+                "times": self.times_,
+                "segment_names": np.array(json.dumps(self.segment_names_)),
+                "n_modelled": np.array(len(self.channels_)),
+                "n_root": np.array(len(self.root_channels_)),
+                "mean": self.mean_,
+                "weights": self.weights_,
+                "components": self.components_,
+                "Y": self.Y_,
+                "X": self.X_,
+                "explained_variance": np.array(self.explained_variance_),
+                "hyper": np.array([self.gp_.variance_, self.gp_.lengthscale_, self.gp_.noise_]),
+                "params": np.array(
+                    json.dumps(
+                        {
+                            "n_components": self.n_components,
+                            "variance": self.variance,
+                            "gplvm": self.gplvm,
+                            "random_state": self.random_state,
+                        }
+                    )
+                ),
+            }
+        )
+        with atomic_write(path, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> LatentModel:
+        """Read a model written by :meth:`save`."""
+        from ...io.tabular import read_npz
+
+        p = Path(path)
+        try:
+            with np.load(p, allow_pickle=False) as data:
+                arrays = {k: data[k] for k in data.files}
+        except (OSError, ValueError) as exc:
+            raise ParseError(f"cannot read a latent model: {exc}", p) from None
+        if str(arrays.get("format", "")) != _FORMAT:
+            raise ParseError(f"not a latent model (no format '{_FORMAT}')", p)
+        with tempfile.TemporaryDirectory() as tmp:
+            np.savez(
+                Path(tmp) / "train.npz",
+                **{k[7:]: v for k, v in arrays.items() if k.startswith("motion_")},
+            )
+            train = read_npz(Path(tmp) / "train.npz")
+        params = json.loads(str(arrays["params"]))
+        m = cls(**params)
+        n_root = int(arrays["n_root"])
+        m.all_channels_ = train.channels
+        root = set(train.root_channels())
+        m.root_channels_ = tuple(c for i, c in enumerate(train.channels) if i in root)
+        m.channels_ = tuple(c for i, c in enumerate(train.channels) if i not in root)
+        if len(m.root_channels_) != n_root or len(m.channels_) != int(arrays["n_modelled"]):
+            raise ParseError("the stored training frames do not match the model's channels", p)
+        m.skeleton_, m.fps_, m.frames_ = train.skeleton, train.fps, np.array(train.frames)
+        m.segments_, m.times_ = arrays["segments"], arrays["times"]
+        m.segment_names_ = json.loads(str(arrays["segment_names"]))
+        m.mean_, m.weights_, m.components_ = arrays["mean"], arrays["weights"], arrays["components"]
+        m.Y_, m.explained_variance_ = arrays["Y"], float(arrays["explained_variance"])
+        m.gp_ = GPLVM.from_arrays(arrays["X"], *arrays["hyper"], m.Y_)
+        starts = np.flatnonzero(np.r_[True, m.segments_[1:] != m.segments_[:-1]])
+        stops = np.r_[starts[1:], len(m.segments_)]
+        tracks = [root_track(train[a:b]) for a, b in zip(starts, stops)]
+        m.root_ = RootTrack(
+            *(
+                np.concatenate([getattr(t, f) for t in tracks])
+                for f in ("height", "velocity", "turn", "tilt")
+            )
+        )
+        m._precompute()
+        return m
+
+
+def _check_skeleton(a: Skeleton, b: Skeleton) -> bool:
+    """Whether two skeletons have the same joints and dofs (bone lengths may differ)."""
+    return [(j.name, j.dofs) for j in a.joints] == [(j.name, j.dofs) for j in b.joints]

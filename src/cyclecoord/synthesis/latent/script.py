@@ -1,0 +1,232 @@
+"""JSON scripts of latent-synthesis commands: models by name, commands, frame rate, seed.
+
+A script is a JSON object::
+
+    {
+      "fps": 30, "seed": 0,
+      "models": {"jumpjack": "jumpjack.npz", "twist": "twist.npz"},
+      "start": {"model": "jumpjack", "at": {"frame": 0}},
+      "particle": {"radius": 0.15, "random": 6},
+      "bridge_threshold": null,
+      "commands": [
+        {"command": "IDLE", "duration": 1.5},
+        {"command": "MOVE", "to": {"segment": "JumpJack", "time": 2.0}, "path": "graph"},
+        {"command": "TRANSITION", "to": "twist", "blend": 0.4},
+        {"command": "PLAY", "segment": "Twist", "start": 0, "stop": 2},
+        {"command": "IDLE", "at": [{"frame": 10}, {"frame": 40}], "duration": 3, "hover": 1}
+      ]
+    }
+
+Model paths are relative to the script's folder.  Every problem is reported as one
+:class:`~cyclecoord.errors.ParameterError` line naming the script and the entry
+(``commands[2] (TRANSITION)``, ``models.twist``, ...).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ...errors import CycleCoordError, ParameterError, ParseError
+from .commands import Synthesizer
+from .model import LatentModel
+from .particle import ParticleParams
+
+__all__ = ["COMMANDS", "TOP_KEYS", "load_script", "run_script"]
+
+TOP_KEYS = {"fps", "seed", "models", "start", "particle", "bridge_threshold", "commands"}
+#: Each command's allowed keys (besides "command").
+COMMANDS = {
+    "MOVE": {"to", "path", "duration", "speed", "radius"},
+    "IDLE": {"at", "duration", "radius", "hover"},
+    "TRANSITION": {"to", "blend", "radius", "route"},
+    "PLAY": {"segment", "start", "stop"},
+}
+_REQUIRED = {"MOVE": {"to"}, "IDLE": {"duration"}, "TRANSITION": {"to"}, "PLAY": {"segment"}}
+
+
+def _fail(path: Path, where: str, message: str) -> ParameterError:
+    return ParameterError(f"{path}: {where}: {message}")
+
+
+def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel]]:
+    """Read and check a script and load its models (nothing is run)."""
+    p = Path(path)
+    try:
+        spec = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ParameterError(f"{p}: script not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ParseError(f"cannot read the script: {exc}", p) from None
+    except json.JSONDecodeError as exc:
+        raise ParseError(f"not valid JSON: {exc.msg}", p, line=exc.lineno) from None
+    if not isinstance(spec, dict):
+        raise _fail(p, "top level", "a script is a JSON object")
+    unknown = sorted(set(spec) - TOP_KEYS)
+    if unknown:
+        raise _fail(p, "top level", f"unknown key(s) {unknown}; known: {sorted(TOP_KEYS)}")
+    fps = spec.get("fps", 30)
+    if (
+        not isinstance(fps, (int, float))
+        or isinstance(fps, bool)
+        or not np.isfinite(fps)
+        or fps <= 0
+    ):
+        raise _fail(p, "fps", f"must be a positive number, got {fps!r}")
+    seed = spec.get("seed", 0)
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise _fail(p, "seed", f"must be a whole number >= 0, got {seed!r}")
+    models_spec = spec.get("models")
+    if not isinstance(models_spec, dict) or not models_spec:
+        raise _fail(p, "models", "must map model names to .npz files")
+    models: dict[str, LatentModel] = {}
+    for name, file in models_spec.items():
+        if not isinstance(file, str):
+            raise _fail(p, f"models.{name}", f"must be a path, got {file!r}")
+        mp = (p.parent / file) if not Path(file).is_absolute() else Path(file)
+        if not mp.is_file():
+            raise _fail(p, f"models.{name}", f"model file {mp} not found")
+        try:
+            models[name] = LatentModel.load(mp)
+        except CycleCoordError as exc:
+            raise _fail(p, f"models.{name}", str(exc)) from None
+    start = spec.get("start", {"model": next(iter(models))})
+    if not isinstance(start, dict) or "model" not in start or set(start) - {"model", "at"}:
+        raise _fail(p, "start", 'must be {"model": NAME} with an optional "at" target')
+    if start["model"] not in models:
+        raise _fail(
+            p, "start", f"unknown model {start['model']!r}; the script defines {sorted(models)}"
+        )
+    try:
+        ParticleParams().replace(**(spec.get("particle") or {}))
+    except (ParameterError, TypeError) as exc:
+        raise _fail(p, "particle", str(exc)) from None
+    thr = spec.get("bridge_threshold")
+    if thr is not None and (not isinstance(thr, (int, float)) or isinstance(thr, bool) or thr <= 0):
+        raise _fail(
+            p, "bridge_threshold", f"must be a positive number of skeleton units, got {thr!r}"
+        )
+    commands = spec.get("commands")
+    if not isinstance(commands, list) or not commands:
+        raise _fail(p, "commands", "must be a non-empty list")
+    for i, c in enumerate(commands):
+        where = f"commands[{i}]"
+        if not isinstance(c, dict) or not isinstance(c.get("command"), str):
+            raise _fail(
+                p, where, 'each command is an object with "command": MOVE, IDLE, TRANSITION or PLAY'
+            )
+        kind = c["command"].upper()
+        where = f"commands[{i}] ({c['command']})"
+        if kind not in COMMANDS:
+            raise _fail(p, where, f"unknown command; use one of {sorted(COMMANDS)}")
+        extra = sorted(set(c) - COMMANDS[kind] - {"command"})
+        if extra:
+            raise _fail(p, where, f"unknown key(s) {extra}; {kind} takes {sorted(COMMANDS[kind])}")
+        missing = sorted(_REQUIRED[kind] - set(c))
+        if missing:
+            raise _fail(p, where, f"missing {missing}")
+        if kind == "TRANSITION" and c["to"] not in models:
+            raise _fail(p, where, f"unknown model {c['to']!r}; the script defines {sorted(models)}")
+    return spec, models
+
+
+def run_script(path: str | Path, check: bool = True, progress: bool = False):
+    """Run a script: the synthesised :class:`~cyclecoord.motion.Motion` and a report dict.
+
+    Parameters
+    ----------
+    path : path-like
+    check : bool, default True
+        Run the plausibility checks (joint ranges against the models' training frames,
+        new limb contacts) for the report.
+    progress : bool
+        A tqdm bar over the commands.
+    """
+    p = Path(path)
+    spec, models = load_script(p)
+    params = ParticleParams().replace(**(spec.get("particle") or {}))
+    syn = Synthesizer(
+        models,
+        fps=float(spec.get("fps", 30)),
+        seed=int(spec.get("seed", 0)),
+        params=params,
+        bridge_threshold=spec.get("bridge_threshold"),
+    )
+    start = spec.get("start", {"model": next(iter(models))})
+    t0 = time.perf_counter()
+    try:
+        syn.start(start["model"], start.get("at"))
+    except ParameterError as exc:
+        raise _fail(p, "start", str(exc)) from None
+    commands = spec["commands"]
+    if progress:
+        from tqdm import tqdm
+
+        iterator = tqdm(list(enumerate(commands)), desc="commands", unit="cmd", delay=2.0)
+    else:
+        iterator = enumerate(commands)
+    for i, c in iterator:
+        kind = c["command"].upper()
+        syn.command = i
+        args = {k: v for k, v in c.items() if k != "command"}
+        try:
+            if kind == "MOVE":
+                syn.move(**args)
+            elif kind == "IDLE":
+                syn.idle(**args)
+            elif kind == "TRANSITION":
+                syn.transition(**args)
+            else:
+                syn.play(**args)
+        except ParameterError as exc:
+            raise _fail(p, f"commands[{i}] ({c['command']})", str(exc)) from None
+    total = time.perf_counter() - t0
+    motion = syn.motion()
+    report: dict[str, Any] = {
+        "script": str(p),
+        "fps": syn.fps,
+        "seed": syn.seed,
+        "frames": motion.n_frames,
+        "duration_s": motion.duration,
+        "models": {k: m.describe() for k, m in models.items()},
+        "output_skeleton_from": syn.chunks[0].model,
+        "commands": syn.segments(),
+        "transitions": syn.events,
+        "clamped_to_training_range": syn.clamped,
+        "bridges": {f"{a}->{b}": br.to_dict() for (a, b), br in syn._bridges.items()},
+        "timing": {
+            "total_s": total,
+            "particle_and_pose_s": syn.sim_seconds,
+            "particle_and_pose_cpu_s": syn.sim_cpu_seconds,
+            "frames_per_second": motion.n_frames / syn.sim_seconds if syn.sim_seconds > 0 else None,
+            "frames_per_cpu_second": motion.n_frames / syn.sim_cpu_seconds
+            if syn.sim_cpu_seconds > 0
+            else None,
+        },
+    }
+    sizes = {round(m.skeleton_.total_length(), 6) for m in models.values()}
+    if len(sizes) > 1:
+        report["notes"] = [
+            "the models' skeletons have the same joints but different bone lengths; "
+            f"the output uses {syn.chunks[0].model!r}'s"
+        ]
+    if check:
+        from ...motion import Motion
+        from ...quality.plausibility import check_plausibility
+
+        used = {c.model for c in syn.chunks}
+        refs = [
+            Motion(
+                frames=models[k].frames_,
+                channels=models[k].all_channels_,
+                fps=models[k].fps_,
+                skeleton=models[k].skeleton_,
+            )
+            for k in sorted(used)
+        ]
+        report["plausibility"] = check_plausibility(motion, refs).to_dict()
+    return motion, report

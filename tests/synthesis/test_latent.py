@@ -1,0 +1,264 @@
+"""Latent synthesis: GPLVM gradients, models, particle, bridges, commands, Kovar distances."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import optimize
+
+import cyclecoord as cc
+from cyclecoord.errors import ParameterError
+from cyclecoord.synthesis.latent import LatentModel, Synthesizer, find_bridges
+from cyclecoord.synthesis.latent.commands import CommandGraph, eased, resample
+from cyclecoord.synthesis.latent.gplvm import GPLVM, objective
+from cyclecoord.synthesis.latent.influence import influence_weights
+from cyclecoord.synthesis.latent.particle import ParticleParams, RandomForce, simulate
+from cyclecoord.synthesis.transitions import (
+    aligned_transform,
+    transition_points,
+    window_distances,
+)
+
+
+def _capture(kind: str, seed: int = 0, n: int = 240):
+    return cc.datasets.make_periodic_capture(kind=kind, n_frames=n, random_state=seed).motion
+
+
+@pytest.fixture(scope="module")
+def walk_model():
+    m = _capture("walk")
+    return LatentModel(gplvm={"max_iter": 60}).fit([m[0:120:4], m[120:240:4]], ["a", "b"])
+
+
+@pytest.fixture(scope="module")
+def jog_model():
+    # another performance of the walk (its own style and noise), standing in for a second kind
+    m = _capture("walk", seed=5)
+    return LatentModel(gplvm={"max_iter": 60}).fit([m[::4]], ["jog"])
+
+
+# ------------------------------------------------------------------------ GPLVM
+@pytest.mark.parametrize("weight", [0.0, 1.0])
+def test_objective_gradient_matches_finite_differences(weight):
+    rng = np.random.default_rng(0)
+    n, q = 30, 3
+    t = np.linspace(0, 2, n)
+    Y = np.c_[np.sin(3 * t), np.cos(3 * t), np.sin(6 * t), t, t**2] + 0.05 * rng.normal(size=(n, 5))
+    Y -= Y.mean(0)
+    seg = (np.arange(n) >= 15).astype(int)
+    times = np.where(seg == 0, t, t - t[15])
+    g = GPLVM(connectivity_weight=weight, connectivity_points=20)
+    X0 = Y[:, :q] / Y[:, 0].std() + 0.02 * rng.normal(size=(n, q))
+    st = g.settings(Y, seg, times, X0)
+    theta = np.concatenate([X0.ravel(), np.log([0.7, 1.3, 0.05])])
+    f, grad = objective(theta, st, q)
+    num = optimize.approx_fprime(theta, lambda x: objective(x, st, q)[0], 1e-6)
+    assert np.isfinite(f)
+    assert np.abs(grad - num).max() < 1e-4 * max(1.0, np.abs(grad).max())
+
+
+def test_connectivity_prior_penalises_separated_segments():
+    # the same two curves, near each other or far apart: the negative log prior is
+    # larger when the graph falls apart into two clusters
+    from cyclecoord.synthesis.latent.gplvm import _connectivity
+
+    t = np.linspace(0, 2 * np.pi, 20, endpoint=False)
+    curve = np.c_[np.cos(t), np.sin(t), 0.3 * np.cos(2 * t)]
+    costs = []
+    for gap in (0.3, 3.0):
+        X = np.vstack([curve, curve + [gap, 0, 0]])
+        costs.append(_connectivity(X, 1.0, 2.0, 4.0, 0.01)[0])
+    assert costs[0] < costs[1]
+
+
+def test_influence_weights_ignore_channels_that_do_not_move_the_body():
+    m = _capture("walk", n=60)
+    root = set(m.root_channels())
+    ch = [c for i, c in enumerate(m.channels) if i not in root]
+    angles = m.frames[:, [m.channel_index(*c) for c in ch]]
+    w = influence_weights(angles, ch, m.skeleton)
+    assert w.shape == (len(ch),)
+    assert np.all(w >= 0)
+    # a constant channel gets 0; the hip's flexion moves the whole leg, a toe the least
+    const = np.flatnonzero(angles.std(0) == 0)
+    assert np.all(w[const] == 0)
+    hip = ch.index(("rfemur", "rx"))
+    moving = np.flatnonzero(angles.std(0) > 0)
+    assert w[hip] >= np.median(w[moving])
+
+
+# ------------------------------------------------------------------------ model
+def test_model_rebuilds_training_frames_and_round_trips(walk_model, tmp_path):
+    m = walk_model
+    train = m.angles(m.frames_)
+    err = np.sqrt(((m.pose(m.X_) - train) ** 2).mean())
+    assert err < 0.5 * train.std(0).mean()
+    assert m.X_.shape[1] == 3
+    assert m.explained_variance_ >= 0.85
+    path = tmp_path / "walk.npz"
+    m.save(path)
+    back = LatentModel.load(path)
+    np.testing.assert_allclose(back.pose(m.X_[:7]), m.pose(m.X_[:7]), atol=1e-8)
+    np.testing.assert_array_equal(back.frames_, m.frames_)
+    assert back.segment_names_ == ["a", "b"]
+    p, grad = back.density(m.X_[3])
+    assert 0 < p <= 1 and grad.shape == (3,)
+    far = back.densities(m.X_[:1] + 100.0)
+    assert far[0] < 0.05
+
+
+def test_density_gradient_matches_finite_differences(walk_model):
+    x = walk_model.X_[5] + 0.05
+    _, g = walk_model.density(x)
+    h = 1e-3  # central differences: the variance is a small difference of large numbers
+    num = [
+        (walk_model.density(x + h * e)[0] - walk_model.density(x - h * e)[0]) / (2 * h)
+        for e in np.eye(3)
+    ]
+    np.testing.assert_allclose(g, num, rtol=1e-3, atol=1e-4)
+
+
+def test_load_rejects_other_files(tmp_path):
+    bad = tmp_path / "x.npz"
+    np.savez(bad, a=np.zeros(3))
+    with pytest.raises(cc.ParseError, match="not a latent model"):
+        LatentModel.load(bad)
+
+
+# --------------------------------------------------------------------- particle
+def test_particle_stays_near_its_path_and_is_seeded(walk_model):
+    m = walk_model
+    path = np.linspace(m.X_[0], m.X_[20], 61)
+    params = ParticleParams(random=6.0)
+    runs = [
+        simulate(m, path, m.X_[0], np.zeros(3), 30.0, params, RandomForce(3, 0.4, random_state=s))[
+            0
+        ]
+        for s in (0, 0, 1)
+    ]
+    np.testing.assert_array_equal(runs[0], runs[1])
+    assert not np.allclose(runs[0], runs[2])
+    r = params.radius * m.speed_
+    dist = np.linalg.norm(runs[0] - path[1:], axis=1)
+    assert dist.max() < 2.0 * r
+
+
+def test_particle_params_are_checked():
+    with pytest.raises(ParameterError, match="unknown particle parameter"):
+        ParticleParams().replace(radiuss=1)
+    with pytest.raises(ParameterError, match="positive"):
+        ParticleParams(width=0)
+
+
+def test_path_helpers():
+    pts = np.array([[0.0, 0, 0], [1, 0, 0], [1, 2, 0]])
+    r = resample(pts, 0.5)
+    steps = np.linalg.norm(np.diff(r, axis=0), axis=1)
+    np.testing.assert_allclose(steps, 0.5)
+    u = eased(20, 5)
+    assert u[0] == 0 and u[-1] == pytest.approx(1) and np.all(np.diff(u) > 0)
+    assert np.diff(u)[0] < np.diff(u)[10]
+
+
+def test_command_graph_path_follows_the_data(walk_model):
+    g = CommandGraph(walk_model)
+    a, b = walk_model.X_[0], walk_model.X_[25]
+    poly = g.path(a, b)
+    assert np.allclose(poly[0], a) and np.allclose(poly[-1], b)
+    # hops are short: no edge longer than the straight jump
+    assert np.linalg.norm(np.diff(poly, axis=0), axis=1).max() <= np.linalg.norm(b - a) + 1e-12
+
+
+# ---------------------------------------------------------------------- bridges
+def test_bridges_of_a_model_to_itself_match_poses(walk_model):
+    br = find_bridges(walk_model, walk_model, names=("w", "w"))
+    assert len(br) > 0.8 * walk_model.X_.shape[0]
+    assert np.all(br.distances < br.threshold)
+    assert br.to_dict()["count"] == len(br)
+
+
+def test_synthesizer_transition_and_output(walk_model, jog_model):
+    syn = Synthesizer({"walk": walk_model, "jog": jog_model}, fps=30, seed=3)
+    syn.start("walk")
+    syn.idle(duration=0.5)
+    syn.move({"segment": "b", "time": 0.5}, path="graph")
+    syn.transition("jog", blend=0.3)
+    syn.play("jog", 0.0, 0.5)
+    motion = syn.motion()
+    assert motion.n_frames == syn.n_frames and motion.fps == 30
+    assert syn.events and syn.events[0]["transition"] == ["walk", "jog"]
+    assert np.isfinite(motion.frames).all()
+    # walking moves the root forward
+    assert (
+        np.ptp(motion.frames[:, motion.channel_index("root", "tz")])
+        + np.ptp(motion.frames[:, motion.channel_index("root", "tx")])
+        > 1.0
+    )
+    again = Synthesizer({"walk": walk_model, "jog": jog_model}, fps=30, seed=3)
+    again.start("walk")
+    again.idle(duration=0.5)
+    again.move({"segment": "b", "time": 0.5}, path="graph")
+    again.transition("jog", blend=0.3)
+    again.play("jog", 0.0, 0.5)
+    np.testing.assert_array_equal(again.motion().frames, motion.frames)
+
+
+def test_synthesizer_errors(walk_model):
+    syn = Synthesizer({"walk": walk_model}, fps=30)
+    with pytest.raises(ParameterError, match="before the particle"):
+        syn.idle(duration=1)
+    syn.start("walk")
+    with pytest.raises(ParameterError, match="outside model"):
+        syn.move([50.0, 50.0, 50.0])
+    with pytest.raises(ParameterError, match="unknown model"):
+        syn.transition("nope")
+    with pytest.raises(ParameterError, match="no segment"):
+        syn.play("zzz")
+
+
+# ------------------------------------------------------------------- Kovar
+def test_window_distance_is_invariant_to_turns_and_floor_moves():
+    rng = np.random.default_rng(0)
+    pa = rng.normal(size=(15, 6, 3))
+    th = 0.9
+    c, s = np.cos(th), np.sin(th)
+    R = np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+    pb = pa @ R.T + np.array([2.0, 0.0, -1.0])
+    D = window_distances(pa, pb, 5)
+    assert np.abs(np.diag(D)).max() < 1e-6
+    theta, t = aligned_transform(pa[:5], pb[:5])
+    c, s = np.cos(theta), np.sin(theta)
+    R2 = np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+    np.testing.assert_allclose(pb[:5] @ R2.T + t, pa[:5], atol=1e-9)
+    # against a brute-force search over angles for an unrelated pair
+    i, j, k = 2, 7, 5
+    best = np.inf
+    for a in np.linspace(-np.pi, np.pi, 7201):
+        c, s = np.cos(a), np.sin(a)
+        q = pb[j : j + k] @ np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]).T
+        shift = (pa[i : i + k] - q).mean((0, 1))
+        shift[1] = 0
+        best = min(best, np.sqrt(((pa[i : i + k] - q - shift) ** 2).sum(-1).mean()))
+    assert D[i, j] == pytest.approx(best, abs=1e-4)
+    tr = transition_points(pa, pb, 5, threshold=1e-3)
+    assert len(tr) >= 1 and np.all(tr.pairs[:, 0] == tr.pairs[:, 1])
+
+
+def test_figures(walk_model, jog_model):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from cyclecoord.plot.latent import plot_bridges, plot_latent, plot_pose_strip
+
+    fig = plot_latent(walk_model, path=walk_model.X_[:10] + 0.01)
+    assert len(fig.axes) == 1
+    br = find_bridges(walk_model, jog_model, names=("w", "j"))
+    fig2 = plot_bridges(walk_model, jog_model, br, ("w", "j"))
+    assert len(fig2.axes) == 2
+    motion = cc.Motion(frames=walk_model.frames_[:20], channels=walk_model.all_channels_,
+                       skeleton=walk_model.skeleton_)
+    fig3 = plot_pose_strip(motion, [0, 10, 19])
+    assert fig3.axes
+    plt.close("all")
