@@ -15,6 +15,7 @@ from typing import Sequence
 import numpy as np
 
 from ..errors import CycleCoordError, NoPeriodicMotionError, ParameterError
+from ..io._paths import input_files, refuse_clobber
 
 __all__ = ["main", "build_parser"]
 
@@ -221,6 +222,11 @@ def cmd_extract(args: argparse.Namespace) -> int:
         _check_output(args.save_model, "model")
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
+    refuse_clobber(
+        input_files(args.input, args.skeleton) + input_files(args.apply),
+        [("-o", args.output), ("--report", args.report), ("--save-model", args.save_model)],
+        [("--plot", args.plot, r".*\.png")],
+    )
     motion = load_input(args.input, args.skeleton, args.fps)
     if args.apply:
         return _apply_model(args, motion)
@@ -374,6 +380,10 @@ def cmd_detect(args: argparse.Namespace) -> int:
         raise ParameterError(f"{args.extract}: exists and is not a folder (--extract takes a folder)")
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
+    refuse_clobber(
+        input_files(args.input, args.skeleton), [("--report", args.report)],
+        [("--extract", args.extract, r"motion\d+_cycle\.bvh"), ("--plot", args.plot, r".*\.png")],
+    )
     motion = load_input(args.input, args.skeleton, args.fps)
     code = EXIT_OK
     try:
@@ -461,6 +471,10 @@ def cmd_render(args: argparse.Namespace) -> int:
     folder = out.parent if str(out.parent) else Path(".")
     if not folder.is_dir():
         raise ParameterError(f"{args.output}: folder {folder} does not exist")
+    refuse_clobber(
+        input_files(args.input, args.skeleton) + input_files(args.side_by_side),
+        [("-o", args.output)],
+    )
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
     other = load_input(args.side_by_side, None, None) if args.side_by_side else None
@@ -497,12 +511,9 @@ def cmd_convert(args: argparse.Namespace) -> int:
     from ..io import save
 
     _check_output(args.output)
-    if Path(args.output).resolve() == Path(args.input).resolve():
-        raise ParameterError(f"{args.output}: refusing to overwrite the input file")
+    refuse_clobber(input_files(args.input, args.skeleton), [("-o", args.output)])
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
-    if Path(args.output).resolve() == Path(args.input).resolve():
-        raise ParameterError(f"{args.output}: refusing to overwrite the input file")
     save(motion, args.output)
     print(f"{args.input} -> {args.output}: {motion.n_frames} frames, {motion.n_channels} channels, {motion.fps:g} fps")
     return EXIT_OK
@@ -566,12 +577,10 @@ def _check_outputs(args: argparse.Namespace) -> None:
     """Fail fast on outputs we could not write or that would overwrite an input."""
     _check_output(args.output)
     _check_output(args.report, "report")
-    for out in (args.output, args.report):
-        if out is None:
-            continue
-        for src in args.inputs:
-            if Path(src).exists() and Path(out).resolve() == Path(src).resolve():
-                raise ParameterError(f"{out}: refusing to overwrite an input file")
+    refuse_clobber(
+        [f for src in args.inputs for f in input_files(src)],
+        [("-o", args.output), ("--report", args.report)],
+    )
 
 
 def _finish(args: argparse.Namespace, motion, payload: dict, report, what: str, problem: str | None = None) -> int:

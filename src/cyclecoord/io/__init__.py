@@ -296,8 +296,11 @@ def convert(
     """
     s, d = Path(src), Path(dst)
     _suffix(d)  # fail on an unknown output format before reading anything
-    if s.exists() and d.exists() and s.resolve() == d.resolve():
-        raise ParameterError(f"convert would overwrite its input {s}")
+    from ._paths import input_files, same_file
+
+    for src in input_files(s, skeleton if isinstance(skeleton, (str, os.PathLike)) else None):
+        if same_file(src, d):
+            raise ParameterError(f"{d}: convert would overwrite its input {src}")
     motion = load(s, skeleton=skeleton, fps=fps)
     save(motion, d, **kwargs)
     return motion
