@@ -1,7 +1,8 @@
 """The ``cyclecoord`` command line: subcommands over the library, JSON reports, exit codes.
 
 Exit codes: 0 success, 1 bad input or failure (one-line message, no traceback),
-2 usage error, 3 no periodic motion found (the report is still written).
+2 usage error, 3 no periodic motion found (the report is still written), 130 interrupted
+by Ctrl-C (atomic writes leave no partial file).
 """
 
 from __future__ import annotations
@@ -37,6 +38,11 @@ def _frame_range(text: str) -> tuple[int | None, int | None]:
         raise argparse.ArgumentTypeError(f"frame range must be integers A:B, got {text!r}") from None
     if start is not None and start < 0 or stop is not None and stop < 0:
         raise argparse.ArgumentTypeError(f"frame numbers must be >= 0, got {text!r}")
+    if start is not None and stop is not None and start >= stop:
+        raise argparse.ArgumentTypeError(
+            f"frame range {text!r} is reversed or empty: A:B means frames A to B-1, so A must be "
+            f"below B (e.g. {min(start, stop)}:{max(start, stop) + (start == stop)})"
+        )
     return start, stop
 
 
@@ -111,6 +117,14 @@ def _check_output(path: str | None, what: str = "output") -> None:
     folder = out.parent if str(out.parent) else Path(".")
     if not folder.is_dir():
         raise ParameterError(f"{path}: folder {folder} does not exist")
+
+
+def _named(path: object, exc: BaseException) -> str:
+    """The error's message, led by the input's name when it does not name it already."""
+    text = str(exc)
+    if isinstance(path, str) and path and path not in text:
+        return f"{path}: {text}"
+    return text
 
 
 def _write_json(path: str, payload: dict) -> None:
@@ -256,7 +270,7 @@ def cmd_extract(args: argparse.Namespace) -> int:
         )
     except NoPeriodicMotionError as exc:
         partial = exc.result
-        print(f"cyclecoord: {exc}", file=sys.stderr)
+        print(f"cyclecoord: {_named(args.input, exc)}", file=sys.stderr)
         if partial is not None:
             print(_summary_barcode(partial.barcode))
             report_payload = {
@@ -394,7 +408,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
             delay=args.delay if args.delay > 0 else None, method=args.method, progress=not args.no_progress,
         )
     except NoPeriodicMotionError as exc:
-        print(f"cyclecoord: {exc}", file=sys.stderr)
+        print(f"cyclecoord: {_named(args.input, exc)}", file=sys.stderr)
         res, code = exc.result, EXIT_NO_PERIODIC
     m = res.motion
     print(
@@ -740,7 +754,8 @@ def build_parser() -> argparse.ArgumentParser:
             "      --scale auto --scale 40 --weights 0.5,0.5 -o walk_jog.bvh --report blend.json\n"
             "  cyclecoord transition walk_cycle.bvh jog_cycle.bvh --cycles 2 -o walk_to_jog.bvh\n"
             "  cyclecoord batch captures/ -o results/ --jobs 4\n"
-            "exit codes: 0 ok, 1 error, 2 usage, 3 no periodic motion found"
+            "exit codes: 0 ok, 1 error (one line naming the file and what was wrong), 2 usage, "
+            "3 no periodic motion found, 130 interrupted (Ctrl-C; no partial files are left)"
         ),
     )
     from .. import __version__
@@ -753,7 +768,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="find the dominant periodic motion and write its typical cycle",
         description=(
             "Barcode -> most persistent H1 class -> circular coordinate per frame -> periodic "
-            "density -> typical cycle (k-nearest-neighbour centroids), resampled to the capture's "
+            "density -> typical cycle (each phase's pose a smooth kernel average of the frames near "
+            "that phase; --weighting mean gives the paper's k-nearest centroids), resampled to the capture's "
             "frame rate and written as a loopable clip. Exit code 3 when no H1 bar stands clear "
             "(death/birth >= 1.5 and at least 2x the next bar's persistence); the report is still written."
         ),
@@ -799,7 +815,9 @@ def build_parser() -> argparse.ArgumentParser:
     c = sub.add_parser("convert", help="convert between ASF/AMC, BVH, NPZ and CSV",
                        description="Convert a capture between formats, chosen by the file suffixes.")
     c.add_argument("input", metavar="INPUT")
-    c.add_argument("-o", "--output", required=True, metavar="OUT")
+    c.add_argument("-o", "--output", required=True, metavar="OUT",
+                   help="output file; its suffix chooses the format (.amc with its .asf beside it, "
+                   ".bvh, .npz, .csv); never one of the inputs")
     c.add_argument("--skeleton", metavar="ASF", help="ASF skeleton for an AMC input")
     c.add_argument("--fps", type=_positive_float, metavar="F", help="frame rate to record in the output")
     c.add_argument("--frames", type=_frame_range, metavar="A:B", help="only these frames")
@@ -809,7 +827,7 @@ def build_parser() -> argparse.ArgumentParser:
         "detect", help="find several periodic motions in one capture and segment it",
         description=(
             "Reads several long H1 bars as several periodic motions (paper sec. 4.6): every candidate "
-            "class (death/birth >= 1.5 and at least 10%% of the longest bar's persistence, at most 30) gets "
+            "class (death/birth >= 1.5 and at least 10% of the longest bar's persistence, at most 30) gets "
             "a circular coordinate at its own scale; a class counts where its coordinate advances steadily "
             "for at least 1.5 cycles; classes exciting the same frames are one motion. The windowed stage "
             "(--method windows or auto, the default) also reads the barcodes of sliding 2, 4 and 6 s windows, "
@@ -981,7 +999,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except CycleCoordError as exc:
-        print(f"cyclecoord: error: {exc}", file=sys.stderr)
+        print(f"cyclecoord: error: {_named(getattr(args, 'input', None), exc)}", file=sys.stderr)
         return EXIT_ERROR
     except FileNotFoundError as exc:
         print(f"cyclecoord: error: {exc}", file=sys.stderr)

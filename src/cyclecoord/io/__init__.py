@@ -129,7 +129,8 @@ def load(
     if suffix == ".bvh":
         if skeleton is not None:
             raise ParameterError(
-                f"{p}: a BVH file carries its own skeleton; do not pass skeleton="
+                f"{p}: a BVH file carries its own skeleton; a skeleton (--skeleton on the "
+                "command line, skeleton= in Python) is only for AMC, NPZ and CSV inputs"
             )
         motion = read_bvh(p)
         return motion if rate is None else replace(motion, fps=rate)

@@ -26,6 +26,8 @@ __all__ = [
     "MAX_FRAME_NUMBER",
     "MAX_MAGNITUDE",
     "MAX_FPS",
+    "MIN_FPS",
+    "fps_problem",
     "MAX_INT_DIGITS",
     "MAX_METADATA_BYTES",
     "MAX_METADATA_DEPTH",
@@ -50,8 +52,9 @@ MAX_FRAME_NUMBER = 1_000_000_000
 #: Largest absolute channel value, offset, length or limit.  Beyond it angles lose all
 #: precision (one float step exceeds a degree near 1e16) and squared distances overflow.
 MAX_MAGNITUDE = 1e9
-#: Highest frame rate.
+#: Highest frame rate, and the lowest (one frame every 11.6 days).
 MAX_FPS = 1e6
+MIN_FPS = 1e-6
 #: Digits of a whole number in a text file (Python refuses beyond 4,300).
 MAX_INT_DIGITS = 12
 #: Size of stored metadata (the NPZ ``metadata_json``), in bytes of JSON text.
@@ -89,6 +92,16 @@ def depths(parents: list[int] | np.ndarray) -> list[int]:
     for i, p in enumerate(parents):
         out.append(0 if p < 0 or p >= i else out[p] + 1)
     return out
+
+
+def fps_problem(fps: float) -> str | None:
+    """What makes a frame rate unfit for a file, or ``None``."""
+    if not np.isfinite(fps) or not MIN_FPS <= fps <= MAX_FPS:
+        return (
+            f"frame rate {fps!r} is not a positive number of frames per second in "
+            f"{MIN_FPS:g}..{MAX_FPS:g}"
+        )
+    return None
 
 
 def _bad_values(a: np.ndarray) -> np.ndarray:
@@ -232,8 +245,9 @@ def check_writable(motion: Any, path: Any, fmt: str) -> None:
     problem = frames_problem(motion.frames, motion.channels)
     if problem is not None:
         raise fail(problem if problem.startswith("frame ") else f"the motion has {problem}")
-    if not np.isfinite(motion.fps) or not 0 < motion.fps <= MAX_FPS:
-        raise fail(f"frame rate {motion.fps!r} is not in (0, {MAX_FPS:g}] frames per second")
+    problem = fps_problem(motion.fps)
+    if problem is not None:
+        raise fail(problem)
     if not 0 <= int(motion.start_frame) <= MAX_FRAME_NUMBER:
         raise fail(f"start frame {motion.start_frame} is not in 0..{MAX_FRAME_NUMBER:,}")
     if motion.skeleton is not None:

@@ -903,7 +903,8 @@ def find_skeleton(amc_path: Path) -> Path:
         f"no skeleton found: looked for {looked}a folder holding exactly one .asf, "
         f"but {folder} holds {len(asfs)} .asf file(s)"
         + (f" ({', '.join(p.name for p in asfs[:5])})" if asfs else "")
-        + "; pass skeleton= explicitly",
+        + "; give the skeleton explicitly (--skeleton ASF on the command line, skeleton= "
+        "in Python)",
         amc_path,
     )
 

@@ -31,6 +31,7 @@ from ._limits import (
     MAX_FRAMES,
     MAX_JOINTS,
     MAX_MAGNITUDE,
+    MIN_FPS,
     check_writable,
     parse_int,
 )
@@ -407,9 +408,9 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
         raise ParseError(
             f"expected a number after 'Frame Time:', found {m.group(1).strip()!r}", spath, tline
         ) from None
-    if not np.isfinite(frame_time) or frame_time <= 0 or not 1.0 / frame_time <= MAX_FPS:
+    if not np.isfinite(frame_time) or not 1 / MAX_FPS <= frame_time <= 1 / MIN_FPS:
         raise ParseError(
-            f"Frame Time must be a positive number of seconds of at least 1/{MAX_FPS:g}, "
+            f"Frame Time must be a positive number of seconds in {1 / MAX_FPS:g}..{1 / MIN_FPS:g}, "
             f"found {m.group(1).strip()}",
             spath,
             tline,
@@ -570,8 +571,9 @@ def write_bvh(
     """
     if motion.skeleton is None:
         raise ParameterError(
-            f"{path}: writing BVH needs a skeleton; this motion has none (write .npz or .csv, "
-            "or give the skeleton: load(..., skeleton=ASF))"
+            f"{path}: writing BVH needs a skeleton and this motion has none; give the capture "
+            "its skeleton (--skeleton ASF on the command line, skeleton= in Python) or write "
+            ".npz or .csv"
         )
     check_writable(motion, path, "BVH")
     forced = None if rotation_order is None else _check_order(rotation_order)

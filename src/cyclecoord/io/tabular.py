@@ -51,13 +51,13 @@ from ..motion import DEFAULT_FPS, Motion
 from ..skeleton import Joint, Skeleton
 from ._atomic import atomic_write
 from ._limits import (
-    MAX_FPS,
     MAX_FRAME_NUMBER,
     MAX_FRAMES,
     MAX_JOINTS,
     MAX_MAGNITUDE,
     MAX_NPZ_BYTES,
     check_writable,
+    fps_problem,
     frames_problem,
     metadata_json,
     metadata_problem,
@@ -119,8 +119,9 @@ def _check_fps(fps) -> float:
         value = float(fps)
     except (TypeError, ValueError):
         raise ParameterError(f"fps must be a positive number, got {fps!r}") from None
-    if not np.isfinite(value) or not 0 < value <= MAX_FPS:
-        raise ParameterError(f"fps must be a positive number of at most {MAX_FPS:g}, got {fps!r}")
+    problem = fps_problem(value)
+    if problem is not None:
+        raise ParameterError(problem)
     return value
 
 
@@ -348,36 +349,42 @@ def _npz_skeleton(arr: _Arrays) -> Skeleton:
 def _open_npz(p: Path, spath: str) -> dict[str, np.ndarray]:
     """Every array of the archive, read without pickling and within the size cap."""
     try:
-        loaded = np.load(p, allow_pickle=False)
-    except ValueError as exc:  # not zip/npy: numpy would need pickle to go further
-        raise ParseError(f"not an .npz archive ({exc})", spath) from None
-    except Exception as exc:  # BadZipFile, EOFError, OSError, unsupported zip features...
-        raise ParseError(
-            f"not a readable .npz archive ({type(exc).__name__}: {exc})", spath
-        ) from None
-    if not isinstance(loaded, np.lib.npyio.NpzFile):
-        raise ParseError(
-            "holds a single .npy array, expected an .npz archive written by write_npz", spath
-        )
-    with loaded as npz:
-        size = sum(info.file_size for info in npz.zip.infolist())
-        if size > MAX_NPZ_BYTES:
+        fh = open(p, "rb")
+    except OSError as exc:
+        raise ParseError(f"cannot read file: {exc.strerror or exc}", spath) from None
+    with fh:  # numpy leaves the file open when the archive is broken: close it here
+        try:
+            loaded = np.load(fh, allow_pickle=False)
+        except ValueError as exc:  # not zip/npy: numpy would need pickle to go further
+            raise ParseError(f"not an .npz archive ({exc})", spath) from None
+        except Exception as exc:  # BadZipFile, EOFError, OSError, unsupported zip features...
             raise ParseError(
-                f"the archive unpacks to {size:,} bytes; at most {MAX_NPZ_BYTES:,} are supported",
-                spath,
+                f"not a readable .npz archive ({type(exc).__name__}: {exc})", spath
+            ) from None
+        if not isinstance(loaded, np.lib.npyio.NpzFile):
+            raise ParseError(
+                "holds a single .npy array, expected an .npz archive written by write_npz", spath
             )
-        data = {}
-        for k in npz.files:
-            try:
-                data[k] = npz[k]
-            except ValueError as exc:
+        with loaded as npz:
+            size = sum(info.file_size for info in npz.zip.infolist())
+            if size > MAX_NPZ_BYTES:
                 raise ParseError(
-                    f"array {k!r}: cannot load without pickling ({exc})", spath
-                ) from None
-            except Exception as exc:  # corrupt members: zlib, zip or format errors
-                raise ParseError(
-                    f"array {k!r}: corrupt ({type(exc).__name__}: {exc})", spath
-                ) from None
+                    f"the archive unpacks to {size:,} bytes; at most {MAX_NPZ_BYTES:,} are "
+                    "supported",
+                    spath,
+                )
+            data = {}
+            for k in npz.files:
+                try:
+                    data[k] = npz[k]
+                except ValueError as exc:
+                    raise ParseError(
+                        f"array {k!r}: cannot load without pickling ({exc})", spath
+                    ) from None
+                except Exception as exc:  # corrupt members: zlib, zip or format errors
+                    raise ParseError(
+                        f"array {k!r}: corrupt ({type(exc).__name__}: {exc})", spath
+                    ) from None
     return data
 
 
@@ -458,8 +465,9 @@ def read_npz(
     if problem is not None:
         raise arr.error("frames", problem)
     stored_fps = arr.real("fps")
-    if not 0 < stored_fps <= MAX_FPS:
-        raise arr.error("fps", f"expected a frame rate in (0, {MAX_FPS:g}], got {stored_fps!r}")
+    problem = fps_problem(stored_fps)
+    if problem is not None:
+        raise arr.error("fps", problem)
     start = arr.integer("start_frame", 0, MAX_FRAME_NUMBER)
     source = None
     if "source" in data:
@@ -511,23 +519,29 @@ def write_csv(motion: Motion, path: str | os.PathLike[str]) -> None:
         naming the output and the channel.
     """
     check_writable(motion, path, "CSV")
-    header = [f"{j}.{d}" if d else j for j, d in motion.channels]
-    seen: set = set()
-    for name, ch in zip(header, motion.channels):
-        back = tuple(name.rsplit(".", 1)) if "." in name else (name, "")
-        if (back != ch or name != name.strip() or not name or name.startswith("#")
-                or any(c in name for c in ',"\r\n') or back in seen):
+    names = [f"{j}.{d}" if d else j for j, d in motion.channels]
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerow(names)
+    header = buf.getvalue()
+    back = next(csv.reader(io.StringIO(header))) if header.count("\n") == 1 else []
+    back = [h.strip() for h in back]
+    if len(back) != len(names) or header.lstrip().startswith("#"):
+        raise ParameterError(
+            f"{path}: cannot write CSV: the channel names {names[:3]}... would not read back "
+            "as one header row (line breaks, or a leading '#'); write .npz instead"
+        )
+    for name, ch, got in zip(names, motion.channels, back):
+        if got != name:
             raise ParameterError(
-                f"{path}: cannot write CSV: channel {ch} would not read back as itself from "
-                f"the header name {name!r}; write .npz instead"
+                f"{path}: cannot write CSV: channel {ch} would read back as {got!r} "
+                "(surrounding spaces or an empty name); write .npz instead"
             )
-        seen.add(back)
     comment = f"# fps={motion.fps!r}"
     if motion.start_frame:
         comment += f" start_frame={motion.start_frame}"
     with atomic_write(path, "w", newline="") as fh:
         fh.write(comment + "\n")
-        fh.write(",".join(header) + "\n")
+        fh.write(header)
         for row in motion.frames.tolist():
             fh.write(",".join(map(repr, row)))
             fh.write("\n")
@@ -548,12 +562,9 @@ def _parse_comment(text: str, spath: str, line: int) -> dict[str, float]:
                 raise ParseError(
                     f"expected a number after 'fps=', found {value!r}", spath, line
                 ) from None
-            if not np.isfinite(fps) or not 0 < fps <= MAX_FPS:
-                raise ParseError(
-                    f"fps must be a positive number of at most {MAX_FPS:g}, found {value!r}",
-                    spath,
-                    line,
-                )
+            problem = fps_problem(fps)
+            if problem is not None:
+                raise ParseError(problem, spath, line)
             found["fps"] = fps
         elif key == "start_frame":
             try:
