@@ -222,7 +222,7 @@ def metadata_json(metadata: dict) -> str:
     return text
 
 
-def check_writable(motion: Any, path: Any, fmt: str) -> None:
+def check_writable(motion: Any, path: Any, fmt: str, skeleton: bool = True) -> None:
     """Refuse, before anything is written, a motion the ``fmt`` reader would refuse.
 
     Parameters
@@ -233,6 +233,8 @@ def check_writable(motion: Any, path: Any, fmt: str) -> None:
         The output (named in the message).
     fmt : str
         The format's name for the message, e.g. ``"BVH"``.
+    skeleton : bool, default True
+        Whether the format stores the skeleton (then it is checked too).
 
     Raises
     ------
@@ -250,7 +252,7 @@ def check_writable(motion: Any, path: Any, fmt: str) -> None:
         raise fail(problem)
     if not 0 <= int(motion.start_frame) <= MAX_FRAME_NUMBER:
         raise fail(f"start frame {motion.start_frame} is not in 0..{MAX_FRAME_NUMBER:,}")
-    if motion.skeleton is not None:
+    if skeleton and motion.skeleton is not None:
         problem = skeleton_problem(motion.skeleton)
         if problem is not None:
             raise fail(f"skeleton: {problem}")

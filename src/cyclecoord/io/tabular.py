@@ -518,7 +518,7 @@ def write_csv(motion: Motion, path: str | os.PathLike[str]) -> None:
         as the same channels (commas, line breaks, a leading ``#``, surrounding spaces),
         naming the output and the channel.
     """
-    check_writable(motion, path, "CSV")
+    check_writable(motion, path, "CSV", skeleton=False)
     names = [f"{j}.{d}" if d else j for j, d in motion.channels]
     buf = io.StringIO()
     csv.writer(buf, lineterminator="\n").writerow(names)
