@@ -634,7 +634,7 @@ def cmd_blend(args: argparse.Namespace) -> int:
     n = len(sources)
     weights = args.weights if args.weights is not None else [1.0 / n] * n
     cycles = [s.cycle for s in sources]
-    out = blend(cycles, weights, allow_reverse=args.allow_reverse, align_heading=not args.no_heading, up=args.up)
+    out = blend(sources, weights, allow_reverse=args.allow_reverse, align_heading=not args.no_heading, up=args.up)
     info = out.metadata["blend"]
     for i, al in enumerate(info["alignments"][1:], start=1):
         rev = ", reversed" if al["reversed"] else ""
@@ -675,7 +675,7 @@ def cmd_transition(args: argparse.Namespace) -> int:
         return EXIT_NO_PERIODIC
     a, b = (s.cycle for s in sources)
     clip = transition(
-        a, b, frames=args.frames, cycles=args.cycles, lead_in=args.lead_in, lead_out=args.lead_out,
+        sources[0], sources[1], frames=args.frames, cycles=args.cycles, lead_in=args.lead_in, lead_out=args.lead_out,
         allow_reverse=args.allow_reverse, align_heading=not args.no_heading, up=args.up,
     )
     info = clip.metadata["transition"]
