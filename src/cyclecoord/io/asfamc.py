@@ -928,8 +928,11 @@ def _resolve_skeleton(
 
 
 def _parse_amc(
-    text: str, path: PathLike, skel: Skeleton, default_angle: str | None, fps: float
+    text: str, path: PathLike, skel: Skeleton, default_angle: str | None, fps: float,
+    skel_file: PathLike | None = None,
 ) -> Motion:
+    # where the skeleton's side of a mismatch comes from, for the messages
+    per = f" (dofs per the skeleton {skel_file})" if skel_file is not None else ""
     if not text.strip():
         raise ParseError("file is empty; expected an AMC header and frames", path, 1)
     # AMC bone name -> (joint name, dofs in listing order)
@@ -1098,7 +1101,8 @@ def _parse_amc(
                 )
             raise ParseError(
                 f"bone {head!r} is not in the skeleton"
-                + (f" {skel.name!r}" if skel.name else ""),
+                + (f" {skel.name!r}" if skel.name else "")
+                + (f" ({skel_file})" if skel_file is not None else ""),
                 path,
                 ln,
                 frame_no,
@@ -1108,7 +1112,7 @@ def _parse_amc(
             got = len(parts) - 1
             raise ParseError(
                 f"bone {head!r} has {nd} dof{'s' if nd != 1 else ''} "
-                f"({' '.join(spec[1]) or 'none'}), got {got} value{'s' if got != 1 else ''}",
+                f"({' '.join(spec[1]) or 'none'}), got {got} value{'s' if got != 1 else ''}{per}",
                 path,
                 ln,
                 frame_no,
@@ -1223,7 +1227,11 @@ def read_amc(
     if not text.strip():
         raise ParseError("file is empty; expected an AMC header and frames", path, 1)
     skel, default_angle = _resolve_skeleton(amc_path, skeleton)
-    return _parse_amc(text, path, skel, default_angle, fps)
+    if isinstance(skeleton, Skeleton):
+        skel_file = None
+    else:
+        skel_file = find_skeleton(amc_path) if skeleton is None else Path(skeleton)
+    return _parse_amc(text, path, skel, default_angle, fps, skel_file)
 
 
 # --------------------------------------------------------------------------- AMC write
