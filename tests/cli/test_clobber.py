@@ -39,21 +39,24 @@ def refused(capsys, cwd, monkeypatch, *argv) -> str:
 
 
 def test_extract_outputs(captures, capsys, monkeypatch):
+    def run(*argv):
+        return refused(capsys, captures, monkeypatch, *argv)
+
     # the cases: -o onto the input, as given and through a relative detour
-    refused(capsys, captures, monkeypatch, "extract", "walk.bvh", "-o", "walk.bvh")
-    refused(capsys, captures, monkeypatch, "extract", "walk.bvh", "-o", f"../{captures.name}/walk.bvh")
-    refused(capsys, captures, monkeypatch, "extract", "s_01.amc", "--frames", "0:100", "-o", "s_01.amc")
-    refused(capsys, captures, monkeypatch, "extract", "s_01.amc", "-o", str(captures / "s_01.amc"))
+    run("extract", "walk.bvh", "-o", "walk.bvh")
+    run("extract", "walk.bvh", "-o", f"../{captures.name}/walk.bvh")
+    run("extract", "s_01.amc", "--frames", "0:100", "-o", "s_01.amc")
+    run("extract", "s_01.amc", "-o", str(captures / "s_01.amc"))
     os.symlink("walk.bvh", captures / "link.npz")
     try:
-        err = refused(capsys, captures, monkeypatch, "extract", "walk.bvh", "--save-model", "link.npz")
+        err = run("extract", "walk.bvh", "--save-model", "link.npz")
         assert "--save-model" in err
     finally:
         (captures / "link.npz").unlink()
     # the AMC's skeleton is an input too (reached through a symlinked name)
     os.symlink("s.asf", captures / "sk.json")
     try:
-        err = refused(capsys, captures, monkeypatch, "extract", "s_01.amc", "--report", "sk.json")
+        err = run("extract", "s_01.amc", "--report", "sk.json")
         assert "s.asf" in err and "--report" in err
     finally:
         (captures / "sk.json").unlink()
@@ -73,7 +76,8 @@ def test_extract_plot_folder_and_outputs_naming_one_file(captures, tmp_path, cap
 
 def test_detect_outputs(captures, tmp_path, capsys, monkeypatch):
     os.symlink(captures / "walk.bvh", tmp_path / "walk.json")
-    refused(capsys, tmp_path, monkeypatch, "detect", str(captures / "walk.bvh"), "--report", "walk.json")
+    refused(capsys, tmp_path, monkeypatch, "detect", str(captures / "walk.bvh"),
+            "--report", "walk.json")
     (tmp_path / "walk.json").unlink()
     # --extract writes motion<k>_cycle.bvh: an input of that name in the folder is refused
     (tmp_path / "motion0_cycle.bvh").write_bytes((captures / "walk.bvh").read_bytes())

@@ -230,13 +230,15 @@ def test_writers_refuse_what_their_readers_refuse(tmp_path, walk):
         name=walk.skeleton.name, source_format=walk.skeleton.source_format,
     ))
     slow = replace(walk, fps=5e-324)
-    for motion, why in ((empty, "no frames"), (big, "1e+300"), (far, "offset"), (slow, "frame rate")):
+    cases = ((empty, "no frames"), (big, "1e+300"), (far, "offset"), (slow, "frame rate"))
+    for motion, why in cases:
         for suffix in (".bvh", ".amc", ".npz", ".csv"):
             if suffix == ".csv" and why == "offset":
                 continue  # CSV stores no skeleton
             out = tmp_path / f"out{suffix}"
             with pytest.raises(ParameterError) as e:
-                cc.save(motion, out, **({"asf_path": tmp_path / "o.asf"} if suffix == ".amc" else {}))
+                extra = {"asf_path": tmp_path / "o.asf"} if suffix == ".amc" else {}
+                cc.save(motion, out, **extra)
             assert why in str(e.value) and str(out) in str(e.value), (suffix, str(e.value))
             assert not out.exists() and not (tmp_path / "o.asf").exists()
     nan_limit = Skeleton(joints=(j[0], replace_joint(j[1], limits={"rx": (np.nan, 1.0)})) + j[2:])
