@@ -122,7 +122,7 @@ def _check_output(path: str | None, what: str = "output") -> None:
 def _named(path: object, exc: BaseException) -> str:
     """The error's message, led by the input's name when it does not name it already."""
     text = str(exc)
-    if isinstance(path, str) and path and path not in text:
+    if isinstance(path, str) and path and path not in text and Path(path).name not in text:
         return f"{path}: {text}"
     return text
 
