@@ -675,7 +675,8 @@ def cmd_transition(args: argparse.Namespace) -> int:
         return EXIT_NO_PERIODIC
     a, b = (s.cycle for s in sources)
     clip = transition(
-        sources[0], sources[1], frames=args.frames, cycles=args.cycles, lead_in=args.lead_in, lead_out=args.lead_out,
+        sources[0], sources[1], frames=args.frames, cycles=args.cycles,
+        lead_in=args.lead_in, lead_out=args.lead_out,
         allow_reverse=args.allow_reverse, align_heading=not args.no_heading, up=args.up,
     )
     info = clip.metadata["transition"]
