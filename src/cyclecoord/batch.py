@@ -49,6 +49,7 @@ from typing import Any, Iterator, Sequence
 
 from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
 from .io._atomic import atomic_write
+from .io._paths import refuse_clobber
 
 __all__ = [
     "run_batch",
@@ -744,6 +745,14 @@ def run_batch(
             options_hash=opt_hash, skeleton=_skeleton_signature(src / f),
         ))
 
+    written = [("the summary", out / SUMMARY_NAME)]
+    for t in tasks:
+        written.append((f"the report of {t.file}", t.report))
+        if write_cycles is not None:  # a capture without a skeleton gets an .npz cycle
+            written += [(f"the cycle of {t.file}", Path(f"{t.base}.cycle.{fmt}"))
+                        for fmt in sorted({write_cycles, "npz"})]
+    refuse_clobber([t.input for t in tasks] + [t.skeleton[0] for t in tasks if t.skeleton],
+                   written)
     out.mkdir(parents=True, exist_ok=True)
     rows: dict[str, dict] = {}
     skipped: list[str] = []

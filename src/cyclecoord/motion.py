@@ -146,6 +146,11 @@ class Motion:
         n = self.n_frames
         a = 0 if a is None else int(a)
         b = n if b is None else int(b)
+        if a >= b:
+            raise ParameterError(
+                f"frame range {a}:{b} is reversed or empty: frames A:B run from A to B-1, so A "
+                "must be below B"
+            )
         if not 0 <= a < b <= n:
             raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames (0-based, half-open)")
         return self if (a, b) == (0, n) else self[a:b]

@@ -82,6 +82,17 @@ class Joint:
             object.__setattr__(
                 self, "end_site", np.asarray(self.end_site, dtype=float).reshape(3)
             )
+        if not np.all(np.isfinite(self.offset)):
+            raise ParameterError(f"joint {self.name!r}: offset {self.offset} is not finite")
+        if self.end_site is not None and not np.all(np.isfinite(self.end_site)):
+            raise ParameterError(f"joint {self.name!r}: end site {self.end_site} is not finite")
+        a = self.axis
+        if not np.all(np.isfinite(a)) or (
+            np.max(np.abs(a @ a.T - np.eye(3))) > 1e-6 or np.linalg.det(a) <= 0
+        ):
+            raise ParameterError(
+                f"joint {self.name!r}: axis is not a rotation matrix (orthonormal, det +1)"
+            )
         for d in self.dofs:
             if d not in DOF_NAMES:
                 raise ParameterError(f"joint {self.name!r}: unknown degree of freedom {d!r}")

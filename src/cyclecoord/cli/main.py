@@ -1,7 +1,8 @@
 """The ``cyclecoord`` command line: subcommands over the library, JSON reports, exit codes.
 
 Exit codes: 0 success, 1 bad input or failure (one-line message, no traceback),
-2 usage error, 3 no periodic motion found (the report is still written).
+2 usage error, 3 no periodic motion found (the report is still written), 130 interrupted
+by Ctrl-C (atomic writes leave no partial file).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from typing import Sequence
 import numpy as np
 
 from ..errors import CycleCoordError, NoPeriodicMotionError, ParameterError
+from ..io._paths import input_files, refuse_clobber
 
 __all__ = ["main", "build_parser"]
 
@@ -36,6 +38,11 @@ def _frame_range(text: str) -> tuple[int | None, int | None]:
         raise argparse.ArgumentTypeError(f"frame range must be integers A:B, got {text!r}") from None
     if start is not None and start < 0 or stop is not None and stop < 0:
         raise argparse.ArgumentTypeError(f"frame numbers must be >= 0, got {text!r}")
+    if start is not None and stop is not None and start >= stop:
+        raise argparse.ArgumentTypeError(
+            f"frame range {text!r} is reversed or empty: A:B means frames A to B-1, so A must be "
+            f"below B (e.g. {min(start, stop)}:{max(start, stop) + (start == stop)})"
+        )
     return start, stop
 
 
@@ -112,6 +119,14 @@ def _check_output(path: str | None, what: str = "output") -> None:
     folder = out.parent if str(out.parent) else Path(".")
     if not folder.is_dir():
         raise ParameterError(f"{path}: folder {folder} does not exist")
+
+
+def _named(path: object, exc: BaseException) -> str:
+    """The error's message, led by the input's name when it does not name it already."""
+    text = str(exc)
+    if isinstance(path, str) and path and path not in text and Path(path).name not in text:
+        return f"{path}: {text}"
+    return text
 
 
 def _write_json(path: str, payload: dict) -> None:
@@ -268,6 +283,11 @@ def cmd_extract(args: argparse.Namespace) -> int:
         _check_output(args.save_model, "model")
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
+    refuse_clobber(
+        input_files(args.input, args.skeleton) + input_files(args.apply),
+        [("-o", args.output), ("--report", args.report), ("--save-model", args.save_model)],
+        [("--plot", args.plot, r".*\.png")],
+    )
     motion = load_input(args.input, args.skeleton, args.fps)
     if args.apply:
         return _apply_model(args, motion)
@@ -297,7 +317,7 @@ def cmd_extract(args: argparse.Namespace) -> int:
         )
     except NoPeriodicMotionError as exc:
         partial = exc.result
-        print(f"cyclecoord: {exc}", file=sys.stderr)
+        print(f"cyclecoord: {_named(args.input, exc)}", file=sys.stderr)
         if partial is not None:
             print(_summary_barcode(partial.barcode))
             report_payload = {
@@ -449,6 +469,10 @@ def cmd_detect(args: argparse.Namespace) -> int:
         raise ParameterError(f"{args.extract}: exists and is not a folder (--extract takes a folder)")
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
+    refuse_clobber(
+        input_files(args.input, args.skeleton), [("--report", args.report)],
+        [("--extract", args.extract, r"motion\d+_cycle\.bvh"), ("--plot", args.plot, r".*\.png")],
+    )
     motion = load_input(args.input, args.skeleton, args.fps)
     code = EXIT_OK
     try:
@@ -459,7 +483,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
             delay=args.delay if args.delay > 0 else None, method=args.method, progress=not args.no_progress,
         )
     except NoPeriodicMotionError as exc:
-        print(f"cyclecoord: {exc}", file=sys.stderr)
+        print(f"cyclecoord: {_named(args.input, exc)}", file=sys.stderr)
         res, code = exc.result, EXIT_NO_PERIODIC
     m = res.motion
     print(
@@ -537,6 +561,10 @@ def cmd_render(args: argparse.Namespace) -> int:
     folder = out.parent if str(out.parent) else Path(".")
     if not folder.is_dir():
         raise ParameterError(f"{args.output}: folder {folder} does not exist")
+    refuse_clobber(
+        input_files(args.input, args.skeleton) + input_files(args.side_by_side),
+        [("-o", args.output)],
+    )
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
     other = load_input(args.side_by_side, None, None) if args.side_by_side else None
@@ -573,12 +601,9 @@ def cmd_convert(args: argparse.Namespace) -> int:
     from ..io import save
 
     _check_output(args.output)
-    if Path(args.output).resolve() == Path(args.input).resolve():
-        raise ParameterError(f"{args.output}: refusing to overwrite the input file")
+    refuse_clobber(input_files(args.input, args.skeleton), [("-o", args.output)])
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
-    if Path(args.output).resolve() == Path(args.input).resolve():
-        raise ParameterError(f"{args.output}: refusing to overwrite the input file")
     save(motion, args.output)
     print(f"{args.input} -> {args.output}: {motion.n_frames} frames, {motion.n_channels} channels, {motion.fps:g} fps")
     return EXIT_OK
@@ -642,12 +667,10 @@ def _check_outputs(args: argparse.Namespace) -> None:
     """Fail fast on outputs we could not write or that would overwrite an input."""
     _check_output(args.output)
     _check_output(args.report, "report")
-    for out in (args.output, args.report):
-        if out is None:
-            continue
-        for src in args.inputs:
-            if Path(src).exists() and Path(out).resolve() == Path(src).resolve():
-                raise ParameterError(f"{out}: refusing to overwrite an input file")
+    refuse_clobber(
+        [f for src in args.inputs for f in input_files(src)],
+        [("-o", args.output), ("--report", args.report)],
+    )
 
 
 def _finish(args: argparse.Namespace, motion, payload: dict, report, what: str, problem: str | None = None) -> int:
@@ -687,7 +710,7 @@ def cmd_blend(args: argparse.Namespace) -> int:
     n = len(sources)
     weights = args.weights if args.weights is not None else [1.0 / n] * n
     cycles = [s.cycle for s in sources]
-    out = blend(cycles, weights, allow_reverse=args.allow_reverse, align_heading=not args.no_heading, up=args.up)
+    out = blend(sources, weights, allow_reverse=args.allow_reverse, align_heading=not args.no_heading, up=args.up)
     info = out.metadata["blend"]
     for i, al in enumerate(info["alignments"][1:], start=1):
         rev = ", reversed" if al["reversed"] else ""
@@ -728,7 +751,8 @@ def cmd_transition(args: argparse.Namespace) -> int:
         return EXIT_NO_PERIODIC
     a, b = (s.cycle for s in sources)
     clip = transition(
-        a, b, frames=args.frames, cycles=args.cycles, lead_in=args.lead_in, lead_out=args.lead_out,
+        sources[0], sources[1], frames=args.frames, cycles=args.cycles,
+        lead_in=args.lead_in, lead_out=args.lead_out,
         allow_reverse=args.allow_reverse, align_heading=not args.no_heading, up=args.up,
     )
     info = clip.metadata["transition"]
@@ -809,7 +833,8 @@ def build_parser() -> argparse.ArgumentParser:
             "      --scale auto --scale 40 --weights 0.5,0.5 -o walk_jog.bvh --report blend.json\n"
             "  cyclecoord transition walk_cycle.bvh jog_cycle.bvh --cycles 2 -o walk_to_jog.bvh\n"
             "  cyclecoord batch captures/ -o results/ --jobs 4\n"
-            "exit codes: 0 ok, 1 error, 2 usage, 3 no periodic motion found"
+            "exit codes: 0 ok, 1 error (one line naming the file and what was wrong), 2 usage, "
+            "3 no periodic motion found, 130 interrupted (Ctrl-C; no partial files are left)"
         ),
     )
     from .. import __version__
@@ -822,7 +847,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="find the dominant periodic motion and write its typical cycle",
         description=(
             "Barcode -> most persistent H1 class -> circular coordinate per frame -> periodic "
-            "density -> typical cycle (k-nearest-neighbour centroids), resampled to the capture's "
+            "density -> typical cycle (each phase's pose a smooth kernel average of the frames near "
+            "that phase; --weighting mean gives the paper's k-nearest centroids), resampled to the capture's "
             "frame rate and written as a loopable clip. Exit code 3 when no H1 bar stands clear "
             "(death/birth >= 1.5 and at least 2x the next bar's persistence); the report is still written."
         ),
@@ -868,7 +894,9 @@ def build_parser() -> argparse.ArgumentParser:
     c = sub.add_parser("convert", help="convert between ASF/AMC, BVH, NPZ and CSV",
                        description="Convert a capture between formats, chosen by the file suffixes.")
     c.add_argument("input", metavar="INPUT")
-    c.add_argument("-o", "--output", required=True, metavar="OUT")
+    c.add_argument("-o", "--output", required=True, metavar="OUT",
+                   help="output file; its suffix chooses the format (.amc with its .asf beside it, "
+                   ".bvh, .npz, .csv); never one of the inputs")
     c.add_argument("--skeleton", metavar="ASF", help="ASF skeleton for an AMC input")
     c.add_argument("--fps", type=_positive_float, metavar="F", help="frame rate to record in the output")
     c.add_argument("--frames", type=_frame_range, metavar="A:B", help="only these frames")
@@ -878,7 +906,7 @@ def build_parser() -> argparse.ArgumentParser:
         "detect", help="find several periodic motions in one capture and segment it",
         description=(
             "Reads several long H1 bars as several periodic motions (paper sec. 4.6): every candidate "
-            "class (death/birth >= 1.5 and at least 10%% of the longest bar's persistence, at most 30) gets "
+            "class (death/birth >= 1.5 and at least 10% of the longest bar's persistence, at most 30) gets "
             "a circular coordinate at its own scale; a class counts where its coordinate advances steadily "
             "for at least 1.5 cycles; classes exciting the same frames are one motion. The windowed stage "
             "(--method windows or auto, the default) also reads the barcodes of sliding 2, 4 and 6 s windows, "
@@ -1062,7 +1090,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except CycleCoordError as exc:
-        print(f"cyclecoord: error: {exc}", file=sys.stderr)
+        print(f"cyclecoord: error: {_named(getattr(args, 'input', None), exc)}", file=sys.stderr)
         return EXIT_ERROR
     except FileNotFoundError as exc:
         print(f"cyclecoord: error: {exc}", file=sys.stderr)

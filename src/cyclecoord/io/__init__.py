@@ -161,7 +161,8 @@ def load(
     if suffix == ".bvh":
         if skeleton is not None:
             raise ParameterError(
-                f"{p}: a BVH file carries its own skeleton; do not pass skeleton="
+                f"{p}: a BVH file carries its own skeleton; a skeleton (--skeleton on the "
+                "command line, skeleton= in Python) is only for AMC, NPZ and CSV inputs"
             )
         motion = read_bvh(p)
         return motion if rate is None else replace(motion, fps=rate)
@@ -350,8 +351,11 @@ def convert(
     """
     s, d = Path(src), Path(dst)
     _suffix(d)  # fail on an unknown output format before reading anything
-    if s.exists() and d.exists() and s.resolve() == d.resolve():
-        raise ParameterError(f"convert would overwrite its input {s}")
+    from ._paths import input_files, same_file
+
+    for src in input_files(s, skeleton if isinstance(skeleton, (str, os.PathLike)) else None):
+        if same_file(src, d):
+            raise ParameterError(f"{d}: convert would overwrite its input {src}")
     motion = load(s, skeleton=skeleton, fps=fps)
     save(motion, d, **kwargs)
     return motion

@@ -47,6 +47,7 @@ ASF uses this mapping:
 
 from __future__ import annotations
 
+import bisect
 import math
 import os
 import re
@@ -62,6 +63,17 @@ from ..errors import ParameterError, ParseError
 from ..motion import Motion
 from ..skeleton import DOF_NAMES, Joint, Skeleton, rotation_order_from_dofs
 from ._atomic import atomic_write
+from ._limits import (
+    MAX_DEPTH,
+    MAX_FRAME_NUMBER,
+    MAX_FRAMES,
+    MAX_JOINTS,
+    MAX_MAGNITUDE,
+    check_writable,
+    depths,
+    parse_int,
+    skeleton_problem,
+)
 
 __all__ = ["read_asf", "write_asf", "read_amc", "write_amc", "find_skeleton"]
 
@@ -113,6 +125,12 @@ def _number(tok: str, path: PathLike, line: int, what: str, allow_inf: bool = Fa
         raise ParseError(f"expected a number for {what}, got {tok!r}", path, line) from None
     if math.isnan(value) or (not allow_inf and math.isinf(value)):
         raise ParseError(f"expected a finite number for {what}, got {tok!r}", path, line)
+    if math.isfinite(value) and abs(value) > MAX_MAGNITUDE:
+        raise ParseError(
+            f"{what} is {tok!r}, beyond the largest supported magnitude {MAX_MAGNITUDE:g}",
+            path,
+            line,
+        )
     return value
 
 
@@ -362,6 +380,13 @@ def _parse_asf(text: str, path: PathLike) -> tuple[Skeleton, dict]:
             if low == "end" and len(toks) == 1:
                 bones.append(_finish_bone(block, path, ln))
                 block = None
+                if len(bones) >= MAX_JOINTS:
+                    raise ParseError(
+                        f"more than {MAX_JOINTS - 1:,} bones; at most {MAX_JOINTS:,} joints "
+                        "(the root and its bones) are supported",
+                        path,
+                        ln,
+                    )
                 continue
             if s.startswith("("):
                 if last_field != "limits":
@@ -517,6 +542,23 @@ def _parse_asf(text: str, path: PathLike) -> tuple[Skeleton, dict]:
     # ------------------------------------------------------------ joints
     scale = _DEG_PER_RAD if units["angle"] == "rad" else 1.0
     index = {n: i for i, n in enumerate(order)}
+    level = depths([-1] + [index[parent_of[n][0]] for n in order[1:]])
+    for n, lv in zip(order, level):
+        if lv > MAX_DEPTH:
+            raise ParseError(
+                f"bone {n!r} hangs {lv} levels below the root; at most {MAX_DEPTH} are supported",
+                path,
+                parent_of[n][1],
+            )
+    for b in bones:
+        vec = b.direction * b.length
+        if not np.all(np.abs(vec) <= MAX_MAGNITUDE):
+            raise ParseError(
+                f"bone {b.name!r}: direction times length reaches {np.max(np.abs(vec)):g}, "
+                f"beyond the largest supported magnitude {MAX_MAGNITUDE:g}",
+                path,
+                b.line,
+            )
     try:
         joints = [
             Joint(
@@ -735,6 +777,9 @@ def _asf_layout(skel: Skeleton) -> list[_LayoutBone]:
 def _asf_text(skel: Skeleton) -> str:
     if not isinstance(skel, Skeleton):
         raise ParameterError(f"expected a Skeleton, got {type(skel).__name__}")
+    problem = skeleton_problem(skel)
+    if problem is not None:
+        raise ParameterError(f"cannot write ASF: skeleton: {problem}")
     unit = float(skel.length_unit)
     if not math.isfinite(unit) or unit <= 0:
         raise ParameterError(f"skeleton length_unit must be a positive number, got {unit}")
@@ -745,6 +790,11 @@ def _asf_text(skel: Skeleton) -> str:
             raise ParameterError(f"joint {b.joint or b.asf_name!r} has non-finite geometry")
         if np.max(np.abs(b.axis @ b.axis.T - np.eye(3))) > 1e-6 or np.linalg.det(b.axis) < 0:
             raise ParameterError(f"joint {b.joint or b.asf_name!r}: axis is not a rotation matrix")
+        if np.linalg.norm(b.vector) > MAX_MAGNITUDE:
+            raise ParameterError(
+                f"cannot write ASF: bone {b.asf_name!r} would be {np.linalg.norm(b.vector):g} "
+                f"long, beyond the largest supported magnitude {MAX_MAGNITUDE:g}"
+            )
     name = " ".join(skel.name.replace("#", "_").split()) or "cyclecoord"
     root = layout[0]
     out = [
@@ -815,7 +865,10 @@ def write_asf(skeleton: Skeleton, path: PathLike) -> None:
     ParameterError
         When the skeleton holds non-finite geometry or a bad ``length_unit``.
     """
-    text = _asf_text(skeleton)
+    try:
+        text = _asf_text(skeleton)
+    except ParameterError as exc:
+        raise ParameterError(f"{path}: {exc}") from None
     with atomic_write(path, "w", newline="") as fh:
         fh.write(text)
 
@@ -850,7 +903,8 @@ def find_skeleton(amc_path: Path) -> Path:
         f"no skeleton found: looked for {looked}a folder holding exactly one .asf, "
         f"but {folder} holds {len(asfs)} .asf file(s)"
         + (f" ({', '.join(p.name for p in asfs[:5])})" if asfs else "")
-        + "; pass skeleton= explicitly",
+        + "; give the skeleton explicitly (--skeleton ASF on the command line, skeleton= "
+        "in Python)",
         amc_path,
     )
 
@@ -874,8 +928,11 @@ def _resolve_skeleton(
 
 
 def _parse_amc(
-    text: str, path: PathLike, skel: Skeleton, default_angle: str | None, fps: float
+    text: str, path: PathLike, skel: Skeleton, default_angle: str | None, fps: float,
+    skel_file: PathLike | None = None,
 ) -> Motion:
+    # where the skeleton's side of a mismatch comes from, for the messages
+    per = f" (dofs per the skeleton {skel_file})" if skel_file is not None else ""
     if not text.strip():
         raise ParseError("file is empty; expected an AMC header and frames", path, 1)
     # AMC bone name -> (joint name, dofs in listing order)
@@ -911,6 +968,13 @@ def _parse_amc(
     def close_frame() -> None:
         nonlocal first_bones, n_frames
         assert frame_no is not None
+        if n_frames >= MAX_FRAMES:
+            raise ParseError(
+                f"more than {MAX_FRAMES:,} frames; at most {MAX_FRAMES:,} are supported",
+                path,
+                frame_line,
+                frame_no,
+            )
         if first_bones is None:
             names = [e[0] for e in entries]
             if not names:
@@ -982,7 +1046,10 @@ def _parse_amc(
         last_line = ln
         head = parts[0]
         if len(parts) == 1 and _INT_RE.fullmatch(head):
-            number = int(head)
+            try:
+                number = parse_int(head, "a frame number", -MAX_FRAME_NUMBER, MAX_FRAME_NUMBER)
+            except ValueError as exc:
+                raise ParseError(str(exc), path, ln, frame_no) from None
             if frame_no is None:
                 first_number = number
             else:
@@ -1034,7 +1101,8 @@ def _parse_amc(
                 )
             raise ParseError(
                 f"bone {head!r} is not in the skeleton"
-                + (f" {skel.name!r}" if skel.name else ""),
+                + (f" {skel.name!r}" if skel.name else "")
+                + (f" ({skel_file})" if skel_file is not None else ""),
                 path,
                 ln,
                 frame_no,
@@ -1044,7 +1112,7 @@ def _parse_amc(
             got = len(parts) - 1
             raise ParseError(
                 f"bone {head!r} has {nd} dof{'s' if nd != 1 else ''} "
-                f"({' '.join(spec[1]) or 'none'}), got {got} value{'s' if got != 1 else ''}",
+                f"({' '.join(spec[1]) or 'none'}), got {got} value{'s' if got != 1 else ''}{per}",
                 path,
                 ln,
                 frame_no,
@@ -1073,6 +1141,18 @@ def _parse_amc(
     if unit == "rad":
         rot = [i for i, (_, d) in enumerate(channels) if d.startswith("r")]
         frames[:, rot] *= _DEG_PER_RAD
+    big = np.abs(frames) > MAX_MAGNITUDE
+    if big.any():
+        k = int(np.argmax(big.reshape(-1)))
+        rec = bisect.bisect_right(rec_start, k) - 1
+        ln, frame, bone = rec_info[rec]
+        raise ParseError(
+            f"value {flat[k]!r} for bone {bone!r} is beyond the largest supported magnitude "
+            f"{MAX_MAGNITUDE:g}" + (" degrees" if unit == "rad" else ""),
+            path,
+            ln,
+            frame,
+        )
     return Motion(
         frames=frames,
         channels=tuple(channels),
@@ -1147,7 +1227,11 @@ def read_amc(
     if not text.strip():
         raise ParseError("file is empty; expected an AMC header and frames", path, 1)
     skel, default_angle = _resolve_skeleton(amc_path, skeleton)
-    return _parse_amc(text, path, skel, default_angle, fps)
+    if isinstance(skeleton, Skeleton):
+        skel_file = None
+    else:
+        skel_file = find_skeleton(amc_path) if skeleton is None else Path(skeleton)
+    return _parse_amc(text, path, skel, default_angle, fps, skel_file)
 
 
 # --------------------------------------------------------------------------- AMC write
@@ -1188,6 +1272,7 @@ def write_amc(
     """
     if not isinstance(motion, Motion):
         raise ParameterError(f"expected a Motion, got {type(motion).__name__}")
+    check_writable(motion, path, "AMC")
     frames = np.asarray(motion.frames, dtype=float)
     if motion.n_channels == 0:
         raise ParameterError("the motion has no channels; an AMC needs at least one bone")
@@ -1216,11 +1301,15 @@ def write_amc(
         for j in joint_order:
             b = by_joint.get(j)
             if b is None:
-                raise ParameterError(f"channel joint {j!r} is not in the motion's skeleton")
+                raise ParameterError(
+                    f"{path}: cannot write AMC: channel joint {j!r} is not in the motion's "
+                    "skeleton (an AMC holds only the skeleton's channels)"
+                )
             for jj, d in motion.channels:
                 if jj == j and d not in b.dofs:
                     raise ParameterError(
-                        f"channel ({j!r}, {d!r}) is not a degree of freedom of that joint "
+                        f"{path}: cannot write AMC: channel ({j!r}, {d!r}) is not a degree "
+                        "of freedom of that joint "
                         f"(it has {' '.join(b.dofs) or 'none'})"
                     )
             groups.append((b.asf_name, [col.get((j, d), zero_col) for d in b.dofs]))

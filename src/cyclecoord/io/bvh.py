@@ -25,6 +25,16 @@ from ..motion import Motion
 from ..skeleton import Joint, Skeleton, rotation_order_from_dofs
 from ..conventions import _check_order
 from ._atomic import atomic_write
+from ._limits import (
+    MAX_DEPTH,
+    MAX_FPS,
+    MAX_FRAMES,
+    MAX_JOINTS,
+    MAX_MAGNITUDE,
+    MIN_FPS,
+    check_writable,
+    parse_int,
+)
 
 __all__ = ["read_bvh", "write_bvh", "BVH_CHANNEL_NAMES"]
 
@@ -76,6 +86,7 @@ class _HierarchyParser:
         self.end_line = end_line  # line of MOTION (or last line): where "ran out" errors point
         self.pos = 0
         self.joints: list[_JointBuild] = []
+        self.names: dict[str, int] = {}  # name -> line, for the duplicate check
 
     # -- token helpers
     def error(self, message: str, line: int | None) -> ParseError:
@@ -99,6 +110,12 @@ class _HierarchyParser:
             raise self.error(f"expected {what}, found {tok!r}", line) from None
         if not np.isfinite(value):
             raise self.error(f"expected {what}, found non-finite value {tok!r}", line)
+        if abs(value) > MAX_MAGNITUDE:
+            raise self.error(
+                f"expected {what}, found {tok!r}, beyond the largest supported magnitude "
+                f"{MAX_MAGNITUDE:g}",
+                line,
+            )
         return value
 
     def vector(self, keyword: str, line: int) -> np.ndarray:
@@ -107,8 +124,18 @@ class _HierarchyParser:
         )
 
     # -- grammar
-    def open_joint(self, keyword: str, line: int, parent: int) -> int:
+    def open_joint(self, keyword: str, line: int, parent: int, depth: int = 0) -> int:
         """After ROOT/JOINT: read the name and the opening brace, register the joint."""
+        if len(self.joints) >= MAX_JOINTS:
+            raise self.error(
+                f"more than {MAX_JOINTS:,} joints; at most {MAX_JOINTS:,} are supported", line
+            )
+        if depth > MAX_DEPTH:
+            raise self.error(
+                f"the hierarchy is more than {MAX_DEPTH} levels deep; at most {MAX_DEPTH} are "
+                "supported",
+                line,
+            )
         name_parts = []
         while True:
             tok = self.peek()
@@ -119,8 +146,11 @@ class _HierarchyParser:
         if not name_parts:
             raise self.error(f"expected a joint name after {keyword}", line)
         name = " ".join(name_parts)
-        if any(j.name == name for j in self.joints):
-            raise self.error(f"joint name {name!r} is used twice", line)
+        if name in self.names:
+            raise self.error(
+                f"joint name {name!r} is used twice (first at line {self.names[name]})", line
+            )
+        self.names[name] = line
         tok, tline = self.next(f"'{{' opening joint {name!r}")
         if tok != "{":
             raise self.error(f"expected '{{' after {keyword} {name}, found {tok!r}", tline)
@@ -133,13 +163,9 @@ class _HierarchyParser:
     def channels(self, joint: _JointBuild, line: int) -> tuple[str, ...]:
         tok, cline = self.next("the number of channels after CHANNELS")
         try:
-            count = int(tok)
-        except ValueError:
-            raise self.error(
-                f"expected the number of channels after CHANNELS, found {tok!r}", cline
-            ) from None
-        if count < 0:
-            raise self.error(f"CHANNELS count must be >= 0, found {count}", cline)
+            count = parse_int(tok, "the number of channels after CHANNELS", 0, 6)
+        except ValueError as exc:
+            raise self.error(str(exc), cline) from None
         names: list[tuple[str, int]] = []
         while True:
             nxt = self.peek()
@@ -214,7 +240,7 @@ class _HierarchyParser:
                     raise self.error(f"joint {current.name!r} has a second CHANNELS line", line)
                 current.dofs = self.channels(current, line)
             elif word == "joint":
-                stack.append(self.open_joint("JOINT", line, stack[-1]))
+                stack.append(self.open_joint("JOINT", line, stack[-1], len(stack)))
             elif word == "end":
                 current.end_site = self.end_site(current, line)
             elif tok == "}":
@@ -359,15 +385,15 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
     if m is None:
         raise ParseError(f"expected 'Frames: <count>', found {ftext[:40]!r}", spath, fline)
     try:
-        n_frames = int(m.group(1).strip())
-    except ValueError:
+        n_frames = parse_int(m.group(1), "the number of frames after 'Frames:'", 1, MAX_FRAMES)
+    except ValueError as exc:
+        raise ParseError(str(exc), spath, fline) from None
+    if n_channels == 0:
         raise ParseError(
-            f"expected a whole number of frames after 'Frames:', found {m.group(1).strip()!r}",
+            "the hierarchy declares no channels (every CHANNELS line is 0): nothing moves",
             spath,
-            fline,
-        ) from None
-    if n_frames < 0:
-        raise ParseError(f"Frames must be >= 0, found {n_frames}", spath, fline)
+            builds[0].line,
+        )
     if len(body) < 2:
         raise ParseError(
             "MOTION section ends early: expected 'Frame Time: <seconds>'", spath, fline
@@ -382,9 +408,10 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
         raise ParseError(
             f"expected a number after 'Frame Time:', found {m.group(1).strip()!r}", spath, tline
         ) from None
-    if not np.isfinite(frame_time) or frame_time <= 0 or not np.isfinite(1.0 / frame_time):
+    if not np.isfinite(frame_time) or not 1 / MAX_FPS <= frame_time <= 1 / MIN_FPS:
         raise ParseError(
-            f"Frame Time must be a positive number of seconds, found {m.group(1).strip()}",
+            f"Frame Time must be a positive number of seconds in {1 / MAX_FPS:g}..{1 / MIN_FPS:g}, "
+            f"found {m.group(1).strip()}",
             spath,
             tline,
         )
@@ -434,13 +461,15 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
                     ) from None
         raise ParseError("frame values are not all numbers", spath)  # pragma: no cover
     frames = np.asarray(numbers, dtype=float).reshape(n_frames, n_channels)
-    bad = ~np.isfinite(frames)
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(frames) | (np.abs(frames) > MAX_MAGNITUDE)
     if bad.any():
         k, c = (int(v) for v in np.argwhere(bad)[0])
         j, d = channels[c]
         raise ParseError(
             f"frame {k + 1}: value {c + 1} ({j} {_DOF_TO_BVH[d]}) is "
-            f"{split_lines[k][c]!r}, expected a finite number",
+            f"{split_lines[k][c]!r}, expected a finite number of at most {MAX_MAGNITUDE:g} "
+            "in magnitude",
             spath,
             frame_lines[k][0],
         )
@@ -541,7 +570,12 @@ def write_bvh(
     ``_`` (a numeric suffix keeps names unique), so such joints read back renamed.
     """
     if motion.skeleton is None:
-        raise ParameterError("writing BVH needs a skeleton; this motion has none")
+        raise ParameterError(
+            f"{path}: writing BVH needs a skeleton and this motion has none; give the capture "
+            "its skeleton (--skeleton ASF on the command line, skeleton= in Python) or write "
+            ".npz or .csv"
+        )
+    check_writable(motion, path, "BVH")
     forced = None if rotation_order is None else _check_order(rotation_order)
     orders = _bvh_ready_orders(motion.skeleton, forced)
     if orders is None:

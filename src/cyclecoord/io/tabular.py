@@ -50,6 +50,20 @@ from ..errors import ParameterError, ParseError
 from ..motion import DEFAULT_FPS, Motion
 from ..skeleton import Joint, Skeleton
 from ._atomic import atomic_write
+from ._limits import (
+    MAX_FRAME_NUMBER,
+    MAX_FRAMES,
+    MAX_JOINTS,
+    MAX_MAGNITUDE,
+    MAX_NPZ_BYTES,
+    check_writable,
+    fps_problem,
+    frames_problem,
+    metadata_json,
+    metadata_problem,
+    parse_int,
+    skeleton_problem,
+)
 
 __all__ = ["read_npz", "write_npz", "read_csv", "write_csv"]
 
@@ -79,18 +93,6 @@ def _str_array(values) -> np.ndarray:
     return np.array(values, dtype=str) if values else np.zeros(0, dtype="<U1")
 
 
-def _json_metadata(metadata: dict) -> str:
-    """JSON of the metadata entries that can be serialised (others are dropped)."""
-    kept = {}
-    for key, value in metadata.items():
-        try:
-            json.dumps(value, allow_nan=True)
-        except (TypeError, ValueError):
-            continue
-        kept[str(key)] = value
-    return json.dumps(kept, allow_nan=True)
-
-
 def _resolve_skeleton(skeleton) -> Skeleton | None:
     """A Skeleton from a Skeleton, an ``.asf``/``.bvh`` path, or ``None``."""
     if skeleton is None or isinstance(skeleton, Skeleton):
@@ -117,8 +119,9 @@ def _check_fps(fps) -> float:
         value = float(fps)
     except (TypeError, ValueError):
         raise ParameterError(f"fps must be a positive number, got {fps!r}") from None
-    if not np.isfinite(value) or value <= 0:
-        raise ParameterError(f"fps must be a positive number, got {fps!r}")
+    problem = fps_problem(value)
+    if problem is not None:
+        raise ParameterError(problem)
     return value
 
 
@@ -129,11 +132,22 @@ def write_npz(motion: Motion, path: str | os.PathLike[str]) -> None:
     Parameters
     ----------
     motion : Motion
-        Any motion; frames are stored bitwise (float64).  Metadata entries that are not
-        JSON-serialisable are dropped.
+        Any motion :func:`read_npz` would accept; frames are stored bitwise (float64).
+        Metadata entries that are not JSON-serialisable are dropped.
     path : path-like
         Output file, written atomically (no ``.npz`` suffix is appended).
+
+    Raises
+    ------
+    ParameterError
+        For a motion the reader would refuse (no frames, non-finite or huge values,
+        metadata too large or too deeply nested, ...), naming the output.
     """
+    check_writable(motion, path, "NPZ")
+    try:
+        meta = metadata_json(motion.metadata)
+    except ParameterError as exc:
+        raise ParameterError(f"{path}: cannot write NPZ: {exc}") from None
     arrays: dict[str, np.ndarray] = {
         "format": np.array(_NPZ_FORMAT),
         "version": np.array(_NPZ_VERSION, dtype=np.int64),
@@ -143,7 +157,7 @@ def write_npz(motion: Motion, path: str | os.PathLike[str]) -> None:
         "fps": np.array(motion.fps, dtype=np.float64),
         "start_frame": np.array(motion.start_frame, dtype=np.int64),
         "source": _str_array([] if motion.source is None else [motion.source]),
-        "metadata_json": np.array(_json_metadata(motion.metadata)),
+        "metadata_json": np.array(meta),
         "has_skeleton": np.array(motion.skeleton is not None),
     }
     skel = motion.skeleton
@@ -181,63 +195,214 @@ def write_npz(motion: Motion, path: str | os.PathLike[str]) -> None:
         np.savez_compressed(fh, **arrays)
 
 
-def _npz_skeleton(data: dict[str, np.ndarray], spath: str) -> Skeleton:
-    def bad(msg: str) -> ParseError:
-        return ParseError(f"malformed skeleton arrays: {msg}", spath)
+class _Arrays:
+    """The arrays of an NPZ motion, each fetched with its expected kind and shape.
 
-    names = [str(n) for n in data["joint_names"].reshape(-1)]
-    J = len(names)
-    parents = data["joint_parents"].reshape(-1)
-    offsets = data["joint_offsets"]
-    dofs = data["joint_dofs"].reshape(-1)
-    orders = data["joint_rotation_orders"].reshape(-1)
-    axes = data["joint_axes"]
-    ends = data["joint_end_sites"]
-    has_end = data["joint_has_end_site"].reshape(-1)
-    expected = {
-        "joint_parents": (parents.shape, (J,)),
-        "joint_offsets": (offsets.shape, (J, 3)),
-        "joint_dofs": (dofs.shape, (J,)),
-        "joint_rotation_orders": (orders.shape, (J,)),
-        "joint_axes": (axes.shape, (J, 3, 3)),
-        "joint_end_sites": (ends.shape, (J, 3)),
-        "joint_has_end_site": (has_end.shape, (J,)),
-    }
-    for key, (got, want) in expected.items():
-        if tuple(got) != want:
-            raise bad(f"{key} has shape {tuple(got)}, expected {want} for {J} joints")
-    lj = data["limit_joints"].reshape(-1)
-    ld = data["limit_dofs"].reshape(-1)
-    lr = data["limit_ranges"]
-    if not (lj.shape[0] == ld.shape[0] and lr.shape == (lj.shape[0], 2)):
-        raise bad("limit_joints, limit_dofs and limit_ranges do not have matching lengths")
-    limits: list[dict] = [{} for _ in range(J)]
-    for ji, dof, rng in zip(lj, ld, lr):
-        if not 0 <= int(ji) < J:
-            raise bad(f"limit for joint index {int(ji)} out of range")
-        limits[int(ji)][str(dof)] = (float(rng[0]), float(rng[1]))
-    try:
-        joints = tuple(
-            Joint(
-                name=names[i],
-                parent=int(parents[i]),
-                offset=offsets[i].astype(float),
-                dofs=tuple(str(dofs[i]).split()),
-                rotation_order=str(orders[i]),
-                axis=axes[i].astype(float),
-                end_site=ends[i].astype(float) if bool(has_end[i]) else None,
-                limits=limits[i],
+    Every failure is a :class:`ParseError` naming the file and the key.
+    """
+
+    def __init__(self, data: dict[str, np.ndarray], spath: str) -> None:
+        self.data = data
+        self.spath = spath
+
+    def error(self, key: str, message: str) -> ParseError:
+        return ParseError(f"array {key!r}: {message}", self.spath)
+
+    def get(self, key: str) -> np.ndarray:
+        if key not in self.data:
+            raise ParseError(f"missing array {key!r}", self.spath)
+        return self.data[key]
+
+    def _one(self, key: str, kinds: str, what: str):
+        a = self.get(key)
+        if a.size != 1 or a.ndim > 1:
+            raise self.error(key, f"expected a single {what}, got shape {a.shape}")
+        if a.dtype.kind not in kinds:
+            raise self.error(key, f"expected a single {what}, got dtype {a.dtype}")
+        return a.reshape(()).item()
+
+    def real(self, key: str) -> float:
+        value = float(self._one(key, "iuf", "number"))
+        if not np.isfinite(value) or abs(value) > MAX_MAGNITUDE:
+            raise self.error(key, f"expected a finite number, got {value!r}")
+        return value
+
+    def integer(self, key: str, low: int, high: int) -> int:
+        value = self._one(key, "iuf", "whole number")
+        if isinstance(value, float) and not (np.isfinite(value) and value == int(value)):
+            raise self.error(key, f"expected a whole number, got {value!r}")
+        value = int(value)
+        if not low <= value <= high:
+            raise self.error(key, f"expected a whole number in {low:,}..{high:,}, got {value:,}")
+        return value
+
+    def flag(self, key: str) -> bool:
+        return bool(self._one(key, "b", "boolean (True or False)"))
+
+    def text(self, key: str) -> str:
+        return str(self._one(key, "U", "string"))
+
+    def strings(self, key: str, n: int | None = None, per: str = "") -> list[str]:
+        a = self.get(key)
+        if a.ndim != 1 or (a.size and a.dtype.kind != "U"):
+            raise self.error(key, f"expected a 1-D array of strings, got {a.dtype} {a.shape}")
+        if n is not None and a.shape[0] != n:
+            raise self.error(key, f"expected {n} strings{per}, got {a.shape[0]}")
+        return [str(v) for v in a]
+
+    def reals(self, key: str, shape: tuple[int, ...], allow_nan: bool = False,
+              allow_inf: bool = False) -> np.ndarray:
+        a = self.get(key)
+        if a.dtype.kind not in "iuf":
+            raise self.error(key, f"expected real numbers, got dtype {a.dtype}")
+        if a.shape != shape:
+            raise self.error(key, f"expected shape {shape}, got {a.shape}")
+        out = a.astype(float)
+        with np.errstate(invalid="ignore"):
+            bad = np.abs(out) > MAX_MAGNITUDE
+            if not allow_inf:
+                bad |= np.isinf(out)
+            else:
+                bad &= np.isfinite(out)
+        if not allow_nan:
+            bad |= np.isnan(out)
+        if bad.any():
+            at = tuple(int(v) for v in np.argwhere(bad)[0])
+            raise self.error(
+                key, f"entry {at} is {out[at]!r}; expected a finite number of at most "
+                f"{MAX_MAGNITUDE:g} in magnitude"
             )
-            for i in range(J)
+        return out
+
+    def integers(self, key: str, n: int, low: int, high: int) -> list[int]:
+        a = self.get(key)
+        if a.dtype.kind not in "iu" and not (a.dtype.kind == "f" and a.size == 0):
+            raise self.error(key, f"expected whole numbers, got dtype {a.dtype}")
+        if a.shape != (n,):
+            raise self.error(key, f"expected shape ({n},), got {a.shape}")
+        out = [int(v) for v in a]
+        for k, v in enumerate(out):
+            if not low <= v <= high:
+                raise self.error(key, f"entry {k} is {v}; expected {low}..{high}")
+        return out
+
+
+def _npz_skeleton(arr: _Arrays) -> Skeleton:
+    missing = [k for k in _SKELETON_KEYS if k not in arr.data]
+    if missing:
+        raise ParseError(f"'has_skeleton' is set but array {missing[0]!r} is missing", arr.spath)
+    names = arr.strings("joint_names")
+    J = len(names)
+    if J == 0:
+        raise arr.error("joint_names", "a skeleton needs at least one joint")
+    if J > MAX_JOINTS:
+        raise arr.error("joint_names", f"{J:,} joints; at most {MAX_JOINTS:,} are supported")
+    parents = arr.integers("joint_parents", J, -1, J - 1)
+    offsets = arr.reals("joint_offsets", (J, 3))
+    per = f", one for each of the {J} joints"
+    dofs = arr.strings("joint_dofs", J, per)
+    orders = arr.strings("joint_rotation_orders", J, per)
+    axes = arr.reals("joint_axes", (J, 3, 3))
+    has_end = arr.get("joint_has_end_site")
+    if has_end.dtype.kind != "b" or has_end.shape != (J,):
+        raise arr.error("joint_has_end_site", f"expected {J} booleans, got {has_end.dtype} "
+                        f"{has_end.shape}")
+    ends = arr.reals("joint_end_sites", (J, 3), allow_nan=True)
+    for i in np.flatnonzero(has_end):
+        if np.isnan(ends[i]).any():
+            raise arr.error("joint_end_sites", f"joint {names[i]!r} has an end site of NaN")
+    lj = arr.get("limit_joints")
+    L = lj.shape[0] if lj.ndim == 1 else -1
+    if L < 0:
+        raise arr.error("limit_joints", f"expected a 1-D array, got shape {lj.shape}")
+    limit_joints = arr.integers("limit_joints", L, 0, J - 1)
+    limit_dofs = arr.strings("limit_dofs", L)
+    ranges = arr.reals("limit_ranges", (L, 2), allow_inf=True)
+    limits: list[dict] = [{} for _ in range(J)]
+    for ji, dof, rng in zip(limit_joints, limit_dofs, ranges):
+        limits[ji][dof] = (float(rng[0]), float(rng[1]))
+    joints = []
+    for i in range(J):
+        try:
+            joints.append(Joint(
+                name=names[i], parent=parents[i], offset=offsets[i], dofs=tuple(dofs[i].split()),
+                rotation_order=orders[i], axis=axes[i],
+                end_site=ends[i] if bool(has_end[i]) else None, limits=limits[i],
+            ))
+        except ParameterError as exc:
+            raise ParseError(f"malformed skeleton arrays: joint {i}: {exc}", arr.spath) from None
+    try:
+        skel = Skeleton(
+            joints=tuple(joints),
+            name=arr.text("skeleton_name"),
+            length_unit=arr.real("skeleton_length_unit"),
+            source_format=arr.text("skeleton_source_format"),
         )
-        return Skeleton(
-            joints=joints,
-            name=str(data["skeleton_name"]),
-            length_unit=float(data["skeleton_length_unit"]),
-            source_format=str(data["skeleton_source_format"]),
-        )
-    except (ParameterError, ValueError, TypeError) as exc:
-        raise bad(str(exc)) from None
+    except ParameterError as exc:
+        raise ParseError(f"malformed skeleton arrays: {exc}", arr.spath) from None
+    problem = skeleton_problem(skel)
+    if problem is not None:
+        raise ParseError(f"malformed skeleton arrays: {problem}", arr.spath)
+    return skel
+
+
+def _open_npz(p: Path, spath: str) -> dict[str, np.ndarray]:
+    """Every array of the archive, read without pickling and within the size cap."""
+    try:
+        fh = open(p, "rb")
+    except OSError as exc:
+        raise ParseError(f"cannot read file: {exc.strerror or exc}", spath) from None
+    with fh:  # numpy leaves the file open when the archive is broken: close it here
+        try:
+            loaded = np.load(fh, allow_pickle=False)
+        except ValueError as exc:  # not zip/npy: numpy would need pickle to go further
+            raise ParseError(f"not an .npz archive ({exc})", spath) from None
+        except Exception as exc:  # BadZipFile, EOFError, OSError, unsupported zip features...
+            raise ParseError(
+                f"not a readable .npz archive ({type(exc).__name__}: {exc})", spath
+            ) from None
+        if not isinstance(loaded, np.lib.npyio.NpzFile):
+            raise ParseError(
+                "holds a single .npy array, expected an .npz archive written by write_npz", spath
+            )
+        with loaded as npz:
+            size = sum(info.file_size for info in npz.zip.infolist())
+            if size > MAX_NPZ_BYTES:
+                raise ParseError(
+                    f"the archive unpacks to {size:,} bytes; at most {MAX_NPZ_BYTES:,} are "
+                    "supported",
+                    spath,
+                )
+            data = {}
+            for k in npz.files:
+                try:
+                    data[k] = npz[k]
+                except ValueError as exc:
+                    raise ParseError(
+                        f"array {k!r}: cannot load without pickling ({exc})", spath
+                    ) from None
+                except Exception as exc:  # corrupt members: zlib, zip or format errors
+                    raise ParseError(
+                        f"array {k!r}: corrupt ({type(exc).__name__}: {exc})", spath
+                    ) from None
+    return data
+
+
+def _npz_metadata(arr: _Arrays) -> dict:
+    if "metadata_json" not in arr.data:
+        return {}
+    text = arr.text("metadata_json")
+    problem = metadata_problem(text)
+    if problem is not None:
+        raise arr.error("metadata_json", problem)
+    try:
+        metadata = json.loads(text)
+    except (ValueError, RecursionError):
+        raise arr.error("metadata_json", "not valid JSON") from None
+    if not isinstance(metadata, dict):
+        kind = type(metadata).__name__
+        raise arr.error("metadata_json", f"must hold a JSON object, holds a {kind}")
+    return metadata
 
 
 def read_npz(
@@ -265,83 +430,62 @@ def read_npz(
     Raises
     ------
     ParseError
-        If the file is missing, not an NPZ archive, lacks a key, or holds inconsistent
-        arrays.
+        Naming the file and the key: a missing file, not an NPZ archive, a missing key,
+        an array of the wrong kind or shape, non-finite or huge values (frames counted
+        from 1), metadata too large or too deeply nested, or an inconsistent skeleton.
     """
     p = Path(path)
     spath = str(p)
     if not p.is_file():
         raise ParseError("no such file" if not p.exists() else "not a file", spath)
-    try:
-        loaded = np.load(p, allow_pickle=False)
-    except ValueError as exc:  # not zip/npy: numpy would need pickle to go further
-        raise ParseError(f"not an .npz archive ({exc})", spath) from None
-    except Exception as exc:  # BadZipFile, EOFError, OSError, unsupported zip features...
-        raise ParseError(
-            f"not a readable .npz archive ({type(exc).__name__}: {exc})", spath
-        ) from None
-    if not isinstance(loaded, np.lib.npyio.NpzFile):
-        raise ParseError(
-            "holds a single .npy array, expected an .npz archive written by write_npz", spath
-        )
-    try:
-        with loaded as npz:
-            data = {k: npz[k] for k in npz.files}
-    except ValueError as exc:
-        raise ParseError(f"cannot load arrays without pickling ({exc})", spath) from None
-    except Exception as exc:  # corrupt members: zlib, zip or format errors
-        raise ParseError(f"corrupt .npz archive ({type(exc).__name__}: {exc})", spath) from None
+    arr = _Arrays(_open_npz(p, spath), spath)
+    data = arr.data
     missing = [k for k in _MOTION_KEYS if k not in data]
     if missing:
         raise ParseError(
             f"missing array {missing[0]!r} (an .npz motion needs {', '.join(_MOTION_KEYS)})",
             spath,
         )
-    frames = data["frames"]
-    if frames.ndim != 2 or not np.issubdtype(frames.dtype, np.number):
-        raise ParseError(
-            f"'frames' must be a 2-D numeric array, got shape {frames.shape} dtype {frames.dtype}",
-            spath,
-        )
-    cj = data["channel_joints"].reshape(-1)
-    cd = data["channel_dofs"].reshape(-1)
-    if cj.shape[0] != frames.shape[1] or cd.shape[0] != frames.shape[1]:
-        raise ParseError(
-            f"{cj.shape[0]} channel joints and {cd.shape[0]} channel dofs for "
-            f"{frames.shape[1]} columns of 'frames'",
-            spath,
-        )
-    try:
-        stored_fps = float(data["fps"])
-        start = int(data["start_frame"])
-    except (TypeError, ValueError):
-        raise ParseError("'fps' and 'start_frame' must be single numbers", spath) from None
-    source = None
-    if "source" in data and data["source"].size:
-        source = str(data["source"].reshape(-1)[0])
-    metadata: dict = {}
-    if "metadata_json" in data:
-        try:
-            metadata = json.loads(str(data["metadata_json"]))
-        except ValueError:
-            raise ParseError("'metadata_json' is not valid JSON", spath) from None
-        if not isinstance(metadata, dict):
-            raise ParseError("'metadata_json' must hold a JSON object", spath)
-    skel = None
-    if "has_skeleton" in data and bool(data["has_skeleton"]):
-        missing = [k for k in _SKELETON_KEYS if k not in data]
-        if missing:
-            raise ParseError(
-                f"'has_skeleton' is set but array {missing[0]!r} is missing", spath
+    if "format" in data and arr.text("format") != _NPZ_FORMAT:
+        raise arr.error("format", f"expected {_NPZ_FORMAT!r}, got {arr.text('format')[:40]!r}")
+    if "version" in data:
+        version = arr.integer("version", -(2**62), 2**62)
+        if version != _NPZ_VERSION:
+            raise arr.error(
+                "version", f"layout version {version}; this cyclecoord reads version {_NPZ_VERSION}"
             )
-        skel = _npz_skeleton(data, spath)
+    frames = data["frames"]
+    if frames.ndim != 2 or frames.dtype.kind not in "iuf":
+        raise arr.error("frames", f"expected a 2-D array of real numbers, got {frames.dtype} "
+                        f"{frames.shape}")
+    per = f", one for each of the {frames.shape[1]} columns of 'frames'"
+    channels = tuple(zip(arr.strings("channel_joints", frames.shape[1], per),
+                         arr.strings("channel_dofs", frames.shape[1], per)))
+    problem = frames_problem(frames, channels)
+    if problem is not None:
+        raise arr.error("frames", problem)
+    stored_fps = arr.real("fps")
+    problem = fps_problem(stored_fps)
+    if problem is not None:
+        raise arr.error("fps", problem)
+    start = arr.integer("start_frame", 0, MAX_FRAME_NUMBER)
+    source = None
+    if "source" in data:
+        src = arr.strings("source")
+        if len(src) > 1:
+            raise arr.error("source", f"expected at most one string, got {len(src)}")
+        source = src[0] if src else None
+    metadata = _npz_metadata(arr)
+    skel = None
+    if "has_skeleton" in data and arr.flag("has_skeleton"):
+        skel = _npz_skeleton(arr)
     if skeleton is not None:
         skel = _resolve_skeleton(skeleton)
     rate = _check_fps(fps) if fps is not None else stored_fps
     try:
         return Motion(
             frames=frames,
-            channels=tuple(zip((str(j) for j in cj), (str(d) for d in cd))),
+            channels=channels,
             fps=rate,
             skeleton=skel,
             source=source,
@@ -349,7 +493,8 @@ def read_npz(
             metadata=metadata,
         )
     except ParameterError as exc:
-        raise ParseError(str(exc), spath) from None
+        raise ParseError(f"{exc} (arrays 'frames', 'channel_joints', 'channel_dofs')",
+                         spath) from None
 
 
 # ----------------------------------------------------------------------------- CSV
@@ -362,18 +507,41 @@ def write_csv(motion: Motion, path: str | os.PathLike[str]) -> None:
     Parameters
     ----------
     motion : Motion
-        Any motion.
+        Any motion :func:`read_csv` would accept.
     path : path-like
         Output file, written atomically.
+
+    Raises
+    ------
+    ParameterError
+        For a motion the reader would refuse, or channel names that would not read back
+        as the same channels (commas, line breaks, a leading ``#``, surrounding spaces),
+        naming the output and the channel.
     """
+    check_writable(motion, path, "CSV", skeleton=False)
+    names = [f"{j}.{d}" if d else j for j, d in motion.channels]
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerow(names)
+    header = buf.getvalue()
+    back = next(csv.reader(io.StringIO(header))) if header.count("\n") == 1 else []
+    back = [h.strip() for h in back]
+    if len(back) != len(names) or header.lstrip().startswith("#"):
+        raise ParameterError(
+            f"{path}: cannot write CSV: the channel names {names[:3]}... would not read back "
+            "as one header row (line breaks, or a leading '#'); write .npz instead"
+        )
+    for name, ch, got in zip(names, motion.channels, back):
+        if got != name:
+            raise ParameterError(
+                f"{path}: cannot write CSV: channel {ch} would read back as {got!r} "
+                "(surrounding spaces or an empty name); write .npz instead"
+            )
     comment = f"# fps={motion.fps!r}"
     if motion.start_frame:
         comment += f" start_frame={motion.start_frame}"
-    header = [f"{j}.{d}" if d else j for j, d in motion.channels]
     with atomic_write(path, "w", newline="") as fh:
         fh.write(comment + "\n")
-        writer = csv.writer(fh, lineterminator="\n")
-        writer.writerow(header)
+        fh.write(header)
         for row in motion.frames.tolist():
             fh.write(",".join(map(repr, row)))
             fh.write("\n")
@@ -394,16 +562,15 @@ def _parse_comment(text: str, spath: str, line: int) -> dict[str, float]:
                 raise ParseError(
                     f"expected a number after 'fps=', found {value!r}", spath, line
                 ) from None
-            if not np.isfinite(fps) or fps <= 0:
-                raise ParseError(f"fps must be a positive number, found {value!r}", spath, line)
+            problem = fps_problem(fps)
+            if problem is not None:
+                raise ParseError(problem, spath, line)
             found["fps"] = fps
         elif key == "start_frame":
             try:
-                found["start_frame"] = int(value)
-            except ValueError:
-                raise ParseError(
-                    f"expected a whole number after 'start_frame=', found {value!r}", spath, line
-                ) from None
+                found["start_frame"] = parse_int(value, "start_frame", 0, MAX_FRAME_NUMBER)
+            except ValueError as exc:
+                raise ParseError(str(exc), spath, line) from None
     return found
 
 
@@ -482,6 +649,20 @@ def read_csv(
             len(lines) or None,
         )
     D = len(header)
+    if D > 6 * MAX_JOINTS:
+        raise ParseError(
+            f"{D:,} columns; at most {6 * MAX_JOINTS:,} channels are supported", spath, header_line
+        )
+    if not rows:
+        raise ParseError(
+            f"no frames: the header row (line {header_line}) is followed by no rows of values",
+            spath,
+            header_line,
+        )
+    if len(rows) > MAX_FRAMES:
+        raise ParseError(
+            f"{len(rows):,} rows; at most {MAX_FRAMES:,} frames are supported", spath, rows[-1][0]
+        )
     for lno, vals in rows:
         if len(vals) != D:
             raise ParseError(
@@ -504,11 +685,13 @@ def read_csv(
                     ) from None
         raise ParseError("values are not all numbers", spath)  # pragma: no cover
     frames = np.asarray(numbers, dtype=float).reshape(len(rows), D)
-    bad = ~np.isfinite(frames)
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(frames) | (np.abs(frames) > MAX_MAGNITUDE)
     if bad.any():
         r, c = (int(v) for v in np.argwhere(bad)[0])
         raise ParseError(
-            f"column {c + 1} ({header[c]}) is {rows[r][1][c].strip()!r}, expected a finite number",
+            f"column {c + 1} ({header[c]}) is {rows[r][1][c].strip()!r}, expected a finite "
+            f"number of at most {MAX_MAGNITUDE:g} in magnitude",
             spath,
             rows[r][0],
         )

@@ -628,8 +628,11 @@ def plot_channels(
 
     The cycle is played at its own constant rate, looped, starting at the phase of the
     clip's first frame, so both curves start in step (paper Fig. 6).  The right panel is
-    the jerk (third derivative, 4th-order finite differences) of the shown channels,
-    norm over channels per frame, for one period of each.
+    the jerk as the console and the report give it (:func:`cyclecoord.quality.metrics.
+    jerk_summary`: third derivative by 4th-order finite differences of every prepared
+    channel, root as per-frame steps, norm over channels; the cycle looped so its seam
+    counts), per frame over one period of each; the title gives the means over the whole
+    clip and the whole cycle, ``result.jerk``.
 
     Parameters
     ----------
@@ -700,20 +703,24 @@ def plot_channels(
         ax_c.legend(handles=[h for h in ax_c.get_lines() if not h.get_label().endswith("(cycle)")],
                     fontsize=7, loc="upper right", ncol=2)
 
-    # jerk over one period of each (the cycle looped so the seam is included)
+    # jerk in the space result.jerk is measured in (one definition everywhere), one period
     n_j = int(min(motion.n_frames, max(8, round(period))))
     stencil = 7
-    seg_o = motion.frames[: n_j + stencil - 1, cols]
+    poses = np.asarray(res.prepared.poses, dtype=float)
+    typ = np.asarray(res.typical.frames, dtype=float)
+    seg_o = poses[: n_j + stencil - 1]
     jo = np.linalg.norm(jerk(seg_o, fps), axis=1)[:n_j] if seg_o.shape[0] >= stencil else np.zeros(0)
-    jc_all = np.linalg.norm(jerk(cyc_frames, fps, cyclic=True), axis=1) if P >= stencil else np.zeros(P)
-    jc = jc_all[(j0 + np.arange(min(n_j, P))) % P] if P else np.zeros(0)
+    Pt = typ.shape[0]
+    jc_all = np.linalg.norm(jerk(typ, fps, cyclic=True), axis=1) if Pt >= stencil else np.zeros(Pt)
+    jc = jc_all[(j0 * Pt // max(P, 1) + np.arange(min(n_j, Pt))) % Pt] if Pt else np.zeros(0)
     ax_j.plot(np.arange(jo.size) + motion.start_frame, jo, color=_ORIGINAL, linewidth=1.2, label="original")
     ax_j.plot(np.arange(jc.size) + motion.start_frame, jc, color=_CYCLE, linewidth=1.2, label="cycle")
     ax_j.set_xlabel("frame")
-    ax_j.set_ylabel("jerk norm (units / s³)")
+    ax_j.set_ylabel("jerk norm, all channels (units / s³)")
+    jr = res.jerk
+    ratio = jr["cycle"] / jr["original"] if jr.get("original", 0) > 0 else float("nan")
     ax_j.set_title(
-        f"jerk, one period: mean {jo.mean() if jo.size else float('nan'):.2g} vs "
-        f"{jc.mean() if jc.size else float('nan'):.2g}",
+        f"jerk: cycle {jr['cycle']:.3g} vs original {jr['original']:.3g} (ratio {ratio:.2f})",
         fontsize=10,
     )
     ax_j.legend(fontsize=8, loc="upper right")

@@ -8,6 +8,23 @@
 * :func:`distance_to_cycle` -- distance of frames to the closed polyline of a cycle.
 * :func:`circular_distance` and :func:`monotonicity` -- how well a circular coordinate
   follows a known phase, up to rotation and reflection of the circle.
+
+One definition of a cycle's quality is used everywhere (``extract``'s console and report,
+``channels.png``, ``blend``/``transition`` and their reports), always on the cycle's frames
+in the *prepared space*: every channel as it is, except the root's translation and
+rotation taken as per-frame steps (:func:`cyclecoord.synthesis.interpolate.prepare_cycle`,
+the space :func:`cyclecoord.extract` builds the cycle in).
+
+* **loop closure** (no unit): the seam step, last frame to first, over the median step
+  between consecutive frames (:func:`loop_closure`).  About 1 or less loops cleanly; above
+  about 1.5 the seam shows.
+* **jerk** (channel units per s³: degrees / s³ for joint angles): the mean over frames of
+  the norm, across all channels, of the third time derivative by 4th-order forward
+  differences, the cycle looped so its seam counts (:func:`jerk_summary`).
+
+The figures depend on the channels a file holds: the same cycle written as AMC or NPZ reads
+back the same figures, written as BVH (three Euler channels a joint) slightly different
+ones (on CMU 69_01: loop closure 0.078 as AMC, 0.071 as BVH).
 """
 
 from __future__ import annotations

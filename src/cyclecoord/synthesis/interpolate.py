@@ -41,6 +41,7 @@ and alignment and resampling are exact.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, replace
 from numbers import Integral, Real
 from typing import Any, Sequence
@@ -110,6 +111,46 @@ def _check_motion(m: object, name: str) -> Motion:
     if not np.all(np.isfinite(m.frames)):
         raise ParameterError(f"{name} holds NaN or infinite values")
     return m
+
+
+def _cycle_of(x: object, name: str) -> Motion:
+    """The cycle to blend from a Motion, an :class:`ExtractionResult` or a :class:`CycleSource`.
+
+    A Motion that does not look like one loop (see :func:`as_cycle`'s rule) is still
+    used as it is, with a warning saying what to pass instead.
+    """
+    cycle = getattr(x, "cycle", None)
+    if not isinstance(x, Motion) and isinstance(cycle, Motion):
+        return _check_motion(cycle, f"{name} (its .cycle)")
+    if not isinstance(x, Motion):
+        raise ParameterError(
+            f"{name} must be a cycle: a Motion, the result of cyclecoord.extract (or its "
+            f".cycle), or a CycleSource from as_cycle; got {type(x).__name__}"
+        )
+    m = _check_motion(x, name)
+    why = _capture_signs(m)
+    if why:
+        warnings.warn(
+            f"{name} looks like a whole capture rather than one loop ({'; '.join(why)}); it is "
+            "blended as it is. Pass cyclecoord.extract(capture) (or its .cycle), or "
+            "as_cycle(capture), to blend its typical cycle",
+            UserWarning,
+            stacklevel=3,
+        )
+    return m
+
+
+def _capture_signs(motion: Motion) -> list[str]:
+    """Why ``motion`` is a capture of several loops (:func:`as_cycle`'s repeat rule; the
+    loop-closure rule is left out: a cycle shifted in phase can fail it)."""
+    meta = motion.metadata if isinstance(motion.metadata, dict) else {}
+    if meta.get("cycle") is True or all(k in meta for k in _EXTRACT_KEYS):
+        return []
+    period = estimate_period(motion)
+    why = []
+    if period is not None and motion.n_frames > CYCLE_LENGTH_LIMIT * period:
+        why.append(f"it repeats every {period:.0f} frames ({motion.n_frames / period:.1f} periods long)")
+    return why
 
 
 def _check_up(up: str) -> int:
@@ -1426,10 +1467,12 @@ def blend(
 
     Parameters
     ----------
-    cycles : sequence of Motion
-        One loop each (see :func:`as_cycle` to turn captures into cycles), with the same
-        channels, or skeletons with the same joints in other conventions (see
-        :func:`common_channels`).
+    cycles : sequence of Motion or ExtractionResult
+        One loop each, with the same channels, or skeletons with the same joints in
+        other conventions (see :func:`common_channels`).  The result of
+        :func:`cyclecoord.extract` (or a :class:`CycleSource`) stands for its ``.cycle``;
+        a Motion that looks like a whole capture is used as it is with a warning (turn
+        captures into cycles with :func:`cyclecoord.extract` or :func:`as_cycle`).
     weights : sequence of float
         One per cycle, non-negative, summing to 1 (within 1e-6); anything else is
         refused.
@@ -1460,8 +1503,11 @@ def blend(
         For no cycles, bad weights, cycles with different channels or too few frames.
     """
     if isinstance(cycles, Motion) or not isinstance(cycles, Sequence) or len(cycles) == 0:
-        raise ParameterError("blend() needs a non-empty sequence of cycles (Motion objects)")
-    motions = [_check_motion(m, f"cycle {i}") for i, m in enumerate(cycles)]
+        raise ParameterError(
+            "blend() needs a non-empty sequence of cycles (Motion objects or the results of "
+            "cyclecoord.extract)"
+        )
+    motions = [_cycle_of(m, f"cycle {i}") for i, m in enumerate(cycles)]
     w = _check_weights(weights, len(motions))
     if n_frames is not None and (isinstance(n_frames, bool) or not isinstance(n_frames, Integral) or n_frames < 4):
         raise ParameterError(f"n_frames must be an integer >= 4, got {n_frames!r}")
@@ -1665,8 +1711,9 @@ def transition(
 
     Parameters
     ----------
-    a, b : Motion
-        Cycles with the same channels (see :func:`as_cycle`).
+    a, b : Motion or ExtractionResult
+        Cycles with the same channels; an extraction result stands for its ``.cycle``
+        (see :func:`blend` and :func:`as_cycle`).
     frames : int, optional
         Length of the ramp in frames (>= 2).
     cycles : float, optional
@@ -1688,8 +1735,8 @@ def transition(
     ParameterError
         For bad lengths, cycles with different channels or too few frames.
     """
-    a = _check_motion(a, "cycle a")
-    b = _check_motion(b, "cycle b")
+    a = _cycle_of(a, "cycle a")
+    b = _cycle_of(b, "cycle b")
     if (frames is None) == (cycles is None):
         raise ParameterError("give exactly one of frames= and cycles= for the transition's length")
     for name, v in (("lead_in", lead_in), ("lead_out", lead_out)):
