@@ -247,13 +247,12 @@ def test_cmu_first_values_and_asf_fields() -> None:
     np.testing.assert_allclose(ltoes.end_site, np.array([1.5356e-011, -4.21729e-011, 1]) * 1.02897)
 
 
-def test_cmu_large_file_is_fast() -> None:
+def test_cmu_large_file_loads() -> None:
+    # its load time is measured by benchmarks/bench_scaling.py, not asserted here
     path = need_cmu() / "01" / "01_09.amc"
-    t0 = time.perf_counter()
     motion = read_amc(path)
-    elapsed = time.perf_counter() - t0
-    assert motion.n_frames == 4242
-    assert elapsed < 2.0, f"01_09.amc took {elapsed:.2f} s"
+    assert motion.n_frames == 4242 and motion.frames.shape == (4242, 62)
+    assert np.all(np.isfinite(motion.frames))
 
 
 def test_cmu_round_trip(tmp_path: Path) -> None:
