@@ -948,10 +948,14 @@ def capture_cycle(
         root = prepared.root_columns
         mean_delta = frames[:, root].mean(axis=0) if travel == "keep" else np.zeros(root.size)
         cyc[:, root] = preprocessor.integrate_root(frames[:, root], motion.frames[rows[0], root], mean_delta, motion)
+    clip = motion.with_frames(cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}",
+                              metadata=dict(metadata or {}))
+    if feats is not None:
+        # the cycle in the prepared space is the written clip's own (one definition of its
+        # root changes, so its jerk and loop closure read the same from the file)
+        frames = preprocessor.transform(clip).poses
     typ = TypicalCycle(frames=frames, phases=phases, curve=frames, sample_phases=phases, bandwidth=width,
                        bandwidth_selection=selection)
     for arr in (typ.frames, typ.phases):
         arr.flags.writeable = False
-    clip = motion.with_frames(cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}",
-                              metadata=dict(metadata or {}))
     return typ, clip, heading_change
