@@ -507,62 +507,20 @@ def extract(
     ParameterError
         For invalid arguments.
     """
-    if isinstance(delay, str) and delay != "auto":
-        raise ParameterError(f"delay must be 'auto', a number of seconds or None, got {delay!r}")
-    kwargs = dict(
-        pca=pca, normalize=normalize, temporal=temporal, difference_root=difference_root, root=root,
-        prime=prime, max_scale=max_scale, scale=scale, class_index=class_index, scale_fraction=scale_fraction,
-        n_samples=n_samples, n_neighbors=n_neighbors, bandwidth=bandwidth, weighting=weighting,
-        sampling=sampling, n_components=n_components, cycle_start=cycle_start, landmarks=landmarks,
-        memory_limit=memory_limit, require_clear=require_clear, random_state=random_state, steady=steady,
-        timing=timing, travel=travel, min_turns=min_turns,
-    )
-    if delay != "auto":
-        return _extract(motion, frames, delay=delay, **kwargs)
-    try:
-        return _extract(motion, frames, delay=None, **kwargs)
-    except NoPeriodicMotionError as first:
+    if isinstance(delay, str):
+        if delay != "auto":
+            raise ParameterError(f"delay must be 'auto', a number of seconds or None, got {delay!r}")
+        options = {k: v for k, v in locals().items() if k not in ("motion", "frames", "delay")}
         try:
-            res = _extract(motion, frames, delay=AUTO_DELAY, **kwargs)
-        except NoPeriodicMotionError:
-            raise first from None
-        res.warnings.insert(0, f"read with a {AUTO_DELAY:g} s delay embedding: the poses alone show no "
-                               "periodic motion (an out-and-back movement, such as a squat)")
-        return res
-
-
-def _extract(
-    motion: Motion,
-    frames: tuple[int | None, int | None] | None = None,
-    *,
-    pca: int | None = None,
-    normalize: bool = False,
-    temporal: bool = False,
-    delay: float | None = None,
-    difference_root: bool = True,
-    root: str = "body",
-    prime: int = DEFAULT_PRIME,
-    max_scale: float | None = None,
-    scale: float | None = None,
-    class_index: int = 0,
-    scale_fraction: float = 0.9,
-    n_samples: int = 500,
-    n_neighbors: int = 10,
-    bandwidth: str | float | None = None,
-    weighting: str = "kernel",
-    sampling: str = "quantile",
-    n_components: int = 30,
-    cycle_start: str = "slowest",
-    landmarks: int | str | None = "auto",
-    memory_limit: float | None = None,
-    require_clear: bool = True,
-    random_state: int | None = 0,
-    steady: bool = True,
-    timing: str = "capture",
-    travel: str = "keep",
-    min_turns: float = MIN_TURNS,
-) -> ExtractionResult:
-    """Body of :func:`extract` for one delay."""
+            return extract(motion, frames, delay=None, **options)
+        except NoPeriodicMotionError as first:
+            try:
+                res = extract(motion, frames, delay=AUTO_DELAY, **options)
+            except NoPeriodicMotionError:
+                raise first from None
+            res.warnings.insert(0, f"read with a {AUTO_DELAY:g} s delay embedding: the poses alone show no "
+                                   "periodic motion (an out-and-back movement, such as a squat)")
+            return res
     opts = _check_options(
         motion, weighting=weighting, sampling=sampling, cycle_start=cycle_start, n_samples=n_samples,
         n_neighbors=n_neighbors, bandwidth=bandwidth, timing=timing, travel=travel, min_turns=min_turns,
