@@ -32,7 +32,8 @@ def phase_table(result: cc.ExtractionResult) -> str:
     out = io.StringIO()
     out.write("frame,phase,cycle\n")
     for k, (theta, c) in enumerate(zip(result.coordinate, cycle)):
-        out.write(f"{result.motion.start_frame + k},{theta:.5f},{c}\n")
+        # rounded to 5 decimals, a phase above 0.999995 would print as 1.00000: wrap it to 0
+        out.write(f"{result.motion.start_frame + k},{round(float(theta), 5) % 1.0:.5f},{c}\n")
     return out.getvalue()
 
 

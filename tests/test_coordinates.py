@@ -246,3 +246,15 @@ def test_extension_table_gives_the_binary_search_lookups_bit_for_bit(monkeypatch
     monkeypatch.setattr(co, "_TABLE_MAX_CENTERS", 0)
     slow = co.extend_coordinate(pts, centers, ctheta, edges, harmonic, 1.0, chunk=700)
     assert np.array_equal(fast[0], slow[0]) and np.array_equal(fast[1], slow[1])
+
+
+def test_coordinates_stay_below_one():
+    """A value a hair below the first frame's wraps to 0, not to 1.0 (np.mod(-1e-17, 1))."""
+    import cyclecoord as cc
+
+    res = cc.extract(cc.datasets.example_capture().motion)
+    assert res.coordinate.min() >= 0.0 and res.coordinate.max() < 1.0
+    from cyclecoord.periodic.coordinates import orient_with_time
+
+    out = orient_with_time(np.array([0.3, np.nextafter(0.3, 0.0), 0.5, 0.7]))
+    assert out.max() < 1.0 and out[1] == 0.0

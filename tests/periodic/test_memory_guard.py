@@ -80,3 +80,25 @@ def test_a_stated_limit_covers_the_whole_run():
     assert peak <= limit
     assert len(res.estimator.landmarks_) == len(res_free.estimator.landmarks_)
     np.testing.assert_array_equal(res.coordinate, res_free.coordinate)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_projected_screening_picks_the_same_landmarks(seed):
+    """Above 50,000 points each greedy step measures only points the projection cannot
+    rule out; the landmarks and covering radius are those of the full pass."""
+    rng = np.random.default_rng(seed)
+    t = rng.random(60_000) * 6 * np.pi
+    x = np.zeros((60_000, 20))
+    x[:, 0], x[:, 1], x[:, 2] = 10 * np.cos(t), 10 * np.sin(t), 3 * np.cos(2 * t)
+    x += rng.normal(0, 0.5, x.shape)
+    sq = np.einsum("ij,ij->i", x, x)
+    idx, nearest, i = [], np.full(len(x), np.inf), 0
+    for _ in range(150):  # the plain algorithm: one full pass a step
+        idx.append(i)
+        np.minimum(nearest, sq + sq[i] - 2.0 * (x @ x[i]), out=nearest)
+        nearest[i] = 0.0
+        i = int(np.argmax(nearest))
+    radius = float(np.linalg.norm(x[i] - x[idx], axis=1).min())
+    got, got_radius = lm.greedy_landmarks(x, 150)
+    np.testing.assert_array_equal(got, idx)
+    assert got_radius == radius

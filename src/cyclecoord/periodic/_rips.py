@@ -68,7 +68,13 @@ def rips_cohomology(
         ``dgms`` (two (m, 2) arrays), ``cocycles`` (``[[], [ (k, 3) int arrays ]]``
         with values mod ``coeff``) and ``num_edges``, as ``ripser.ripser`` returns them.
     """
-    from pyRipser import doRipsFiltrationDM
+    try:
+        from pyRipser import doRipsFiltrationDM
+    except ImportError:  # a ripser build without the extension at top level: its own wrapper
+        import ripser
+
+        return ripser.ripser(x, maxdim=1, thresh=thresh, coeff=coeff, do_cocycles=True,
+                             distance_matrix=distance_matrix)
 
     x = np.asarray(x, dtype=float)
     dm = x if distance_matrix else _euclidean_distances(x)
@@ -92,7 +98,14 @@ def sparse_rips_cohomology(
 ) -> dict:
     """As :func:`rips_cohomology` from a sparse distance matrix's entries, which must be
     sorted by (row, col) (``scipy.sparse`` COO after ``tocsr().tocoo()`` is)."""
-    from pyRipser import doRipsFiltrationDMSparse
+    try:
+        from pyRipser import doRipsFiltrationDMSparse
+    except ImportError:
+        import ripser
+        from scipy.sparse import coo_matrix
+
+        mat = coo_matrix((data, (row, col)), shape=(int(n), int(n)))
+        return ripser.ripser(mat, maxdim=1, thresh=thresh, coeff=coeff, do_cocycles=True, distance_matrix=True)
 
     res = doRipsFiltrationDMSparse(
         np.asarray(row).astype(np.int32, order="C"),

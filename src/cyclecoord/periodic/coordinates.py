@@ -197,7 +197,7 @@ def harmonic_coordinate(
     delta = sp.csr_matrix((vals, (rows, cols)), shape=(e, n))
     w = _least_squares_potential(delta, edges, z, n, weights)
     harmonic = z + delta @ w
-    theta = np.mod(-w, 1.0)
+    theta = _unit(-w)
     return theta, harmonic
 
 
@@ -251,6 +251,13 @@ def _least_squares_potential(
     return w
 
 
+def _unit(x: np.ndarray) -> np.ndarray:
+    """``x mod 1`` in [0, 1): ``np.mod(-1e-17, 1.0)`` is 1.0 in floating point, which is 0."""
+    out = np.mod(x, 1.0)
+    out[out >= 1.0] = 0.0
+    return out
+
+
 def orient_with_time(theta: np.ndarray, return_transform: bool = False):
     """Flip the coordinate if it runs backwards in frame order, and put frame 0 at 0.
 
@@ -259,9 +266,9 @@ def orient_with_time(theta: np.ndarray, return_transform: bool = False):
     """
     steps = np.mod(np.diff(theta) + 0.5, 1.0) - 0.5
     sign = -1.0 if steps.sum() < 0 else 1.0
-    t = np.mod(sign * theta, 1.0)
+    t = _unit(sign * theta)
     offset = float(t[0])
-    out = np.mod(t - offset, 1.0)
+    out = _unit(t - offset)
     return (out, sign, offset) if return_transform else out
 
 
@@ -334,7 +341,7 @@ def extend_coordinate(
         if (~cov).any():
             _, nn = tree.query(q[~cov], k=1)
             out[~cov] = center_theta[np.asarray(nn).ravel()]
-        theta[a : a + chunk] = np.mod(out, 1.0)
+        theta[a : a + chunk] = _unit(out)
         covered[a : a + chunk] = cov
     return theta, covered
 
@@ -718,7 +725,7 @@ class CircularCoordinates:
             )
         raw, _ = extend_coordinate(x, self.centers_, self.center_theta_, self.edges_, self.harmonic_cocycle_, self.radius_)
         sign, offset = self.orientation_
-        return np.mod(sign * raw - offset, 1.0)
+        return _unit(sign * raw - offset)
 
     def fit_transform(self, X, y=None) -> np.ndarray:
         return self.fit(X).coordinates_.copy()

@@ -208,7 +208,11 @@ def greedy_landmarks(
     already chosen.  Distances to a new landmark come from one matrix-vector product
     (``|x|² + |l|² - 2 x·l``), so a step costs one pass over the points: on 64,000
     frames of 62 channels 500 landmarks take about a second, where ripser's own
-    greedy step (one ``pairwise_distances`` call per landmark) took about four.
+    greedy step (one ``pairwise_distances`` call per landmark) took about four.  From
+    50,000 points on, each step first screens every point by its distance in a
+    4-dimensional principal projection (a lower bound of the true distance, one cheap
+    pass) and measures in full only the points that bound cannot rule out: at 200,000
+    frames 6.2 -> 1.5 CPU-s, the same landmarks (tested against the full pass).
 
     Parameters
     ----------
@@ -239,10 +243,22 @@ def greedy_landmarks(
     idx = np.empty(int(n), dtype=np.int64)
     nearest = np.full(T, np.inf)  # squared distances for points, distances for a matrix
     i = int(start)
+    bound = None
+    if not distance_matrix and T >= _PROJECTED_FROM and x.shape[1] > _PROJECTED_DIMS:
+        bound = _projection(x)
+        bsq = np.einsum("ij,ij->i", bound, bound)
+        slack = 1e-12 * float(sq.max())  # far above either product form's rounding
     for k in range(int(n)):
         idx[k] = i
-        d = x[i] if distance_matrix else sq + sq[i] - 2.0 * (x @ x[i])
-        np.minimum(nearest, d, out=nearest)
+        if bound is not None and k > 0:
+            # only points whose projected distance (a lower bound) might beat their nearest
+            lower = bsq + bsq[i] - 2.0 * (bound @ bound[i])
+            cand = np.flatnonzero(lower < nearest + slack)
+            d = sq[cand] + sq[i] - 2.0 * (x[cand] @ x[i])
+            nearest[cand] = np.minimum(nearest[cand], d)
+        else:
+            d = x[i] if distance_matrix else sq + sq[i] - 2.0 * (x @ x[i])
+            np.minimum(nearest, d, out=nearest)
         nearest[i] = 0.0
         i = int(np.argmax(nearest))
     if n == T:
@@ -250,6 +266,26 @@ def greedy_landmarks(
     # the farthest point's distance, exactly (the product form loses digits near 0)
     radius = x[i, idx].min() if distance_matrix else np.linalg.norm(x[i] - x[idx], axis=1).min()
     return idx, float(radius)
+
+
+#: From this many points on, greedy_landmarks screens each step with a projection of the
+#: points on their first principal directions: the projected distance is a lower bound
+#: of the true one, so only points it cannot rule out are measured in full.
+_PROJECTED_FROM = 50_000
+_PROJECTED_DIMS = 4
+
+
+def _projection(x: np.ndarray, block: int = 65_536) -> np.ndarray:
+    """Coordinates of ``x`` on its first principal directions (orthonormal: distances
+    between projections never exceed the true ones), from a sample of at most 20,000."""
+    T = x.shape[0]
+    sub = x[:: max(1, T // 20_000)]
+    _, _, vt = np.linalg.svd(sub - sub.mean(axis=0), full_matrices=False)
+    basis = vt[:_PROJECTED_DIMS].T
+    out = np.empty((T, basis.shape[1]))
+    for a in range(0, T, block):
+        out[a : a + block] = x[a : a + block] @ basis
+    return out
 
 
 def estimate_complex(
