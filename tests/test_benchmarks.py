@@ -347,7 +347,9 @@ def test_scaling_mixed_capture_is_timed_both_ways():
     assert {"barcode", "coordinate"} <= set(full["stages"]) or "steady" in full["stages"]
     assert full["outcome"] in ("ok", "no periodic motion")
     assert full["stages"]["total"] == pytest.approx(sum(v for k, v in full["stages"].items() if k != "total"))
-    assert full["landmarks"] == 500 and "cycles" in full
+    # 500 landmarks for the final fit, 150 when the first pass (which finds the steady
+    # frames of a long take) already finds too few turns
+    assert full["landmarks"] in (150, 500) and "cycles" in full
     (target, *_) = scaling.evaluate_targets([c])
     assert target["passed"] is not None and target["value"] == full["stages"]["total"]
     assert "require_clear=False" in target["note"]
