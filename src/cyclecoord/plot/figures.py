@@ -666,11 +666,14 @@ def plot_channels(
     ccols = [cycle.channel_index(*motion.channels[c]) for c in cols]
     fps = motion.fps
     period = float(res.period_frames)
-    n_show = int(min(motion.n_frames, max(8, round(periods * period))))
-    orig = motion.frames[:n_show, cols]
+    # the capture from its first steady frame (a whole take's standing start is not the cycle's)
+    used = getattr(res, "used_frames", None) or [(0, motion.n_frames)]
+    s0 = int(used[0][0])
+    n_show = int(min(motion.n_frames - s0, max(8, round(periods * period))))
+    orig = motion.frames[s0 : s0 + n_show, cols]
     cyc_frames = np.asarray(cycle.frames[:, ccols], dtype=float)
     P = cyc_frames.shape[0]
-    j0 = _best_offset(motion, cycle, root)
+    j0 = _best_offset(motion.window((s0, None)) if s0 else motion, cycle, root)
     idx = (j0 + np.arange(n_show)) % P
     cyc = cyc_frames[idx]
     # angles: the cycle and the clip may sit a whole turn apart; align each channel to the clip
@@ -690,7 +693,7 @@ def plot_channels(
     import matplotlib as mpl
 
     palette = mpl.colormaps["tab10"] if len(cols) <= 10 else mpl.colormaps["turbo"]
-    t = np.arange(n_show) + motion.start_frame
+    t = np.arange(n_show) + motion.start_frame + s0
     for k, name in enumerate(names):
         colour = palette(k % 10) if len(cols) <= 10 else palette(k / max(1, len(cols) - 1))
         lw = 1.4 if len(cols) <= 10 else 0.7
@@ -704,24 +707,24 @@ def plot_channels(
                     fontsize=7, loc="upper right", ncol=2)
 
     # jerk in the space result.jerk is measured in (one definition everywhere), one period
-    n_j = int(min(motion.n_frames, max(8, round(period))))
+    n_j = int(min(motion.n_frames - s0, max(8, round(period))))
     stencil = 7
-    poses = np.asarray(res.prepared.poses, dtype=float)
+    poses = np.asarray(res.prepared.poses, dtype=float)[s0:]
     typ = np.asarray(res.typical.frames, dtype=float)
     seg_o = poses[: n_j + stencil - 1]
     jo = np.linalg.norm(jerk(seg_o, fps), axis=1)[:n_j] if seg_o.shape[0] >= stencil else np.zeros(0)
     Pt = typ.shape[0]
     jc_all = np.linalg.norm(jerk(typ, fps, cyclic=True), axis=1) if Pt >= stencil else np.zeros(Pt)
     jc = jc_all[(j0 * Pt // max(P, 1) + np.arange(min(n_j, Pt))) % Pt] if Pt else np.zeros(0)
-    ax_j.plot(np.arange(jo.size) + motion.start_frame, jo, color=_ORIGINAL, linewidth=1.2, label="original")
-    ax_j.plot(np.arange(jc.size) + motion.start_frame, jc, color=_CYCLE, linewidth=1.2, label="cycle")
+    ax_j.plot(np.arange(jo.size) + motion.start_frame + s0, jo, color=_ORIGINAL, linewidth=1.2, label="original")
+    ax_j.plot(np.arange(jc.size) + motion.start_frame + s0, jc, color=_CYCLE, linewidth=1.2, label="cycle")
     ax_j.set_xlabel("frame")
     ax_j.set_ylabel("jerk norm, all channels (units / s³)")
     jr = res.jerk
     ratio = jr["cycle"] / jr["original"] if jr.get("original", 0) > 0 else float("nan")
     ax_j.set_title(
-        f"jerk: cycle {jr['cycle']:.3g} vs original {jr['original']:.3g} (ratio {ratio:.2f})",
-        fontsize=10,
+        f"jerk: cycle {jr['cycle']:.3g} vs original {jr['original']:.3g}\n(ratio {ratio:.2f})",
+        fontsize=9,
     )
     ax_j.legend(fontsize=8, loc="upper right")
     if jo.size and jc.size and min(jo.min(), jc.min()) > 0:
