@@ -49,6 +49,8 @@ CAPTURE_WIDTH = 1.0
 MAX_SPREAD = 0.25
 #: A bar alive at the threshold is followed until the threshold is this many times its birth.
 ALIVE_RATIO = 4.0
+#: At most this many phased frames are aligned and averaged into the capture-timed cycle.
+MAX_CYCLE_FRAMES = 20_000
 #: Delay embedding (seconds) tried when a take's poses alone show no periodic motion.
 AUTO_DELAY = 0.25
 #: Landmarks of the rough first pass over a long take (which finds its steady frames).
@@ -873,6 +875,16 @@ def capture_cycle(
     """
     P = max(2, int(round(period)))
     width = CAPTURE_WIDTH if bandwidth is None or bandwidth == "auto" else float(bandwidth)
+    phase = np.array(phase, dtype=float)
+    finite = np.flatnonzero(np.isfinite(phase))
+    if finite.size > MAX_CYCLE_FRAMES:
+        # a long take's cycle is averaged from its middle MAX_CYCLE_FRAMES phased frames
+        # (over a hundred repetitions): registration's cost stays bounded
+        mid = finite.size // 2
+        keep = finite[mid - MAX_CYCLE_FRAMES // 2 : mid + MAX_CYCLE_FRAMES // 2]
+        drop = np.ones(phase.size, dtype=bool)
+        drop[keep] = False
+        phase[drop] = np.nan
     if register_iter:
         joints = _joint_columns(motion, prepared)
         phase = register(phase, prepared.poses[:, joints], stretches(np.isfinite(phase)), P,
