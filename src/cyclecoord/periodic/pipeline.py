@@ -514,10 +514,10 @@ def extract(
             raise ParameterError(f"delay must be 'auto', a number of seconds or None, got {delay!r}")
         options = {k: v for k, v in locals().items() if k not in ("motion", "frames", "delay")}
         try:
-            return extract(motion, frames, delay=None, **options)
+            return extract(motion, frames=frames, delay=None, **options)
         except NoPeriodicMotionError as first:
             try:
-                res = extract(motion, frames, delay=AUTO_DELAY, **options)
+                res = extract(motion, frames=frames, delay=AUTO_DELAY, **options)
             except NoPeriodicMotionError:
                 raise first from None
             res.warnings.insert(0, f"read with a {AUTO_DELAY:g} s delay embedding: the poses alone show no "
