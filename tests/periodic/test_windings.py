@@ -70,3 +70,23 @@ def test_phase_average_recovers_a_periodic_signal():
         phase_average(ph, vals[:10], 50, 0.01)
     with pytest.raises(ParameterError):
         phase_average(ph, vals, 50, 0.0)
+
+
+def test_typical_amplitude_restores_what_averaging_flattens():
+    from cyclecoord.periodic.pipeline import MAX_AMPLITUDE_GAIN, typical_amplitude
+
+    rng = np.random.default_rng(0)
+    P, n = 100, 12
+    phase, poses = [], []
+    for _ in range(n):  # a sharp flick whose timing differs from repetition to repetition
+        centre = 0.5 + rng.normal(0, 0.03)
+        ph = np.arange(P) / P
+        phase.append(ph)
+        poses.append(np.exp(-0.5 * ((ph - centre) / 0.02) ** 2)[:, None] * [30.0, 0.0] + [0.0, 1.0])
+    phase, poses = np.concatenate(phase), np.vstack(poses)
+    avg = phase_average(phase, poses, P, 0.01)
+    assert np.ptp(avg[:, 0]) < 0.8 * 30.0  # the plain average flattens the flick
+    out = typical_amplitude(avg, phase, poses)
+    assert np.ptp(out[:, 0]) == pytest.approx(min(30.0, MAX_AMPLITUDE_GAIN * np.ptp(avg[:, 0])), rel=0.1)
+    np.testing.assert_allclose(out[:, 1], avg[:, 1])  # a constant channel stays as it is
+    assert np.argmax(out[:, 0]) == np.argmax(avg[:, 0])  # the shape is kept, only widened
