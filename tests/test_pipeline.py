@@ -5,7 +5,8 @@ import pytest
 
 import cyclecoord as cc
 from cyclecoord.quality.metrics import distance_to_cycle, loop_closure
-from cyclecoord.periodic.pipeline import cycle_lengths, slowest_frame
+from cyclecoord.periodic.clip import slowest_frame
+from cyclecoord.periodic.pipeline import cycle_lengths
 from cyclecoord.periodic.preprocess import Preprocessor
 from cyclecoord.periodic.windings import crossing_times
 

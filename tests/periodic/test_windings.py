@@ -73,7 +73,7 @@ def test_phase_average_recovers_a_periodic_signal():
 
 
 def test_typical_amplitude_restores_what_averaging_flattens():
-    from cyclecoord.periodic.pipeline import MAX_AMPLITUDE_GAIN, typical_amplitude
+    from cyclecoord.periodic.clip import MAX_AMPLITUDE_GAIN, typical_amplitude
 
     rng = np.random.default_rng(0)
     P, n = 100, 12

@@ -930,7 +930,7 @@ def motion_cycles(
     segments hold.  The typical cycle is then built as :func:`cyclecoord.extract` builds
     it: by default (``timing="capture"``) in a phase re-timed to the capture's pace
     between the coordinate's crossings and aligned by time warping
-    (:func:`~cyclecoord.periodic.pipeline.capture_cycle`), slowest pose first, root tilt
+    (:func:`~cyclecoord.periodic.clip.capture_cycle`), slowest pose first, root tilt
     averaged and heading integrated; with ``timing="coordinate"`` by the paper's density
     sampling.  No fresh barcode is computed.  (A fresh
     ``extract`` on the segment picks the segment's most persistent class, which is often
@@ -951,7 +951,8 @@ def motion_cycles(
     from .cycle import typical_cycle
     from .density import PeriodicDensity
     from ..quality.metrics import loop_closure
-    from .pipeline import TIMINGS, capture_cycle, loop_cycle
+    from .clip import capture_cycle, loop_cycle
+    from .pipeline import TIMINGS
     from .windings import complete_windings, retime, stretches
 
     if not isinstance(result, DetectionResult):

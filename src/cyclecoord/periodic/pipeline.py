@@ -20,21 +20,18 @@ from .barcode import (
     CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, DEFAULT_PRIME, Barcode, BarSelection, refine_birth, select_bar,
 )
 from .coordinates import REFINE_BYTES_PER_EDGE, CircularCoordinates, unwrap
-from .cycle import TypicalCycle, check_bandwidth, select_bandwidth, typical_cycle
+from .cycle import TypicalCycle, check_bandwidth, typical_cycle
 from .density import PeriodicDensity
 from ..errors import NoPeriodicMotionError, ParameterError
 from ..quality.metrics import distance_to_cycle, frame_steps, jerk_summary, loop_closure
 from ..motion import Motion
 from .preprocess import PreparedData, Preprocessor
-from .root import compose_root, decompose_root, heading, root_layout
-from .registration import register
+from .clip import capture_cycle, joint_columns, loop_cycle
+from .root import heading, root_layout
 from .steady import moving_mask, recurrence, steady_mask
-from .windings import Windings, complete_windings, phase_average, retime, stretches
+from .windings import Windings, complete_windings, retime, stretches
 
-__all__ = [
-    "extract", "ExtractionResult", "loop_cycle", "capture_cycle", "cycle_lengths", "slowest_frame",
-    "MIN_TURNS", "TIMINGS", "TRAVELS", "CAPTURE_WIDTH",
-]
+__all__ = ["extract", "ExtractionResult", "cycle_lengths", "MIN_TURNS", "TIMINGS", "TRAVELS"]
 
 #: Fewer turns of the coordinate over the steady frames than this is no periodic motion
 #: (the rule :func:`~cyclecoord.periodic.detection.detect` applies to its segments).
@@ -43,34 +40,14 @@ MIN_TURNS = 1.5
 TIMINGS = ("capture", "coordinate")
 #: What the cycle's root does: travel and turn as captured, walk straight, stay in place.
 TRAVELS = ("keep", "straight", "in_place")
-#: Default width (frames of time) of the kernel that averages the re-timed cycle.
-CAPTURE_WIDTH = 1.0
 #: Complete windings varying by more than this (p10-p90 over the median) are not steady.
 MAX_SPREAD = 0.25
 #: A bar alive at the threshold is followed until the threshold is this many times its birth.
 ALIVE_RATIO = 4.0
-#: At most this many phased frames are aligned and averaged into the capture-timed cycle.
-MAX_CYCLE_FRAMES = 20_000
 #: Delay embedding (seconds) tried when a take's poses alone show no periodic motion.
 AUTO_DELAY = 0.25
 #: Landmarks of the rough first pass over a long take (which finds its steady frames).
 FIRST_PASS_LANDMARKS = 150
-
-
-def slowest_frame(frames: np.ndarray, window: int = 5) -> int:
-    """Index of the frame where a closed cycle moves least.
-
-    Step sizes around the loop are smoothed over ``window`` frames (cyclically); the frame
-    between the two smallest smoothed steps is returned.  Starting a loop there hides the
-    seam best, as animators cut loops at a rest pose.
-    """
-    f = np.asarray(frames, dtype=float)
-    steps = np.linalg.norm(np.roll(f, -1, axis=0) - f, axis=1)  # step i: frame i -> i+1
-    around = steps + np.roll(steps, 1)  # motion entering and leaving frame i
-    w = max(1, min(window, len(f)))
-    kernel = np.ones(w) / w
-    smooth = np.convolve(np.concatenate([around[-w:], around, around[:w]]), kernel, mode="same")[w:-w]
-    return int(np.argmin(smooth))
 
 
 def cycle_lengths(unwrapped: np.ndarray) -> np.ndarray:
@@ -245,71 +222,6 @@ def _landmark_report(est: CircularCoordinates | None) -> dict | None:
         "complex_estimate": est.complex_estimate_.to_dict(),
         "frames_outside_landmark_balls": int(np.sum(~est.covered_)) if hasattr(est, "covered_") else None,
     }
-
-
-def loop_cycle(
-    typical: TypicalCycle,
-    motion: Motion,
-    prepared: PreparedData,
-    preprocessor: Preprocessor,
-    cycle_start: str = "slowest",
-    rows: np.ndarray | None = None,
-    metadata: dict | None = None,
-) -> tuple[TypicalCycle, Motion]:
-    """Turn a typical cycle in the prepared space into a loopable clip of the capture.
-
-    The cycle is rotated to begin at its slowest pose (``cycle_start="slowest"``, where
-    a loop's seam is least visible), and its root channels, per-frame differences in the
-    prepared space, are integrated so that the clip travels and turns per frame as the
-    capture did on average.
-
-    Parameters
-    ----------
-    typical : TypicalCycle
-        From :func:`~cyclecoord.periodic.cycle.typical_cycle` on ``prepared.poses`` (or rows of it).
-    motion : Motion
-        The capture ``prepared`` was made from.
-    prepared : PreparedData
-    preprocessor : Preprocessor
-        The fitted preprocessor that made ``prepared``.
-    cycle_start : {"slowest", "first"}
-    rows : ndarray of int, optional
-        The frames the cycle was averaged from (default all); their root differences
-        give the travel per frame.
-    metadata : dict, optional
-        Stored on the returned clip.
-
-    Returns
-    -------
-    (TypicalCycle, Motion)
-        The cycle (rotated when ``cycle_start="slowest"``) and the clip, with the
-        capture's channels, skeleton and frame rate.
-    """
-    if cycle_start not in ("slowest", "first"):
-        raise ParameterError(f"cycle_start must be 'slowest' or 'first', got {cycle_start!r}")
-    root = prepared.root_columns
-    if cycle_start == "slowest":
-        joints = np.delete(typical.frames, root, axis=1) if root.size < typical.frames.shape[1] else typical.frames
-        shift = slowest_frame(joints)
-        if shift:
-            from dataclasses import replace
-
-            typical = replace(
-                typical,
-                frames=np.roll(typical.frames, -shift, axis=0),
-                phases=np.roll(typical.phases, -shift),
-            )
-    cyc = np.array(typical.frames, dtype=float)
-    if root.size:
-        last = len(prepared.poses) - 1  # the last row repeats the one before (see difference_root)
-        used = np.arange(last) if rows is None else np.asarray(rows, dtype=int)
-        used = used[used < last] if np.any(used < last) else used
-        mean_delta = prepared.poses[used][:, root].mean(axis=0)
-        cyc[:, root] = preprocessor.integrate_root(typical.frames[:, root], motion.frames[int(used.min()), root], mean_delta, motion)
-    clip = motion.with_frames(
-        cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}", metadata=dict(metadata or {}),
-    )
-    return typical, clip
 
 
 def _first_clear(est: CircularCoordinates, points: np.ndarray, class_index: int, scale, scale_fraction: float):
@@ -549,7 +461,7 @@ def extract(
     lag = int(round(delay * motion.fps)) if delay else None
     prep = Preprocessor(difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=lag)
     prepared = prep.fit_transform(motion)
-    joints = _joint_columns(motion, prepared)
+    joints = joint_columns(motion, prepared)
     moving = moving_mask(prepared.poses[:, joints], motion.fps) if steady else np.ones(T, dtype=bool)
     if not steady or moving.sum() >= 0.95 * T or moving.sum() < max(10, 2 * n_neighbors):
         moving = np.ones(T, dtype=bool)
@@ -700,12 +612,6 @@ def _check_options(motion, **o) -> dict:
     return o
 
 
-def _joint_columns(motion: Motion, prepared: PreparedData) -> np.ndarray:
-    """Columns of the poses that are joint angles (not the root)."""
-    cols = np.setdiff1d(np.arange(prepared.poses.shape[1]), prepared.root_columns)
-    return cols if cols.size else np.arange(prepared.poses.shape[1])
-
-
 def _row_runs(rows: np.ndarray) -> list[tuple[int, int]]:
     """Runs of consecutive frame indices in a sorted index array."""
     if rows.size == 0:
@@ -826,159 +732,3 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     )
 
 
-#: A channel of the averaged cycle is widened at most this much (typical amplitude).
-MAX_AMPLITUDE_GAIN = 1.5
-
-
-def typical_amplitude(cycle: np.ndarray, phase: np.ndarray, poses: np.ndarray, spike: int = 5) -> np.ndarray:
-    """Give each channel of an averaged cycle the median range of the capture's repetitions.
-
-    Averaging repetitions whose sharp features (a toe's flick, a foot's roll) differ a
-    little in timing and size flattens them: the average's range is smaller than any
-    single repetition's.  Each channel is scaled about the cycle's mean by the median,
-    over the complete repetitions (runs of frames between two wraps of ``phase``), of the
-    repetition's range over the cycle's range, both after a running median of ``spike``
-    frames (a one- or two-frame marker glitch is not amplitude).  The gain is kept in
-    ``[1, MAX_AMPLITUDE_GAIN]``: a channel is never narrowed, nor a noisy one blown up.
-
-    Parameters
-    ----------
-    cycle : ndarray, shape (P, C)
-    phase : ndarray, shape (T,)
-        Phase per frame, NaN where there is none.
-    poses : ndarray, shape (T, C)
-
-    Returns
-    -------
-    ndarray, shape (P, C)
-    """
-    from scipy.ndimage import median_filter
-
-    ph = np.asarray(phase, dtype=float)
-    ok = np.isfinite(ph)
-    wraps = np.flatnonzero(ok[1:] & ok[:-1] & (np.diff(np.where(ok, ph, 0.0)) < -0.5)) + 1
-    ranges = []
-    for a, b in zip(wraps[:-1], wraps[1:]):
-        if np.all(ok[a:b]) and b - a > spike:
-            ranges.append(np.ptp(median_filter(poses[a:b], size=(spike, 1), mode="nearest"), axis=0))
-    if not ranges:
-        return cycle
-    typical = np.median(np.asarray(ranges), axis=0)
-    have = np.ptp(median_filter(cycle, size=(spike, 1), mode="wrap"), axis=0)
-    gain = np.clip(np.where(have > 1e-9, typical / np.maximum(have, 1e-9), 1.0), 1.0, MAX_AMPLITUDE_GAIN)
-    mean = cycle.mean(axis=0)
-    return mean + (cycle - mean) * gain
-
-
-def capture_cycle(
-    phase: np.ndarray,
-    motion: Motion,
-    prepared: PreparedData,
-    preprocessor: Preprocessor,
-    period: float,
-    *,
-    bandwidth: str | float | None = None,
-    cycle_start: str = "slowest",
-    travel: str = "keep",
-    k: int = 10,
-    register_iter: int = 2,
-    amplitude: str = "typical",
-    metadata: dict | None = None,
-) -> tuple[TypicalCycle, Motion, float]:
-    """The typical cycle averaged in a phase that advances at the capture's pace.
-
-    Parameters
-    ----------
-    phase : ndarray, shape (T,)
-        Re-timed phase per frame in ``[0, 1)`` (:func:`~cyclecoord.periodic.windings.retime`),
-        NaN for frames left out.
-    motion, prepared, preprocessor
-        The capture, its prepared data and the fitted preprocessor.
-    period : float
-        Period in frames; the cycle has ``round(period)`` frames.
-    bandwidth : None, "auto" or float
-        Kernel width in frames of time (None: :data:`CAPTURE_WIDTH`).
-    cycle_start : {"slowest", "first"}
-    travel : {"keep", "straight", "in_place"}
-        See :func:`~cyclecoord.periodic.root.compose_root`.
-    k : int
-        Neighbours for the ``"auto"`` bandwidth's cross-validation.
-    register_iter : int
-        Rounds of :func:`~cyclecoord.periodic.registration.register` (0: none), which
-        align every repetition to the cycle so that sharp features are not averaged
-        away.
-    amplitude : {"typical", "average"}
-        ``"typical"``: each joint channel of the average is widened about its mean to the
-        median range of the capture's own repetitions (:func:`typical_amplitude`);
-        ``"average"``: the plain average, whose sharp features shrink where repetitions
-        differ.
-    metadata : dict, optional
-        Stored on the returned clip.
-
-    Returns
-    -------
-    (TypicalCycle, Motion, float)
-        The cycle in the prepared space, the loopable clip (root pitch, roll and height
-        averaged as absolute values, so they close; heading and ground travel integrated
-        from their mean changes) and the heading change per cycle in degrees (NaN
-        without a six-dof root and a skeleton).
-    """
-    P = max(2, int(round(period)))
-    width = CAPTURE_WIDTH if bandwidth is None or bandwidth == "auto" else float(bandwidth)
-    phase = np.array(phase, dtype=float)
-    finite = np.flatnonzero(np.isfinite(phase))
-    if finite.size > MAX_CYCLE_FRAMES:
-        # a long take's cycle is averaged from its middle MAX_CYCLE_FRAMES phased frames
-        # (over a hundred repetitions): registration's cost stays bounded
-        mid = finite.size // 2
-        keep = finite[mid - MAX_CYCLE_FRAMES // 2 : mid + MAX_CYCLE_FRAMES // 2]
-        drop = np.ones(phase.size, dtype=bool)
-        drop[keep] = False
-        phase[drop] = np.nan
-    if register_iter:
-        joints = _joint_columns(motion, prepared)
-        phase = register(phase, prepared.poses[:, joints], stretches(np.isfinite(phase)), P,
-                         width / float(period), n_iter=register_iter)
-    rows = np.flatnonzero(np.isfinite(phase))
-    ph = phase[rows]
-    poses = prepared.poses[rows]
-    selection = None
-    if bandwidth == "auto":
-        selection = select_bandwidth(ph, poses, float(period), k=min(k, rows.size))
-        width = float(selection.bandwidth)
-    frames = phase_average(ph, poses, P, width / float(period))
-    if amplitude == "typical":
-        joints = _joint_columns(motion, prepared)
-        frames[:, joints] = typical_amplitude(frames[:, joints], phase, prepared.poses[:, joints])
-    layout = root_layout(motion) if prepared.root_columns.size else None
-    feats = phase_average(ph, decompose_root(motion.frames, layout)[rows], P, width / float(period)) if layout else None
-    shift = 0
-    if cycle_start == "slowest":
-        joints = np.delete(frames, prepared.root_columns, axis=1) if prepared.root_columns.size < frames.shape[1] else frames
-        shift = slowest_frame(joints)
-    frames = np.roll(frames, -shift, axis=0)
-    phases = np.mod((np.arange(P) + shift) / P, 1.0)
-    cyc = frames.copy()
-    heading_change = float("nan")
-    if feats is not None:
-        feats = np.roll(feats, -shift, axis=0)
-        heading_change = float(feats[:, 4].sum())
-        first = motion.frames[rows[0]]
-        start_heading = float(heading(first[None, :], layout)[0])
-        ground = (float(first[layout.column("tx")]), float(first[layout.column("tz")]))
-        cyc[:, layout.columns] = compose_root(feats, layout, start_heading, ground, travel=travel)
-    elif prepared.root_columns.size:
-        root = prepared.root_columns
-        mean_delta = frames[:, root].mean(axis=0) if travel == "keep" else np.zeros(root.size)
-        cyc[:, root] = preprocessor.integrate_root(frames[:, root], motion.frames[rows[0], root], mean_delta, motion)
-    clip = motion.with_frames(cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}",
-                              metadata=dict(metadata or {}))
-    if feats is not None:
-        # the cycle in the prepared space is the written clip's own (one definition of its
-        # root changes, so its jerk and loop closure read the same from the file)
-        frames = preprocessor.transform(clip).poses
-    typ = TypicalCycle(frames=frames, phases=phases, curve=frames, sample_phases=phases, bandwidth=width,
-                       bandwidth_selection=selection)
-    for arr in (typ.frames, typ.phases):
-        arr.flags.writeable = False
-    return typ, clip, heading_change
