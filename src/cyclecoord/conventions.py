@@ -25,7 +25,8 @@ __all__ = ["to_bvh_convention", "local_rotations", "continuous_euler"]
 _AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 
 
-def _check_order(order: str) -> str:
+def check_order(order: str) -> str:
+    """``order`` upper-cased, checked to be a permutation of ``"XYZ"`` (ParameterError if not)."""
     up = str(order).upper()
     if len(up) != 3 or sorted(up) != ["X", "Y", "Z"]:
         raise ParameterError(
@@ -94,7 +95,7 @@ def continuous_euler(matrices: np.ndarray, order: str) -> np.ndarray:
     ndarray, shape (T, J, 3)
         Angles in ``order``, degrees.
     """
-    order = _check_order(order)
+    order = check_order(order)
     mats = np.asarray(matrices, dtype=float)
     if mats.ndim != 4 or mats.shape[2:] != (3, 3):
         raise ParameterError(f"expected matrices of shape (T, J, 3, 3), got {mats.shape}")
@@ -155,7 +156,7 @@ def to_bvh_convention(motion: Motion, rotation_order: str = "ZXY") -> Motion:
     ParameterError
         If the motion has no skeleton or ``rotation_order`` is not a permutation of XYZ.
     """
-    order = _check_order(rotation_order)
+    order = check_order(rotation_order)
     skel = motion.skeleton
     if skel is None:
         raise ParameterError("converting to BVH conventions needs a skeleton; this motion has none")

@@ -676,7 +676,7 @@ def _check_outputs(args: argparse.Namespace) -> None:
 def _finish(args: argparse.Namespace, motion, payload: dict, report, what: str, problem: str | None = None) -> int:
     """Print the plausibility verdict, honour --strict, write the motion and the report."""
     from ..io import save
-    from ..quality.plausibility import ImplausibleMotionError
+    from ..errors import ImplausibleMotionError
 
     print(report.summary())
     payload["plausibility"] = report.to_dict()
