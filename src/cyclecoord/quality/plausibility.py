@@ -501,7 +501,7 @@ def _in_convention_of(reference: Motion, motion: Motion) -> Motion:
     A blend of an AMC capture with a BVH cycle is written in one convention; comparing
     joint angles needs the references in the same one.
     """
-    from ..synthesis.interpolate import in_conventions_of
+    from ..conventions import in_conventions_of
 
     return in_conventions_of(reference, motion)
 
