@@ -278,10 +278,16 @@ def _reexpress(motion: Motion, conventions) -> Motion:
         values = {}
         for d in t_dofs:
             k = col.get((mine.name, d))
-            values[d] = motion.frames[:, k] if k is not None else np.full(T, mine.offset["xyz".index(d[1])])
+            values[d] = (
+                motion.frames[:, k] if k is not None else np.full(T, mine.offset["xyz".index(d[1])])
+            )
         if order:
             missing = [a for a in "XYZ" if a not in order]
-            full = order[0] + "".join(missing) + order[1:] if len(order) == 2 else order + "".join(missing)
+            full = (
+                order[0] + "".join(missing) + order[1:]
+                if len(order) == 2
+                else order + "".join(missing)
+            )
             keep = [0, 2] if len(order) == 2 else list(range(len(order)))
             rel = conv.axis.T @ local[i] @ conv.axis
             angles = continuous_euler(rel[:, None], full)[:, 0, keep]
@@ -290,13 +296,24 @@ def _reexpress(motion: Motion, conventions) -> Motion:
         for d in conv.dofs:
             columns.append(values[d])
             channels.append((mine.name, d))
-        joints.append(Joint(
-            name=mine.name, parent=mine.parent, offset=mine.offset.copy(), dofs=tuple(conv.dofs),
-            rotation_order=order, axis=conv.axis.copy(),
-            end_site=None if mine.end_site is None else mine.end_site.copy(), limits=dict(conv.limits),
-        ))
-    new = Skeleton(joints=tuple(joints), name=skel.name, length_unit=skel.length_unit,
-                   source_format=conventions.source_format)
+        joints.append(
+            Joint(
+                name=mine.name,
+                parent=mine.parent,
+                offset=mine.offset.copy(),
+                dofs=tuple(conv.dofs),
+                rotation_order=order,
+                axis=conv.axis.copy(),
+                end_site=None if mine.end_site is None else mine.end_site.copy(),
+                limits=dict(conv.limits),
+            )
+        )
+    new = Skeleton(
+        joints=tuple(joints),
+        name=skel.name,
+        length_unit=skel.length_unit,
+        source_format=conventions.source_format,
+    )
     frames = np.column_stack(columns) if columns else np.zeros((T, 0))
     return replace(motion, frames=frames, channels=tuple(channels), skeleton=new)
 
@@ -335,7 +352,9 @@ def _match_branches(motion: Motion, target: Motion) -> Motion:
 
         def nearest(v: np.ndarray) -> tuple[np.ndarray, float]:
             v = v - 360.0 * np.round((v.mean(axis=0) - goal) / 360.0)
-            return v, float(np.abs(wrap_degrees(v - goal)).sum() + 1e-9 * np.abs(v.mean(axis=0) - goal).sum())
+            return v, float(
+                np.abs(wrap_degrees(v - goal)).sum() + 1e-9 * np.abs(v.mean(axis=0) - goal).sum()
+            )
 
         x1, d1 = nearest(x)
         x2, d2 = nearest(alt)
@@ -379,7 +398,9 @@ def common_channels(motions: Sequence[Motion]) -> list[Motion]:
     """
     motions = list(motions)
     ref = motions[0]
-    if all(set(m.channels) == set(ref.channels) and m.n_channels == ref.n_channels for m in motions):
+    if all(
+        set(m.channels) == set(ref.channels) and m.n_channels == ref.n_channels for m in motions
+    ):
         return [m if m.channels == ref.channels else m.select(ref.channels) for m in motions]
     skels = [m.skeleton for m in motions]
     if (
@@ -392,11 +413,15 @@ def common_channels(motions: Sequence[Motion]) -> list[Motion]:
     asf = [i for i, sk in enumerate(skels) if bvh_ready(sk) is None]
     if asf:
         anchor = motions[asf[0]]
-        out = [m if m.skeleton is anchor.skeleton else _reexpress(m, anchor.skeleton) for m in motions]
+        out = [
+            m if m.skeleton is anchor.skeleton else _reexpress(m, anchor.skeleton) for m in motions
+        ]
     else:
         order = bvh_ready(skels[0])
         anchor = motions[0]
-        out = [m if bvh_ready(m.skeleton) == order else to_bvh_convention(m, order) for m in motions]
+        out = [
+            m if bvh_ready(m.skeleton) == order else to_bvh_convention(m, order) for m in motions
+        ]
     # converted motions take the Euler solutions nearest the unconverted anchor's
     out = [m if m is orig else _match_branches(m, anchor) for m, orig in zip(out, motions)]
     first = out[0].channels

@@ -89,8 +89,11 @@ def _cross_terms(fa: np.ndarray, fb: np.ndarray) -> tuple[np.ndarray, float]:
     fa, fb = pad(fa), pad(fb)
     h = np.einsum("kd,kd->k", np.conj(fa), fb)
     energy = (
-        np.sum(fa[0].real ** 2) + np.sum(fb[0].real ** 2) - 2.0 * np.sum(fa[0].real * fb[0].real)
-        + 0.5 * np.sum(np.abs(fa[1:]) ** 2) + 0.5 * np.sum(np.abs(fb[1:]) ** 2)
+        np.sum(fa[0].real ** 2)
+        + np.sum(fb[0].real ** 2)
+        - 2.0 * np.sum(fa[0].real * fb[0].real)
+        + 0.5 * np.sum(np.abs(fa[1:]) ** 2)
+        + 0.5 * np.sum(np.abs(fb[1:]) ** 2)
     )
     return h, float(energy)
 
@@ -121,7 +124,7 @@ def _best_shift(h: np.ndarray, energy: float) -> tuple[float, float]:
         return (
             float(np.sum(e.real)),
             float(np.sum((2j * np.pi * k * e).real)),
-            float(np.sum((-(2 * np.pi * k) ** 2 * e).real)),
+            float(np.sum((-((2 * np.pi * k) ** 2) * e).real)),
         )
 
     lo, hi = (j - 1) / M, (j + 1) / M
@@ -158,7 +161,9 @@ def harmonise_angles(curve: CycleCurve, reference: CycleCurve) -> CycleCurve:
     return curve.offset(360.0 * turns)
 
 
-def align_curves(a: CycleCurve, b: CycleCurve, columns: np.ndarray, allow_reverse: bool) -> Alignment:
+def align_curves(
+    a: CycleCurve, b: CycleCurve, columns: np.ndarray, allow_reverse: bool
+) -> Alignment:
     fa = a.coefficients[:, columns]
     fb = b.coefficients[:, columns]
     n_cols = max(int(columns.size), 1)
@@ -277,10 +282,13 @@ def root_rotation(motion: Motion) -> tuple[np.ndarray, str, np.ndarray]:
     order = root.rotation_order
     if len(order) != 3:
         raise ParameterError(
-            f"turning a motion needs a root with three rotation channels; {root.name!r} has {order or 'none'}"
+            "turning a motion needs a root with three rotation channels; "
+            f"{root.name!r} has {order or 'none'}"
         )
     try:
-        cols = np.array([motion.channel_index(root.name, "r" + ax.lower()) for ax in order], dtype=int)
+        cols = np.array(
+            [motion.channel_index(root.name, "r" + ax.lower()) for ax in order], dtype=int
+        )
     except KeyError as exc:
         raise ParameterError(f"turning a motion needs every root rotation channel: {exc}") from None
     local = Rotation.from_euler(order, motion.frames[:, cols], degrees=True).as_matrix()

@@ -24,9 +24,25 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Motion
-from .align import Alignment, align_curves, apply_alignment, check_up, harmonise_angles, mean_heading, root_rotation, rotate_heading
+from .align import (
+    Alignment,
+    align_curves,
+    apply_alignment,
+    check_up,
+    harmonise_angles,
+    mean_heading,
+    root_rotation,
+    rotate_heading,
+)
 from ..conventions import bvh_ready, common_channels, wrap_degrees
-from .curve import CycleCurve, angle_columns, continuous_root, horizontal_columns, root_columns, root_drift
+from .curve import (
+    CycleCurve,
+    angle_columns,
+    continuous_root,
+    horizontal_columns,
+    root_columns,
+    root_drift,
+)
 from .sources import cycle_of
 
 __all__ = [
@@ -57,11 +73,14 @@ def _check_weights(weights: object, n: int) -> np.ndarray:
     if not np.all(np.isfinite(w)):
         raise ParameterError(f"weights must be finite numbers, got {w.tolist()}")
     if np.any(w < 0):
-        raise ParameterError(f"weights must be non-negative (a convex combination), got {w.tolist()}")
+        raise ParameterError(
+            f"weights must be non-negative (a convex combination), got {w.tolist()}"
+        )
     total = float(w.sum())
     if abs(total - 1.0) > 1e-6:
         raise ParameterError(
-            f"weights must sum to 1 (a convex combination), got {' + '.join(f'{v:g}' for v in w)} = {total:g}"
+            "weights must sum to 1 (a convex combination), got "
+            f"{' + '.join(f'{v:g}' for v in w)} = {total:g}"
         )
     return w
 
@@ -106,7 +125,11 @@ def _common_frame(
         style = bvh_ready(converted[0].skeleton)
         notes.append(
             "the cycles store their joints in different conventions; all were re-expressed in "
-            + (f"BVH conventions ({style} Euler order)" if style else "the ASF conventions (axes, dofs)")
+            + (
+                f"BVH conventions ({style} Euler order)"
+                if style
+                else "the ASF conventions (axes, dofs)"
+            )
             + " to share channels"
         )
     motions = converted
@@ -117,7 +140,13 @@ def _common_frame(
     for i, m in enumerate(motions):
         scale = 1.0
         size = _skeleton_size(m)
-        if i and scale_root and ref_size is not None and size is not None and abs(size - ref_size) > 1e-9 * ref_size:
+        if (
+            i
+            and scale_root
+            and ref_size is not None
+            and size is not None
+            and abs(size - ref_size) > 1e-9 * ref_size
+        ):
             scale = ref_size / size
             frames = np.array(m.frames, dtype=float)
             tcols = [c for c in root_columns(m) if m.channels[c][1] in ("tx", "ty", "tz")]
@@ -138,13 +167,20 @@ def _common_frame(
             if max(abs(wrap_degrees(h - hs[0])) for h in hs) > 1e-9:
                 turned = True
                 headings = hs
-                fixed = [rotate_heading(m, -h, up, near=None) if abs(h) > 0 else m for m, h in zip(fixed, hs)]
+                fixed = [
+                    rotate_heading(m, -h, up, near=None) if abs(h) > 0 else m
+                    for m, h in zip(fixed, hs)
+                ]
         elif hs:
-            notes.append("cycles not turned to a common heading: a cycle spins round (no mean heading)")
+            notes.append(
+                "cycles not turned to a common heading: a cycle spins round (no mean heading)"
+            )
 
     curves = [_curve_of_extended(m) for m in fixed]
     ref_curve = curves[0]
-    pose = np.array([i for i in range(ref_curve.n_channels) if i not in set(ref_curve.root_columns)], dtype=int)
+    pose = np.array(
+        [i for i in range(ref_curve.n_channels) if i not in set(ref_curve.root_columns)], dtype=int
+    )
     if pose.size == 0:
         pose = np.arange(ref_curve.n_channels)
     alignments: list[Alignment] = [Alignment(0.0, False, 0.0, 0.0, 0.0)]
@@ -162,8 +198,15 @@ def _common_frame(
         alignments.append(al)
         out.append(c)
     return _Prepared(
-        curves=out, alignments=alignments, headings=[float(h) for h in headings], root_scales=scales,
-        notes=notes, reference=fixed[0][:-1], reference_heading=float(headings[0]), turned=turned, up=u,
+        curves=out,
+        alignments=alignments,
+        headings=[float(h) for h in headings],
+        root_scales=scales,
+        notes=notes,
+        reference=fixed[0][:-1],
+        reference_heading=float(headings[0]),
+        turned=turned,
+        up=u,
         base=ref[:-1],
     )
 
@@ -265,10 +308,16 @@ def blend(
         )
     motions = [cycle_of(m, f"cycle {i}") for i, m in enumerate(cycles)]
     w = _check_weights(weights, len(motions))
-    if n_frames is not None and (isinstance(n_frames, bool) or not isinstance(n_frames, Integral) or n_frames < 4):
+    if n_frames is not None and (
+        isinstance(n_frames, bool) or not isinstance(n_frames, Integral) or n_frames < 4
+    ):
         raise ParameterError(f"n_frames must be an integer >= 4, got {n_frames!r}")
     prep = _common_frame(
-        motions, allow_reverse=allow_reverse, align_heading=align_heading, scale_root=scale_root, up=up,
+        motions,
+        allow_reverse=allow_reverse,
+        align_heading=align_heading,
+        scale_root=scale_root,
+        up=up,
     )
     ref = prep.base
     seconds = float(sum(wi * c.period_seconds for wi, c in zip(w, prep.curves)))
@@ -302,7 +351,11 @@ def blend(
     }
     label = " + ".join(f"{wi:g}*{n}" for wi, n in zip(w, names))
     return replace(
-        ref, frames=frames, start_frame=0, source=f"blend of {label}", metadata=meta,
+        ref,
+        frames=frames,
+        start_frame=0,
+        source=f"blend of {label}",
+        metadata=meta,
     )
 
 
@@ -337,7 +390,9 @@ def _prepared_steps(values: np.ndarray, root: np.ndarray) -> np.ndarray:
     return np.linalg.norm(np.diff(prep, axis=0), axis=1)
 
 
-def _curve_steps(curve: CycleCurve, phases: np.ndarray, dphase: float, root: np.ndarray) -> np.ndarray:
+def _curve_steps(
+    curve: CycleCurve, phases: np.ndarray, dphase: float, root: np.ndarray
+) -> np.ndarray:
     """Step norm of a cycle played at its own rate, from each phase (prepared space)."""
     x0 = curve(phases)
     x1 = curve(phases + dphase)
@@ -387,10 +442,14 @@ def transition_steps(
     root = np.asarray(a.root_columns, dtype=int)
     steps = _prepared_steps(values, root)
     ph = np.asarray(phases, dtype=float)[: steps.shape[0]]
-    grid = np.arange(4 * int(np.ceil(max(period_a, period_b)))) / (4 * int(np.ceil(max(period_a, period_b))))
+    grid = np.arange(4 * int(np.ceil(max(period_a, period_b)))) / (
+        4 * int(np.ceil(max(period_a, period_b)))
+    )
     med_a = float(np.median(_curve_steps(a, grid, 1.0 / period_a, root)))
     med_b = float(np.median(_curve_steps(b, grid, 1.0 / period_b, root)))
-    local = np.maximum(_curve_steps(a, ph, 1.0 / period_a, root), _curve_steps(b, ph, 1.0 / period_b, root))
+    local = np.maximum(
+        _curve_steps(a, ph, 1.0 / period_a, root), _curve_steps(b, ph, 1.0 / period_b, root)
+    )
     typical = np.maximum(local, min(med_a, med_b))
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(typical > 0, steps / typical, np.where(steps > 0, np.inf, 0.0))
@@ -401,7 +460,9 @@ def transition_steps(
         "median_step_b": med_b,
         "max_ratio": float(ratio.max()) if ratio.size else 0.0,
         "worst_frame": worst,
-        "max_ratio_to_median": float(steps.max() / max(med_a, med_b)) if steps.size and max(med_a, med_b) > 0 else 0.0,
+        "max_ratio_to_median": float(steps.max() / max(med_a, med_b))
+        if steps.size and max(med_a, med_b) > 0
+        else 0.0,
         "limit": STEP_LIMIT,
     }
 
@@ -411,17 +472,21 @@ def _transition_frames(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Values ``(T, D)`` (common frame), phase and weight per frame of a transition clip."""
     ca, cb = prep.curves
-    inc = np.concatenate([
-        np.full(n_in, 1.0 / p_a),
-        _phase_increments(p_a, p_b, n_ramp),
-        np.full(n_out, 1.0 / p_b),
-    ])
+    inc = np.concatenate(
+        [
+            np.full(n_in, 1.0 / p_a),
+            _phase_increments(p_a, p_b, n_ramp),
+            np.full(n_out, 1.0 / p_b),
+        ]
+    )
     phases = np.concatenate([[0.0], np.cumsum(inc)])  # the clip starts at a's frame 0
-    weight = np.concatenate([
-        np.zeros(n_in),
-        _smoothstep(np.arange(n_ramp) / (n_ramp - 1)),
-        np.ones(n_out),
-    ])
+    weight = np.concatenate(
+        [
+            np.zeros(n_in),
+            _smoothstep(np.arange(n_ramp) / (n_ramp - 1)),
+            np.ones(n_out),
+        ]
+    )
     va = ca(phases)
     vb = cb(phases)
     w = weight[:, None]
@@ -434,6 +499,20 @@ def _transition_frames(
         values[0, horiz] = va[0, horiz]
         values[1:, horiz] = va[0, horiz] + np.cumsum(step, axis=0)
     return values, phases, weight
+
+
+def _longer_ramp(
+    prep: _Prepared, p_a: float, p_b: float, n_ramp: int, n_in: int, n_out: int
+) -> int | None:
+    """The shortest ramp, ``n_ramp`` times a power of 1.25 up to 1.25^16 (about 35x), whose
+    steps all stay within :data:`STEP_LIMIT`; None when none does."""
+    ca, cb = prep.curves
+    for factor in 1.25 ** np.arange(1, 17):
+        n_try = int(np.ceil(n_ramp * factor))
+        v, ph, _ = _transition_frames(prep, p_a, p_b, n_try, n_in, n_out)
+        if transition_steps(v, ph, ca, cb, p_a, p_b)["max_ratio"] <= STEP_LIMIT:
+            return n_try
+    return None
 
 
 def transition(
@@ -498,7 +577,11 @@ def transition(
         if isinstance(v, bool) or not isinstance(v, Integral) or v < 0:
             raise ParameterError(f"{name} must be a whole number of cycles >= 0, got {v!r}")
     prep = _common_frame(
-        [a, b], allow_reverse=allow_reverse, align_heading=align_heading, scale_root=scale_root, up=up,
+        [a, b],
+        allow_reverse=allow_reverse,
+        align_heading=align_heading,
+        scale_root=scale_root,
+        up=up,
     )
     ca, cb = prep.curves
     a = prep.base
@@ -509,7 +592,12 @@ def transition(
             raise ParameterError(f"frames must be an integer >= 2, got {frames!r}")
         n_ramp = int(frames)
     else:
-        if isinstance(cycles, bool) or not isinstance(cycles, Real) or not np.isfinite(cycles) or cycles <= 0:
+        if (
+            isinstance(cycles, bool)
+            or not isinstance(cycles, Real)
+            or not np.isfinite(cycles)
+            or cycles <= 0
+        ):
             raise ParameterError(f"cycles must be a positive number, got {cycles!r}")
         n_ramp = max(2, _ramp_frames_for_cycles(p_a, p_b, float(cycles)))
     n_in = int(lead_in) * a.n_frames
@@ -518,18 +606,16 @@ def transition(
     continuity = transition_steps(values, phases, ca, cb, p_a, p_b)
     notes = list(prep.notes)
     if continuity["max_ratio"] > STEP_LIMIT:
-        longer = None
-        for factor in 1.25 ** np.arange(1, 17):
-            n_try = int(np.ceil(n_ramp * factor))
-            v, ph, _ = _transition_frames(prep, p_a, p_b, n_try, n_in, n_out)
-            if transition_steps(v, ph, ca, cb, p_a, p_b)["max_ratio"] <= STEP_LIMIT:
-                longer = n_try
-                break
+        longer = _longer_ramp(prep, p_a, p_b, n_ramp, n_in, n_out)
         continuity["suggested_ramp_frames"] = longer
         notes.append(
-            f"a step is {continuity['max_ratio']:.2f}x the typical step at its phase (limit {STEP_LIMIT}): "
-            + (f"a ramp of {longer} frames or more keeps every step within the limit" if longer
-               else "even a ramp 35x longer does not keep every step within the limit")
+            f"a step is {continuity['max_ratio']:.2f}x the typical step at its phase "
+            f"(limit {STEP_LIMIT}): "
+            + (
+                f"a ramp of {longer} frames or more keeps every step within the limit"
+                if longer
+                else "even a ramp 35x longer does not keep every step within the limit"
+            )
         )
     values = _turn_back(values, prep, a)
     meta = {
@@ -551,6 +637,9 @@ def transition(
         }
     }
     return replace(
-        a, frames=values, start_frame=0,
-        source=f"transition {a.source or 'a'} -> {b.source or 'b'}", metadata=meta,
+        a,
+        frames=values,
+        start_frame=0,
+        source=f"transition {a.source or 'a'} -> {b.source or 'b'}",
+        metadata=meta,
     )

@@ -69,7 +69,11 @@ def horizontal_columns(m: Motion, up_index: int) -> np.ndarray:
     """Root translation columns across the ground (every root t* but the up axis)."""
     up = "t" + AXES[up_index]
     return np.array(
-        [c for c in root_columns(m) if m.channels[c][1] in ("tx", "ty", "tz") and m.channels[c][1] != up],
+        [
+            c
+            for c in root_columns(m)
+            if m.channels[c][1] in ("tx", "ty", "tz") and m.channels[c][1] != up
+        ],
         dtype=int,
     )
 
@@ -311,12 +315,15 @@ def root_drift(motion: Motion, displacement: np.ndarray | None = None) -> np.nda
     """
     root = root_columns(motion)
     if displacement is None:
-        displacement = motion.metadata.get("root_displacement") if isinstance(motion.metadata, dict) else None
+        displacement = (
+            motion.metadata.get("root_displacement") if isinstance(motion.metadata, dict) else None
+        )
     if displacement is not None:
         disp = np.asarray(displacement, dtype=float).reshape(-1)
         if disp.shape[0] != root.size or not np.all(np.isfinite(disp)):
             raise ParameterError(
-                f"root displacement needs {root.size} finite values (one per root channel), got {disp.shape[0]}"
+                f"root displacement needs {root.size} finite values (one per root channel), "
+                f"got {disp.shape[0]}"
             )
         return disp
     if root.size == 0:
@@ -330,7 +337,11 @@ def root_drift(motion: Motion, displacement: np.ndarray | None = None) -> np.nda
     closed[rot] = wrap_degrees(closed[rot])
     estimate = _seam_estimate(steps)
     med_step = np.median(np.abs(steps), axis=0)
-    med_change = np.median(np.abs(np.diff(steps, axis=0)), axis=0) if steps.shape[0] > 1 else np.zeros(root.size)
+    med_change = (
+        np.median(np.abs(np.diff(steps, axis=0)), axis=0)
+        if steps.shape[0] > 1
+        else np.zeros(root.size)
+    )
     neighbour = np.maximum(np.abs(steps[-1]), np.abs(steps[0]))
     tol = 0.5 * np.maximum(neighbour, med_step) + 2.0 * med_change + 1e-9
     wrap = np.where(np.abs(closed - estimate) <= tol, closed, estimate)

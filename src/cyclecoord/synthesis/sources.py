@@ -86,7 +86,9 @@ def _capture_signs(motion: Motion) -> list[str]:
     period = estimate_period(motion)
     why = []
     if period is not None and motion.n_frames > CYCLE_LENGTH_LIMIT * period:
-        why.append(f"it repeats every {period:.0f} frames ({motion.n_frames / period:.1f} periods long)")
+        why.append(
+            f"it repeats every {period:.0f} frames ({motion.n_frames / period:.1f} periods long)"
+        )
     return why
 
 
@@ -97,8 +99,9 @@ def cycle_summary(motion: Motion) -> dict[str, float]:
     -------
     dict
         ``frames``, ``seconds``, ``loop_closure`` (last-to-first step over the median
-        step; up to about 1.5 loops cleanly; see :func:`cyclecoord.quality.metrics.loop_closure`), ``jerk``
-        (mean jerk norm, looping, channel units / s³) and ``median_step``.
+        step; up to about 1.5 loops cleanly; see
+        :func:`cyclecoord.quality.metrics.loop_closure`), ``jerk`` (mean jerk norm,
+        looping, channel units / s³) and ``median_step``.
     """
     prep = prepare_cycle(motion)
     steps = np.linalg.norm(np.roll(prep, -1, axis=0) - prep, axis=1)
@@ -106,7 +109,9 @@ def cycle_summary(motion: Motion) -> dict[str, float]:
         "frames": int(motion.n_frames),
         "seconds": float(motion.n_frames / motion.fps),
         "loop_closure": float(loop_closure(prep)),
-        "jerk": float(jerk_summary(prep, motion.fps, cyclic=True)) if motion.n_frames >= 7 else float("nan"),
+        "jerk": float(jerk_summary(prep, motion.fps, cyclic=True))
+        if motion.n_frames >= 7
+        else float("nan"),
         "median_step": float(np.median(steps)),
     }
 
@@ -145,12 +150,17 @@ class CycleSource:
             "extracted": bool(self.extracted),
             "reason": self.reason,
             "input_loop_closure": float(self.loop_closure),
-            "input_period_estimate": None if self.period_estimate is None else float(self.period_estimate),
+            "input_period_estimate": None
+            if self.period_estimate is None
+            else float(self.period_estimate),
         }
         if self.extraction is not None:
             r = self.extraction
             out["extraction"] = {
-                "frames": [int(r.motion.start_frame), int(r.motion.start_frame + r.motion.n_frames)],
+                "frames": [
+                    int(r.motion.start_frame),
+                    int(r.motion.start_frame + r.motion.n_frames),
+                ],
                 "period_frames": float(r.period_frames),
                 "cycles": float(r.cycles),
                 "loop_closure": float(r.loop_closure),
@@ -314,24 +324,35 @@ def as_cycle(
         return CycleSource(motion, False, "taken as a cycle (forced)", closure, period)
     if mode == "auto":
         if frames is None and (meta.get("cycle") is True or all(k in meta for k in _EXTRACT_KEYS)):
-            return CycleSource(motion, False, "a cycle written by cyclecoord (metadata)", closure, period)
+            return CycleSource(
+                motion, False, "a cycle written by cyclecoord (metadata)", closure, period
+            )
         loops = closure <= CYCLE_CLOSURE_LIMIT
         single = period is None or motion.n_frames <= CYCLE_LENGTH_LIMIT * period
         spread = _pose_spread(motion)
         moves = spread >= _MIN_SPREAD
         if loops and single and moves:
             return CycleSource(
-                motion, False,
-                f"taken as a cycle: loop closure {closure:.2f} <= {CYCLE_CLOSURE_LIMIT} and no repeat within its "
-                f"{motion.n_frames} frames", closure, period,
+                motion,
+                False,
+                f"taken as a cycle: loop closure {closure:.2f} <= {CYCLE_CLOSURE_LIMIT} "
+                "and no repeat within its "
+                f"{motion.n_frames} frames",
+                closure,
+                period,
             )
         why = []
         if not loops:
             why.append(f"loop closure {closure:.2f} > {CYCLE_CLOSURE_LIMIT}")
         if not single:
-            why.append(f"it repeats every {period:.0f} frames ({motion.n_frames / period:.1f} periods long)")
+            why.append(
+                f"it repeats every {period:.0f} frames "
+                f"({motion.n_frames / period:.1f} periods long)"
+            )
         if not moves:
-            why.append(f"its poses stay within {spread:.1f} median steps of their mean (it barely moves)")
+            why.append(
+                f"its poses stay within {spread:.1f} median steps of their mean (it barely moves)"
+            )
         reason = "extracted: " + " and ".join(why)
     else:
         reason = "extracted (forced)"
