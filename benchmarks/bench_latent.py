@@ -96,10 +96,10 @@ def split(segments, keep: float = 0.8):
 
 def local_positions(motion: cc.Motion) -> np.ndarray:
     """Joint positions relative to the root, turned to the root's heading, (T, P, 3)."""
-    from cyclecoord.synthesis.interpolate import _root_rotation
+    from cyclecoord.synthesis.align import root_rotation
 
     pos = motion.positions().positions
-    mats, _, _ = _root_rotation(motion)
+    mats, _, _ = root_rotation(motion)
     fwd = mats[:, :, 2]
     th = np.arctan2(fwd[:, 0], fwd[:, 2])
     c, s = np.cos(th), np.sin(th)
@@ -221,7 +221,8 @@ def kovar(mA: LatentModel, mB: LatentModel, thr: float):
 
 def mg_transition(mA, mB, D, hits, scale) -> tuple[cc.Motion, int, bool]:
     """Kovar transition at the best candidate (or the best pair): A's frames, blend, B's frames."""
-    from cyclecoord.synthesis.interpolate import _continuous_euler, _root_rotation
+    from cyclecoord.conventions import continuous_euler
+    from cyclecoord.synthesis.align import root_rotation
 
     under = len(hits) > 0
     i, j = (
@@ -240,12 +241,12 @@ def mg_transition(mA, mB, D, hits, scale) -> tuple[cc.Motion, int, bool]:
     c, s = np.cos(theta), np.sin(theta)
     Ry = np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
     Bseg = B.with_frames(fb)
-    rb, order, rcols = _root_rotation(Bseg)
+    rb, order, rcols = root_rotation(Bseg)
     rb = Ry @ rb
     tcols = [B.channel_index(B.skeleton.joints[0].name, d) for d in ("tx", "ty", "tz")]
     fb = fb.copy()
     fb[:, tcols] = fb[:, tcols] @ Ry.T + t
-    ra, _, _ = _root_rotation(A.with_frames(fa))
+    ra, _, _ = root_rotation(A.with_frames(fa))
     n_pre = i - a0
     w = 1.0 - (
         2 * ((np.arange(BLEND) + 1) / BLEND) ** 3 - 3 * ((np.arange(BLEND) + 1) / BLEND) ** 2 + 1
@@ -256,7 +257,7 @@ def mg_transition(mA, mB, D, hits, scale) -> tuple[cc.Motion, int, bool]:
         out[n_pre + k] = (1 - w[k]) * fa[n_pre + k] + w[k] * fb[k]
         U, _, Vt = np.linalg.svd((1 - w[k]) * ra[n_pre + k] + w[k] * rb[k])
         mats[n_pre + k] = U @ Vt
-    out[:, rcols] = _continuous_euler(mats, order, None)
+    out[:, rcols] = continuous_euler(mats[:, None], order)[:, 0]
     return A.with_frames(out), n_pre, bool(under)
 
 

@@ -131,6 +131,23 @@ def test_continuous_euler_matches_scipy_up_to_equivalence():
     np.testing.assert_allclose(ang[0], Rotation.from_matrix(mats[0]).as_euler("YXZ", degrees=True))
 
 
+def test_continuous_euler_near_picks_the_first_frames_solution():
+    rng = np.random.default_rng(6)
+    rv = np.cumsum(rng.normal(scale=0.2, size=(40, 3)), axis=0)
+    mats = Rotation.from_rotvec(rv).as_matrix()[:, None]
+    plain = continuous_euler(mats, "ZXY")
+    # the other Tait-Bryan solution of frame 0, one whole turn up on the first angle
+    other = plain[0, 0] + np.array([540.0, 0.0, 180.0])
+    other[1] = 180.0 - plain[0, 0, 1]
+    near = continuous_euler(mats, "ZXY", near=other + 10.0)
+    np.testing.assert_allclose(near[0, 0], other, atol=1e-9)
+    back = Rotation.from_euler("ZXY", near[:, 0], degrees=True).as_matrix()
+    np.testing.assert_allclose(back, mats[:, 0], atol=1e-12)
+    assert np.abs(np.diff(near[:, 0], axis=0)).max() < 60.0
+    # near the principal solution: the same angles as without near
+    np.testing.assert_array_equal(continuous_euler(mats, "ZXY", near=plain[0]), plain)
+
+
 def test_to_bvh_convention_bad_input():
     m = asf_like_motion()
     with pytest.raises(ParameterError, match="permutation of XYZ"):

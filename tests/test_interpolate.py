@@ -1,4 +1,4 @@
-"""Alignment, blending and transitions between cycles (cyclecoord.synthesis.interpolate)."""
+"""Alignment, blending and transitions between cycles (cyclecoord.synthesis: curve, align, sources, blend)."""
 
 from dataclasses import replace
 
@@ -7,20 +7,10 @@ import pytest
 
 import cyclecoord as cc
 from cyclecoord.errors import ParameterError
-from cyclecoord.synthesis.interpolate import (
-    STEP_LIMIT,
-    CycleCurve,
-    align,
-    as_cycle,
-    blend,
-    cycle_summary,
-    estimate_period,
-    mean_heading,
-    prepare_cycle,
-    root_drift,
-    rotate_heading,
-    transition,
-)
+from cyclecoord.synthesis.align import align, mean_heading, rotate_heading
+from cyclecoord.synthesis.blend import STEP_LIMIT, blend, transition
+from cyclecoord.synthesis.curve import CycleCurve, prepare_cycle, root_drift
+from cyclecoord.synthesis.sources import as_cycle, cycle_summary, estimate_period
 from cyclecoord.quality.metrics import jerk_summary
 
 

@@ -47,9 +47,9 @@ _LAZY = {
     "PhaseModel": "periodic.phase_model",
     "detect": "periodic.detection",
     "DetectionResult": "periodic.detection",
-    "blend": "synthesis.interpolate",
-    "transition": "synthesis.interpolate",
-    "align": "synthesis.interpolate",
+    "blend": "synthesis.blend",
+    "transition": "synthesis.blend",
+    "align": "synthesis.align",
     "run_batch": "batch",
 }
 _SUBMODULES = {
@@ -85,6 +85,11 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
     from .periodic.pipeline import ExtractionResult, extract
     from .periodic.preprocess import PreparedData, Preprocessor
     from .skeleton import Joint, JointPositions, Skeleton, forward_kinematics
+    from .periodic.phase_model import PhaseModel
+    from .periodic.detection import DetectionResult, detect
+    from .synthesis.align import align
+    from .synthesis.blend import blend, transition
+    from .batch import run_batch
 
 __version__ = "0.1.0"
 
@@ -94,6 +99,7 @@ __all__ = [
     "CircularCoordinates",
     "CycleCoordError",
     "DEFAULT_FPS",
+    "DetectionResult",
     "ExtractionResult",
     "Joint",
     "JointPositions",
@@ -102,17 +108,23 @@ __all__ = [
     "ParameterError",
     "ParseError",
     "PeriodicDensity",
+    "PhaseModel",
     "PreparedData",
     "Preprocessor",
     "Skeleton",
     "TypicalCycle",
+    "align",
+    "blend",
     "compute_barcode",
     "convert",
     "datasets",
+    "detect",
     "extract",
     "forward_kinematics",
     "load",
+    "run_batch",
     "save",
+    "transition",
     "typical_cycle",
     "__version__",
 ]

@@ -15,6 +15,7 @@ __all__ = [
     "ParseError",
     "ParameterError",
     "NoPeriodicMotionError",
+    "ImplausibleMotionError",
 ]
 
 
@@ -76,3 +77,7 @@ class NoPeriodicMotionError(CycleCoordError):
     def __init__(self, message: str, result: object | None = None) -> None:
         super().__init__(message)
         self.result = result
+
+
+class ImplausibleMotionError(CycleCoordError):
+    """Raised (by the CLI's ``--strict``) when a motion fails its plausibility checks."""

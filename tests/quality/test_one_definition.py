@@ -5,7 +5,7 @@ import pytest
 
 import cyclecoord as cc
 from cyclecoord.plot.figures import plot_channels
-from cyclecoord.synthesis.interpolate import cycle_summary
+from cyclecoord.synthesis.sources import cycle_summary
 
 
 @pytest.fixture(scope="module")

@@ -637,7 +637,7 @@ def _per_input(values: list | None, n: int, option: str) -> list:
 
 def _load_cycles(args: argparse.Namespace) -> list:
     """Every input as a cycle (captures are extracted first), with why."""
-    from ..synthesis.interpolate import as_cycle
+    from ..synthesis.sources import as_cycle
 
     n = len(args.inputs)
     windows = _per_input(args.window, n, "--window")
@@ -676,7 +676,7 @@ def _check_outputs(args: argparse.Namespace) -> None:
 def _finish(args: argparse.Namespace, motion, payload: dict, report, what: str, problem: str | None = None) -> int:
     """Print the plausibility verdict, honour --strict, write the motion and the report."""
     from ..io import save
-    from ..quality.plausibility import ImplausibleMotionError
+    from ..errors import ImplausibleMotionError
 
     print(report.summary())
     payload["plausibility"] = report.to_dict()
@@ -698,7 +698,8 @@ def _finish(args: argparse.Namespace, motion, payload: dict, report, what: str, 
 
 
 def cmd_blend(args: argparse.Namespace) -> int:
-    from ..synthesis.interpolate import blend, cycle_summary
+    from ..synthesis.blend import blend
+    from ..synthesis.sources import cycle_summary
     from ..quality.plausibility import check_plausibility
 
     _check_outputs(args)
@@ -740,7 +741,7 @@ def cmd_blend(args: argparse.Namespace) -> int:
 
 
 def cmd_transition(args: argparse.Namespace) -> int:
-    from ..synthesis.interpolate import transition
+    from ..synthesis.blend import transition
     from ..quality.plausibility import check_plausibility
 
     _check_outputs(args)

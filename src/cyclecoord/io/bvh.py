@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import ParameterError, ParseError
 from ..motion import Motion
 from ..skeleton import Joint, Skeleton, rotation_order_from_dofs
-from ..conventions import _check_order
+from ..conventions import check_order
 from ._atomic import atomic_write
 from ._limits import (
     MAX_DEPTH,
@@ -576,7 +576,7 @@ def write_bvh(
             ".npz or .csv"
         )
     check_writable(motion, path, "BVH")
-    forced = None if rotation_order is None else _check_order(rotation_order)
+    forced = None if rotation_order is None else check_order(rotation_order)
     orders = _bvh_ready_orders(motion.skeleton, forced)
     if orders is None:
         from ..conventions import to_bvh_convention

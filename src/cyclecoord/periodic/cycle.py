@@ -27,7 +27,7 @@ from numbers import Integral, Real
 import numpy as np
 
 from ._kernel import _KERNEL_REACH, _kernel_dense, _kernel_windowed
-from .density import PeriodicDensity, _as_generator
+from .density import PeriodicDensity, as_generator
 from ..errors import ParameterError
 
 __all__ = [
@@ -694,7 +694,7 @@ def typical_cycle(
     if isinstance(k, bool) or not isinstance(k, Integral) or not 1 <= k <= theta.shape[0]:
         raise ParameterError(f"k must be an integer between 1 and the number of frames ({theta.shape[0]}), got {k!r}")
     bandwidth = check_bandwidth(bandwidth, weighting)
-    rng = _as_generator(random_state)
+    rng = as_generator(random_state)
 
     if density is None:
         density = PeriodicDensity(random_state=rng).fit(theta)

@@ -37,7 +37,7 @@ from scipy.special import ndtr
 
 from ..errors import ParameterError
 
-__all__ = ["PeriodicDensity"]
+__all__ = ["PeriodicDensity", "as_generator"]
 
 #: Grid size used to tabulate the cdf for :meth:`PeriodicDensity.ppf`.
 _PPF_GRID = 4096
@@ -47,7 +47,7 @@ _TAIL_SIGMAS = 8.0
 _INV_SQRT_2PI = 1.0 / np.sqrt(2.0 * np.pi)
 
 
-def _as_generator(random_state: None | int | np.random.Generator) -> np.random.Generator:
+def as_generator(random_state: None | int | np.random.Generator) -> np.random.Generator:
     """A numpy Generator from ``None``, an integer seed or a Generator."""
     if isinstance(random_state, np.random.Generator):
         return random_state
@@ -66,7 +66,7 @@ def _consume_seed(random_state: None | int | np.random.Generator) -> None:
     if isinstance(random_state, np.random.Generator):
         random_state.integers(0, 2**31 - 1)
     elif random_state is not None:
-        _as_generator(random_state)  # validates
+        as_generator(random_state)  # validates
 
 
 def _em_1d(x: np.ndarray, n_components: int, max_iter: int, reg_covar: float, tol: float = 3e-4):
@@ -431,7 +431,7 @@ class PeriodicDensity:
         """
         self._check_fitted()
         n = self._check_count(n)
-        rng = _as_generator(random_state)
+        rng = as_generator(random_state)
         comp = rng.choice(self.n_components_, size=n, p=self.weights_)
         draws = np.mod(self.means_[comp] + self.stds_[comp] * rng.standard_normal(n), 1.0)
         draws[draws >= 1.0] = 0.0  # -1e-17 % 1 == 1.0 in floating point

@@ -12,7 +12,7 @@
 One definition of a cycle's quality is used everywhere (``extract``'s console and report,
 ``channels.png``, ``blend``/``transition`` and their reports), always on the cycle's frames
 in the *prepared space*: every channel as it is, except the root's translation and
-rotation taken as per-frame steps (:func:`cyclecoord.synthesis.interpolate.prepare_cycle`,
+rotation taken as per-frame steps (:func:`cyclecoord.synthesis.curve.prepare_cycle`,
 the space :func:`cyclecoord.extract` builds the cycle in).
 
 * **loop closure** (no unit): the seam step, last frame to first, over the median step

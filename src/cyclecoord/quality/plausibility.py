@@ -18,7 +18,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..errors import CycleCoordError, ParameterError
+from ..errors import ImplausibleMotionError, ParameterError
 from ..motion import Motion
 
 __all__ = [
@@ -44,10 +44,6 @@ DEFAULT_CLEARANCE = 0.02
 _NEW_TOLERANCE = 0.1
 #: Frames x bone pairs per chunk in the distance computation.
 _CHUNK = 400_000
-
-
-class ImplausibleMotionError(CycleCoordError):
-    """Raised (by the CLI's ``--strict``) when a motion fails its plausibility checks."""
 
 
 # ---------------------------------------------------------------------------- bones
@@ -505,7 +501,7 @@ def _in_convention_of(reference: Motion, motion: Motion) -> Motion:
     A blend of an AMC capture with a BVH cycle is written in one convention; comparing
     joint angles needs the references in the same one.
     """
-    from ..synthesis.interpolate import in_conventions_of
+    from ..conventions import in_conventions_of
 
     return in_conventions_of(reference, motion)
 

@@ -247,9 +247,9 @@ def path_to_target(
 # ----------------------------------------------------------------------------- root
 def _root_features(motion: Motion) -> dict[str, np.ndarray]:
     """Per-frame heading, local step, heading change, height and tilt of a take's root."""
-    from ..interpolate import _root_rotation
+    from ..align import root_rotation
 
-    mats, order, rcols = _root_rotation(motion)
+    mats, order, rcols = root_rotation(motion)
     root = motion.skeleton.joints[0].name  # type: ignore[union-attr]
     pos = np.zeros((motion.n_frames, 3))
     for ax in range(3):
@@ -299,7 +299,7 @@ def root_trajectory(
     -------
     ndarray, shape (N, R)
     """
-    from ..interpolate import _continuous_euler
+    from ...conventions import continuous_euler
 
     feats = [_root_features(m) for m in takes]
     cat = {k: np.concatenate([f[k] for f in feats]) for k in ("step", "turn", "height", "tilt")}
@@ -328,7 +328,7 @@ def root_trajectory(
         rot = root_joint.axis.T @ rot @ root_joint.axis
     order, rcols = feats[0]["order"], feats[0]["rcols"]
     near = start_motion.frames[start_frame, rcols] if start_motion is not None else None
-    euler = _continuous_euler(rot, order, near)
+    euler = continuous_euler(rot[:, None], order, near)[:, 0]
     cols = template.root_channels()
     out = np.zeros((n, len(cols)))
     for j, c in enumerate(cols):

@@ -500,7 +500,7 @@ class Synthesizer:
 
     def motion(self) -> Motion:
         """The frames so far as a motion on the first model's skeleton (root integrated)."""
-        from ..interpolate import _continuous_euler
+        from ...conventions import continuous_euler
 
         if not self.chunks:
             raise ParameterError("the script made no frames")
@@ -522,7 +522,7 @@ class Synthesizer:
         rj = first.skeleton_.joints[0]
         if not np.allclose(rj.axis, np.eye(3)):
             mats = rj.axis.T @ mats @ rj.axis
-        euler = _continuous_euler(mats, rj.rotation_order, None)
+        euler = continuous_euler(mats[:, None], rj.rotation_order)[:, 0]
         channels = first.all_channels_
         frames = np.zeros((T, len(channels)))
         col = {c: i for i, c in enumerate(channels)}

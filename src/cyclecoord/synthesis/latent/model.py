@@ -63,9 +63,9 @@ class RootTrack:
 
 def root_track(motion: Motion) -> RootTrack:
     """The :class:`RootTrack` of one contiguous capture (y up, CMU facing +z at rest)."""
-    from ..interpolate import _root_rotation
+    from ..align import root_rotation
 
-    mats, _, _ = _root_rotation(motion)
+    mats, _, _ = root_rotation(motion)
     pos = motion.frames[
         :, [motion.channel_index(motion.skeleton.joints[0].name, d) for d in ("tx", "ty", "tz")]
     ]

@@ -1,0 +1,645 @@
+"""Blends and transitions between periodic motion cycles (paper §4.5 and §7).
+
+:func:`blend` forms the paper's convex combination ``y(θ) = Σ w_i x_i(θ)`` of any number
+of aligned cycles; :func:`transition` ramps the weight from one cycle to another while
+the phase keeps advancing (the paper's homotopy).
+
+Before blending, cycles are brought into a common frame: cycles of one skeleton written
+in different conventions (an AMC capture, a BVH cycle) are re-expressed in one
+(:func:`cyclecoord.conventions.common_channels`), root translations are scaled to the
+reference skeleton's size, every cycle is turned about the vertical axis so that it faces
+the same way (otherwise a walk heading north and a jog heading east would have their
+velocities cancel, and a CMU root facing east sits at the gimbal lock of its Euler
+angles), and joint angles are moved by multiples of 360 degrees to lie within 180 degrees
+of the reference's, so that 179 and -179 do not average to 0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from numbers import Integral, Real
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..motion import Motion
+from .align import (
+    Alignment,
+    align_curves,
+    apply_alignment,
+    check_up,
+    harmonise_angles,
+    mean_heading,
+    root_rotation,
+    rotate_heading,
+)
+from ..conventions import bvh_ready, common_channels, wrap_degrees
+from .curve import (
+    CycleCurve,
+    angle_columns,
+    continuous_root,
+    horizontal_columns,
+    root_columns,
+    root_drift,
+)
+from .sources import cycle_of
+
+__all__ = [
+    "blend",
+    "transition",
+    "transition_steps",
+    "STEP_LIMIT",
+]
+
+
+#: A transition is continuous when no step exceeds this many typical steps.
+STEP_LIMIT = 1.5
+
+
+def _smoothstep(u: np.ndarray) -> np.ndarray:
+    """C2 ramp from 0 (u <= 0) to 1 (u >= 1): 6u^5 - 15u^4 + 10u^3."""
+    u = np.clip(np.asarray(u, dtype=float), 0.0, 1.0)
+    return u * u * u * (10.0 + u * (-15.0 + 6.0 * u))
+
+
+def _check_weights(weights: object, n: int) -> np.ndarray:
+    try:
+        w = np.asarray(weights, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ParameterError(f"weights must be numbers, got {weights!r}") from None
+    if w.shape[0] != n:
+        raise ParameterError(f"{w.shape[0]} weights for {n} cycles; give one weight per cycle")
+    if not np.all(np.isfinite(w)):
+        raise ParameterError(f"weights must be finite numbers, got {w.tolist()}")
+    if np.any(w < 0):
+        raise ParameterError(
+            f"weights must be non-negative (a convex combination), got {w.tolist()}"
+        )
+    total = float(w.sum())
+    if abs(total - 1.0) > 1e-6:
+        raise ParameterError(
+            "weights must sum to 1 (a convex combination), got "
+            f"{' + '.join(f'{v:g}' for v in w)} = {total:g}"
+        )
+    return w
+
+
+@dataclass
+class _Prepared:
+    curves: list
+    alignments: list
+    headings: list
+    root_scales: list
+    notes: list
+    reference: Motion
+    reference_heading: float
+    turned: bool
+    up: int
+    base: Motion  # the reference in the common channels, not turned
+
+
+def _skeleton_size(m: Motion) -> float | None:
+    if m.skeleton is None:
+        return None
+    size = m.skeleton.total_length()
+    return size if size > 0 else None
+
+
+def _common_frame(
+    motions: Sequence[Motion],
+    *,
+    allow_reverse: bool,
+    align_heading: bool,
+    scale_root: bool,
+    up: str,
+) -> _Prepared:
+    """Bring cycles into the reference's (``motions[0]``) frame as aligned curves."""
+    u = check_up(up)
+    notes: list[str] = []
+    # every cycle carries the next loop's first frame through the conversions below, so
+    # its per-loop root change stays exact in whatever frame it ends up in
+    extended = [_with_next_frame(m) for m in motions]
+    converted = common_channels(extended)
+    if any(set(c.channels) != set(m.channels) for c, m in zip(converted, motions)):
+        style = bvh_ready(converted[0].skeleton)
+        notes.append(
+            "the cycles store their joints in different conventions; all were re-expressed in "
+            + (
+                f"BVH conventions ({style} Euler order)"
+                if style
+                else "the ASF conventions (axes, dofs)"
+            )
+            + " to share channels"
+        )
+    motions = converted
+    ref = motions[0]
+    fixed: list[Motion] = []
+    scales: list[float] = []
+    ref_size = _skeleton_size(ref)
+    for i, m in enumerate(motions):
+        scale = 1.0
+        size = _skeleton_size(m)
+        if (
+            i
+            and scale_root
+            and ref_size is not None
+            and size is not None
+            and abs(size - ref_size) > 1e-9 * ref_size
+        ):
+            scale = ref_size / size
+            frames = np.array(m.frames, dtype=float)
+            tcols = [c for c in root_columns(m) if m.channels[c][1] in ("tx", "ty", "tz")]
+            frames[:, tcols] *= scale
+            m = m.with_frames(frames)
+        scales.append(scale)
+        fixed.append(m)
+
+    headings: list[float] = [0.0] * len(fixed)
+    turned = False
+    if align_heading:
+        try:
+            hs = [mean_heading(m[:-1], up) for m in fixed]
+        except ParameterError as exc:
+            notes.append(f"cycles not turned to a common heading: {exc}")
+            hs = []
+        if hs and all(np.isfinite(h) for h in hs):
+            if max(abs(wrap_degrees(h - hs[0])) for h in hs) > 1e-9:
+                turned = True
+                headings = hs
+                fixed = [
+                    rotate_heading(m, -h, up, near=None) if abs(h) > 0 else m
+                    for m, h in zip(fixed, hs)
+                ]
+        elif hs:
+            notes.append(
+                "cycles not turned to a common heading: a cycle spins round (no mean heading)"
+            )
+
+    curves = [_curve_of_extended(m) for m in fixed]
+    ref_curve = curves[0]
+    pose = np.array(
+        [i for i in range(ref_curve.n_channels) if i not in set(ref_curve.root_columns)], dtype=int
+    )
+    if pose.size == 0:
+        pose = np.arange(ref_curve.n_channels)
+    alignments: list[Alignment] = [Alignment(0.0, False, 0.0, 0.0, 0.0)]
+    out = [ref_curve]
+    horiz = horizontal_columns(ref, u)
+    start_ref = ref_curve(0.0)[0]
+    for c in curves[1:]:
+        c = harmonise_angles(c, ref_curve)
+        al = align_curves(ref_curve, c, pose, allow_reverse)
+        c = apply_alignment(c, al)
+        if horiz.size:
+            delta = np.zeros(c.n_channels)
+            delta[horiz] = start_ref[horiz] - c(0.0)[0, horiz]
+            c = c.offset(delta)
+        alignments.append(al)
+        out.append(c)
+    return _Prepared(
+        curves=out,
+        alignments=alignments,
+        headings=[float(h) for h in headings],
+        root_scales=scales,
+        notes=notes,
+        reference=fixed[0][:-1],
+        reference_heading=float(headings[0]),
+        turned=turned,
+        up=u,
+        base=ref[:-1],
+    )
+
+
+def _with_next_frame(cycle: Motion) -> Motion:
+    """The cycle with one more frame: the next loop's first (root moved by its drift)."""
+    nxt = np.array(cycle.frames[:1], dtype=float)
+    root = root_columns(cycle)
+    if root.size:
+        nxt[0, root] = cycle.frames[0, root] + root_drift(cycle)
+    meta = {k: v for k, v in cycle.metadata.items() if k != "root_displacement"}
+    return replace(cycle, frames=np.vstack([cycle.frames, nxt]), metadata=meta)
+
+
+def _curve_of_extended(extended: Motion) -> CycleCurve:
+    """The curve of a cycle carrying its next loop's first frame (see :func:`_with_next_frame`)."""
+    root = root_columns(extended)
+    rot = angle_columns([extended.channels[c] for c in root])
+    x = continuous_root(extended.frames[:, root], rot)
+    return CycleCurve.from_motion(extended[:-1], displacement=x[-1] - x[0])
+
+
+def _turn_back(frames: np.ndarray, prep: _Prepared, original: Motion) -> np.ndarray:
+    """Frames from the common heading back to the reference's, root Euler near the original's."""
+    if not prep.turned or prep.reference_heading == 0.0:
+        return frames
+    m = prep.reference.with_frames(frames)
+    _, _, rcols = root_rotation(original)
+    back = rotate_heading(m, prep.reference_heading, "xyz"[prep.up], near=original.frames[0, rcols])
+    return np.array(back.frames)
+
+
+def blend(
+    cycles: Sequence[Motion],
+    weights: Sequence[float],
+    *,
+    allow_reverse: bool = False,
+    align_heading: bool = True,
+    scale_root: bool = True,
+    up: str = "y",
+    n_frames: int | None = None,
+) -> Motion:
+    """Convex combination of cycles, ``y(θ) = Σ w_i x_i(θ)`` after alignment (paper §4.5).
+
+    The first cycle is the reference: the result starts at its phase 0, faces its
+    heading, starts where it starts, uses its skeleton and frame rate.  Each other cycle
+    is brought into the reference's frame (root translation scaled by the ratio of
+    skeleton sizes, turned to the same mean heading about ``up``, angles within 180
+    degrees of the reference's, shifted in phase by :func:`align`, ground position moved
+    to the reference's start), then every channel is blended on the phase circle:
+    joint angles and root height/orientation as values, the root's travel per loop as
+    the weighted mean of the inputs' (so the root's velocity along the loop is the
+    weighted mean of theirs, in distance per cycle).  The blended loop lasts
+    ``Σ w_i T_i`` seconds (``T_i`` the inputs' periods), i.e.
+    ``round(Σ w_i P_i)`` frames for inputs at the same rate, and is resampled to that
+    length without aliasing (:meth:`CycleCurve.sample`).
+
+    Parameters
+    ----------
+    cycles : sequence of Motion or ExtractionResult
+        One loop each, with the same channels, or skeletons with the same joints in
+        other conventions (see :func:`common_channels`).  The result of
+        :func:`cyclecoord.extract` (or a :class:`CycleSource`) stands for its ``.cycle``;
+        a Motion that looks like a whole capture is used as it is with a warning (turn
+        captures into cycles with :func:`cyclecoord.extract` or :func:`as_cycle`).
+    weights : sequence of float
+        One per cycle, non-negative, summing to 1 (within 1e-6); anything else is
+        refused.
+    allow_reverse : bool, default False
+        Let :func:`align` play a cycle backwards when that matches better (cycles from
+        :func:`cyclecoord.extract` always run forward in time).
+    align_heading : bool, default True
+        Turn every cycle to the reference's heading (needs skeletons whose root has 3
+        rotation channels; otherwise skipped with a note in the metadata).
+    scale_root : bool, default True
+        Scale root translations by the reference skeleton's size over each cycle's
+        (total bone length), so strides keep their proportion to the legs.
+    up : {"x", "y", "z"}
+        Vertical axis (``"y"`` for CMU and BVH data).
+    n_frames : int, optional
+        Force the output length (default from the blended period).
+
+    Returns
+    -------
+    Motion
+        One loop, ``metadata`` holding ``cycle: True``, ``period_frames``,
+        ``root_displacement`` (exact per-loop root change) and ``blend`` (weights,
+        sources, alignments, headings, scales, notes).
+
+    Raises
+    ------
+    ParameterError
+        For no cycles, bad weights, cycles with different channels or too few frames.
+    """
+    if isinstance(cycles, Motion) or not isinstance(cycles, Sequence) or len(cycles) == 0:
+        raise ParameterError(
+            "blend() needs a non-empty sequence of cycles (Motion objects or the results of "
+            "cyclecoord.extract)"
+        )
+    motions = [cycle_of(m, f"cycle {i}") for i, m in enumerate(cycles)]
+    w = _check_weights(weights, len(motions))
+    if n_frames is not None and (
+        isinstance(n_frames, bool) or not isinstance(n_frames, Integral) or n_frames < 4
+    ):
+        raise ParameterError(f"n_frames must be an integer >= 4, got {n_frames!r}")
+    prep = _common_frame(
+        motions,
+        allow_reverse=allow_reverse,
+        align_heading=align_heading,
+        scale_root=scale_root,
+        up=up,
+    )
+    ref = prep.base
+    seconds = float(sum(wi * c.period_seconds for wi, c in zip(w, prep.curves)))
+    n_out = int(n_frames) if n_frames is not None else max(4, int(round(seconds * ref.fps)))
+    K = max(c.coefficients.shape[0] for c in prep.curves) - 1
+    coef = sum(wi * c.padded(K) for wi, c in zip(w, prep.curves))
+    drift = sum(wi * c.drift for wi, c in zip(w, prep.curves))
+    mixed = replace(prep.curves[0], coefficients=coef, drift=drift, n_frames=n_out, fps=ref.fps)
+    # one frame more than the loop: the next loop's first frame gives the exact displacement
+    loop = mixed.sample(n_out)
+    values = np.vstack([loop, loop[:1] + drift])
+    values = _turn_back(values, prep, ref)
+    root = root_columns(ref)
+    displacement = values[-1, root] - values[0, root]
+    frames = values[:-1]
+    names = [m.source or f"cycle {i}" for i, m in enumerate(motions)]
+    meta = {
+        "cycle": True,
+        "period_frames": float(n_out),
+        "root_displacement": [float(v) for v in displacement],
+        "blend": {
+            "weights": [float(v) for v in w],
+            "sources": names,
+            "periods_frames": [float(c.n_frames) for c in prep.curves],
+            "periods_seconds": [float(c.period_seconds) for c in prep.curves],
+            "alignments": [a.to_dict() for a in prep.alignments],
+            "headings_deg": prep.headings if prep.turned else None,
+            "root_scales": prep.root_scales,
+            "notes": prep.notes,
+        },
+    }
+    label = " + ".join(f"{wi:g}*{n}" for wi, n in zip(w, names))
+    return replace(
+        ref,
+        frames=frames,
+        start_frame=0,
+        source=f"blend of {label}",
+        metadata=meta,
+    )
+
+
+def _phase_increments(p_a: float, p_b: float, n: int) -> np.ndarray:
+    """Phase advanced between ramp frames ``t`` and ``t + 1`` (``n - 1`` values).
+
+    The weight is ``w(u) = smoothstep(u)``, ``u = t / (n - 1)``; the phase advances at
+    ``dθ/dt = 1 / P(w)``, ``P(w) = (1 - w) P_a + w P_b`` frames, integrated over each
+    frame interval by Simpson's rule.
+    """
+    u0 = np.arange(n - 1) / (n - 1)
+    du = 1.0 / (n - 1)
+
+    def rate(u: np.ndarray) -> np.ndarray:
+        w = _smoothstep(u)
+        return 1.0 / ((1.0 - w) * p_a + w * p_b)
+
+    return (rate(u0) + 4.0 * rate(u0 + 0.5 * du) + rate(u0 + du)) / 6.0
+
+
+def _ramp_frames_for_cycles(p_a: float, p_b: float, cycles: float) -> int:
+    u = (np.arange(4000) + 0.5) / 4000
+    w = _smoothstep(u)
+    mean_rate = float(np.mean(1.0 / ((1.0 - w) * p_a + w * p_b)))  # cycles per frame
+    return int(round(cycles / mean_rate)) + 1
+
+
+def _prepared_steps(values: np.ndarray, root: np.ndarray) -> np.ndarray:
+    """Step norms ``(T - 2,)`` of a clip in the prepared space (root as per-frame steps)."""
+    prep = np.array(values[:-1], dtype=float)
+    prep[:, root] = np.diff(values[:, root], axis=0)
+    return np.linalg.norm(np.diff(prep, axis=0), axis=1)
+
+
+def _curve_steps(
+    curve: CycleCurve, phases: np.ndarray, dphase: float, root: np.ndarray
+) -> np.ndarray:
+    """Step norm of a cycle played at its own rate, from each phase (prepared space)."""
+    x0 = curve(phases)
+    x1 = curve(phases + dphase)
+    x2 = curve(phases + 2 * dphase)
+    p0 = x0.copy()
+    p1 = x1.copy()
+    p0[:, root] = x1[:, root] - x0[:, root]
+    p1[:, root] = x2[:, root] - x1[:, root]
+    return np.linalg.norm(p1 - p0, axis=1)
+
+
+def transition_steps(
+    values: np.ndarray,
+    phases: np.ndarray,
+    a: CycleCurve,
+    b: CycleCurve,
+    period_a: float,
+    period_b: float,
+) -> dict[str, Any]:
+    """Continuity of a transition clip, step by step.
+
+    A step is the norm of the change between consecutive frames in the prepared space
+    (root channels as per-frame steps, angles as values).  A gait's own step varies a
+    lot along its loop (fast swing, slow stance), so each clip step is compared with
+    the *typical step at the same phase*: the larger of the steps ``a`` and ``b`` take
+    there at their own rates, and never less than the smaller of their median steps.
+    The clip is continuous when no ratio exceeds :data:`STEP_LIMIT` (1.5).
+
+    Parameters
+    ----------
+    values : ndarray, shape (T, D)
+        The clip (absolute root), in the same frame as the curves.
+    phases : ndarray, shape (T,)
+        Phase of each frame.
+    a, b : CycleCurve
+        The aligned cycles.
+    period_a, period_b : float
+        Their periods in the clip's frames.
+
+    Returns
+    -------
+    dict
+        ``max_step``, ``median_step_a``, ``median_step_b``, ``max_ratio`` (clip step over
+        the typical step at its phase), ``worst_frame`` and ``max_ratio_to_median``
+        (largest step over the larger median step).
+    """
+    root = np.asarray(a.root_columns, dtype=int)
+    steps = _prepared_steps(values, root)
+    ph = np.asarray(phases, dtype=float)[: steps.shape[0]]
+    grid = np.arange(4 * int(np.ceil(max(period_a, period_b)))) / (
+        4 * int(np.ceil(max(period_a, period_b)))
+    )
+    med_a = float(np.median(_curve_steps(a, grid, 1.0 / period_a, root)))
+    med_b = float(np.median(_curve_steps(b, grid, 1.0 / period_b, root)))
+    local = np.maximum(
+        _curve_steps(a, ph, 1.0 / period_a, root), _curve_steps(b, ph, 1.0 / period_b, root)
+    )
+    typical = np.maximum(local, min(med_a, med_b))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(typical > 0, steps / typical, np.where(steps > 0, np.inf, 0.0))
+    worst = int(np.argmax(ratio)) if ratio.size else 0
+    return {
+        "max_step": float(steps.max()) if steps.size else 0.0,
+        "median_step_a": med_a,
+        "median_step_b": med_b,
+        "max_ratio": float(ratio.max()) if ratio.size else 0.0,
+        "worst_frame": worst,
+        "max_ratio_to_median": float(steps.max() / max(med_a, med_b))
+        if steps.size and max(med_a, med_b) > 0
+        else 0.0,
+        "limit": STEP_LIMIT,
+    }
+
+
+def _transition_frames(
+    prep: "_Prepared", p_a: float, p_b: float, n_ramp: int, n_in: int, n_out: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Values ``(T, D)`` (common frame), phase and weight per frame of a transition clip."""
+    ca, cb = prep.curves
+    inc = np.concatenate(
+        [
+            np.full(n_in, 1.0 / p_a),
+            _phase_increments(p_a, p_b, n_ramp),
+            np.full(n_out, 1.0 / p_b),
+        ]
+    )
+    phases = np.concatenate([[0.0], np.cumsum(inc)])  # the clip starts at a's frame 0
+    weight = np.concatenate(
+        [
+            np.zeros(n_in),
+            _smoothstep(np.arange(n_ramp) / (n_ramp - 1)),
+            np.ones(n_out),
+        ]
+    )
+    va = ca(phases)
+    vb = cb(phases)
+    w = weight[:, None]
+    values = (1.0 - w) * va + w * vb
+    horiz = horizontal_columns(prep.reference, prep.up)
+    if horiz.size:
+        # the ground position integrates the blended steps instead of blending positions
+        w_mid = 0.5 * (weight[1:] + weight[:-1])[:, None]
+        step = (1.0 - w_mid) * np.diff(va[:, horiz], axis=0) + w_mid * np.diff(vb[:, horiz], axis=0)
+        values[0, horiz] = va[0, horiz]
+        values[1:, horiz] = va[0, horiz] + np.cumsum(step, axis=0)
+    return values, phases, weight
+
+
+def _longer_ramp(
+    prep: _Prepared, p_a: float, p_b: float, n_ramp: int, n_in: int, n_out: int
+) -> int | None:
+    """The shortest ramp, ``n_ramp`` times a power of 1.25 up to 1.25^16 (about 35x), whose
+    steps all stay within :data:`STEP_LIMIT`; None when none does."""
+    ca, cb = prep.curves
+    for factor in 1.25 ** np.arange(1, 17):
+        n_try = int(np.ceil(n_ramp * factor))
+        v, ph, _ = _transition_frames(prep, p_a, p_b, n_try, n_in, n_out)
+        if transition_steps(v, ph, ca, cb, p_a, p_b)["max_ratio"] <= STEP_LIMIT:
+            return n_try
+    return None
+
+
+def transition(
+    a: Motion,
+    b: Motion,
+    frames: int | None = None,
+    cycles: float | None = None,
+    *,
+    lead_in: int = 1,
+    lead_out: int = 1,
+    allow_reverse: bool = False,
+    align_heading: bool = True,
+    scale_root: bool = True,
+    up: str = "y",
+) -> Motion:
+    """A clip that turns cycle ``a`` into cycle ``b`` without a hitch (the paper's homotopy).
+
+    ``b`` is brought into ``a``'s frame and phase exactly as in :func:`blend`.  Over
+    the ramp the pose is ``(1 - w) a(θ) + w b(θ)`` with ``w`` rising smoothly
+    (smoothstep, zero slope at both ends) from 0 to 1 while the phase keeps advancing
+    at ``dθ/dt = 1 / P(w)``, ``P(w) = (1 - w) P_a + w P_b`` frames: the cadence slides
+    from ``a``'s to ``b``'s.  Root height and orientation are blended as values; the
+    root's ground position integrates the blended per-frame steps, so the character
+    keeps going instead of jumping between where ``a`` and ``b`` would be.  ``lead_in``
+    whole cycles of ``a`` come first (exactly ``a``'s frames) and ``lead_out`` cycles
+    of ``b`` last, so the clip starts in ``a`` and ends in ``b``.
+
+    Continuity is measured by :func:`transition_steps` and stored in
+    ``metadata["transition"]["continuity"]``.
+
+    Parameters
+    ----------
+    a, b : Motion or ExtractionResult
+        Cycles with the same channels; an extraction result stands for its ``.cycle``
+        (see :func:`blend` and :func:`as_cycle`).
+    frames : int, optional
+        Length of the ramp in frames (>= 2).
+    cycles : float, optional
+        Length of the ramp in cycles of phase (> 0); exactly one of ``frames`` and
+        ``cycles``.
+    lead_in, lead_out : int, default 1
+        Whole cycles of ``a`` before and of ``b`` after the ramp (>= 0).
+    allow_reverse, align_heading, scale_root, up
+        As in :func:`blend`.
+
+    Returns
+    -------
+    Motion
+        At ``a``'s rate and skeleton; ``metadata["transition"]`` holds the ramp's frame
+        range, the per-frame weight and phase, the alignment and the continuity figures.
+
+    Raises
+    ------
+    ParameterError
+        For bad lengths, cycles with different channels or too few frames.
+    """
+    a = cycle_of(a, "cycle a")
+    b = cycle_of(b, "cycle b")
+    if (frames is None) == (cycles is None):
+        raise ParameterError("give exactly one of frames= and cycles= for the transition's length")
+    for name, v in (("lead_in", lead_in), ("lead_out", lead_out)):
+        if isinstance(v, bool) or not isinstance(v, Integral) or v < 0:
+            raise ParameterError(f"{name} must be a whole number of cycles >= 0, got {v!r}")
+    prep = _common_frame(
+        [a, b],
+        allow_reverse=allow_reverse,
+        align_heading=align_heading,
+        scale_root=scale_root,
+        up=up,
+    )
+    ca, cb = prep.curves
+    a = prep.base
+    p_a = float(a.n_frames)
+    p_b = cb.period_seconds * a.fps
+    if frames is not None:
+        if isinstance(frames, bool) or not isinstance(frames, Integral) or frames < 2:
+            raise ParameterError(f"frames must be an integer >= 2, got {frames!r}")
+        n_ramp = int(frames)
+    else:
+        if (
+            isinstance(cycles, bool)
+            or not isinstance(cycles, Real)
+            or not np.isfinite(cycles)
+            or cycles <= 0
+        ):
+            raise ParameterError(f"cycles must be a positive number, got {cycles!r}")
+        n_ramp = max(2, _ramp_frames_for_cycles(p_a, p_b, float(cycles)))
+    n_in = int(lead_in) * a.n_frames
+    n_out = int(round(int(lead_out) * p_b))
+    values, phases, weight = _transition_frames(prep, p_a, p_b, n_ramp, n_in, n_out)
+    continuity = transition_steps(values, phases, ca, cb, p_a, p_b)
+    notes = list(prep.notes)
+    if continuity["max_ratio"] > STEP_LIMIT:
+        longer = _longer_ramp(prep, p_a, p_b, n_ramp, n_in, n_out)
+        continuity["suggested_ramp_frames"] = longer
+        notes.append(
+            f"a step is {continuity['max_ratio']:.2f}x the typical step at its phase "
+            f"(limit {STEP_LIMIT}): "
+            + (
+                f"a ramp of {longer} frames or more keeps every step within the limit"
+                if longer
+                else "even a ramp 35x longer does not keep every step within the limit"
+            )
+        )
+    values = _turn_back(values, prep, a)
+    meta = {
+        "transition": {
+            "sources": [a.source or "cycle a", b.source or "cycle b"],
+            "ramp": [n_in, n_in + n_ramp],
+            "ramp_frames": n_ramp,
+            "ramp_cycles": float(phases[n_in + n_ramp - 1] - phases[n_in]),
+            "periods_frames": [p_a, p_b],
+            "lead_in_frames": n_in,
+            "lead_out_frames": n_out,
+            "alignment": prep.alignments[1].to_dict(),
+            "headings_deg": prep.headings if prep.turned else None,
+            "root_scales": prep.root_scales,
+            "continuity": continuity,
+            "notes": notes,
+            "weight": [float(v) for v in weight],
+            "phase": [float(v) for v in phases],
+        }
+    }
+    return replace(
+        a,
+        frames=values,
+        start_frame=0,
+        source=f"transition {a.source or 'a'} -> {b.source or 'b'}",
+        metadata=meta,
+    )
