@@ -37,7 +37,7 @@ def add_parser(subparsers) -> None:
         metavar="W1,W2,...",
         help="one non-negative weight per input, summing to 1 (default: equal)",
     )
-    cycle_inputs(bl)
+    add_input_options(bl)
     bl.set_defaults(func=cmd_blend)
 
     tr = subparsers.add_parser(
@@ -64,11 +64,12 @@ def add_parser(subparsers) -> None:
     tr.add_argument(
         "--lead-out", type=int, default=1, metavar="K", help="whole cycles of B after the ramp (1)"
     )
-    cycle_inputs(tr)
+    add_input_options(tr)
     tr.set_defaults(func=cmd_transition)
 
 
-def cycle_inputs(q: argparse.ArgumentParser) -> None:
+def add_input_options(q: argparse.ArgumentParser) -> None:
+    """The input, matching and output options that blend and transition share."""
     g = q.add_argument_group(
         "inputs",
         "An input is taken as one cycle when it was written by extract or blend (NPZ metadata), "
