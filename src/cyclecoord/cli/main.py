@@ -47,6 +47,7 @@ COMMAND_MODULES: tuple[str, ...] = (
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``cyclecoord`` parser: top-level options and every module of ``COMMAND_MODULES``."""
     p = argparse.ArgumentParser(
         prog="cyclecoord",
         description=(
@@ -57,17 +58,21 @@ def build_parser() -> argparse.ArgumentParser:
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog=(
-            "examples:\n  cyclecoord extract example -o walk_cycle.bvh --report report.json\n  "
-            "cyclecoord extract 69_01.amc --frames 200:450 --max-scale 50 -o cycle.bvh\n  "
-            "cyclecoord barcode 69_01.amc --frames 200:450 --json\n  cyclecoord convert 69_01.amc "
-            "-o 69_01.bvh\n  cyclecoord extract 69_01.amc --frames 200:450 --max-scale 50 -o "
-            "cycle.bvh --plot figures\n  cyclecoord render 69_01.amc --frames 200:450 -o walk.gif "
-            "--side-by-side cycle.bvh\n  cyclecoord blend 69_01.amc 143_01.amc --window 200:450 "
-            "--window 0:96 --max-scale 50 \\\n      --scale auto --scale 40 --weights 0.5,0.5 -o "
-            "walk_jog.bvh --report blend.json\n  cyclecoord transition walk_cycle.bvh "
-            "jog_cycle.bvh --cycles 2 -o walk_to_jog.bvh\n  cyclecoord batch captures/ -o results/ "
-            "--jobs 4\nexit codes: 0 ok, 1 error (one line naming the file and what was wrong), 2 "
-            "usage, 3 no periodic motion found, 130 interrupted (Ctrl-C; no partial files are left)"
+            "examples:\n"
+            "  cyclecoord extract example -o walk_cycle.bvh --report report.json\n"
+            "  cyclecoord extract 69_01.amc --frames 200:450 --max-scale 50 -o cycle.bvh\n"
+            "  cyclecoord barcode 69_01.amc --frames 200:450 --json\n"
+            "  cyclecoord convert 69_01.amc -o 69_01.bvh\n"
+            "  cyclecoord extract 69_01.amc --frames 200:450 --max-scale 50 -o cycle.bvh "
+            "--plot figures\n"
+            "  cyclecoord render 69_01.amc --frames 200:450 -o walk.gif --side-by-side cycle.bvh\n"
+            "  cyclecoord blend 69_01.amc 143_01.amc --window 200:450 --window 0:96 "
+            "--max-scale 50 \\\n"
+            "      --scale auto --scale 40 --weights 0.5,0.5 -o walk_jog.bvh --report blend.json\n"
+            "  cyclecoord transition walk_cycle.bvh jog_cycle.bvh --cycles 2 -o walk_to_jog.bvh\n"
+            "  cyclecoord batch captures/ -o results/ --jobs 4\n"
+            "exit codes: 0 ok, 1 error (one line naming the file and what was wrong), 2 usage, "
+            "3 no periodic motion found, 130 interrupted (Ctrl-C; no partial files are left)"
         ),
     )
     from .. import __version__
@@ -81,6 +86,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command line; returns the exit code (errors become one line on stderr)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "command", None):
