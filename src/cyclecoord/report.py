@@ -13,7 +13,7 @@ import numpy as np
 
 from .errors import NoPeriodicMotionError
 
-__all__ = ["write_json", "clean", "partial_report"]
+__all__ = ["clean", "partial_report", "write_json"]
 
 
 def write_json(path: str, payload: dict) -> None:

@@ -240,14 +240,14 @@ def add_cycle_options(g: argparse._ArgumentGroup) -> None:
 
 def cycle_options(args: argparse.Namespace) -> dict:
     """The typical-cycle keyword arguments of :func:`extract` from parsed options."""
-    return dict(
-        steady=args.steady,
-        timing=args.timing,
-        travel=args.travel,
-        min_turns=args.min_turns,
-        bandwidth=args.bandwidth,
-        cycle_start=args.cycle_start,
-    )
+    return {
+        "steady": args.steady,
+        "timing": args.timing,
+        "travel": args.travel,
+        "min_turns": args.min_turns,
+        "bandwidth": args.bandwidth,
+        "cycle_start": args.cycle_start,
+    }
 
 
 def check_output(path: str | None, what: str = "output") -> None:

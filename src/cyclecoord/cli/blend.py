@@ -254,8 +254,8 @@ def finish(
 
 
 def cmd_blend(args: argparse.Namespace) -> int:
-    from ..synthesis.interpolate import blend, cycle_summary
     from ..quality.plausibility import check_plausibility
+    from ..synthesis.interpolate import blend, cycle_summary
 
     _check_outputs(args)
     try:
@@ -308,8 +308,8 @@ def cmd_blend(args: argparse.Namespace) -> int:
 
 
 def cmd_transition(args: argparse.Namespace) -> int:
-    from ..synthesis.interpolate import transition
     from ..quality.plausibility import check_plausibility
+    from ..synthesis.interpolate import transition
 
     _check_outputs(args)
     try:

@@ -113,8 +113,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def cmd_detect(args: argparse.Namespace) -> int:
     """``cyclecoord detect``: several periodic motions, their segments and per-frame labels."""
-    from ..periodic.detection import detect, motion_cycles
     from ..io import save
+    from ..periodic.detection import detect, motion_cycles
 
     check_output(args.report, "report")
     if args.extract and Path(args.extract).exists() and not Path(args.extract).is_dir():

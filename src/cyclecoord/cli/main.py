@@ -10,19 +10,19 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
-from typing import Sequence
+from collections.abc import Sequence
 
 from ..errors import CycleCoordError
 from ._options import EXIT_ERROR, EXIT_NO_PERIODIC, EXIT_OK, EXIT_USAGE, named
 
 __all__ = [
-    "main",
-    "build_parser",
     "COMMAND_MODULES",
-    "EXIT_OK",
     "EXIT_ERROR",
-    "EXIT_USAGE",
     "EXIT_NO_PERIODIC",
+    "EXIT_OK",
+    "EXIT_USAGE",
+    "build_parser",
+    "main",
 ]
 
 

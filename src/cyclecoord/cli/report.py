@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..report import clean, partial_report, write_json
 
-__all__ = ["load_input", "summary_barcode", "write_json", "clean", "partial_report"]
+__all__ = ["clean", "load_input", "partial_report", "summary_barcode", "write_json"]
 
 EXAMPLES = ("walk", "jog", "jumping_jack", "arm_circles", "squat", "chain", "take")
 
@@ -46,11 +46,10 @@ def load_input(path: str, skeleton: str | None = None, fps: float | None = None)
 
 
 def summary_barcode(bc, sel=None) -> str:
+    """The barcode in a few lines: its size and the five longest H1 bars (``sel`` marked)."""
     pers = bc.persistence(1)
-    lines = [
-        f"barcode up to {bc.threshold:.4g} (Z/{bc.prime}): {len(bc.h0)} H0 bars, {len(bc.h1)} H1 "
-        f"bars"
-    ]
+    head = f"barcode up to {bc.threshold:.4g} (Z/{bc.prime}): "
+    lines = [head + f"{len(bc.h0)} H0 bars, {len(bc.h1)} H1 bars"]
     for k, (b, d) in enumerate(bc.h1[:5]):
         mark = "  <- selected" if sel is not None and k == sel.index else ""
         ds = "inf" if not np.isfinite(d) else f"{d:.4g}"
