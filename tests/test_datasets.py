@@ -674,7 +674,7 @@ def test_whole_take_is_deterministic_and_jogs():
 
 
 def test_whole_take_is_the_cli_example(take):
-    from cyclecoord.cli.main import load_input
+    from cyclecoord.cli.report import load_input
 
     motion = load_input("example:take")
     assert np.array_equal(motion.frames, take.motion.frames)

@@ -50,6 +50,7 @@ from typing import Any, Iterator, Sequence
 from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
 from .io._atomic import atomic_write
 from .io._paths import refuse_clobber
+from .report import clean, partial_report, write_json
 
 __all__ = [
     "run_batch",
@@ -281,35 +282,6 @@ def _options_hash(normalised: dict, fps: float | None, cycle_format: str | None)
 
 
 # ------------------------------------------------------------------ reports
-def _json_helpers():
-    from .cli.main import _clean, _write_json
-
-    return _clean, _write_json
-
-
-def _no_periodic_report(exc: NoPeriodicMotionError) -> dict[str, Any]:
-    """Report of a capture with nothing periodic: its barcode and why it was rejected."""
-    partial = exc.result
-    if partial is None:
-        return {"selected": None, "error": str(exc)}
-    m = partial.motion
-    return {
-        "source": m.source,
-        "frames": [int(m.start_frame), int(m.start_frame + m.n_frames)],
-        "n_frames": int(m.n_frames),
-        "fps": m.fps,
-        "dims": int(partial.prepared.points.shape[1]),
-        "parameters": partial.parameters,
-        "threshold": partial.barcode.threshold,
-        "prime": int(partial.barcode.prime),
-        "barcode": partial.barcode.to_dict(),
-        "selected": None,
-        "error": str(exc),
-        "timings": {k: round(float(v), 6) for k, v in partial.timings.items()},
-        "warnings": list(partial.warnings),
-    }
-
-
 def _batch_block(task: _Task, status: str, message: str, **extra: Any) -> dict[str, Any]:
     from . import __version__
 
@@ -356,7 +328,7 @@ def _analyse(task: _Task) -> dict[str, Any]:
     try:
         result = extract(motion, **task.options)
     except NoPeriodicMotionError as exc:
-        report = _no_periodic_report(exc)
+        report = partial_report(exc)
         report["batch"] = _batch_block(task, "no_periodic", str(exc))
         written = None
     else:
@@ -383,10 +355,9 @@ def _analyse(task: _Task) -> dict[str, Any]:
 
 def _write_report(task: _Task, report: dict) -> dict[str, Any]:
     """Write ``report`` atomically; return its summary row."""
-    _clean, _write_json = _json_helpers()
-    report = _clean(report)
+    report = clean(report)
     task.report.parent.mkdir(parents=True, exist_ok=True)
-    _write_json(str(task.report), report)
+    write_json(str(task.report), report)
     return _row(report)
 
 

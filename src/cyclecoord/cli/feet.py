@@ -67,17 +67,18 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..io import save
     from ..quality.contacts import contact_runs, foot_contacts, foot_skating
-    from .main import _check_output, _write_json, load_input
-    from .view import _range
+    from ._options import check_output
+    from .report import load_input, write_json
+    from .view import frame_window
 
     if args.lock and not args.output:
         raise ParameterError("--lock writes the locked motion: give -o OUT")
-    _check_output(args.output)
-    _check_output(args.report, "report")
+    check_output(args.output)
+    check_output(args.report, "report")
     for out in (args.output, args.report):
         if out and Path(out).exists() and Path(out).resolve() == Path(args.input).resolve():
             raise ParameterError(f"{out} is the input; choose another output name")
-    motion = load_input(args.input, args.skeleton, args.fps).window(_range(args.frames))
+    motion = load_input(args.input, args.skeleton, args.fps).window(frame_window(args.frames))
     options = {"height": args.height, "speed": args.speed}
     contacts = foot_contacts(motion, **options)
     skating = foot_skating(motion, contacts, skate_speed=args.skate_speed)
@@ -125,6 +126,6 @@ def run(args: argparse.Namespace) -> int:
         save(result, args.output)
         print(f"wrote {args.output}")
     if args.report:
-        _write_json(args.report, json.loads(json.dumps(payload, default=float)))
+        write_json(args.report, json.loads(json.dumps(payload, default=float)))
         print(f"wrote {args.report}")
     return 0

@@ -11,15 +11,8 @@ import argparse
 from pathlib import Path
 
 from ..errors import ParameterError
-from .main import (
-    EXIT_OK,
-    _check_output,
-    _clean,
-    _positive_float,
-    _positive_int,
-    _write_json,
-    load_input,
-)
+from ._options import EXIT_OK, check_output, positive_float, positive_int
+from .report import clean, load_input, write_json
 
 __all__ = ["add_parser", "run"]
 
@@ -60,14 +53,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--dims",
-        type=_positive_int,
+        type=positive_int,
         default=2,
         help="latent PCA dimensions (default 2, as the paper)",
     )
     p.add_argument(
         "-k",
         "--k",
-        type=_positive_int,
+        type=positive_int,
         default=16,
         help="neighbours of the k-NN graph and field (default 16)",
     )
@@ -79,7 +72,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--step-scale",
-        type=_positive_float,
+        type=positive_float,
         default=None,
         help="step length in training vectors (half a frame's change): 1 is the paper's step "
         "(about half speed; crossval default), 2 the captured speed (generation default)",
@@ -97,7 +90,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="instead of following the field, the shortest graph path to this pose",
     )
     p.add_argument(
-        "--frames", type=_positive_int, default=450, help="frames to generate (default 450)"
+        "--frames", type=positive_int, default=450, help="frames to generate (default 450)"
     )
     p.add_argument("-o", "--output", default=None, help="generated motion (.bvh, .amc, ...)")
     p.add_argument("--report", default=None, help="JSON report")
@@ -139,9 +132,9 @@ def run(args: argparse.Namespace) -> int:
 
     crossval = args.inputs[0] == "crossval" and not Path("crossval").exists()
     inputs = args.inputs[1:] if crossval else list(args.inputs)
-    _check_output(args.report, "report")
+    check_output(args.report, "report")
     if not crossval:
-        _check_output(args.output)
+        check_output(args.output)
         for out in (args.output, args.report):
             if out and any(
                 Path(out).exists() and Path(out).resolve() == Path(s).resolve()
@@ -181,7 +174,7 @@ def _crossval(args: argparse.Namespace, motions: list) -> int:
         f"{outside} steps outside the hull"
     )
     if args.report:
-        _write_json(args.report, _clean(cv.to_report()))
+        write_json(args.report, clean(cv.to_report()))
         print(f"wrote {args.report}")
     if args.plot:
         from ..plot.graph import save_crossval_figures
@@ -194,7 +187,7 @@ def _crossval(args: argparse.Namespace, motions: list) -> int:
 def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int:
     from ..quality.plausibility import check_plausibility
     from ..synthesis.graph import MotionGraphSynth
-    from .main import _finish
+    from .blend import finish
 
     method = args.method or "delaunay"
     if "," in method:
@@ -263,4 +256,4 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int
         for p in save_graph_figures(synth, gen, args.plot):
             print(f"wrote {p}")
     report = check_plausibility(gen.motion, motions)
-    return _finish(args, gen.motion, payload, report, "generated motion")
+    return finish(args, gen.motion, payload, report, "generated motion")

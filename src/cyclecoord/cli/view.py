@@ -51,7 +51,7 @@ def add_parser(subparsers) -> None:
     p.set_defaults(func=run)
 
 
-def _range(text: str | None):
+def frame_window(text: str | None):
     from ..errors import ParameterError
 
     if text is None:
@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..plot.viewer import ViewerInput, skeleton_figure, write_viewer
     from ..quality.contacts import foot_skating
-    from .main import load_input
+    from .report import load_input
 
     out = Path(args.output)
     if out.suffix.lower() not in (".html", ".htm"):
@@ -81,10 +81,10 @@ def run(args: argparse.Namespace) -> int:
         if src and Path(src).exists() and Path(src).resolve() == out.resolve():
             raise ParameterError(f"{out} is an input; choose another output name")
     items = []
-    m = load_input(args.input, args.skeleton, args.fps).window(_range(args.frames))
+    m = load_input(args.input, args.skeleton, args.fps).window(frame_window(args.frames))
     items.append(ViewerInput(m, Path(args.input).name, args.cycle))
     if args.side_by_side:
-        o = load_input(args.side_by_side).window(_range(args.other_frames))
+        o = load_input(args.side_by_side).window(frame_window(args.other_frames))
         items.append(ViewerInput(o, Path(args.side_by_side).name, args.other_cycle))
     for it in items:
         try:
