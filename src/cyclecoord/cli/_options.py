@@ -121,19 +121,29 @@ def byte_size(text: str) -> float:
     return v
 
 
-def add_selection_options(p: argparse.ArgumentParser) -> None:
-    g = p.add_argument_group("what to analyse and how")
-    g.add_argument(
-        "--skeleton",
-        metavar="ASF",
-        help="ASF skeleton for an AMC input (default: found beside the AMC)",
-    )
-    g.add_argument(
-        "--frames",
-        type=frame_range,
-        metavar="A:B",
-        help="0-based half-open frame range, e.g. 200:450",
-    )
+def add_selection_options(
+    p: argparse.ArgumentParser,
+    title: str = "what to analyse and how",
+    per_file: bool = True,
+) -> argparse._ArgumentGroup:
+    """The options that choose what is analysed and how, in one group (returned).
+
+    ``per_file=False`` (batch: the same options for every capture) leaves out the ones
+    that belong to one input: ``--skeleton``, ``--frames`` and ``--no-root-diff``.
+    """
+    g = p.add_argument_group(title)
+    if per_file:
+        g.add_argument(
+            "--skeleton",
+            metavar="ASF",
+            help="ASF skeleton for an AMC input (default: found beside the AMC)",
+        )
+        g.add_argument(
+            "--frames",
+            type=frame_range,
+            metavar="A:B",
+            help="0-based half-open frame range, e.g. 200:450",
+        )
     g.add_argument(
         "--fps",
         type=positive_float,
@@ -154,9 +164,12 @@ def add_selection_options(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="time-aware metric: consecutive frames at distance 0",
     )
-    g.add_argument(
-        "--no-root-diff", action="store_true", help="keep root translation/orientation as they are"
-    )
+    if per_file:
+        g.add_argument(
+            "--no-root-diff",
+            action="store_true",
+            help="keep root translation/orientation as they are",
+        )
     g.add_argument(
         "--prime",
         type=int,
@@ -188,6 +201,7 @@ def add_selection_options(p: argparse.ArgumentParser) -> None:
         "whose landmarks are reduced to fit (default: 2G for the filtration alone; never more "
         "than the machine has)",
     )
+    return g
 
 
 def add_cycle_options(g: argparse._ArgumentGroup) -> None:

@@ -4,16 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from ._options import (
-    EXIT_ERROR,
-    EXIT_OK,
-    add_cycle_options,
-    byte_size,
-    cycle_options,
-    landmarks,
-    positive_float,
-    positive_int,
-)
+from ._options import EXIT_ERROR, EXIT_OK, add_cycle_options, add_selection_options, cycle_options
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -66,54 +57,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="format of the cycle written per capture (default bvh; none: reports only)",
     )
     w.add_argument("--no-progress", action="store_true", help="no progress bar")
-    g = ba.add_argument_group("what to analyse and how (the same for every capture)")
-    g.add_argument(
-        "--fps",
-        type=positive_float,
-        metavar="F",
-        help="frame rate (AMC files carry none; default 120)",
-    )
-    g.add_argument(
-        "--pca",
-        type=positive_int,
-        metavar="K",
-        help="project poses onto K principal components first",
-    )
-    g.add_argument(
-        "--normalize", action="store_true", help="scale each channel by its standard deviation"
-    )
-    g.add_argument(
-        "--temporal",
-        action="store_true",
-        help="time-aware metric: consecutive frames at distance 0",
-    )
-    g.add_argument(
-        "--prime",
-        type=int,
-        default=47,
-        metavar="P",
-        help="coefficient field Z/P, a prime > 11 (default 47)",
-    )
-    g.add_argument(
-        "--max-scale",
-        type=positive_float,
-        metavar="E",
-        help="Rips threshold in the analysed space's units (default: half the point cloud's "
-        "diameter)",
-    )
-    g.add_argument(
-        "--landmarks",
-        type=landmarks,
-        default="auto",
-        metavar="N|auto|none",
-        help="filtration on N greedy landmarks (auto: every frame up to 1000 frames, 500 beyond)",
-    )
-    g.add_argument(
-        "--memory-limit",
-        type=byte_size,
-        default=None,
-        metavar="SIZE",
-        help="memory budget per capture for the filtration, e.g. 2G; above it landmarks are used",
+    g = add_selection_options(
+        ba, "what to analyse and how (the same for every capture)", per_file=False
     )
     g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (0)")
     add_cycle_options(ba.add_argument_group("the cycle (the same for every capture)"))
