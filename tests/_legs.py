@@ -1,0 +1,37 @@
+"""A two-legged test skeleton and motions on it (foot contacts and foot locking tests)."""
+
+import numpy as np
+
+from cyclecoord.motion import Motion
+from cyclecoord.skeleton import Joint, Skeleton
+
+
+def legs_skeleton(
+    names=("lfemur", "ltibia", "lfoot", "ltoes", "rfemur", "rtibia", "rfoot", "rtoes"),
+):
+    """Root at hip height 10 over a floor at 3 (not 0); thigh 4, shin 4, foot 1, toes 0.5."""
+    lf, lt, lfo, lto, rf, rt, rfo, rto = names
+    joints = [Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX")]
+    for side, (f, t, fo, to), x in (
+        ("l", (lf, lt, lfo, lto), 1.0),
+        ("r", (rf, rt, rfo, rto), -1.0),
+    ):
+        base = len(joints)
+        joints += [
+            Joint(f, 0, [x, -1, 0], ("rx", "ry", "rz"), "ZYX"),
+            Joint(t, base, [0, -4, 0], ("rx",), "X"),
+            Joint(fo, base + 1, [0, -4, 0], ("rx",), "X"),
+            Joint(to, base + 2, [0, -0.5, 1], ("rx",), "X", end_site=[0, 0, 0.5]),
+        ]
+    return Skeleton(tuple(joints), name="legs")
+
+
+def make_motion(skel, T=120, fps=60.0, root_speed=0.0, lift_left=None):
+    channels = skel.channels
+    frames = np.zeros((T, len(channels)))
+    col = {c: i for i, c in enumerate(channels)}
+    frames[:, col[("root", "ty")]] = 10.0
+    frames[:, col[("root", "tz")]] = root_speed * np.arange(T) / fps
+    if lift_left is not None:
+        frames[lift_left, col[(skel.names[1], "rx")]] = -40.0  # swing the left thigh forward
+    return Motion(frames, channels, fps=fps, skeleton=skel)
