@@ -462,7 +462,7 @@ def extract(
     prep = Preprocessor(difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=lag)
     prepared = prep.fit_transform(motion)
     joints = joint_columns(motion, prepared)
-    moving = moving_mask(prepared.poses[:, joints], motion.fps) if steady else np.ones(T, dtype=bool)
+    moving = moving_mask(prepared.poses, motion.fps, columns=joints) if steady else np.ones(T, dtype=bool)
     if not steady or moving.sum() >= 0.95 * T or moving.sum() < max(10, 2 * n_neighbors):
         moving = np.ones(T, dtype=bool)
     timings["prepare"] = time.perf_counter() - t0
@@ -493,7 +493,7 @@ def extract(
     def fit_rows(rows: np.ndarray, stage: str, first_pass: bool = False) -> _Fit:
         est = make_estimator(first_pass)
         t0 = time.perf_counter()
-        barcode, sel = _first_clear(est, prepared.points[rows], class_index, scale, scale_fraction)
+        barcode, sel = _first_clear(est, _rows_of(prepared.points, rows), class_index, scale, scale_fraction)
         timings[f"barcode{stage}"] = time.perf_counter() - t0
         if sel is None:
             if len(barcode.h1) and class_index >= len(barcode.h1):
@@ -535,7 +535,7 @@ def extract(
             # the class's birth on every frame, for the report (landmarks are born later)
             budget = getattr(fit.est, "memory_budget_", None)
             max_edges = 3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
-            full = refine_birth(prepared.points[rows], fit.selection.birth, fit.est.prime_, max_edges=max_edges,
+            full = refine_birth(_rows_of(prepared.points, rows), fit.selection.birth, fit.est.prime_, max_edges=max_edges,
                                 covering_radius=fit.est.covering_radius_) if max_edges > 0 else None
             fit.selection = BarSelection(**{**fit.selection.__dict__, "full_birth": full})
             fit.est.selection_ = fit.selection
@@ -586,6 +586,13 @@ def extract(
         sampling=sampling, bandwidth=bandwidth, random_state=random_state, cycle_start=cycle_start,
         timing=timing, travel=travel, min_turns=min_turns,
     )
+
+
+def _rows_of(x: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """``x[rows]``, as a view when the rows are one contiguous run (no copy of a long take)."""
+    if rows.size and rows[-1] - rows[0] + 1 == rows.size:
+        return x[rows[0] : rows[-1] + 1]
+    return x[rows]
 
 
 def _check_options(motion, **o) -> dict:
@@ -713,7 +720,7 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
         "cycle": float(jerk_summary(typ.frames, fps, cyclic=True)),
     }
     closure = float(loop_closure(typ.frames))
-    dist = distance_to_cycle(prepared.poses[rows], typ.frames)
+    dist = distance_to_cycle(_rows_of(prepared.poses, rows), typ.frames)
     step = np.concatenate([frame_steps(prepared.poses[a:b]) for a, b in runs])
     distance = {
         "median": float(np.median(dist)),

@@ -46,19 +46,48 @@ def clean_runs(mask: np.ndarray, min_run: int, max_gap: int) -> np.ndarray:
     return m
 
 
-def moving_mask(joints: np.ndarray, fps: float, *, min_speed: float = 0.35, smooth_seconds: float = 0.5) -> np.ndarray:
+def _smoothed_steps(joints: np.ndarray, sigma: float, columns: np.ndarray | None, block: int = 32768) -> np.ndarray:
+    """Norm of each frame step of the Gaussian-smoothed poses, computed in blocks of frames.
+
+    Each block is smoothed with a margin of the kernel's radius, so the steps equal those
+    of smoothing the whole array at once (the same sums), while memory stays
+    O(block x channels) beside the output instead of three copies of the take.
+    """
+    T = len(joints)
+    radius = int(4.0 * sigma + 0.5)  # gaussian_filter1d's default truncation
+    out = np.empty(T - 1)
+    for a in range(0, T - 1, block):
+        b = min(T - 1, a + block)  # steps a .. b-1 need smoothed frames a .. b
+        lo, hi = max(0, a - radius), min(T, b + 1 + radius)
+        part = joints[lo:hi] if columns is None else joints[lo:hi][:, columns]
+        sm = gaussian_filter1d(np.asarray(part, dtype=float), sigma=sigma, axis=0, mode="nearest")
+        out[a:b] = np.linalg.norm(np.diff(sm[a - lo : b + 1 - lo], axis=0), axis=1)
+    return out
+
+
+def moving_mask(
+    joints: np.ndarray,
+    fps: float,
+    *,
+    min_speed: float = 0.35,
+    smooth_seconds: float = 0.5,
+    columns: np.ndarray | None = None,
+) -> np.ndarray:
     """Frames whose joints move at a good fraction of the take's moving level.
 
     Parameters
     ----------
     joints : ndarray, shape (T, J)
         Joint-angle channels (degrees), root excluded.
+        With ``columns``, any (T, D) poses of which those columns are the joints.
     fps : float
     min_speed : float
         Fraction of the 80th percentile of the smoothed speed below which a frame is
         still.
     smooth_seconds : float
         Width of the moving average of the speed.
+    columns : ndarray of int, optional
+        Joint columns of ``joints`` (read block by block, never copied whole).
 
     Returns
     -------
@@ -66,13 +95,13 @@ def moving_mask(joints: np.ndarray, fps: float, *, min_speed: float = 0.35, smoo
         Still stretches shorter than half a second inside motion count as moving; moving
         stretches shorter than a second count as still.
     """
-    j = np.asarray(joints, dtype=float)
-    if len(j) < 3 or j.shape[1] == 0:
+    j = np.asarray(joints)
+    width = j.shape[1] if columns is None else len(columns)
+    if len(j) < 3 or width == 0:
         return np.ones(len(j), dtype=bool)
     # measurement noise adds a constant to the norm of raw frame steps (0.5 degrees of noise
     # on 56 channels reads as 5 degrees a frame); steps of lightly smoothed poses do not
-    j = gaussian_filter1d(j, sigma=max(1.0, 0.04 * fps), axis=0, mode="nearest")
-    step = np.linalg.norm(np.diff(j, axis=0), axis=1)
+    step = _smoothed_steps(j, max(1.0, 0.04 * fps), None if columns is None else np.asarray(columns))
     step = np.concatenate([step, step[-1:]])
     speed = _smooth(step, round(smooth_seconds * fps))
     level = np.percentile(speed, 80)
