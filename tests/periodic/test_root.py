@@ -41,3 +41,51 @@ def test_straight_and_in_place(walk):
 def test_no_layout_without_a_skeleton(walk):
     bare = cc.Motion(frames=walk.frames, channels=walk.channels, fps=walk.fps)
     assert root_layout(bare) is None
+
+
+def _striding(turn_per_frame=0.0):
+    """The left leg sweeps back under a root that stays put (and may turn)."""
+    from tests._legs import legs_skeleton, make_motion
+
+    skel = legs_skeleton()
+    m = make_motion(skel, T=40)
+    f = m.frames.copy()
+    col = {c: i for i, c in enumerate(m.channels)}
+    f[:, col[("lfemur", "rx")]] = np.linspace(-25.0, 25.0, len(f))
+    f[:, col[("rfemur", "rx")]] = np.linspace(25.0, -25.0, len(f))
+    f[:, col[("root", "ry")]] = turn_per_frame * np.arange(len(f))
+    return m.with_frames(f)
+
+
+@pytest.mark.parametrize("turn", [0.0, 1.5])
+def test_planted_ground_keeps_the_planted_foot_still(turn):
+    from cyclecoord.periodic.root import planted_ground
+
+    clip = _striding(turn)
+    layout = root_layout(clip)
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    pos = clip.positions()
+    before = 0.5 * (pos["lfoot"] + pos["ltoes"])[:, [0, 2]]  # the planted points' mean
+    assert np.ptp(before, axis=0).max() > 3.0  # the foot slides under a root that stays put
+    weights = np.tile([1.0, 1.0, 0.0, 0.0], (clip.n_frames, 1))
+    ground = planted_ground(clip, layout, feet, weights)
+    f = clip.frames.copy()
+    f[:, [layout.column("tx"), layout.column("tz")]] = ground
+    after = clip.with_frames(f).positions()
+    held = 0.5 * (after["lfoot"] + after["ltoes"])[:, [0, 2]]
+    np.testing.assert_allclose(held, np.tile(before[0], (clip.n_frames, 1)), atol=1e-9)
+    # the root moved instead, by the stride, while the swinging foot travels twice as far
+    assert np.ptp(after["root"][:, 2]) > 3.0
+    np.testing.assert_allclose(ground[0], clip.frames[0, [layout.column("tx"), layout.column("tz")]])
+
+
+def test_planted_ground_without_contacts_keeps_the_clips_own_steps():
+    from cyclecoord.periodic.root import planted_ground
+
+    clip = _striding()
+    f = clip.frames.copy()
+    f[:, clip.channels.index(("root", "tz"))] += 0.3 * np.arange(clip.n_frames)
+    clip = clip.with_frames(f)
+    layout = root_layout(clip)
+    ground = planted_ground(clip, layout, ("lfoot", "ltoes", "rfoot", "rtoes"), np.zeros((clip.n_frames, 4)))
+    np.testing.assert_allclose(ground, clip.frames[:, [layout.column("tx"), layout.column("tz")]], atol=1e-9)

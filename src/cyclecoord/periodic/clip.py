@@ -4,8 +4,10 @@
 averages the repetitions in a phase re-timed to the capture's pace
 (:func:`~cyclecoord.periodic.windings.retime`), aligned by time warping
 (:func:`~cyclecoord.periodic.registration.register`) and given back their typical
-amplitude (:func:`typical_amplitude`); its root closes in height, pitch and roll and
-travels and turns by its mean steps (:mod:`~cyclecoord.periodic.root`).
+amplitude (:func:`typical_amplitude`); its root closes in height, pitch and roll, turns
+by its mean heading steps and travels as its planted feet carry it
+(:func:`planted_weights`, :func:`~cyclecoord.periodic.root.planted_ground`), so that a
+foot on the ground does not slide (:mod:`~cyclecoord.periodic.root`).
 :func:`loop_cycle` turns the paper's density-sampled cycle into a clip.  Both start the
 loop at its slowest pose (:func:`slowest_frame`), where a seam is least visible.
 """
@@ -21,11 +23,11 @@ from ..motion import Motion
 from .cycle import TypicalCycle, select_bandwidth
 from .preprocess import PreparedData, Preprocessor
 from .registration import register
-from .root import compose_root, decompose_root, heading, root_layout
+from .root import compose_root, decompose_root, heading, planted_ground, root_layout
 from .windings import phase_average, stretches
 
 __all__ = [
-    "capture_cycle", "loop_cycle", "typical_amplitude", "slowest_frame", "joint_columns",
+    "capture_cycle", "loop_cycle", "planted_weights", "typical_amplitude", "slowest_frame", "joint_columns",
     "CAPTURE_WIDTH", "MAX_CYCLE_FRAMES", "MAX_AMPLITUDE_GAIN",
 ]
 
@@ -164,6 +166,35 @@ def typical_amplitude(cycle: np.ndarray, phase: np.ndarray, poses: np.ndarray, s
     return mean + (cycle - mean) * gain
 
 
+def planted_weights(
+    motion: Motion, rows: np.ndarray, phase: np.ndarray, n_out: int, width: float
+) -> tuple[tuple[str, ...], np.ndarray] | None:
+    """How often each foot point is planted at each phase of the cycle, over the capture.
+
+    Contacts (:func:`~cyclecoord.quality.contacts.foot_contacts`) are found on the
+    capture's frames ``rows[0] .. rows[-1]`` and averaged at ``n_out`` phases with the
+    cycle's kernel, so a point planted in every repetition at some phase weighs 1 there.
+
+    Returns
+    -------
+    (feet, weights) or None
+        The foot point names and an array of shape ``(n_out, len(feet))`` in ``[0, 1]``;
+        None without a skeleton or recognisable feet.
+    """
+    from ..quality.contacts import find_feet, foot_contacts
+
+    if motion.skeleton is None or rows.size < 2:
+        return None
+    try:
+        feet = find_feet(motion.skeleton)
+    except ParameterError:
+        return None
+    lo, hi = int(rows[0]), int(rows[-1]) + 1
+    contacts = foot_contacts(motion[lo:hi], feet)
+    planted = contacts.planted[rows - lo].astype(float)
+    return feet, phase_average(phase, planted, n_out, width)
+
+
 def capture_cycle(
     phase: np.ndarray,
     motion: Motion,
@@ -213,8 +244,9 @@ def capture_cycle(
     -------
     (TypicalCycle, Motion, float)
         The cycle in the prepared space, the loopable clip (root pitch, roll and height
-        averaged as absolute values, so they close; heading and ground travel integrated
-        from their mean changes) and the heading change per cycle in degrees (NaN
+        averaged as absolute values, so they close; heading integrated from its mean
+        changes; ground travel from the planted feet, the mean ground step where no foot
+        is planted) and the heading change per cycle in degrees (NaN
         without a six-dof root and a skeleton).
     """
     P = max(2, int(round(period)))
@@ -229,23 +261,30 @@ def capture_cycle(
         drop = np.ones(phase.size, dtype=bool)
         drop[keep] = False
         phase[drop] = np.nan
+        finite = keep
+    # work on the span of phased frames only (a view: a long take is never copied whole)
+    lo, hi = (int(finite[0]), int(finite[-1]) + 1) if finite.size else (0, phase.size)
+    phase = phase[lo:hi]
+    span = prepared.poses[lo:hi]
+    joints = joint_columns(motion, prepared)
     if register_iter:
-        joints = joint_columns(motion, prepared)
-        phase = register(phase, prepared.poses[:, joints], stretches(np.isfinite(phase)), P,
+        phase = register(phase, span[:, joints], stretches(np.isfinite(phase)), P,
                          width / float(period), n_iter=register_iter)
-    rows = np.flatnonzero(np.isfinite(phase))
-    ph = phase[rows]
-    poses = prepared.poses[rows]
+    local = np.flatnonzero(np.isfinite(phase))
+    rows = local + lo
+    ph = phase[local]
+    poses = span[local]
     selection = None
     if bandwidth == "auto":
         selection = select_bandwidth(ph, poses, float(period), k=min(k, rows.size))
         width = float(selection.bandwidth)
     frames = phase_average(ph, poses, P, width / float(period))
     if amplitude == "typical":
-        joints = joint_columns(motion, prepared)
-        frames[:, joints] = typical_amplitude(frames[:, joints], phase, prepared.poses[:, joints])
+        frames[:, joints] = typical_amplitude(frames[:, joints], phase, span[:, joints])
     layout = root_layout(motion) if prepared.root_columns.size else None
-    feats = phase_average(ph, decompose_root(motion.frames, layout)[rows], P, width / float(period)) if layout else None
+    feats = None
+    if layout:
+        feats = phase_average(ph, decompose_root(motion.frames[lo:hi], layout)[local], P, width / float(period))
     shift = 0
     if cycle_start == "slowest":
         joints = np.delete(frames, prepared.root_columns, axis=1) if prepared.root_columns.size < frames.shape[1] else frames
@@ -267,6 +306,13 @@ def capture_cycle(
         cyc[:, root] = preprocessor.integrate_root(frames[:, root], motion.frames[rows[0], root], mean_delta, motion)
     clip = motion.with_frames(cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}",
                               metadata=dict(metadata or {}))
+    if feats is not None and travel != "in_place":
+        planted = planted_weights(motion, rows, ph, P, width / float(period))
+        if planted is not None:
+            feet, weights = planted
+            cyc[:, [layout.column("tx"), layout.column("tz")]] = planted_ground(
+                clip, layout, feet, np.roll(weights, -shift, axis=0))
+            clip = clip.with_frames(cyc)
     if feats is not None:
         # the cycle in the prepared space is the written clip's own (one definition of its
         # root changes, so its jerk and loop closure read the same from the file)

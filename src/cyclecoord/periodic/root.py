@@ -185,3 +185,60 @@ def compose_root(
     out[:, layout.dofs.index("ty")] = x[:, 0]
     out[:, layout.dofs.index("tz")] = ground[:, 1]
     return out
+
+
+def planted_ground(
+    clip: Motion,
+    layout: RootLayout,
+    points: list[str] | tuple[str, ...],
+    weights: np.ndarray,
+) -> np.ndarray:
+    """Root ground positions that keep the planted foot points of a clip still.
+
+    A walk cycle averaged over repetitions moves its feet relative to the root by the
+    average stride, while its root travels by the average ground step; the two disagree
+    (and more so once the strides are widened to their typical amplitude), so the
+    planted foot slides.  Here the root follows the feet instead, as an animator does
+    when extracting root motion: on each step from frame t to t+1 the root moves by
+    minus the horizontal displacement, relative to the root, of the points that are
+    planted, weighted by how surely they are; the weights' shortfall from 1 (a flight
+    phase) takes the clip's own ground step.
+
+    Parameters
+    ----------
+    clip : Motion
+        The cycle with its composed root (heading and tilt as they will be written).
+    layout : RootLayout
+    points : sequence of str
+        Foot point joint names (e.g. ``lfoot ltoes rfoot rtoes``).
+    weights : ndarray, shape (P, F)
+        How surely each point is planted on each frame, in ``[0, 1]``.
+
+    Returns
+    -------
+    ndarray, shape (P, 2)
+        Values for the root's ``tx`` and ``tz`` channels (y up), the first frame's kept.
+    """
+    pos = clip.positions()
+    cols = [pos.names.index(p) for p in points]
+    root = pos.positions[:, 0, :][:, [0, 2]]
+    rel = pos.positions[:, cols][:, :, [0, 2]] - root[:, None, :]  # (P, F, 2)
+    w = np.clip(np.asarray(weights, dtype=float), 0.0, 1.0)
+    w = 0.5 * (w[1:] + w[:-1])  # a step's weight: the mean of its two frames
+    total = w.sum(axis=1, keepdims=True)
+    share = np.where(total > 1.0, w / np.maximum(total, 1e-12), w)
+    free = 1.0 - share.sum(axis=1, keepdims=True)
+    own = np.diff(root, axis=0)
+    follow = -np.einsum("tf,tfk->tk", share, np.diff(rel, axis=0))
+    steps = follow + free * own
+    tx, tz = layout.column("tx"), layout.column("tz")
+    # the root channels' translation reaches the world unscaled in ASF and BVH alike, but
+    # measure it rather than assume it
+    scale = 1.0
+    moved = clip.frames[:1].copy()
+    moved[0, tx] += 1.0
+    probe = clip.with_frames(np.vstack([clip.frames[:1], moved])).positions().positions[:, 0, 0]
+    if abs(probe[1] - probe[0]) > 1e-9:
+        scale = float(probe[1] - probe[0])
+    start = clip.frames[0, [tx, tz]]
+    return start + np.vstack([[0.0, 0.0], np.cumsum(steps, axis=0)]) / scale
