@@ -131,17 +131,21 @@ def typical_amplitude(cycle: np.ndarray, phase: np.ndarray, poses: np.ndarray, s
 
     Averaging repetitions whose sharp features (a toe's flick, a foot's roll) differ a
     little in timing and size flattens them: the average's range is smaller than any
-    single repetition's.  Each channel is scaled about the cycle's mean by the median,
-    over the complete repetitions (runs of frames between two wraps of ``phase``), of the
-    repetition's range over the cycle's range, both after a running median of ``spike``
-    frames (a one- or two-frame marker glitch is not amplitude).  The gain is kept in
-    ``[1, MAX_AMPLITUDE_GAIN]``: a channel is never narrowed, nor a noisy one blown up.
+    single repetition's.  Each channel is scaled about the cycle's mean by the median
+    range of the capture over one period, over the cycle's range, both after a running
+    median of ``spike`` frames (a one- or two-frame marker glitch is not amplitude).  The
+    capture's ranges are taken over every window of one period (the cycle's length)
+    inside the phased runs, a window starting every eighth of a period: a take of two
+    and a half repetitions gives about a dozen windows rather than the two complete
+    repetitions between wraps, so one odd repetition does not set the amplitude.  The
+    gain is kept in ``[1, MAX_AMPLITUDE_GAIN]``: a channel is never narrowed, nor a noisy
+    one blown up.
 
     Parameters
     ----------
     cycle : ndarray, shape (P, C)
     phase : ndarray, shape (T,)
-        Phase per frame, NaN where there is none.
+        Phase per frame, NaN where there is none (only which frames are phased is read).
     poses : ndarray, shape (T, C)
 
     Returns
@@ -150,13 +154,15 @@ def typical_amplitude(cycle: np.ndarray, phase: np.ndarray, poses: np.ndarray, s
     """
     from scipy.ndimage import median_filter
 
-    ph = np.asarray(phase, dtype=float)
-    ok = np.isfinite(ph)
-    wraps = np.flatnonzero(ok[1:] & ok[:-1] & (np.diff(np.where(ok, ph, 0.0)) < -0.5)) + 1
+    ok = np.isfinite(np.asarray(phase, dtype=float))
+    P = len(cycle)
     ranges = []
-    for a, b in zip(wraps[:-1], wraps[1:]):
-        if np.all(ok[a:b]) and b - a > spike:
-            ranges.append(np.ptp(median_filter(poses[a:b], size=(spike, 1), mode="nearest"), axis=0))
+    for a, b in stretches(ok):
+        if b - a < max(P, spike + 1):
+            continue
+        smooth = median_filter(poses[a:b], size=(spike, 1), mode="nearest")
+        for s in range(0, b - a - P + 1, max(1, P // 8)):
+            ranges.append(np.ptp(smooth[s : s + P], axis=0))
     if not ranges:
         return cycle
     typical = np.median(np.asarray(ranges), axis=0)
