@@ -226,3 +226,44 @@ def test_greedy_landmarks_make_ripsers_choice(shape):
     for bad in (0, len(x) + 1, 2.5, True):
         with pytest.raises(ParameterError):
             greedy_landmarks(x, bad)
+
+
+def test_winding_birth_follows_the_class_past_a_loop_of_noise():
+    """A small loop elsewhere closes first, but the coordinate does not wind around it."""
+    from cyclecoord.periodic.barcode import refine_birth, winding_birth
+
+    rng = np.random.default_rng(3)
+    t = np.sort(rng.uniform(0, 1, 300))
+    circle = np.c_[np.cos(2 * np.pi * t), np.sin(2 * np.pi * t)]
+    gaps = np.diff(np.r_[t, t[0] + 1])
+    born = 2 * np.sin(np.pi * gaps.max())  # the circle's loop closes across its widest gap
+    # a small ring (radius 0.2, 40 points) beside it: born at its spacing, alive until
+    # about its radius times sqrt(3), beyond the big circle's birth
+    s = np.arange(40) / 40
+    ring = 0.2 * np.c_[np.cos(2 * np.pi * s), np.sin(2 * np.pi * s)] + [3.0, 3.0]
+    x = np.vstack([circle, ring])
+    theta = np.r_[t, np.zeros(len(ring))]
+    assert born > 0.1
+    # the bars alone (no coordinate) take the ring, alive at that scale and born first
+    assert refine_birth(x, born * 1.01) == pytest.approx(0.4 * np.sin(np.pi / 40), rel=1e-6)
+    assert refine_birth(x, born * 1.01, coordinate=theta) == pytest.approx(born, rel=1e-9)
+    pairs = np.array([[i, (i + 1) % 300] for i in range(300)])
+    lengths = np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1)
+    assert winding_birth(pairs, lengths, theta) == pytest.approx(born, rel=1e-9)
+    assert winding_birth(pairs[:-1], lengths[:-1], theta) is None  # an open chain never winds
+
+
+def test_full_birth_follows_the_selected_class_on_joined_walks(cmu_dir):
+    """Issue 12's case: landmarks on ~900 frames of walking in 3 PCA dimensions; the
+    bars of the sparse full complex alone gave 2.73 (a loop of noise) for a bar born at
+    3.59 on every frame."""
+    import cyclecoord as cc
+
+    a, b = (cc.load(cmu_dir / "35" / f"35_{k}.amc") for k in ("08", "13"))
+    joined = a.with_frames(np.vstack([a.frames, b.frames]))
+    full = cc.extract(joined, pca=3, landmarks=None, steady=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        lm = cc.extract(joined, pca=3, landmarks=500, steady=False)
+    assert lm.selection.birth > 1.1 * full.selection.birth  # landmarks are born later
+    assert lm.selection.full_birth == pytest.approx(full.selection.birth, rel=1e-5)

@@ -536,7 +536,8 @@ def extract(
             budget = getattr(fit.est, "memory_budget_", None)
             max_edges = 3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
             full = refine_birth(_rows_of(prepared.points, rows), fit.selection.birth, fit.est.prime_, max_edges=max_edges,
-                                covering_radius=fit.est.covering_radius_) if max_edges > 0 else None
+                                covering_radius=fit.est.covering_radius_,
+                                coordinate=fit.est.coordinates_) if max_edges > 0 else None
             fit.selection = BarSelection(**{**fit.selection.__dict__, "full_birth": full})
             fit.est.selection_ = fit.selection
         timings[f"coordinate{stage}"] = time.perf_counter() - t0
