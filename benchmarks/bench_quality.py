@@ -52,11 +52,13 @@ import numpy as np
 import cyclecoord as cc
 from cyclecoord.errors import CycleCoordError, NoPeriodicMotionError
 from cyclecoord.io._atomic import atomic_path, atomic_write
-from cyclecoord.quality.cycle_quality import TARGETS, cycle_quality, foot_skating_speed, targets
+from cyclecoord.quality.cycle_quality import TARGETS, coverage, cycle_quality, foot_skating_speed, targets
 from cyclecoord.quality.reference import (
     autocorrelation_period,
     average_cycle,
     best_loop_cut,
+    joint_angles,
+    used_mask,
     wrap_times,
 )
 
@@ -145,6 +147,15 @@ def _take_skating(take: cc.Motion, used: list | None) -> float:
     return (
         float(sum(v * n for v, n in values) / sum(n for _, n in values)) if values else float("nan")
     )
+
+
+def _coverage_outside(take: cc.Motion, clip: cc.Motion, used: list | None, start: int, stop: int) -> float:
+    """Coverage (degrees) of the used frames of ``take`` outside ``start:stop``."""
+    mask = used_mask(take.n_frames, used)
+    take_x = joint_angles(take)
+    cyc_x = joint_angles(clip, like=take_x[mask].mean(axis=0))
+    mask[int(start) : int(stop)] = False
+    return coverage(take_x, cyc_x, mask) if mask.any() else float("nan")
 
 
 def run_case(case: Case, plot_dir: Path | None = None) -> dict:
@@ -236,6 +247,13 @@ def run_case(case: Case, plot_dir: Path | None = None) -> dict:
             clips["average"] = avg
         else:
             row["average_error"] = "our phase wraps fewer than twice: no complete piece to average"
+    if ref is not None:
+        # coverage of the used frames outside the loop cut: the cut covers its own frames at
+        # distance 0 (a third to a half of a short take's), which no average can
+        for name, q in methods.items():
+            q.extra["cover_outside_cut"] = _coverage_outside(
+                take, clips[name], used, ref.extra["start"], ref.extra["stop"]
+            )
     row["methods"] = {k: v.to_dict() for k, v in methods.items()}
     if "ours" in methods:
         row["targets"] = targets(methods["ours"])
@@ -400,6 +418,7 @@ HEADERS = [
     "seam",
     "p90/p10",
     "cover",
+    "cover out",
     "skate/take",
     "root deg",
     "root st",
@@ -447,6 +466,7 @@ def table_rows(report: dict) -> list[list[str]]:
                     _f(q["seam"]),
                     _f(q["step_spread"], "{:.1f}"),
                     _f(q["coverage"]),
+                    _f(q.get("extra", {}).get("cover_outside_cut")),
                     _f(q["skating_ratio"]),
                     _f(q["root_closure_degrees"]),
                     _f(q["root_closure_steps"], "{:.1f}"),
@@ -473,7 +493,8 @@ def format_report(report: dict) -> str:
         "err%: vs the autocorrelation (ac) of the used frames; jerk/cut, leg/cut (smallest ratio",
         "of a leg channel's range, channel named), fem/tib (the same over femur and tibia only):",
         "over the loop cut's; p90/p10: spread of the cycle's frame steps (hold-and-snap; no",
-        "target); cover: mean distance of the used frames to the cycle (deg); skate/take: foot",
+        "target); cover: mean distance of the used frames to the cycle (deg); cover out: the same",
+        "over the used frames outside the loop cut (no target); skate/take: foot",
         "skating over the take's; root deg / st: root pitch+roll last-to-first (deg / median",
         "steps); head: heading turn per cycle (deg).",
         "targets: " + ", ".join(f"{k} {v}" for k, v in TARGETS.items()),
