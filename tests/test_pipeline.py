@@ -233,6 +233,19 @@ def test_synthetic_whole_take():
     assert np.mean(used[steady]) > 0.6  # and most steady walking is used
 
 
+def test_long_whole_take_with_turns_and_pauses_is_not_refused():
+    """Issue 12: whole walks of 5,000+ frames with pauses are read, not refused."""
+    cap = cc.datasets.make_whole_take(n_frames=6000, random_state=1)
+    assert [p[0] for p in cap.parts].count("stand") >= 4  # a start, pauses and a stop
+    res = cc.extract(cap.motion)
+    assert res.period_frames == pytest.approx(cap.period, rel=0.05)
+    standing = np.zeros(cap.motion.n_frames, dtype=bool)
+    for name, a, b in cap.parts:
+        standing[a:b] |= name == "stand"
+    assert not np.isfinite(res.coordinate[standing]).any()
+    assert len(res.used_frames) >= 4  # several steady stretches between the pauses and turns
+
+
 def test_out_and_back_motion_is_read_with_a_delay(cmu_dir):
     """13_29's jumping jacks are a segment in pose space; the automatic delay makes a loop."""
     m = cc.load(cmu_dir / "13" / "13_29.amc")
