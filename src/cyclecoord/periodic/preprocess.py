@@ -219,6 +219,11 @@ class Preprocessor:
 
     def fit(self, motion: Motion) -> "Preprocessor":
         """Learn root columns, scaling and principal axes from ``motion``."""
+        self._setup(motion)
+        self._fit_poses(self._poses(motion), motion)
+        return self
+
+    def _setup(self, motion: Motion) -> None:
         if not isinstance(motion, Motion):
             raise ParameterError(f"expected a Motion, got {type(motion).__name__}")
         if motion.n_frames < 3:
@@ -229,7 +234,8 @@ class Preprocessor:
         if self.root not in ("body", "euler"):
             raise ParameterError(f"root must be 'body' or 'euler', got {self.root!r}")
         self.root_mode_ = "body" if (self.root == "body" and _root_layout(motion, cols) is not None) else "euler"
-        poses = self._poses(motion)
+
+    def _fit_poses(self, poses: np.ndarray, motion: Motion) -> None:
         self.mean_ = poses.mean(axis=0)
         if self.normalize:
             sd = poses.std(axis=0)
@@ -253,7 +259,6 @@ class Preprocessor:
         if self.delay is not None:
             _delays(self.delay)  # validates
         self.n_channels_ = motion.n_channels
-        return self
 
     def transform(self, motion: Motion) -> PreparedData:
         """Prepare ``motion`` with the learned settings."""
@@ -263,7 +268,9 @@ class Preprocessor:
             raise ParameterError(
                 f"motion has {motion.n_channels} channels, the preprocessor was fitted on {self.n_channels_}"
             )
-        poses = self._poses(motion)
+        return self._transform_poses(self._poses(motion))
+
+    def _transform_poses(self, poses: np.ndarray) -> PreparedData:
         if self.components_ is not None:
             points = ((poses - self.mean_) / self.scale_) @ self.components_.T
         elif self.normalize:
@@ -279,7 +286,12 @@ class Preprocessor:
         return PreparedData(points=np.ascontiguousarray(points), poses=poses, root_columns=self.root_columns_)
 
     def fit_transform(self, motion: Motion) -> PreparedData:
-        return self.fit(motion).transform(motion)
+        """``fit(motion).transform(motion)``, preparing the poses once (the root's
+        rotations of a long take are the costliest part of preparing it)."""
+        self._setup(motion)
+        poses = self._poses(motion)
+        self._fit_poses(poses, motion)
+        return self._transform_poses(poses)
 
     def integrate_root(
         self, deltas: np.ndarray, start: np.ndarray, mean_delta: np.ndarray | None, motion: Motion
