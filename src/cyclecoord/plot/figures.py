@@ -388,7 +388,12 @@ def _coordinate_series(data: Any, start_frame: int | None) -> tuple[list[tuple[s
         if data.coordinate is None:
             raise ParameterError("this extraction has no circular coordinate (no periodic motion was found)")
         start = data.motion.start_frame if start_frame is None else start_frame
-        return [("coordinate", np.asarray(data.coordinate, dtype=float))], int(start)
+        series = [("coordinate", np.asarray(data.coordinate, dtype=float))]
+        phase = getattr(data, "phase", None)
+        if phase is not None and np.isfinite(phase).any():
+            # the phase the cycle is averaged in: the coordinate re-timed to the capture's pace
+            series.append(("phase (re-timed)", np.asarray(phase, dtype=float)))
+        return series, int(start)
     if isinstance(data, (str, bytes)):
         items = None
     elif isinstance(data, Mapping):
@@ -615,6 +620,22 @@ def _best_offset(motion: "Motion", cycle: "Motion", root: set[int]) -> int:
     return int(np.argmin(costs))
 
 
+def _cycle_frames_at_phase(res: Any, s0: int, n: int, P: int) -> np.ndarray | None:
+    """Cycle frame index at the capture's phase of frames ``s0 .. s0 + n - 1`` (-1 where a
+    frame has no phase), or None when the result has no capture-timed phase."""
+    phase = getattr(res, "phase", None)
+    phases = np.asarray(getattr(res.typical, "phases", []), dtype=float)
+    if phase is None or phases.size != P or res.parameters.get("timing", "capture") != "capture":
+        return None
+    seg = np.asarray(phase, dtype=float)[s0 : s0 + n]
+    ok = np.isfinite(seg)
+    if not ok.any():
+        return None
+    k = np.full(seg.size, -1)
+    k[ok] = np.mod(np.round((seg[ok] - phases[0]) * P).astype(int), P)
+    return k
+
+
 def plot_channels(
     result: "ExtractionResult",
     channels: Any = None,
@@ -626,8 +647,10 @@ def plot_channels(
 ) -> "Figure":
     """Original channels against the typical cycle over a few periods, and their jerk.
 
-    The cycle is played at its own constant rate, looped, starting at the phase of the
-    clip's first frame, so both curves start in step (paper Fig. 6).  The right panel is
+    Each frame of the clip shows the cycle's frame at that frame's phase (the capture-timed
+    ``result.phase``), so the curves stay in step over repetitions of different lengths;
+    frames without a phase, and results timed by the coordinate, play the cycle at its
+    own constant rate from the phase of the clip's first frame (paper Fig. 6).  The right panel is
     the jerk as the console and the report give it (:func:`cyclecoord.quality.metrics.
     jerk_summary`: third derivative by 4th-order finite differences of every prepared
     channel, root as per-frame steps, norm over channels; the cycle looped so its seam
@@ -675,6 +698,11 @@ def plot_channels(
     P = cyc_frames.shape[0]
     j0 = _best_offset(motion.window((s0, None)) if s0 else motion, cycle, root)
     idx = (j0 + np.arange(n_show)) % P
+    at_phase = _cycle_frames_at_phase(res, s0, n_show, P)
+    if at_phase is not None:
+        # each frame shows the cycle's frame at its own phase: the two stay in step over
+        # repetitions of different lengths (a constant rate drifts by their differences)
+        idx = np.where(at_phase >= 0, at_phase, idx)
     cyc = cyc_frames[idx]
     # angles: the cycle and the clip may sit a whole turn apart; align each channel to the clip
     for k, c in enumerate(cols):
@@ -701,7 +729,10 @@ def plot_channels(
         ax_c.plot(t, cyc[:, k], color=colour, linewidth=lw, linestyle="--", label=f"{name} (cycle)")
     ax_c.set_xlabel("frame")
     ax_c.set_ylabel("channel value (degrees / length units)")
-    ax_c.set_title(f"original (solid) vs cycle (dashed), {n_show / period:.1f} periods", fontsize=10)
+    ax_c.set_title(
+        f"original (solid) vs cycle (dashed, at each frame's phase), {n_show / period:.1f} periods",
+        fontsize=10,
+    )
     if len(cols) <= 10:
         ax_c.legend(handles=[h for h in ax_c.get_lines() if not h.get_label().endswith("(cycle)")],
                     fontsize=7, loc="upper right", ncol=2)
