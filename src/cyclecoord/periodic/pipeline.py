@@ -28,7 +28,7 @@ from ..motion import Motion
 from .preprocess import PreparedData, Preprocessor
 from .clip import capture_cycle, joint_columns, loop_cycle
 from .root import heading, root_layout
-from .steady import moving_mask, recurrence, steady_mask
+from .steady import moving_mask, period_speed, recurrence, steady_mask
 from .windings import Windings, complete_windings, retime, stretches
 
 __all__ = ["extract", "ExtractionResult", "cycle_lengths", "MIN_TURNS", "TIMINGS", "TRAVELS"]
@@ -635,7 +635,8 @@ def _steady_frames(motion, prepared, joints, unwrapped, moving, period) -> np.nd
     rec = recurrence(prepared.poses[:, joints], period)
     layout = root_layout(motion)
     hd = heading(motion.frames, layout) if layout is not None else None
-    return steady_mask(unwrapped, moving, period, recurrence_distance=rec, heading=hd)
+    speed = period_speed(prepared.poses, motion.fps, period, columns=joints)
+    return steady_mask(unwrapped, moving, period, recurrence_distance=rec, heading=hd, speed=speed)
 
 
 def _too_few_turns(turns: float, n_frames: int, min_turns: float) -> str:
