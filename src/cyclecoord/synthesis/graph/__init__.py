@@ -9,13 +9,23 @@ both (:func:`build_graph`), the interpolated field of the takes' velocities
 """
 
 from .build import METHODS, MotionGraph, build_graph, training_vectors
-from .crossval import PAPER_W1, CrossValidation, bottleneck, cross_validate, h1_diagram, path_errors
-from .field import VectorField
+from .crossval import (
+    DEFAULT_METHODS,
+    PAPER_W1,
+    CrossValidation,
+    bottleneck,
+    cross_validate,
+    h1_diagram,
+    path_errors,
+)
+from .field import FIELD_OPTIONS, VectorField, parse_variant
 from .latent import PoseSpace, check_takes
 from .model import Generation, MotionGraphSynth
 from .paths import GraphPath, follow_field, path_to_target, root_trajectory, shortest_path
 
 __all__ = [
+    "DEFAULT_METHODS",
+    "FIELD_OPTIONS",
     "METHODS",
     "PAPER_W1",
     "CrossValidation",
@@ -32,6 +42,7 @@ __all__ = [
     "follow_field",
     "h1_diagram",
     "path_errors",
+    "parse_variant",
     "path_to_target",
     "root_trajectory",
     "shortest_path",
