@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._blas import one_blas_thread
 from ...errors import ParameterError
 from .build import METHODS, MotionGraph, check_method
 
@@ -90,6 +91,18 @@ def _idw(points: np.ndarray, x: np.ndarray, idx: np.ndarray, valid: np.ndarray) 
     if hit.any():
         w[hit] = zero[hit].astype(float)
     return w / w.sum(axis=1, keepdims=True)
+
+
+@one_blas_thread
+def _barycentric(tri) -> None:
+    """Compute Qhull's per-simplex barycentric transforms (``find_simplex`` needs them).
+
+    SciPy solves one small LAPACK system per simplex; a multi-threaded BLAS wakes its
+    threads for each, which on 2 busy cores made the first point location 6-100x slower
+    than on one thread (1,712 random points: 0.38 s against 0.014 s in 3 dims, 1.7 s
+    against 0.066 s in 4; medians of 5).
+    """
+    tri.transform  # noqa: B018 (a lazily computed property)
 
 
 def _ring(tri) -> np.ndarray:
@@ -157,6 +170,7 @@ class VectorField:
                 self._extra[int(s)] = cop[cop[:, 1] == s, 0]
         self._cells = None
         if graph.delaunay is not None:
+            _barycentric(graph.delaunay)
             self._cells = _ring(graph.delaunay) if self.ring else graph.delaunay.simplices
 
     @property

@@ -150,7 +150,7 @@ def follow_field(
         if t == n_frames - 1:
             inside[t] = bool(ins[0])
             break
-        k1 = w[0] @ vel[idx[0]]
+        k1 = np.einsum("k,kd->d", w[0], vel[idx[0]])  # no BLAS call per step
         if integrator == "euler":
             inside[t] = bool(ins[0])
             step = s * k1
