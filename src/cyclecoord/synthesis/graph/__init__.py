@@ -3,9 +3,12 @@
 From a few training takes: a PCA space of the joint angles (:class:`PoseSpace`), a motion
 graph over the training frames from a Delaunay triangulation, k nearest neighbours or
 both (:func:`build_graph`), the interpolated field of the takes' velocities
-(:class:`VectorField`), paths that follow it or run to a target along the graph
-(:func:`follow_field`, :func:`path_to_target`), a playable result with a root trajectory
-(:class:`MotionGraphSynth`) and the paper's leave-one-out table (:func:`cross_validate`).
+(:class:`VectorField`; the Delaunay field optionally widened to the adjacent simplices and
+weighted by agreement with the path's heading, ``"delaunay+ring+agree"``, which keeps the
+2-D paths from stalling at a walk's cusps), paths that follow it or run to a target
+along the graph (:func:`follow_field`, :func:`path_to_target`), a playable result with a
+root trajectory (:class:`MotionGraphSynth`) and the paper's leave-one-out table
+(:func:`cross_validate`).
 """
 
 from .build import METHODS, MotionGraph, build_graph, training_vectors
