@@ -99,7 +99,7 @@ def plot_vector_field(
         v[inside, 1],
         color="tab:blue",
         angles="xy",
-        label=f"{field.neighbourhood} field",
+        label=f"{field.name} field" + (" (no heading: plain weights)" if field.agree else ""),
     )
     if (~inside).any():
         ax.quiver(
@@ -115,7 +115,7 @@ def plot_vector_field(
     ax.set_ylabel("latent 2")
     ax.set_aspect("equal", adjustable="datalim")
     ax.legend(fontsize=8, loc="upper right")
-    ax.set_title(title or f"vector field ({field.neighbourhood})")
+    ax.set_title(title or f"vector field ({field.name})")
     return fig
 
 
