@@ -44,3 +44,21 @@ def test_period_speed_averages_the_smoothed_steps_over_a_period():
     assert v[:200].max() < 0.05 and np.allclose(v[400:550], 0.5 * np.sqrt(3), rtol=0.02)
     cols = period_speed(np.c_[x, 100 * x], 120.0, 60.0, columns=np.array([0, 1, 2]))
     np.testing.assert_allclose(cols, v)
+
+
+def test_recurrence_is_the_nearest_pose_one_period_away_either_way():
+    from cyclecoord.periodic.steady import recurrence
+
+    rng = np.random.default_rng(1)
+    x = rng.normal(size=(700, 4))
+    period = 50.0
+    got = recurrence(x, period, chunk=64)  # blocks smaller than the lags
+    lags = range(35, 73)  # 0.7 and 1.45 periods
+    want = np.full(len(x), np.inf)
+    for t in range(len(x)):
+        for lag in lags:
+            for s in (t - lag, t + lag):
+                if 0 <= s < len(x):
+                    want[t] = min(want[t], np.linalg.norm(x[s] - x[t]))
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+    assert np.isinf(recurrence(x[:30], period)).all()  # no pose a period away
