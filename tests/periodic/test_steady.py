@@ -53,7 +53,7 @@ def test_recurrence_is_the_nearest_pose_one_period_away_either_way():
     x = rng.normal(size=(700, 4))
     period = 50.0
     got = recurrence(x, period, chunk=64)  # blocks smaller than the lags
-    lags = range(35, 73)  # 0.7 and 1.45 periods
+    lags = range(35, 74)  # floor(0.7 * 50) to ceil(1.45 * 50)
     want = np.full(len(x), np.inf)
     for t in range(len(x)):
         for lag in lags:
