@@ -92,10 +92,10 @@ def test_lock_69_01_extracted_cycle(walk_69_01, frames):
     # per leg joint 0.7-4.3 degrees on average over the frames (lfoot most)
     assert max(r.joint_change[k] for k in LEGS) < 6.0
     # no leg flips between two inverse-kinematics solutions from one frame to the next
-    # (a leg channel moved 31-46 degrees in one frame before the toe's lock was made to
-    # fit the ankle's); captured steps reach 4.3 degrees, locked ones 15
+    # and no foot slapped flat in one frame (the earlier solver moved a leg channel up to
+    # 93 degrees in one frame); captured steps reach 4.3 degrees, locked ones 4.8-6.5
     cols = _leg_columns(cycle)
-    assert np.abs(np.diff(r.motion.frames[:, cols], axis=0)).max() < 20.0
+    assert np.abs(np.diff(r.motion.frames[:, cols], axis=0)).max() < 10.0
 
 
 def test_lock_passes_checked():

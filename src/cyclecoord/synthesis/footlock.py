@@ -13,11 +13,13 @@ degrees of freedom on a CMU skeleton) are then solved for every frame with a tar
 frames at once, by Levenberg-Marquardt: horizontal lock errors weigh 1, the locked
 point's captured height :data:`_HEIGHT` (heights give way where the leg cannot reach a
 lock at them, e.g. the straight leg at heel strike) and the change of the angles a
-little (:data:`_REGULARISATION`), so the legs move as little as the locks need.  Two
-details keep the foot from flipping between its two possible pitches: a toe still coming
-down after heel strike is asked for the flat foot's height under the ankle, and a toe
-easing towards its lock while the ankle is held is left to the foot.  Only the leg
-chains change: the root, spine, arms and the toes' own rotation keep their values.
+little (:data:`_REGULARISATION`), so the legs move as little as the locks need.  After
+heel strike, with heel and toe both held, the foot cannot pitch: a held toe still coming
+down is asked for the flat foot's height under the ankle (so the solver does not jump
+between pitching the foot up and down), and before its lock the toe is carried by the
+foot and lowered to that height over its ease (so the foot does not slap down in one
+frame).  Only the leg chains change: the root, spine, arms and the toes' own rotation
+keep their values.
 """
 
 from __future__ import annotations
@@ -196,8 +198,8 @@ def _targets(
     carry: np.ndarray | None = None,
 ):
     """Targets ``(T, 3)`` (horizontal components eased into locks), ease weights ``(T,)``,
-    run labels (-1: free) and the side of the lock ``(T,)`` (-1 easing in, 0 held, 1
-    easing out) for one foot point.
+    run labels (-1: free) and the side of the contact ``(T,)`` (-1 before it, held frame
+    included; 0 on it; 1 after it) for one foot point.
 
     Each contact is pinned at its mean horizontal position; with ``carry`` ``(T, 3)``
     (finite on some frames of the contact) at the mean of ``points + carry`` over those
@@ -237,8 +239,8 @@ def _targets(
         off[after] = lock - pts[min(b, n_ext - 1), horiz]
         eased = pts[rows][:, horiz] + w[rows, None] * off
         eased[~(before | after)] = lock
-        side[rows[before]] = -1
-        side[rows[after]] = 1
+        side[rows[rows < a]] = -1
+        side[rows[rows >= b]] = 1
         target[rows[:, None], horiz] = eased
     return target[mid], np.where(label >= 0, w, 0.0)[mid], label[mid], side[mid]
 
@@ -406,7 +408,7 @@ def _lock_once(
             if first is not None:
                 # a deeper point (the toe) is locked where the ankle's lock carries it on
                 # the frames both rest flat, so the two locks fit the foot between them
-                a_col, a_tgt, a_pos, _ = first
+                a_col, a_tgt, a_pos = first[:3]
                 low = 0.5 * contacts.height_threshold
                 low_a = contacts.planted[:, a_col] & (contacts.height[:, a_col] < low)
                 low_here = contacts.planted[:, i] & (contacts.height[:, i] < low)
@@ -434,19 +436,22 @@ def _lock_once(
                 # ease instead of slapping down on the frame the lock begins
                 rel_flat = (wpos[flat, pts[m], contacts.up] - a_pos[flat, contacts.up]).mean()
                 flat_height = a_tgt[:, contacts.up] + rel_flat
-                down = (ease >= 1) & low_a & ~low_here
+                # (the ankle held: planted low, or on the held frame before its contact)
+                a_ease, a_side = first[3], first[4]
+                a_held = (a_ease >= 1) & (low_a | (a_side < 0))
+                down = (ease >= 1) & (side <= 0) & a_held & ~low_here
                 tgt[down, contacts.up] = flat_height[down]
-                easing = (label >= 0) & (side < 0) & (first[3] > 0)
+                easing = (label >= 0) & (side < 0) & (ease < 1) & (a_ease > 0) & (a_side <= 0)
                 y = tgt[easing, contacts.up]
                 tgt[easing, contacts.up] = y + ease[easing] * (flat_height[easing] - y)
                 weights[easing, m, horiz[0]] = weights[easing, m, horiz[1]] = 0.0
                 weights[easing, m, contacts.up] = _HEIGHT
             elif first is not None:
-                easing = (label >= 0) & (side < 0) & (first[3] > 0)
+                easing = (label >= 0) & (side < 0) & (ease < 1) & (first[3] > 0) & (first[4] <= 0)
                 weights[easing, m] = 0.0
             targets[:, m] = tgt
             if first is None:
-                first = (i, tgt, wpos[:, pts[m]], ease)
+                first = (i, tgt, wpos[:, pts[m]], ease, side)
             active |= locked
         rows = np.flatnonzero(active)
         if rows.size == 0:
