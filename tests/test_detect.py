@@ -117,6 +117,18 @@ def test_cli_detect(tmp_path, capsys):
     assert r["n_motions"] == 3 and len(r["labels"]) == r["n_frames"]
     cycles = sorted(out.glob("motion*_cycle.bvh"))
     assert len(cycles) == 3 and all(cc.load(p).n_frames > 50 for p in cycles)
+    # each written cycle's foot skating, in the report and on one line each
+    from cyclecoord.quality.contacts import skating_report
+
+    stdout = capsys.readouterr().out
+    assert [e["path"] for e in sorted(r["extracted"], key=lambda e: e["path"])] == [
+        str(p) for p in cycles
+    ]
+    for e in r["extracted"]:
+        written = skating_report(cc.load(e["path"]))
+        assert e["foot_skating"]["skating_frames"] == written["skating_frames"]
+        assert e["frames"] == cc.load(e["path"]).n_frames
+    assert stdout.count("foot skating: ") == 3
     src = tmp_path / "still.npz"
     cc.save(cc.datasets.make_static_capture(n_frames=600, random_state=1).motion, src)
     capsys.readouterr()

@@ -7,7 +7,8 @@ distributed cluster -- and writes, mirroring the input tree under the output fol
 * ``<relative path without suffix>.report.json`` per capture: the extraction report
   (:meth:`~cyclecoord.periodic.pipeline.ExtractionResult.to_report`) plus a ``"batch"`` block
   (status, message, input size and modification time, options and their hash, seconds);
-* ``<relative path without suffix>.cycle.bvh`` (or ``.npz``): the typical cycle;
+* ``<relative path without suffix>.cycle.bvh`` (or ``.npz``, ``.csv``, ``.glb``, ``.gltf``
+  with a ``.bin``, ``.usda``, ``.usdc``): the typical cycle;
 * ``summary.csv``: one row per capture with the key figures (see :data:`SUMMARY_COLUMNS`).
 
 When two captures in one folder share a stem (``walk.bvh`` and ``walk.npz``) their
@@ -75,7 +76,10 @@ SUMMARY_COLUMNS = (
 STATUSES = ("ok", "no_periodic", "error")
 SUMMARY_NAME = "summary.csv"
 REPORT_SUFFIX = ".report.json"
-CYCLE_FORMATS = ("bvh", "npz")
+#: Formats a cycle can be written in (the suffix, as for ``extract -o``).  The ones in
+#: :data:`SKELETON_FORMATS` need a skeleton: a capture without one gets ``.npz``.
+CYCLE_FORMATS = ("bvh", "npz", "csv", "glb", "gltf", "usda", "usdc")
+SKELETON_FORMATS = ("bvh", "glb", "gltf", "usda", "usdc")
 #: Seconds to wait for a Dask scheduler given by address.
 CONNECT_TIMEOUT = 10.0
 _CRASHED = (
@@ -337,9 +341,9 @@ def _analyse(task: _Task) -> dict[str, Any]:
         written = None
         if task.cycle_format is not None:
             fmt = task.cycle_format
-            if fmt == "bvh" and result.cycle.skeleton is None:
+            if fmt in SKELETON_FORMATS and result.cycle.skeleton is None:
+                notes.append(f"the capture has no skeleton, so its cycle was written as .npz instead of .{fmt}")
                 fmt = "npz"
-                notes.append("the capture has no skeleton, so its cycle was written as .npz instead of .bvh")
                 report["warnings"] = notes
             written = _cycle_path(task, fmt)
             save(result.cycle, written)
@@ -350,6 +354,8 @@ def _analyse(task: _Task) -> dict[str, Any]:
         stale = _cycle_path(task, fmt)
         if stale != written and stale.exists():
             stale.unlink()
+            if fmt == "gltf":  # and the buffer written beside a .gltf
+                stale.with_suffix(".bin").unlink(missing_ok=True)
     return report
 
 
@@ -633,9 +639,11 @@ def run_batch(
         Keyword arguments for :func:`~cyclecoord.periodic.pipeline.extract` (``frames``, ``pca``,
         ``max_scale``, ``random_state``, ...), the same for every capture.  Checked
         against extract's signature before anything runs.
-    write_cycles : {"bvh", "npz", None}, default "bvh"
-        Format of the typical cycle written per capture, or None for reports only.  A
-        capture without a skeleton gets ``.npz`` when BVH is asked for.
+    write_cycles : {"bvh", "npz", "csv", "glb", "gltf", "usda", "usdc", None}, default "bvh"
+        Format of the typical cycle written per capture (``NAME.cycle.<format>``, written
+        by :func:`cyclecoord.save` as ``extract -o`` writes it; ``gltf`` adds
+        ``NAME.cycle.bin``), or None for reports only.  A capture without a skeleton gets
+        ``.npz`` when a format that needs one is asked for.  USD needs usd-core.
     fps : float, optional
         Frame rate overriding the files' own (AMC files carry none: 120).
     progress : bool, default True
@@ -669,8 +677,16 @@ def run_batch(
     jobs = jobs or (os.cpu_count() or 1)
     if isinstance(write_cycles, str) and write_cycles.lower() == "none":
         write_cycles = None
+    if isinstance(write_cycles, str):
+        write_cycles = write_cycles.lower().lstrip(".")
     if write_cycles is not None and write_cycles not in CYCLE_FORMATS:
-        raise ParameterError(f"write_cycles must be 'bvh', 'npz' or None, got {write_cycles!r}")
+        raise ParameterError(
+            f"write_cycles must be one of {', '.join(CYCLE_FORMATS)} or None, got {write_cycles!r}"
+        )
+    if write_cycles in ("usda", "usdc"):
+        from .io.usd import _pxr
+
+        _pxr()  # usd-core missing: one clear error before anything runs
     if fps is not None:
         try:
             fps = float(fps)

@@ -63,7 +63,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     d.add_argument(
         "--report",
         metavar="R.json",
-        help="JSON: segments, labels per frame, classes, windows, barcode",
+        help="JSON: segments, labels per frame, classes, windows, barcode (and the --extract "
+        "cycles with their foot skating)",
     )
     d.add_argument(
         "--extract", metavar="OUTDIR", help="write a typical cycle (BVH) for each detected motion"
@@ -173,7 +174,10 @@ def cmd_detect(args: argparse.Namespace) -> int:
         )
     for w in res.warnings:
         print(f"warning: {w}")
+    extracted = []
     if args.extract and code == EXIT_OK:
+        from ..quality.contacts import skating_line, skating_report
+
         folder = Path(args.extract)
         folder.mkdir(parents=True, exist_ok=True)
         for mc in motion_cycles(
@@ -195,10 +199,26 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 f"{m.start_frame + mc.start}:{m.start_frame + mc.stop} ({how}), loop closure "
                 f"{mc.loop_closure:.2f} -> {out}"
             )
+            skating = skating_report(mc.cycle)
+            print("  " + skating_line(skating))
+            extracted.append(
+                {
+                    "motion": int(mc.motion),
+                    "path": str(out),
+                    "frames": int(mc.cycle.n_frames),
+                    "source_frames": [m.start_frame + mc.start, m.start_frame + mc.stop],
+                    "loop_closure": float(mc.loop_closure),
+                    "foot_skating": skating,
+                }
+            )
     if args.plot:
         _save_plots(res, args.plot)
     if args.report:
-        write_json(args.report, clean(res.to_report()))
+        payload = res.to_report()
+        if args.extract:
+            # the cycles written by --extract, with their foot skating (as extract's report)
+            payload["extracted"] = extracted
+        write_json(args.report, clean(payload))
         print(f"wrote {args.report}")
     print("time: " + ", ".join(f"{k} {v:.3f}s" for k, v in res.timings.items()))
     return code

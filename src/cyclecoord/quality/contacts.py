@@ -34,6 +34,7 @@ __all__ = [
     "foot_contacts",
     "foot_skating",
     "leg_length",
+    "skating_line",
     "skating_report",
 ]
 
@@ -178,11 +179,16 @@ class FootSkating:
 
     def summary(self) -> str:
         """One line for reports."""
-        return (
-            f"foot skating: {self.mean_speed:.3g} units/s "
-            f"({self.mean_speed_legs:.3g} leg lengths/s) while planted, "
-            f"{self.skating_frames} frames skating ({100 * self.skating_fraction:.1f}%)"
+        return _summary_line(
+            self.mean_speed, self.mean_speed_legs, self.skating_frames, self.skating_fraction
         )
+
+
+def _summary_line(speed: float, speed_legs: float, frames: int, fraction: float) -> str:
+    return (
+        f"foot skating: {speed:.3g} units/s ({speed_legs:.3g} leg lengths/s) while planted, "
+        f"{frames} frames skating ({100 * fraction:.1f}%)"
+    )
 
 
 # ---------------------------------------------------------------- skeleton help
@@ -512,3 +518,19 @@ def skating_report(motion: Motion, **options) -> dict | None:
     }
     out["floor"] = contacts.floor
     return out
+
+
+def skating_line(report: dict | None, label: str = "") -> str:
+    """One console line for a :func:`skating_report` dict (``None``: not measured).
+
+    ``label`` (e.g. ``"blend"``) is put in front: ``"blend foot skating: ..."``.
+    """
+    head = f"{label} " if label else ""
+    if report is None:
+        return f"{head}foot skating: not measured (no skeleton with recognisable feet)"
+    return head + _summary_line(
+        report["mean_speed_units_per_s"],
+        report["mean_speed_leg_lengths_per_s"],
+        report["skating_frames"],
+        report["skating_fraction"],
+    )
