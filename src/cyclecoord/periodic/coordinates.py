@@ -35,6 +35,7 @@ from .barcode import (
     temporal_distance_matrix,
 )
 from ..errors import ParameterError
+from ._estimator import ParamsMixin
 from .landmarks import choose_landmarks, estimate_complex, memory_budget, run_bytes
 
 __all__ = [
@@ -366,13 +367,27 @@ def unwrap(theta: np.ndarray) -> np.ndarray:
     return np.concatenate([[theta[0]], theta[0] + np.cumsum(steps)])
 
 
-class CircularCoordinates:
+class CircularCoordinates(ParamsMixin):
     """Circle-valued coordinate of a point cloud from its persistent cohomology.
 
-    scikit-learn style estimator: parameters in ``__init__``; :meth:`fit` computes the
-    barcode, chooses a class and a scale, and solves for the coordinate; learned state
-    lives in attributes ending in ``_``.  :meth:`transform` gives the coordinate of
-    points the model never saw; :meth:`save` / :meth:`load` keep a fitted model.
+    scikit-learn style estimator: every parameter of ``__init__`` is stored unchanged
+    under its own name (``get_params``/``set_params``/``repr`` from
+    :class:`~cyclecoord.periodic._estimator.ParamsMixin`, so :func:`sklearn.base.clone`
+    works) and checked when fitting; :meth:`fit` computes the barcode, chooses a class
+    and a scale, solves for the coordinate and returns ``self``; learned state lives in
+    attributes ending in ``_``.  :meth:`transform` gives the coordinate of points the
+    model never saw; :meth:`to_arrays` / :meth:`from_arrays` keep a fitted model.
+
+    The fit runs in two stages, :meth:`fit_barcode` then :meth:`fit_coordinate`, so a
+    caller can read several classes of one barcode: :meth:`with_coordinate_params` gives
+    a new estimator for another class (or scale) that shares this one's barcode and
+    leaves this one as it is.
+
+    There is no ``random_state``: the fit is deterministic.  Its only random draw, the
+    pairs of points sampled to estimate the filtration's size for the memory guard
+    (:func:`~cyclecoord.periodic.landmarks.estimate_complex`), is seeded with 0, the
+    package's one ``random_state`` default (as :func:`cyclecoord.extract` and
+    :class:`~cyclecoord.periodic.density.PeriodicDensity`).
 
     Parameters
     ----------
@@ -510,7 +525,7 @@ class CircularCoordinates:
         self.complex_estimate_ = est
         self._complex_deferred = est is None  # computed on first access (report)
         self.landmark_reason_ = reason
-        self.barcode_ = self._barcode(check_prime(self.prime))
+        self.barcode_ = self._stage_barcode = self._barcode(check_prime(self.prime))
         self.landmarks_ = self.barcode_.point_indices
         self.covering_radius_ = float(self.barcode_.extras.get("covering_radius", 0.0))
         return self.barcode_
@@ -554,7 +569,7 @@ class CircularCoordinates:
         self.n_landmarks_ = None
         self.complex_estimate_ = None
         self.landmark_reason_ = "every frame (barcode supplied)"
-        self.barcode_ = barcode
+        self.barcode_ = self._stage_barcode = barcode
         self.landmarks_ = None
         self.covering_radius_ = 0.0
         return self
@@ -566,9 +581,66 @@ class CircularCoordinates:
         ----------
         X : array-like, shape (T, K)
             Points (one per frame, in frame order: the orientation follows it).
+        y : None
+            Ignored (scikit-learn convention).
+
+        Returns
+        -------
+        CircularCoordinates
+            ``self``, fitted.
         """
         self.fit_barcode(X)
         return self.fit_coordinate()
+
+    #: Parameters used only by :meth:`fit_coordinate` (the barcode does not depend on them).
+    COORDINATE_PARAMS = ("class_index", "scale", "scale_fraction", "refine_birth")
+    #: Fitted state of the barcode stage, shared by :meth:`with_coordinate_params`.
+    _BARCODE_STATE = (
+        "points_", "_dist_", "memory_budget_", "threshold_", "n_landmarks_", "_complex_estimate",
+        "_complex_deferred", "landmark_reason_", "_stage_barcode", "landmarks_", "covering_radius_",
+    )
+
+    def with_coordinate_params(self, **params) -> "CircularCoordinates":
+        """A new estimator with coordinate parameters changed, on this one's barcode.
+
+        The new estimator is built from this one's parameters with ``params`` replacing
+        some of them, and shares (does not copy, does not recompute) the barcode stage of
+        this one (the points, threshold, landmarks and barcode of :meth:`fit_barcode` or
+        :meth:`use_barcode`); call :meth:`fit_coordinate` on it next.  This estimator is
+        not changed, so one barcode can be read for several classes at the cost of the
+        coordinates alone (:func:`cyclecoord.detect` reads every candidate class so).
+
+        Parameters
+        ----------
+        **params
+            Any of :data:`COORDINATE_PARAMS` (``class_index``, ``scale``,
+            ``scale_fraction``, ``refine_birth``).
+
+        Returns
+        -------
+        CircularCoordinates
+            Ready for :meth:`fit_coordinate`.
+
+        Raises
+        ------
+        ParameterError
+            When this estimator has no barcode yet, or for a parameter the barcode
+            depends on (set it on a clone and fit that instead).
+        """
+        if not hasattr(self, "_stage_barcode"):
+            raise ParameterError("call fit_barcode() or use_barcode() before with_coordinate_params()")
+        other = sorted(set(params) - set(self.COORDINATE_PARAMS))
+        if other:
+            raise ParameterError(
+                f"with_coordinate_params() changes {', '.join(self.COORDINATE_PARAMS)} only; "
+                f"the barcode depends on {', '.join(other)}"
+            )
+        new = type(self)(**{**self.get_params(deep=False), **params})
+        for name in self._BARCODE_STATE:
+            if name in self.__dict__:
+                setattr(new, name, self.__dict__[name])
+        new.barcode_ = new._stage_barcode
+        return new
 
     def _centers(self) -> tuple[np.ndarray, np.ndarray | None]:
         """Points the complex is built on, and (for the temporal metric) their distances."""
@@ -596,9 +668,11 @@ class CircularCoordinates:
         """Second half of :meth:`fit`: select the class and solve for the coordinate,
         reusing the barcode from :meth:`fit_barcode` (so a caller can inspect the
         barcode first without computing it twice)."""
-        if not hasattr(self, "barcode_"):
+        if not hasattr(self, "_stage_barcode"):
             raise ParameterError("call fit_barcode() before fit_coordinate()")
-        barcode = self.barcode_
+        # the barcode of the barcode stage, not barcode_: a prime retry below replaces
+        # barcode_, and a second call (another class_index) must index the same bars
+        barcode = self._stage_barcode
         selection = select_bar(barcode, self.class_index, self.scale, self.scale_fraction)
         notes = []
         scale = selection.scale

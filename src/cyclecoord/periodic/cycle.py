@@ -629,7 +629,7 @@ def typical_cycle(
     k: int = 10,
     weighting: str = "kernel",
     sampling: str = "quantile",
-    random_state: None | int | np.random.Generator = None,
+    random_state: None | int | np.random.Generator = 0,
     bandwidth: None | str | float = None,
 ) -> TypicalCycle:
     """Build the typical cycle of a motion from its circular coordinate.
@@ -659,8 +659,9 @@ def typical_cycle(
         ``"quantile"`` (default): deterministic phases ``ppf((i + 0.5) / N)``, which are
         at times ``(i + 0.5) / N`` of the period.  ``"random"``: the paper's random
         draws from the density, placed in time by the density's cdf.
-    random_state : None, int or numpy Generator
-        Seed for the density fit and the random sampling.
+    random_state : None, int or numpy Generator, default 0
+        Seed for the density fit and the random sampling (0, the package's one default,
+        as for :func:`cyclecoord.extract`; None for fresh entropy).
     bandwidth : None, "auto" or float
         Width ``σ`` of the ``"kernel"`` weighting, in frames of one period.  None:
         ``k`` frames' worth, ``k / (T √(2π))`` in phase units (a fraction of a frame

@@ -36,6 +36,7 @@ import numpy as np
 from scipy.special import ndtr
 
 from ..errors import ParameterError
+from ._estimator import ParamsMixin
 
 __all__ = ["PeriodicDensity", "as_generator"]
 
@@ -128,12 +129,13 @@ def _em_1d(x: np.ndarray, n_components: int, max_iter: int, reg_covar: float, to
     return weights / weights.sum(), means, var, converged, it
 
 
-class PeriodicDensity:
+class PeriodicDensity(ParamsMixin):
     """Density of circular coordinates on ``[0, 1)``, fitted as a wrapped Gaussian mixture.
 
-    A scikit-learn style estimator (with ``get_params``/``set_params``): parameters are
-    stored untouched by ``__init__`` and checked by :meth:`fit`; learned state ends in an
-    underscore.  The mixture is fitted by a deterministic EM of our own
+    A scikit-learn style estimator (``get_params``/``set_params`` and ``repr`` from
+    :class:`~cyclecoord.periodic._estimator.ParamsMixin`, so :func:`sklearn.base.clone`
+    works): parameters are stored untouched by ``__init__`` and checked by :meth:`fit`;
+    learned state ends in an underscore.  The mixture is fitted by a deterministic EM of our own
     (:func:`_em_1d`: scikit-learn's steps, started from equal-count bins instead of a
     seeded k-means; importing scikit-learn cost a fresh process 1.5-2 s).
 
@@ -151,9 +153,11 @@ class PeriodicDensity:
     n_copies : int, default 3
         Number of tiled copies of the data, centred on the original: 3 gives
         ``theta - 1, theta, theta + 1`` (paper); must be odd and at least 1.
-    random_state : None, int or numpy Generator
-        Kept for :meth:`sample` callers and compatibility: the fit itself is deterministic
-        (a Generator is advanced by one draw, as when it seeded a k-means start).
+    random_state : None, int or numpy Generator, default 0
+        Kept for compatibility: the fit itself is deterministic (a Generator is advanced
+        by one draw, as when it seeded a k-means start).  The default 0 is the package's
+        one ``random_state`` default (as :func:`cyclecoord.extract`'s): results are the
+        same run to run unless a caller asks for fresh entropy with None.
     max_samples : int or None, default 20000
         Longer inputs are fitted on this many values evenly spaced in input (time)
         order; None fits every value.  EM's cost grows with the number of values while
@@ -185,7 +189,7 @@ class PeriodicDensity:
         max_iter: int = 100,
         reg_covar: float = 1e-5,
         n_copies: int = 3,
-        random_state: None | int | np.random.Generator = None,
+        random_state: None | int | np.random.Generator = 0,
         max_samples: int | None = 20_000,
     ) -> None:
         self.n_components = n_components
@@ -194,24 +198,6 @@ class PeriodicDensity:
         self.n_copies = n_copies
         self.random_state = random_state
         self.max_samples = max_samples
-
-    _PARAMS = ("n_components", "max_iter", "reg_covar", "n_copies", "random_state", "max_samples")
-
-    def get_params(self, deep: bool = True) -> dict:
-        """Parameters as given to ``__init__`` (scikit-learn convention)."""
-        return {name: getattr(self, name) for name in self._PARAMS}
-
-    def set_params(self, **params) -> "PeriodicDensity":
-        """Set parameters by name (scikit-learn convention); returns ``self``."""
-        for name, value in params.items():
-            if name not in self._PARAMS:
-                raise ParameterError(f"PeriodicDensity has no parameter {name!r}")
-            setattr(self, name, value)
-        return self
-
-    def __repr__(self) -> str:
-        changed = {k: v for k, v in self.get_params().items() if v != type(self)().get_params()[k]}
-        return f"PeriodicDensity({', '.join(f'{k}={v!r}' for k, v in changed.items())})"
 
     # ------------------------------------------------------------------ fitting
     def _check_params(self) -> None:

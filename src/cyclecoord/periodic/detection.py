@@ -195,7 +195,12 @@ class DetectionResult:
         Seconds per stage: ``prepare``, ``barcode``, ``coordinates`` (global classes),
         ``windows`` (windowed stage, when run), ``segments`` (grouping and labelling),
         ``total``.
+    parameters : dict
+        The arguments of :func:`detect`.
     warnings : list of str
+    estimator : CircularCoordinates or None
+        The estimator whose barcode the global classes were read from (barcode stage
+        only: each class's coordinate is in ``classes``).
     windows : list of WindowInfo
         Every window of the windowed stage (empty with ``method="global"``).
     method : str
@@ -1193,19 +1198,20 @@ def detect(
     classes: list[DetectedClass] = []
     t0 = time.perf_counter()
     for i in cand if method != "windows" else ():
-        est.class_index = i
+        # each class on its own estimator sharing est's barcode (est itself is not changed)
+        class_est = est.with_coordinate_params(class_index=i)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
-                est.fit_coordinate()
+                class_est.fit_coordinate()
             except ParameterError as exc:
                 notes.append(f"H1 class {i} skipped: {exc}")
                 continue
-        theta = est.coordinates_.copy()
+        theta = class_est.coordinates_
         speed, cons = excitation(theta, w)
         excited = (np.abs(speed) >= v_min) & (cons >= min_consistency)
         mask = _stretches(theta, excited, gap=w, min_cycles=min_cycles)
-        sel = est.selection_
+        sel = class_est.selection_
         classes.append(
             DetectedClass(
                 index=i, birth=sel.birth, death=sel.death, scale=sel.scale, coordinate=theta,
@@ -1213,7 +1219,6 @@ def detect(
                 status="kept" if mask.any() else f"never completes {min_cycles:g} steady cycles",
             )
         )
-        est.barcode_ = barcode  # a prime retry may have replaced it; keep indices consistent
     timings["coordinates"] = time.perf_counter() - t0
 
     # 5. motions: union of classes exciting the same frames
