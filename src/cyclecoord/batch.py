@@ -48,8 +48,8 @@ from pathlib import Path
 from typing import Any, Iterator, Sequence
 
 from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
-from .io._atomic import atomic_write
-from .io._paths import refuse_clobber
+from .io import atomic_write
+from .io import refuse_clobber
 from .report import clean, partial_report, write_json
 
 __all__ = [

@@ -16,7 +16,7 @@ import numpy as np
 
 from .coordinates import CircularCoordinates, unwrap
 from ..errors import ParameterError, ParseError
-from ..io._atomic import atomic_write
+from ..io import atomic_write
 from ..motion import Motion
 from .preprocess import Preprocessor
 

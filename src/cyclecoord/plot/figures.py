@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any, Mapping, Sequence
 import numpy as np
 
 from ..errors import ParameterError
+from ._canvas import detached_figure, new_figure
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -59,25 +60,6 @@ _CYCLE = "#d62728"
 
 
 # ------------------------------------------------------------------ helpers
-def _new_figure(figsize: tuple[float, float], fig: "Figure | None" = None) -> "Figure":
-    """``fig`` cleared for reuse, or a new pyplot figure (shown by notebooks)."""
-    if fig is not None:
-        return fig
-    import matplotlib.pyplot as plt
-
-    return plt.figure(figsize=figsize)
-
-
-def _detached_figure(figsize: tuple[float, float], dpi: float = 100) -> "Figure":
-    """A figure with an Agg canvas that pyplot does not know about (no GUI, no leak)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize, dpi=dpi)
-    FigureCanvasAgg(fig)
-    return fig
-
-
 def _check_result(result: Any, what: str) -> "ExtractionResult":
     from ..periodic.pipeline import ExtractionResult
 
@@ -146,7 +128,7 @@ def plot_barcode(
     h0 = h0[np.argsort(-np.minimum(h0[:, 1], thr), kind="stable")] if len(h0) else h0
 
     if ax is None:
-        fig = _new_figure((7.0, 5.0), fig)
+        fig = new_figure((7.0, 5.0), fig)
         n0, n1 = max(len(h0), 1), max(len(h1), 1)
         w0 = float(np.clip(np.log1p(n0), 1.0, 3.0))
         w1 = float(np.clip(np.log1p(n1), 1.0, 3.0))
@@ -297,7 +279,7 @@ def plot_pca(
     cyc = proj(res.typical.frames)
     cyc = np.vstack([cyc, cyc[:1]])
     if ax is None:
-        fig = _new_figure((6.0, 5.0), fig)
+        fig = new_figure((6.0, 5.0), fig)
         ax = fig.add_subplot(projection="3d" if dims == 3 else None)
     else:
         fig = ax.figure
@@ -357,7 +339,7 @@ def plot_density(
     if not isinstance(bins, (int, np.integer)) or bins < 2:
         raise ParameterError(f"bins must be a whole number >= 2, got {bins!r}")
     if ax is None:
-        fig = _new_figure((6.0, 3.5), fig)
+        fig = new_figure((6.0, 3.5), fig)
         ax = fig.add_subplot()
     else:
         fig = ax.figure
@@ -461,7 +443,7 @@ def plot_coordinate(
     """
     series, start = _coordinate_series(data, start_frame)
     if ax is None:
-        fig = _new_figure((8.0, 1.2 + 1.3 * len(series)), fig)
+        fig = new_figure((8.0, 1.2 + 1.3 * len(series)), fig)
         ax = fig.add_subplot()
     else:
         fig = ax.figure
@@ -533,7 +515,7 @@ def plot_windows(result: Any, *, ax: "Axes | None" = None, fig: "Figure | None" 
     if not windows:
         raise ParameterError("the detection ran no windows (method='global'); nothing to draw")
     if ax is None:
-        fig = _new_figure((9.0, 2.6), fig)
+        fig = new_figure((9.0, 2.6), fig)
         ax = fig.add_subplot()
     else:
         fig = ax.figure
@@ -683,7 +665,7 @@ def plot_channels(
             cyc[:, k] += turn
 
     if ax is None:
-        fig = _new_figure((11.0, 4.2), fig)
+        fig = new_figure((11.0, 4.2), fig)
         ax_c, ax_j = fig.subplots(1, 2, gridspec_kw={"width_ratios": [2.2, 1.0]})
     else:
         if len(ax) != 2:
@@ -751,7 +733,7 @@ def save_figures(result: "ExtractionResult", folder: str | os.PathLike[str], *, 
         extraction (``NoPeriodicMotionError.result``, no coordinate) only
         ``barcode.png`` is written: the barcode shows why nothing stood clear.
     """
-    from ..io._atomic import atomic_write
+    from ..io import atomic_write
     from ..periodic.pipeline import ExtractionResult
 
     if not isinstance(result, ExtractionResult):
@@ -772,7 +754,7 @@ def save_figures(result: "ExtractionResult", folder: str | os.PathLike[str], *, 
     written = []
     for name in FIGURE_NAMES if complete else FIGURE_NAMES[:1]:
         size, make = makers[name]
-        fig = _detached_figure(size, dpi)
+        fig = detached_figure(size, dpi)
         make(fig)
         fig.tight_layout()
         path = out / name
@@ -1034,7 +1016,7 @@ def render(
     # even pixel sizes: H.264 in yuv420p needs them, and GIFs do not mind
     px_w = max(2, 2 * int(round(width_in * dpi / 2)))
     px_h = max(2, 2 * int(round(size * dpi / 2)))
-    fig = _detached_figure((px_w / dpi, px_h / dpi), dpi)
+    fig = detached_figure((px_w / dpi, px_h / dpi), dpi)
     axes = []
     artists = []
     spacing = _grid_spacing(body)
@@ -1123,7 +1105,7 @@ def render(
         writer = anim.FFMpegWriter(fps=play_fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
     import matplotlib as mpl
 
-    from ..io._atomic import atomic_path
+    from ..io import atomic_path
 
     with atomic_path(out, suffix=f".tmp{suffix}") as tmp, mpl.rc_context({"savefig.bbox": None}):
         # (a 'tight' bbox would change the frame size)
