@@ -664,8 +664,41 @@ def run_batch(
     under ``if __name__ == "__main__":``.
     """
     t_start = time.perf_counter()
+    jobs, write_cycles, fps = _check_run_arguments(jobs, write_cycles, fps)
+    options = dict(extract_options or {})
+    normalised = _check_options(options)
+    opt_hash = _options_hash(normalised, fps, write_cycles)
+    patterns = _as_patterns(pattern)
+    src, out = _check_folders(folder, out_dir)
+    files = find_captures(src, patterns, recursive)
+    tasks = _plan_tasks(files, src, out, folder, options, fps, write_cycles, opt_hash)
+    _refuse_overwrites(tasks, out, write_cycles)
+    out.mkdir(parents=True, exist_ok=True)
+    rows, skipped, todo = _split_up_to_date(tasks, force)
+    for t in todo:
+        t.report.parent.mkdir(parents=True, exist_ok=True)
+    _execute(todo, jobs, scheduler, progress, rows)
+    for t in todo:  # defensive: every capture gets a row even if an executor lost it
+        if t.file not in rows:
+            rows[t.file] = _record_failure(t, "the capture was not analysed (lost by the executor)")
+    ordered = [rows[t.file] for t in tasks]
+    summary_path = out / SUMMARY_NAME
+    _write_summary(summary_path, ordered)
+    return BatchSummary(
+        folder=src, out_dir=out, rows=ordered, processed=[t.file for t in todo],
+        skipped=skipped, seconds=time.perf_counter() - t_start, summary_path=summary_path,
+        patterns=patterns,
+    )
+
+
+def _check_run_arguments(
+    jobs: Any, write_cycles: Any, fps: Any
+) -> tuple[int, str | None, float | None]:
+    """``jobs`` (0: one per core), ``write_cycles`` ("none": None) and ``fps`` checked."""
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 0:
-        raise ParameterError(f"jobs must be a whole number >= 1 (0: one per CPU core), got {jobs!r}")
+        raise ParameterError(
+            f"jobs must be a whole number >= 1 (0: one per CPU core), got {jobs!r}"
+        )
     jobs = jobs or (os.cpu_count() or 1)
     if isinstance(write_cycles, str) and write_cycles.lower() == "none":
         write_cycles = None
@@ -678,11 +711,13 @@ def run_batch(
             raise ParameterError(f"fps must be a positive number, got {fps!r}") from None
         if not (0 < fps < math.inf):
             raise ParameterError(f"fps must be a positive number, got {fps!r}")
-    options = dict(extract_options or {})
-    normalised = _check_options(options)
-    opt_hash = _options_hash(normalised, fps, write_cycles)
-    patterns = _as_patterns(pattern)
+    return jobs, write_cycles, fps
 
+
+def _check_folders(
+    folder: str | os.PathLike[str], out_dir: str | os.PathLike[str]
+) -> tuple[Path, Path]:
+    """The resolved input and output folders; the output may not hold the input's files."""
     src = Path(folder)
     if not src.is_dir():
         raise ParameterError(f"{folder}: no such folder")
@@ -695,9 +730,24 @@ def run_batch(
             f"the output folder {out_dir} is the input folder or inside it; choose a folder "
             "outside the input (outputs are never written among the captures)"
         )
-    files = find_captures(src, patterns, recursive)
+    return src, out
 
-    # output names: the stem, or the full name when several captures share a stem
+
+def _plan_tasks(
+    files: Sequence[str],
+    src: Path,
+    out: Path,
+    folder: str | os.PathLike[str],
+    options: dict,
+    fps: float | None,
+    write_cycles: str | None,
+    opt_hash: str,
+) -> list[_Task]:
+    """One task per capture, its outputs mirroring the input tree under ``out``.
+
+    Outputs are named by the capture's stem, or by its full name when several captures
+    of one folder share a stem (``walk.amc`` and ``walk.bvh``).
+    """
     stems = Counter((Path(f).parent.as_posix(), Path(f).stem) for f in files)
     tasks: list[_Task] = []
     for f in files:
@@ -706,8 +756,8 @@ def run_batch(
         base = out / p.parent / name
         if _outputs_inside(base, src):
             raise ParameterError(
-                f"the outputs of {f} would go to {base.parent}, inside the input folder {folder}; "
-                "choose an output folder that does not hold the input folder's tree"
+                f"the outputs of {f} would go to {base.parent}, inside the input folder "
+                f"{folder}; choose an output folder that does not hold the input folder's tree"
             )
         st = (src / f).stat()
         tasks.append(_Task(
@@ -715,7 +765,11 @@ def run_batch(
             mtime_ns=int(st.st_mtime_ns), options=options, fps=fps, cycle_format=write_cycles,
             options_hash=opt_hash, skeleton=_skeleton_signature(src / f),
         ))
+    return tasks
 
+
+def _refuse_overwrites(tasks: Sequence[_Task], out: Path, write_cycles: str | None) -> None:
+    """ParameterError when any output (summary, report, cycle) would overwrite an input."""
     written = [("the summary", out / SUMMARY_NAME)]
     for t in tasks:
         written.append((f"the report of {t.file}", t.report))
@@ -724,7 +778,12 @@ def run_batch(
                         for fmt in sorted({write_cycles, "npz"})]
     refuse_clobber([t.input for t in tasks] + [t.skeleton[0] for t in tasks if t.skeleton],
                    written)
-    out.mkdir(parents=True, exist_ok=True)
+
+
+def _split_up_to_date(
+    tasks: Sequence[_Task], force: bool
+) -> tuple[dict[str, dict], list[str], list[_Task]]:
+    """Rows of the captures whose report is up to date, their names, and the rest to run."""
     rows: dict[str, dict] = {}
     skipped: list[str] = []
     todo: list[_Task] = []
@@ -735,9 +794,13 @@ def run_batch(
         else:
             rows[t.file] = row
             skipped.append(t.file)
-    for t in todo:
-        t.report.parent.mkdir(parents=True, exist_ok=True)
+    return rows, skipped, todo
 
+
+def _execute(
+    todo: Sequence[_Task], jobs: int, scheduler: Any, progress: bool, rows: dict[str, dict]
+) -> None:
+    """Analyse ``todo`` locally or on Dask, adding each capture's row to ``rows``."""
     client, own_client = (None, False)
     if todo and scheduler is not None:
         client, own_client = _dask_client(scheduler)  # fail on a bad address before starting
@@ -750,7 +813,8 @@ def run_batch(
             runner = _run_local(todo, jobs)
         from tqdm.auto import tqdm
 
-        with tqdm(total=len(todo), desc="batch", unit="file", disable=not progress or not todo) as bar:
+        with tqdm(total=len(todo), desc="batch", unit="file",
+                  disable=not progress or not todo) as bar:
             for row in runner:
                 rows[row["file"]] = row
                 bar.set_postfix_str(f"{row['file']}: {row['status']}", refresh=False)
@@ -758,15 +822,3 @@ def run_batch(
     finally:
         if own_client:
             client.close()
-
-    for t in todo:  # defensive: every capture gets a row even if an executor lost it
-        if t.file not in rows:
-            rows[t.file] = _record_failure(t, "the capture was not analysed (lost by the executor)")
-    ordered = [rows[t.file] for t in tasks]
-    summary_path = out / SUMMARY_NAME
-    _write_summary(summary_path, ordered)
-    return BatchSummary(
-        folder=src, out_dir=out, rows=ordered, processed=[t.file for t in todo],
-        skipped=skipped, seconds=time.perf_counter() - t_start, summary_path=summary_path,
-        patterns=patterns,
-    )
