@@ -1,4 +1,4 @@
-"""Batch extraction: run :func:`~cyclecoord.periodic.pipeline.extract` over every capture in a folder.
+"""Batch extraction: :func:`~cyclecoord.periodic.pipeline.extract` over every capture in a folder.
 
 :func:`run_batch` finds the captures under a folder (recursively, in sorted order), runs
 load + extract on each -- in this process, in a local process pool or on a Dask
@@ -181,8 +181,10 @@ class BatchSummary:
         parts = [f"{self.n_ok} ok", f"{self.n_no_periodic} no periodic motion",
                  f"{self.n_error} error" + ("s" if self.n_error != 1 else "")]
         lines = [
-            f"{n} capture{'s' if n != 1 else ''} under {self.folder}: " + ", ".join(parts)
-            + f" ({len(self.processed)} analysed, {len(self.skipped)} up to date) in {self.seconds:.1f} s"
+            f"{n} capture{'s' if n != 1 else ''} under {self.folder}: "
+            + ", ".join(parts)
+            + f" ({len(self.processed)} analysed, {len(self.skipped)} up to date)"
+            + f" in {self.seconds:.1f} s"
         ]
         for r in self.errors:
             lines.append(f"error: {r['file']}: {r['message']}")
@@ -194,7 +196,9 @@ class BatchSummary:
 def _as_patterns(pattern: str | Sequence[str]) -> tuple[str, ...]:
     pats = (pattern,) if isinstance(pattern, str) else tuple(pattern)
     if not pats or not all(isinstance(p, str) and p for p in pats):
-        raise ParameterError(f"pattern must be a glob or a non-empty list of globs, got {pattern!r}")
+        raise ParameterError(
+            f"pattern must be a glob or a non-empty list of globs, got {pattern!r}"
+        )
     return pats
 
 
@@ -264,7 +268,9 @@ def _check_options(options: dict) -> dict:
     try:
         bound = sig.bind(None, **options)
     except TypeError:
-        allowed = ", ".join(p for p in params[1:] if sig.parameters[p].kind is not inspect.Parameter.VAR_KEYWORD)
+        allowed = ", ".join(
+            p for p in params[1:] if sig.parameters[p].kind is not inspect.Parameter.VAR_KEYWORD
+        )
         unknown = sorted(k for k in options if k not in sig.parameters)
         raise ParameterError(f"unknown extract option(s) {unknown}; allowed: {allowed}") from None
     bound.apply_defaults()
@@ -277,7 +283,9 @@ def _check_options(options: dict) -> dict:
 
 
 def _options_hash(normalised: dict, fps: float | None, cycle_format: str | None) -> str:
-    blob = json.dumps({"extract": normalised, "fps": fps, "cycles": cycle_format}, sort_keys=True, default=repr)
+    blob = json.dumps(
+        {"extract": normalised, "fps": fps, "cycles": cycle_format}, sort_keys=True, default=repr
+    )
     return hashlib.sha256(blob.encode("utf-8")).hexdigest()[:16]
 
 
@@ -339,7 +347,9 @@ def _analyse(task: _Task) -> dict[str, Any]:
             fmt = task.cycle_format
             if fmt == "bvh" and result.cycle.skeleton is None:
                 fmt = "npz"
-                notes.append("the capture has no skeleton, so its cycle was written as .npz instead of .bvh")
+                notes.append(
+                    "the capture has no skeleton, so its cycle was written as .npz instead of .bvh"
+                )
                 report["warnings"] = notes
             written = _cycle_path(task, fmt)
             save(result.cycle, written)
@@ -382,7 +392,7 @@ def _process_one(task: _Task) -> dict[str, Any]:
 
 
 def _record_failure(task: _Task, exc: BaseException | str) -> dict[str, Any]:
-    """Failure seen by the dispatcher (worker died, cluster error): report it like a worker would."""
+    """Failure seen by the dispatcher (worker died, cluster error), reported as a worker would."""
     report = _failure_report(task, exc)
     report["batch"]["seconds"] = None
     try:
@@ -467,8 +477,13 @@ def _up_to_date(task: _Task) -> dict[str, Any] | None:
         b = report["batch"]
         if b.get("status") not in ("ok", "no_periodic"):
             return None
-        if (b.get("file"), b.get("input_size"), b.get("input_mtime_ns"), b.get("options_hash"),
-                b.get("skeleton")) != (task.file, task.size, task.mtime_ns, task.options_hash, task.skeleton):
+        if (
+            b.get("file"),
+            b.get("input_size"),
+            b.get("input_mtime_ns"),
+            b.get("options_hash"),
+            b.get("skeleton"),
+        ) != (task.file, task.size, task.mtime_ns, task.options_hash, task.skeleton):
             return None
         if b["status"] == "ok" and task.cycle_format is not None:
             cyc = b.get("cycle_file")
@@ -565,7 +580,9 @@ def _dask_client(scheduler: Any) -> tuple[Any, bool]:
     try:
         return Client(scheduler, timeout=CONNECT_TIMEOUT), True
     except (OSError, ValueError, TypeError) as exc:
-        raise ParameterError(f"could not connect to the Dask scheduler at {scheduler!r}: {exc}") from None
+        raise ParameterError(
+            f"could not connect to the Dask scheduler at {scheduler!r}: {exc}"
+        ) from None
 
 
 def _run_dask(tasks: Sequence[_Task], client: Any) -> Iterator[dict]:

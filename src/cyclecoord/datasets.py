@@ -217,7 +217,9 @@ def cmu_skeleton() -> Skeleton:
             )
         )
         index[name] = len(joints) - 1
-    return Skeleton(tuple(joints), name="synthetic-cmu", length_unit=0.45, source_format="synthetic")
+    return Skeleton(
+        tuple(joints), name="synthetic-cmu", length_unit=0.45, source_format="synthetic"
+    )
 
 
 # ----------------------------------------------------------------------- result type
@@ -307,7 +309,9 @@ def _smooth_open(phi: np.ndarray) -> np.ndarray:
 Pose = dict[tuple[str, str], "np.ndarray | float"]
 
 
-def _set_both(pose: Pose, joint: str, dof: str, right: np.ndarray | float, left: np.ndarray | float) -> None:
+def _set_both(
+    pose: Pose, joint: str, dof: str, right: np.ndarray | float, left: np.ndarray | float
+) -> None:
     pose[("r" + joint, dof)] = right
     pose[("l" + joint, dof)] = left
 
@@ -362,7 +366,9 @@ def _gait_pose(phi: np.ndarray, amp: float, p: dict) -> Pose:
             + p["knee_stance"] * _bump(psi, 0.14, 18.0)
         )
         a1, a2, a3 = p["ankle"]
-        plantar = amp * (a1 * _bump(psi, 0.07, 20.0) - a2 * _bump(psi, 0.42, 8.0) + a3 * _bump(psi, 0.62, 20.0))
+        plantar = amp * (
+            a1 * _bump(psi, 0.07, 20.0) - a2 * _bump(psi, 0.42, 8.0) + a3 * _bump(psi, 0.62, 20.0)
+        )
         pose[(side + "femur", "rx")] = -hip
         pose[(side + "femur", "ry")] = -s * amp * _wave(psi, 3.0, 1, 0.3)
         pose[(side + "femur", "rz")] = s * (1.5 + amp * _wave(psi, 3.0, 1, 0.6))
@@ -661,7 +667,9 @@ def _check_int(name: str, value: object, minimum: int) -> int:
     return out
 
 
-def _check_float(name: str, value: object, low: float, *, low_open: bool = False, high: float | None = None) -> float:
+def _check_float(
+    name: str, value: object, low: float, *, low_open: bool = False, high: float | None = None
+) -> float:
     try:
         out = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
@@ -686,7 +694,9 @@ def _check_random_state(random_state: object) -> np.random.Generator:
     try:
         return np.random.default_rng(random_state)  # type: ignore[arg-type]
     except (TypeError, ValueError) as exc:
-        raise ParameterError(f"random_state must be None, an int or a numpy Generator: {exc}") from None
+        raise ParameterError(
+            f"random_state must be None, an int or a numpy Generator: {exc}"
+        ) from None
 
 
 # ------------------------------------------------------------------- public makers
@@ -760,7 +770,14 @@ def make_periodic_capture(
     meta = {"kind": kind, "period": period, "noise": noise, "speed_variation": variation}
     return SyntheticCapture(
         motion=Motion(noisy, _CHANNELS, fps=fps, skeleton=skeleton, source=source, metadata=meta),
-        clean=Motion(clean, _CHANNELS, fps=fps, skeleton=skeleton, source=source + ":clean", metadata=dict(meta)),
+        clean=Motion(
+            clean,
+            _CHANNELS,
+            fps=fps,
+            skeleton=skeleton,
+            source=source + ":clean",
+            metadata=dict(meta),
+        ),
         phase=phase,
         period=period,
         labels=np.zeros(n, dtype=int),
@@ -845,7 +862,9 @@ def make_motion_chain(
         try:
             seq = list(segment_frames)  # type: ignore[arg-type]
         except TypeError:
-            raise ParameterError(f"segment_frames must be an integer or a sequence, got {segment_frames!r}") from None
+            raise ParameterError(
+                f"segment_frames must be an integer or a sequence, got {segment_frames!r}"
+            ) from None
         if len(seq) != m:
             raise ParameterError(f"segment_frames has {len(seq)} entries for {m} kinds")
         lengths = [_check_int("segment_frames", s, 2) for s in seq]
@@ -855,7 +874,9 @@ def make_motion_chain(
         try:
             seq = list(periods)
         except TypeError:
-            raise ParameterError(f"periods must be a sequence of numbers, got {periods!r}") from None
+            raise ParameterError(
+                f"periods must be a sequence of numbers, got {periods!r}"
+            ) from None
         if len(seq) != m:
             raise ParameterError(f"periods has {len(seq)} entries for {m} kinds")
         pers = [_check_float("periods", p, 1.0, low_open=True) for p in seq]
@@ -914,11 +935,23 @@ def make_motion_chain(
     seed = _seed_text(random_state)
     source = f"synthetic:chain({','.join(kinds)}; seed={seed})"
     boundaries = [(starts[k], starts[k] + lengths[k], kinds[k]) for k in range(m)]
-    meta = {"kinds": list(kinds), "periods": list(pers), "boundaries": list(boundaries), "noise": noise}
+    meta = {
+        "kinds": list(kinds),
+        "periods": list(pers),
+        "boundaries": list(boundaries),
+        "noise": noise,
+    }
     mean_period = float(np.dot(lengths, pers) / sum(lengths))
     return SyntheticCapture(
         motion=Motion(noisy, _CHANNELS, fps=fps, skeleton=skeleton, source=source, metadata=meta),
-        clean=Motion(clean, _CHANNELS, fps=fps, skeleton=skeleton, source=source + ":clean", metadata=dict(meta)),
+        clean=Motion(
+            clean,
+            _CHANNELS,
+            fps=fps,
+            skeleton=skeleton,
+            source=source + ":clean",
+            metadata=dict(meta),
+        ),
         phase=phase,
         period=mean_period,
         labels=labels,
@@ -934,7 +967,9 @@ def _non_periodic(
     source = f"synthetic:{kind}(seed={_seed_text(random_state)})"
     return SyntheticCapture(
         motion=Motion(noisy, _CHANNELS, skeleton=skeleton, source=source, metadata={"kind": kind}),
-        clean=Motion(clean, _CHANNELS, skeleton=skeleton, source=source + ":clean", metadata={"kind": kind}),
+        clean=Motion(
+            clean, _CHANNELS, skeleton=skeleton, source=source + ":clean", metadata={"kind": kind}
+        ),
         phase=np.full(n, np.nan),
         period=float("nan"),
         labels=np.full(n, -1, dtype=int),
@@ -1011,7 +1046,9 @@ def make_random_walk_capture(
     steps = np.zeros_like(frames)
     steps[1:, _ANGLE_COLS] = rng.normal(0.0, step, size=(n - 1, _ANGLE_COLS.size))
     for d in ("tx", "tz"):
-        steps[1:, _COL[("root", d)]] = rng.normal(0.0, step * _TRANSLATION_NOISE_PER_DEGREE, size=n - 1)
+        steps[1:, _COL[("root", d)]] = rng.normal(
+            0.0, step * _TRANSLATION_NOISE_PER_DEGREE, size=n - 1
+        )
     frames += np.cumsum(steps, axis=0)
     frames[:, _COL[("root", "ty")]] = _ground(frames, skeleton)
     return _non_periodic(frames, frames, "random_walk", random_state, skeleton)

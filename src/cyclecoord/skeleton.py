@@ -180,7 +180,9 @@ class Skeleton:
     def total_length(self) -> float:
         """Sum of bone lengths (offsets and end sites), a scale for tolerances."""
         total = sum(float(np.linalg.norm(j.offset)) for j in self.joints[1:])
-        total += sum(float(np.linalg.norm(j.end_site)) for j in self.joints if j.end_site is not None)
+        total += sum(
+            float(np.linalg.norm(j.end_site)) for j in self.joints if j.end_site is not None
+        )
         return total
 
 

@@ -160,7 +160,9 @@ def load(
     rate = _check_fps(fps)
     if suffix in _GLTF + _USD:
         if skeleton is not None:
-            raise ParameterError(f"{p}: a {suffix} file carries its own skeleton; do not pass skeleton=")
+            raise ParameterError(
+                f"{p}: a {suffix} file carries its own skeleton; do not pass skeleton="
+            )
         if suffix in _GLTF:
             from .gltf import read_gltf as reader
         else:

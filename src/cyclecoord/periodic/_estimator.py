@@ -81,7 +81,8 @@ class ParamsMixin:
             name, sep, sub = key.partition("__")
             if name not in valid:
                 raise ParameterError(
-                    f"{type(self).__name__} has no parameter {name!r} (parameters: {', '.join(valid)})"
+                    f"{type(self).__name__} has no parameter "
+                    f"{name!r} (parameters: {', '.join(valid)})"
                 )
             if sep:
                 nested.setdefault(name, {})[sub] = value

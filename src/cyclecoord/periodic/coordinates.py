@@ -112,7 +112,9 @@ class CocycleCheck:
         return self.n_violations == 0
 
 
-def _edge_values(edges: np.ndarray, cocycle: np.ndarray, values: np.ndarray, n: int) -> tuple[np.ndarray, int]:
+def _edge_values(
+    edges: np.ndarray, cocycle: np.ndarray, values: np.ndarray, n: int
+) -> tuple[np.ndarray, int]:
     """Spread cocycle values onto ``edges`` (zero elsewhere); count support edges not found."""
     key = edges[:, 0] * n + edges[:, 1]
     ckey = cocycle[:, 0].astype(np.int64) * n + cocycle[:, 1].astype(np.int64)
@@ -224,11 +226,15 @@ def _least_squares_potential(
         # walk/jog/squat chain moved a boundary 16 frames); its landmarks are few (500),
         # so this costs little, and every landmark result stays as it was, bit for bit
         sw = np.sqrt(np.asarray(weights, dtype=float))
-        return lsqr(sp.diags(sw) @ delta, -sw * z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
+        return lsqr(sp.diags(sw) @ delta, -sw * z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[
+            0
+        ]
     wts = np.ones(len(z))
     a, b = edges[:, 0], edges[:, 1]
     wz = wts * z
-    rhs = np.bincount(a, weights=wz, minlength=n) - np.bincount(b, weights=wz, minlength=n)  # -δᵀ W z
+    rhs = np.bincount(a, weights=wz, minlength=n) - np.bincount(
+        b, weights=wz, minlength=n
+    )  # -δᵀ W z
     ncomp, label = connected_components(
         sp.csr_matrix((np.ones(len(edges)), (a, b)), shape=(n, n)), directed=False
     )
@@ -248,7 +254,9 @@ def _least_squares_potential(
         vals = np.concatenate([deg[fv], -wts[both], -wts[both]])
         lap = sp.csc_matrix((vals, (rows, cols)), shape=(fv.size, fv.size))
         w[fv] = splu(lap, permc_spec="COLAMD").solve(rhs[fv])
-    w -= (np.bincount(label, weights=w, minlength=ncomp) / np.bincount(label, minlength=ncomp))[label]
+    w -= (np.bincount(label, weights=w, minlength=ncomp) / np.bincount(label, minlength=ncomp))[
+        label
+    ]
     return w
 
 
@@ -332,7 +340,9 @@ def extend_coordinate(
         out = np.empty(len(q))
         if cov.any():
             jj = np.repeat(nearest[cov][:, None], k, axis=1)
-            kk = np.where(valid[cov], idx[cov], jj)  # padded slots point at j itself: zero increment
+            kk = np.where(
+                valid[cov], idx[cov], jj
+            )  # padded slots point at j itself: zero increment
             if table is not None:
                 inc = -table[jj, kk]
             else:
@@ -511,8 +521,9 @@ class CircularCoordinates(ParamsMixin):
             need = (8.0 + DENSE_BYTES_PER_PAIR) * T**2
             if need > budget:
                 raise ParameterError(
-                    f"the temporal metric needs a full {T} x {T} distance matrix "
-                    f"({need / 1e9:.1f} GB, over the {note}); drop --temporal or analyse fewer frames"
+                    f"the temporal metric needs a full {T} x {T} "
+                    f"distance matrix ({need / 1e9:.1f} GB, over the "
+                    f"{note}); drop --temporal or analyse fewer frames"
                 )
             self._dist_ = temporal_distance_matrix(x)
         else:
@@ -535,7 +546,9 @@ class CircularCoordinates(ParamsMixin):
         """Size estimate of the filtration that was built (computed when first asked
         for if the memory guard did not need it)."""
         if getattr(self, "_complex_deferred", False):
-            self._complex_estimate = estimate_complex(self.points_, self.threshold_, n_vertices=self.n_landmarks_)
+            self._complex_estimate = estimate_complex(
+                self.points_, self.threshold_, n_vertices=self.n_landmarks_
+            )
             self._complex_deferred = False
         return self._complex_estimate
 
@@ -628,7 +641,9 @@ class CircularCoordinates(ParamsMixin):
             depends on (set it on a clone and fit that instead).
         """
         if not hasattr(self, "_stage_barcode"):
-            raise ParameterError("call fit_barcode() or use_barcode() before with_coordinate_params()")
+            raise ParameterError(
+                "call fit_barcode() or use_barcode() before with_coordinate_params()"
+            )
         other = sorted(set(params) - set(self.COORDINATE_PARAMS))
         if other:
             raise ParameterError(
@@ -688,9 +703,9 @@ class CircularCoordinates(ParamsMixin):
                 )
             else:
                 notes.append(
-                    f"the landmark covering radius {self.covering_radius_:.4g} exceeds half the bar's "
-                    "extent: frames far from every landmark take their nearest landmark's coordinate; "
-                    "use more landmarks"
+                    f"the landmark covering radius {self.covering_radius_:.4g} exceeds half the "
+                    "bar's extent: frames far from every landmark take their nearest landmark's "
+                    "coordinate; use more landmarks"
                 )
         selection = BarSelection(**{**selection.__dict__, "scale": float(scale)})
         centers, cdist = self._centers()
@@ -714,7 +729,9 @@ class CircularCoordinates(ParamsMixin):
                 b, d = bc.h1[idx]
                 if not b <= selection.scale < d:
                     continue
-                sel = BarSelection(**{**selection.__dict__, "index": idx, "birth": float(b), "death": float(d)})
+                sel = BarSelection(
+                    **{**selection.__dict__, "index": idx, "birth": float(b), "death": float(d)}
+                )
             cocycle = self._cocycle_on_centers(bc.cocycles[sel.index])
             z, outside = _edge_values(edges, cocycle, lift_cocycle(cocycle, p).astype(float), n)
             check = check_cocycle(edges, z, n)
@@ -727,15 +744,17 @@ class CircularCoordinates(ParamsMixin):
         p, bc, sel, check, z = best
         if not check.ok:
             warnings.warn(
-                f"the integer lift of the cocycle fails the cocycle condition on {check.n_violations} "
-                f"of {check.n_triangles} triangles for every prime tried; using p={p}",
+                "the integer lift of the cocycle fails the cocycle "
+                f"condition on {check.n_violations} of {check.n_triangles} "
+                f"triangles for every prime tried; using p={p}",
                 RuntimeWarning,
                 stacklevel=2,
             )
         for note in notes:
             warnings.warn(note, RuntimeWarning, stacklevel=2)
         ncomp, _ = connected_components(
-            sp.csr_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n)), directed=False
+            sp.csr_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n)),
+            directed=False,
         )
         if self.landmarks_ is None:
             weights = None
@@ -757,7 +776,9 @@ class CircularCoordinates(ParamsMixin):
         if self.landmarks_ is not None and not self.temporal and self.refine_birth:
             # the sparse complex within what the filtration was allowed (it is gone by now)
             budget = getattr(self, "memory_budget_", None)
-            max_edges = 3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
+            max_edges = (
+                3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
+            )
             full = (refine_birth(self.points_, sel.birth, p, max_edges=max_edges,
                                  covering_radius=self.covering_radius_) if max_edges > 0 else None)
             sel = BarSelection(**{**sel.__dict__, "full_birth": full})
@@ -791,13 +812,20 @@ class CircularCoordinates(ParamsMixin):
         """
         self._check_fitted()
         x = self._validate(X)
-        if hasattr(self, "points_") and x.shape == self.points_.shape and np.array_equal(x, self.points_):
+        if (
+            hasattr(self, "points_")
+            and x.shape == self.points_.shape
+            and np.array_equal(x, self.points_)
+        ):
             return self.coordinates_.copy()
         if x.shape[1] != self.centers_.shape[1]:
             raise ParameterError(
-                f"points have {x.shape[1]} dimensions, the model was fitted on {self.centers_.shape[1]}"
+                f"points have {x.shape[1]} dimensions, the model was fitted on "
+                f"{self.centers_.shape[1]}"
             )
-        raw, _ = extend_coordinate(x, self.centers_, self.center_theta_, self.edges_, self.harmonic_cocycle_, self.radius_)
+        raw, _ = extend_coordinate(
+            x, self.centers_, self.center_theta_, self.edges_, self.harmonic_cocycle_, self.radius_
+        )
         sign, offset = self.orientation_
         return _unit(sign * raw - offset)
 
@@ -814,7 +842,12 @@ class CircularCoordinates(ParamsMixin):
         out["radius"] = np.array(self.radius_)
         out["orientation"] = np.array(self.orientation_, dtype=float)
         out["selection"] = np.array(
-            [self.selection_.index, self.selection_.birth, self.selection_.death, self.selection_.scale]
+            [
+                self.selection_.index,
+                self.selection_.birth,
+                self.selection_.death,
+                self.selection_.scale,
+            ]
         )
         out["prime"] = np.array(self.prime_)
         return out

@@ -57,7 +57,8 @@ def as_generator(random_state: None | int | np.random.Generator) -> np.random.Ge
             raise ParameterError(f"random_state must be a non-negative integer, got {random_state}")
         return np.random.default_rng(random_state)
     raise ParameterError(
-        f"random_state must be None, an integer or a numpy Generator, got {type(random_state).__name__}"
+        "random_state must be None, an integer or a numpy Generator, got "
+        f"{type(random_state).__name__}"
     )
 
 
@@ -77,10 +78,10 @@ def _em_1d(x: np.ndarray, n_components: int, max_iter: int, reg_covar: float, to
     added to every variance; stop when the mean log-likelihood changes by less than
     ``tol``, 3e-4 where scikit-learn stops at 1e-3: a few more steps, and on the test
     densities a closer fit than scikit-learn's), and so is the start (responsibilities
-    of a k-means partition); only the k-means is deterministic: Lloyd's steps from ``n_components`` runs of equal size of
-    the sorted values (in 1-D every k-means cluster is such a run, so a step costs
-    ``n_components`` binary searches).  Returns weights, means, variances, whether EM
-    converged and the iterations run.
+    of a k-means partition); only the k-means is deterministic: Lloyd's steps from
+    ``n_components`` runs of equal size of the sorted values (in 1-D every k-means cluster
+    is such a run, so a step costs ``n_components`` binary searches).  Returns weights,
+    means, variances, whether EM converged and the iterations run.
     """
     x = np.sort(np.asarray(x, dtype=float))
     n, k = x.size, int(n_components)
@@ -94,7 +95,9 @@ def _em_1d(x: np.ndarray, n_components: int, max_iter: int, reg_covar: float, to
         cnt = np.diff(bounds)
         means = (csum[bounds[1:]] - csum[bounds[:-1]]) / np.maximum(cnt, 1)
         means = np.where(cnt > 0, means, x[np.minimum(bounds[:-1], n - 1)])
-        new = np.concatenate([[0], np.searchsorted(x, 0.5 * (means[:-1] + means[1:]), side="right"), [n]])
+        new = np.concatenate(
+            [[0], np.searchsorted(x, 0.5 * (means[:-1] + means[1:]), side="right"), [n]]
+        )
         new = np.maximum.accumulate(new)
         if np.array_equal(new, bounds):
             break
@@ -206,11 +209,17 @@ class PeriodicDensity(ParamsMixin):
             if isinstance(value, bool) or not isinstance(value, Integral) or value < 1:
                 raise ParameterError(f"{name} must be a positive integer, got {value!r}")
         if self.max_samples is not None and (
-            isinstance(self.max_samples, bool) or not isinstance(self.max_samples, Integral) or self.max_samples < 2
+            isinstance(self.max_samples, bool)
+            or not isinstance(self.max_samples, Integral)
+            or self.max_samples < 2
         ):
-            raise ParameterError(f"max_samples must be None or an integer >= 2, got {self.max_samples!r}")
+            raise ParameterError(
+                f"max_samples must be None or an integer >= 2, got {self.max_samples!r}"
+            )
         if self.n_copies % 2 != 1:
-            raise ParameterError(f"n_copies must be odd (copies centred on the data), got {self.n_copies}")
+            raise ParameterError(
+                f"n_copies must be odd (copies centred on the data), got {self.n_copies}"
+            )
         if (
             isinstance(self.reg_covar, bool)
             or not isinstance(self.reg_covar, Real)
@@ -284,7 +293,9 @@ class PeriodicDensity(ParamsMixin):
         self._scale = scale[keep]
         self._weight = weight[keep]
         self._cdf_at_zero = ndtr(-self._loc / self._scale)
-        self._total = float(self._weight @ (ndtr((1.0 - self._loc) / self._scale) - self._cdf_at_zero))
+        self._total = float(
+            self._weight @ (ndtr((1.0 - self._loc) / self._scale) - self._cdf_at_zero)
+        )
         self._grid = None  # cdf table for ppf, built on first use
         return self
 

@@ -165,7 +165,12 @@ def _loop_shift(root: np.ndarray, rot: np.ndarray, up: int) -> tuple:
 
 
 def _targets(
-    points: np.ndarray, planted: np.ndarray, up: int, nb: int, cyclic: bool, loop_shift: tuple | None = None
+    points: np.ndarray,
+    planted: np.ndarray,
+    up: int,
+    nb: int,
+    cyclic: bool,
+    loop_shift: tuple | None = None,
 ):
     """Targets ``(T, 3)`` (horizontal components eased into locks), weights ``(T,)`` and run
     labels for one foot point.

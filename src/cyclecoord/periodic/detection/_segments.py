@@ -91,6 +91,13 @@ def drop_unsteady(
             if y - x < min_run:
                 labels[x:y] = -1
                 continue
-            out.append(replace(seg, start=int(x), stop=int(y), cycles=float(seg.cycles) * (y - x) / max(length, 1)))
+            out.append(
+                replace(
+                    seg,
+                    start=int(x),
+                    stop=int(y),
+                    cycles=float(seg.cycles) * (y - x) / max(length, 1),
+                )
+            )
     out.sort(key=lambda s: s.start)
     return labels, out

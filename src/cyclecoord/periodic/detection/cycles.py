@@ -93,7 +93,9 @@ def motion_cycles(
     from ..windings import complete_windings, retime, stretches
 
     if not isinstance(result, DetectionResult):
-        raise ParameterError(f"motion_cycles() takes a DetectionResult, got {type(result).__name__}")
+        raise ParameterError(
+            f"motion_cycles() takes a DetectionResult, got {type(result).__name__}"
+        )
     if timing not in TIMINGS:
         raise ParameterError(f"timing must be one of {TIMINGS}, got {timing!r}")
     motion = result.motion
@@ -109,7 +111,11 @@ def motion_cycles(
         if not np.isfinite(period) or period < 2:
             continue
         rows = np.arange(a, b)
-        lead = next((cl for cl in result.classes if cl.index == seg.classes[0]), None) if seg.classes else None
+        lead = (
+            next((cl for cl in result.classes if cl.index == seg.classes[0]), None)
+            if seg.classes
+            else None
+        )
         if lead is not None and lead.mask[a:b].sum() >= period:  # at least one full turn
             rows = a + np.flatnonzero(lead.mask[a:b])
             theta, source = np.mod(lead.coordinate[rows], 1.0), f"class {lead.index}"
@@ -122,22 +128,36 @@ def motion_cycles(
             runs = stretches(mask)
             u = np.full(motion.n_frames, np.nan)
             for lo, hi in runs:
-                part = unwrap(np.asarray(theta[np.searchsorted(rows, lo):np.searchsorted(rows, hi)]))
+                part = unwrap(
+                    np.asarray(theta[np.searchsorted(rows, lo) : np.searchsorted(rows, hi)])
+                )
                 u[lo:hi] = part if part[-1] >= part[0] else -part
             wind = complete_windings(u, runs)
             phase = retime(u, runs, wind)
             if not np.isfinite(phase).any():
                 phase = np.full(motion.n_frames, np.nan)
                 phase[rows] = np.mod((rows - a) / period, 1.0)
-            typ, clip, _ = capture_cycle(phase, motion, prepared, prep, period, bandwidth=bandwidth,
-                                         cycle_start=cycle_start, travel=travel, k=n_neighbors, metadata=meta)
+            typ, clip, _ = capture_cycle(
+                phase,
+                motion,
+                prepared,
+                prep,
+                period,
+                bandwidth=bandwidth,
+                cycle_start=cycle_start,
+                travel=travel,
+                k=n_neighbors,
+                metadata=meta,
+            )
         else:
             density = PeriodicDensity(random_state=random_state).fit(theta)
             typ = typical_cycle(
                 theta, prepared.poses[rows], period, density=density, n_samples=n_samples,
                 k=min(n_neighbors, rows.size), bandwidth=bandwidth, random_state=random_state,
             )
-            typ, clip = loop_cycle(typ, motion, prepared, prep, cycle_start=cycle_start, rows=rows, metadata=meta)
+            typ, clip = loop_cycle(
+                typ, motion, prepared, prep, cycle_start=cycle_start, rows=rows, metadata=meta
+            )
         out.append(MotionCycle(
             motion=mid, start=a, stop=b, phase_from=source, n_frames_used=int(rows.size),
             period_frames=period, cycle=clip, loop_closure=float(loop_closure(typ.frames)),

@@ -161,7 +161,11 @@ def detect(
     notes: list[str] = []
 
     t0 = time.perf_counter()
-    lag = [int(round(d * motion.fps)) for d in np.atleast_1d(delay) if d] if delay is not None else None
+    lag = (
+        [int(round(d * motion.fps)) for d in np.atleast_1d(delay) if d]
+        if delay is not None
+        else None
+    )
     lag = lag or None
     prepared = Preprocessor(
         difference_root=difference_root, normalize=normalize, pca=pca, delay=lag
@@ -292,7 +296,9 @@ def _check_arguments(
     if not lengths or not all(np.isfinite(v) and v > 0 for v in lengths):
         raise ParameterError(f"window_lengths must be positive numbers of seconds, got {lengths}")
     for name, val in (
-        ("window_stride", window_stride), ("window_cycles", window_cycles), ("similarity", similarity)
+        ("window_stride", window_stride),
+        ("window_cycles", window_cycles),
+        ("similarity", similarity),
     ):
         _positive(name, val)
     if not 0 <= window_steadiness <= 1:

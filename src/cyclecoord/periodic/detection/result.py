@@ -198,7 +198,10 @@ class DetectionResult:
         chosen = {c.index: c.motion for c in self.classes if c.motion >= 0}
         return {
             "source": self.motion.source,
-            "frames": [int(self.motion.start_frame), int(self.motion.start_frame + self.motion.n_frames)],
+            "frames": [
+                int(self.motion.start_frame),
+                int(self.motion.start_frame + self.motion.n_frames),
+            ],
             "n_frames": int(self.motion.n_frames),
             "fps": self.motion.fps,
             "parameters": self.parameters,

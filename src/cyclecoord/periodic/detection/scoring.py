@@ -22,7 +22,9 @@ def boundary_errors(segments: list, truth: list, n_frames: int) -> list[int]:
     """
     tr = sorted(truth)
     spans = [(tr[i][1], tr[i + 1][0]) for i in range(len(tr) - 1)]
-    spans += [(a, a) for a, _, _ in tr[:1] if a > 0] + [(b, b) for _, b, _ in tr[-1:] if b < n_frames]
+    spans += [(a, a) for a, _, _ in tr[:1] if a > 0] + [
+        (b, b) for _, b, _ in tr[-1:] if b < n_frames
+    ]
     pred = sorted({b for s in segments for b in (s.start, s.stop) if 0 < b < n_frames})
 
     def dist(p: int, span: tuple) -> int:

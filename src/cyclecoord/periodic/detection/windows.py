@@ -106,7 +106,9 @@ def _amplitude(cycle: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.sum((cycle - cycle.mean(axis=0)) ** 2, axis=1))))
 
 
-def _fit_window(points: np.ndarray, prime: int, scale_fraction: float) -> tuple[dict, np.ndarray | None]:
+def _fit_window(
+    points: np.ndarray, prime: int, scale_fraction: float
+) -> tuple[dict, np.ndarray | None]:
     """Barcode of one window and, when its longest bar stands clear, the coordinate."""
     bc = compute_barcode(points, prime=prime)
     info: dict[str, Any] = {"threshold": bc.threshold, "birth": float("nan"), "death": float("nan")}
@@ -116,7 +118,9 @@ def _fit_window(points: np.ndarray, prime: int, scale_fraction: float) -> tuple[
     info.update(birth=sel.birth, death=sel.death, clear=sel.clear)
     if not sel.clear:
         return info, None
-    est = CircularCoordinates(prime=prime, scale_fraction=scale_fraction, landmarks=None, refine_birth=False)
+    est = CircularCoordinates(
+        prime=prime, scale_fraction=scale_fraction, landmarks=None, refine_birth=False
+    )
     est.use_barcode(points, bc)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -190,8 +194,14 @@ def window_table(
         step = max(1, int(np.ceil(n / max_points)))
         plan.extend((a, a + n, step) for a in starts)
     out: list[WindowInfo] = []
-    with tqdm(total=len(plan), desc="detect windows", unit="window", disable=not progress or not plan,
-              delay=2.0, leave=False) as bar:
+    with tqdm(
+        total=len(plan),
+        desc="detect windows",
+        unit="window",
+        disable=not progress or not plan,
+        delay=2.0,
+        leave=False,
+    ) as bar:
         for a, b, step in plan:
             idx = np.arange(a, b, step)
             info, theta = _fit_window(points[idx], prime, scale_fraction)
@@ -224,7 +234,9 @@ def _cluster_windows(windows: list[WindowInfo], similarity: float) -> list[list[
     d = np.zeros((n, n))
     for i in range(n):
         for j in range(i + 1, n):
-            d[i, j] = d[j, i] = cycle_distance(loops[i].cycle, loops[j].cycle) / np.sqrt(amp[i] * amp[j])
+            d[i, j] = d[j, i] = cycle_distance(loops[i].cycle, loops[j].cycle) / np.sqrt(
+                amp[i] * amp[j]
+            )
     groups = fcluster(linkage(squareform(d, checks=False), "average"), similarity, "distance")
     return [[w for w, g in zip(loops, groups) if g == k] for k in np.unique(groups)]
 
@@ -398,8 +410,14 @@ def windowed_motions(
                 labels[a:b] = -1
 
     # number motions by first labelled frame (global motions that label nothing go last)
-    with_frames = sorted((int(np.flatnonzero(labels == k)[0]), k) for k in range(K) if np.any(labels == k))
-    rest = [(int(np.flatnonzero(cands[k].classes[0].mask)[0]), k) for k in range(n_global) if not np.any(labels == k)]
+    with_frames = sorted(
+        (int(np.flatnonzero(labels == k)[0]), k) for k in range(K) if np.any(labels == k)
+    )
+    rest = [
+        (int(np.flatnonzero(cands[k].classes[0].mask)[0]), k)
+        for k in range(n_global)
+        if not np.any(labels == k)
+    ]
     order = [k for _, k in with_frames] + [k for _, k in sorted(rest)]
     new_id = {k: i for i, k in enumerate(order)}
     labels = np.array([new_id.get(int(v), -1) for v in labels], dtype=int)
@@ -422,13 +440,26 @@ def windowed_motions(
             else:
                 inside = [w for w in c.windows if w.stop > a and w.start < b] or c.windows
                 multi = [w for w in inside if w.cycles >= min_cycles] or inside
-                period = autocorrelation_period(poses[a:b], float(np.median([w.period_frames for w in multi])))
+                period = autocorrelation_period(
+                    poses[a:b], float(np.median([w.period_frames for w in multi]))
+                )
                 cyc = (b - a) / period
                 classes = tuple(cl.index for cl in sorted(c.classes, key=lambda cl: cl.index))
                 birth = float(np.median([w.birth for w in inside]))
                 death = float(np.median([w.death for w in inside]))
                 scale = float(np.median([w.scale for w in inside]))
-            segments.append(Segment(start=int(a), stop=int(b), motion=mid, classes=classes, birth=birth,
-                                    death=death, scale=scale, cycles=cyc, period_frames=period))
+            segments.append(
+                Segment(
+                    start=int(a),
+                    stop=int(b),
+                    motion=mid,
+                    classes=classes,
+                    birth=birth,
+                    death=death,
+                    scale=scale,
+                    cycles=cyc,
+                    period_frames=period,
+                )
+            )
     segments.sort(key=lambda sg: sg.start)
     return labels, segments, len(order)
