@@ -15,11 +15,13 @@ from ..coordinates import unwrap
 
 __all__ = ["mask_runs", "class_period", "drop_unsteady", "MAX_TURN", "MIN_SPEED"]
 
+
 def mask_runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """Half-open (start, stop) runs of True."""
     m = np.concatenate([[False], np.asarray(mask, bool), [False]])
     d = np.diff(m.astype(np.int8))
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1)))
+
 
 def class_period(coordinate: np.ndarray, mask: np.ndarray, a: int, b: int) -> tuple[float, float]:
     """Turns of a class's coordinate over frames ``a:b`` and the period they give.
@@ -51,11 +53,13 @@ def class_period(coordinate: np.ndarray, mask: np.ndarray, a: int, b: int) -> tu
         return cyc, sum(hi - lo - 1 for lo, hi in runs) / excited
     return cyc, (b - a - 1) / cyc if cyc > 0 else float("nan")
 
+
 #: Heading change per period (degrees) above which detect labels a stretch as turning.
 MAX_TURN = 45.0
 
 #: Joint speed, as a fraction of a segment's moving level, below which detect sees a pause.
 MIN_SPEED = 0.2
+
 
 def drop_unsteady(
     labels: np.ndarray, segments: list, joints: np.ndarray, motion: Motion, min_run: int

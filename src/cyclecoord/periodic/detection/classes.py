@@ -22,6 +22,7 @@ from .result import DetectedClass, Segment
 
 __all__ = ["excitation", "candidate_classes", "read_classes", "motions_from_classes"]
 
+
 def excitation(theta: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarray]:
     """Smoothed signed speed (cycles/frame) and direction consistency of a coordinate.
 
@@ -54,6 +55,7 @@ def _stretches(theta: np.ndarray, excited: np.ndarray, gap: int, min_cycles: flo
         if abs(v[a : max(a, b - 1)].sum()) >= min_cycles:
             out[a:b] = True
     return out
+
 
 def candidate_classes(
     barcode: Barcode, n_classes: int | None, max_classes: int, min_persistence: float

@@ -14,6 +14,7 @@ from .result import DetectionResult
 
 __all__ = ["MotionCycle", "motion_cycles"]
 
+
 @dataclass
 class MotionCycle:
     """The typical cycle of one detected motion (see :func:`motion_cycles`).

@@ -13,6 +13,7 @@ from ..coordinates import CircularCoordinates
 
 __all__ = ["Segment", "DetectedClass", "WindowInfo", "DetectionResult"]
 
+
 @dataclass(frozen=True)
 class Segment:
     """A frame range where one motion is performed (0-based, half-open)."""

@@ -11,6 +11,7 @@ import numpy as np
 
 __all__ = ["best_match_accuracy", "boundary_errors"]
 
+
 def boundary_errors(segments: list, truth: list, n_frames: int) -> list[int]:
     """Boundary errors in frames, both ways.
 

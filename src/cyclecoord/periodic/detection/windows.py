@@ -38,6 +38,7 @@ CYCLE_BINS = 16
 #: every motion's cycle than those frames are is left unlabelled.
 NONE_COST = 2.0
 
+
 def binned_cycle(theta: np.ndarray, poses: np.ndarray, bins: int = CYCLE_BINS) -> np.ndarray:
     """Mean pose per phase bin of a circular coordinate (a small typical cycle).
 
