@@ -97,7 +97,7 @@ class PhaseModel:
         arrays = {f"cc_{k}": v for k, v in self.estimator.to_arrays().items()}
         arrays.update(
             pre_root_columns=np.asarray(p.root_columns_),
-            pre_rot_mask=np.asarray(p._rot_mask_),
+            pre_rot_mask=np.asarray(p.root_rotation_mask_),
             pre_mean=np.asarray(p.mean_),
             pre_scale=np.asarray(p.scale_),
             pre_components=np.asarray(
@@ -148,7 +148,7 @@ class PhaseModel:
         )
         try:
             pre.root_columns_ = arrays["pre_root_columns"].astype(int)
-            pre._rot_mask_ = arrays["pre_rot_mask"].astype(bool)
+            pre.root_rotation_mask_ = arrays["pre_rot_mask"].astype(bool)
             pre.root_mode_ = header.get("root", "euler")
             pre.mean_ = arrays["pre_mean"]
             pre.scale_ = arrays["pre_scale"]

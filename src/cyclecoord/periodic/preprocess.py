@@ -179,6 +179,8 @@ class Preprocessor:
     ----------
     root_columns_ : ndarray of int
         Root channels that were differenced.
+    root_rotation_mask_ : ndarray of bool, shape (len(root_columns_),)
+        Which of them are rotations (differenced as angles, wrapped into [-180, 180)).
     mean_ : ndarray, shape (D,)
         Channel means of the prepared poses (used by PCA).
     scale_ : ndarray, shape (D,)
@@ -223,7 +225,7 @@ class Preprocessor:
             out = np.array(frames, dtype=float)
             out[:, self.root_columns_] = body_frame_differences(frames, self.root_columns_, *layout)
             return out
-        return difference_root(frames, self.root_columns_, self._rot_mask_)
+        return difference_root(frames, self.root_columns_, self.root_rotation_mask_)
 
     def fit(self, motion: Motion) -> "Preprocessor":
         """Learn root columns, scaling and principal axes from ``motion``."""
@@ -233,7 +235,7 @@ class Preprocessor:
             raise ParameterError(f"need at least 3 frames, got {motion.n_frames}")
         cols = np.asarray(motion.root_channels() if self.difference_root else [], dtype=int)
         self.root_columns_ = cols
-        self._rot_mask_ = np.array(
+        self.root_rotation_mask_ = np.array(
             [motion.channels[c][1].startswith("r") for c in cols], dtype=bool
         )
         if self.root not in ("body", "euler"):

@@ -267,6 +267,10 @@ class Synthesizer:
             "tilt": np.einsum("tn,nab->tab", w, r.tilt),
         }
 
+    def bridges_found(self) -> dict[tuple[str, str], Bridges]:
+        """The bridges looked up so far (by :meth:`bridges`), by ``(from, to)`` model names."""
+        return dict(self._bridges)
+
     def bridges(self, a: str, b: str) -> Bridges:
         key = (a, b)
         if key not in self._bridges:
