@@ -36,7 +36,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 import cyclecoord as cc
-from cyclecoord.io._atomic import atomic_write
+from cyclecoord.io import atomic_write
 from cyclecoord.synthesis.graph import (
     MotionGraphSynth,
     PoseSpace,

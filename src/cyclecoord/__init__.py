@@ -53,7 +53,16 @@ _LAZY = {
     "run_batch": "batch",
 }
 _SUBMODULES = {
-    "batch", "cli", "conventions", "datasets", "io", "periodic", "plot", "quality", "skeleton", "synthesis",
+    "batch",
+    "cli",
+    "conventions",
+    "datasets",
+    "io",
+    "periodic",
+    "plot",
+    "quality",
+    "skeleton",
+    "synthesis",
 }
 
 

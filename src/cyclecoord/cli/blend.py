@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io._paths import input_files, refuse_clobber
+from ..io import input_files, refuse_clobber
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,

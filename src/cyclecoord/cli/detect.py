@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io._paths import input_files, refuse_clobber
+from ..io import input_files, refuse_clobber
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
@@ -251,7 +251,7 @@ def _save_plots(res, folder: str) -> None:
         )
     if res.windows:
         figs["windows.png"] = plot_windows(res)
-    from ..io._atomic import atomic_write
+    from ..io import atomic_write
 
     for name, fig in figs.items():
         with atomic_write(folder / name, "wb") as fh:

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io._paths import input_files, refuse_clobber
+from ..io import input_files, refuse_clobber
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,

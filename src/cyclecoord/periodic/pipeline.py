@@ -7,7 +7,6 @@ typical cycle as a loopable :class:`~cyclecoord.motion.Motion`.
 
 from __future__ import annotations
 
-import copy
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -517,8 +516,7 @@ def extract(
             while (wind.turns < min_turns or not wind.spread <= MAX_SPREAD) and j < min(4, len(barcode.h1)):
                 other = select_bar(barcode, j, None, scale_fraction)
                 if other.ratio >= CLEAR_RATIO:
-                    alt_est = copy.copy(est)
-                    alt_est.class_index = j
+                    alt_est = est.with_coordinate_params(class_index=j)
                     try:
                         alt = coordinate_of(alt_est, other, rows)
                     except ParameterError:

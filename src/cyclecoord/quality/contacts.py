@@ -30,6 +30,7 @@ __all__ = [
     "FootContacts",
     "FootSkating",
     "contact_runs",
+    "contact_skeleton",
     "find_feet",
     "foot_contacts",
     "foot_skating",
@@ -289,7 +290,24 @@ def leg_length(skeleton: Skeleton, feet: tuple[str, ...] | None = None) -> float
     return value
 
 
-def _check_motion(motion: Motion) -> Skeleton:
+def contact_skeleton(motion: Motion) -> Skeleton:
+    """The skeleton of a motion checked fit for foot-contact analysis.
+
+    Parameters
+    ----------
+    motion : Motion
+
+    Returns
+    -------
+    Skeleton
+        ``motion.skeleton``.
+
+    Raises
+    ------
+    ParameterError
+        When the motion has no skeleton, fewer than 2 frames, or a frame holding NaN or
+        infinite values (the message names the source and the first such frame).
+    """
     if motion.skeleton is None:
         raise ParameterError(
             f"{motion.source or 'motion'}: foot contacts need a skeleton "
@@ -376,7 +394,7 @@ def foot_contacts(
         A motion without a skeleton, fewer than 2 frames, non-finite frames, unknown
         foot joints or non-positive thresholds.
     """
-    skel = _check_motion(motion)
+    skel = contact_skeleton(motion)
     if up not in _UP:
         raise ParameterError(f"up axis must be one of x, y, z, got {up!r}")
     for label, value in (("height", height), ("speed", speed)):
@@ -472,7 +490,7 @@ def foot_skating(
     elif contact_options:
         raise ParameterError("pass either contacts or contact options, not both")
     else:
-        _check_motion(motion)
+        contact_skeleton(motion)
     if contacts.n_frames != motion.n_frames:
         raise ParameterError(
             f"contacts cover {contacts.n_frames} frames, the motion has {motion.n_frames}"

@@ -33,12 +33,12 @@ from ..motion import Motion
 from ..quality.contacts import (
     FootContacts,
     FootSkating,
-    _check_motion,
     contact_runs,
+    contact_skeleton,
     foot_contacts,
     foot_skating,
 )
-from ..skeleton import Skeleton, _rotation_matrices
+from ..skeleton import Skeleton, rotation_matrices
 
 __all__ = ["FootLockResult", "lock_feet"]
 
@@ -302,7 +302,7 @@ class _LegIK:
                 if cj == ci:
                     vals[:, k] = q[:, v]
             if joint.rotation_order:
-                local = joint.axis @ _rotation_matrices(vals, joint.rotation_order) @ joint.axis.T
+                local = joint.axis @ rotation_matrices(vals, joint.rotation_order) @ joint.axis.T
                 rot = rot @ local
             out[j] = (pos, rot)
         res = []
@@ -513,7 +513,7 @@ def lock_feet(
     if contacts is None:
         contacts = foot_contacts(motion, **contact_options)
     else:
-        _check_motion(motion)
+        contact_skeleton(motion)
     if contacts.n_frames != motion.n_frames:
         raise ParameterError(
             f"contacts cover {contacts.n_frames} frames, the motion has {motion.n_frames}"

@@ -201,7 +201,11 @@ class Synthesizer:
                 idx = np.flatnonzero(m.segments_ == s)
                 t = spec.get("time", 0.0)
                 end = float(m.times_[idx][-1])
-                if not isinstance(t, (int, float)) or isinstance(t, bool) or not 0 <= t <= end + 1e-9:
+                if (
+                    not isinstance(t, (int, float))
+                    or isinstance(t, bool)
+                    or not 0 <= t <= end + 1e-9
+                ):
                     raise ParameterError(
                         f"time {t!r} is not inside segment {spec['segment']!r} (0..{end:.3g} s)"
                     )
@@ -262,6 +266,10 @@ class Synthesizer:
             "turn": w @ r.turn,
             "tilt": np.einsum("tn,nab->tab", w, r.tilt),
         }
+
+    def bridges_found(self) -> dict[tuple[str, str], Bridges]:
+        """The bridges looked up so far (by :meth:`bridges`), by ``(from, to)`` model names."""
+        return dict(self._bridges)
 
     def bridges(self, a: str, b: str) -> Bridges:
         key = (a, b)
