@@ -262,6 +262,10 @@ def test_13_29_windows_find_the_slow_exercises(cmu_dir):
         name = spans[match[s.motion]][2]
         if name in truth_period:
             assert s.period_frames == pytest.approx(truth_period[name], rel=0.2), (name, s)
+    # the twist and the one-handed toe touch hold about one repetition each (under 1.5
+    # cycles, as extract finds too): they are segmented, but get no typical cycle
+    got = {spans[match[c.motion]][2] for c in motion_cycles(res)}
+    assert got == {"JumpJack", "ArmCircle", "KneeRaise", "Squat"}
 
 
 def test_autocorrelation_period_refines_a_window_length_guess():
@@ -277,3 +281,18 @@ def test_autocorrelation_period_refines_a_window_length_guess():
     assert autocorrelation_period(noise, 300.0) == 300.0
     assert autocorrelation_period(poses[:50], 480.0) == 480.0
     assert autocorrelation_period(poses, float("nan")) != autocorrelation_period(poses, float("nan"))
+
+
+def test_motion_cycles_need_one_and_a_half_cycles(chain):
+    """The rule extract applies (min_turns): a motion of one repetition and a part gets no
+    cycle; the CLI says which and why."""
+    _, res = chain
+    longest = {}
+    for sg in res.segments:
+        if sg.stop - sg.start > longest.get(sg.motion, (0, 0))[0]:
+            longest[sg.motion] = (sg.stop - sg.start, sg.cycles)
+    fewest = min(c for _, c in longest.values())
+    assert [c.motion for c in motion_cycles(res, min_cycles=fewest + 0.01)] == [
+        m for m, (_, c) in sorted(longest.items()) if c >= fewest + 0.01
+    ]
+    assert len(motion_cycles(res, min_cycles=fewest)) == res.n_motions

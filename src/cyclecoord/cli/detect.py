@@ -169,7 +169,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
     for sg in res.segments:
         print(
             f"  motion {sg.motion}: frames {m.start_frame + sg.start}-{m.start_frame + sg.stop} "
-            f"({sg.cycles:.1f} cycles, period {sg.period_frames:.1f} frames, classes "
+            f"({sg.cycles:.2f} cycles, period {sg.period_frames:.1f} frames, classes "
             f"{list(sg.classes)})"
         )
     for w in res.warnings:
@@ -180,13 +180,23 @@ def cmd_detect(args: argparse.Namespace) -> int:
 
         folder = Path(args.extract)
         folder.mkdir(parents=True, exist_ok=True)
-        for mc in motion_cycles(
+        cycles = motion_cycles(
             res,
             bandwidth=args.bandwidth,
             cycle_start=args.cycle_start,
             timing=args.timing,
             travel=args.travel,
-        ):
+        )
+        have = {mc.motion for mc in cycles}
+        for mid in range(res.n_motions):
+            segs = [sg for sg in res.segments if sg.motion == mid]
+            if segs and mid not in have:
+                seg = max(segs, key=lambda sg: sg.stop - sg.start)
+                print(
+                    f"motion {mid}: no cycle written: its longest segment holds {seg.cycles:.2f} "
+                    "cycles, under the 1.5 a typical cycle needs (extract refuses such a take too)"
+                )
+        for mc in cycles:
             out = folder / f"motion{mc.motion}_cycle.{args.extract_format}"
             save(mc.cycle, out)
             how = (

@@ -57,6 +57,7 @@ def motion_cycles(
     random_state: int | None = 0,
     timing: str = "capture",
     travel: str = "keep",
+    min_cycles: float = 1.5,
 ) -> list[MotionCycle]:
     """A typical cycle for every motion :func:`detect` found, with the phase it found.
 
@@ -80,11 +81,15 @@ def motion_cycles(
     result : DetectionResult
     n_samples, n_neighbors, bandwidth, cycle_start, random_state, timing, travel
         As for :func:`cyclecoord.extract`.
+    min_cycles : float, default 1.5
+        A motion whose longest segment holds fewer cycles gets no cycle: one repetition
+        and a part is no typical cycle (the rule :func:`cyclecoord.extract` applies with
+        ``min_turns``; 13_29's twist holds 1.4).
 
     Returns
     -------
     list of MotionCycle
-        One per motion that labels frames, by motion id.
+        One per motion that labels frames and holds ``min_cycles``, by motion id.
     """
     from ...quality.metrics import loop_closure
     from ..clip import capture_cycle, loop_cycle
@@ -109,7 +114,7 @@ def motion_cycles(
             continue
         seg = max(segs, key=lambda sg: sg.stop - sg.start)
         a, b, period = seg.start, seg.stop, float(seg.period_frames)
-        if not np.isfinite(period) or period < 2:
+        if not np.isfinite(period) or period < 2 or not seg.cycles >= min_cycles:
             continue
         rows = np.arange(a, b)
         lead = (
