@@ -487,7 +487,11 @@ def winding_birth(pairs: np.ndarray, lengths: np.ndarray, coordinate: np.ndarray
         The birth scale, or None when no loop with winding closes among the edges.
     """
     from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
+    from scipy.sparse.csgraph import (
+        breadth_first_order,
+        connected_components,
+        minimum_spanning_tree,
+    )
 
     theta = np.asarray(coordinate, dtype=float)
     n = theta.size
@@ -506,7 +510,9 @@ def winding_birth(pairs: np.ndarray, lengths: np.ndarray, coordinate: np.ndarray
     _, roots = np.unique(labels, return_index=True)
     th = theta.tolist()
     for root in roots:
-        order, pred = breadth_first_order(forest, int(root), directed=False, return_predecessors=True)
+        order, pred = breadth_first_order(
+            forest, int(root), directed=False, return_predecessors=True
+        )
         lift[root] = theta[root]
         lf = lift  # local alias; parents come before children in breadth-first order
         for v, u in zip(order[1:].tolist(), pred[order[1:]].tolist()):

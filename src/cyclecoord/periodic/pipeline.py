@@ -16,7 +16,14 @@ import numpy as np
 
 from .._blas import one_blas_thread
 from .barcode import (
-    CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, DEFAULT_PRIME, Barcode, BarSelection, refine_birth, select_bar,
+    CLEAR_GAP,
+    CLEAR_MIN_FRACTION,
+    CLEAR_RATIO,
+    DEFAULT_PRIME,
+    Barcode,
+    BarSelection,
+    refine_birth,
+    select_bar,
 )
 from .coordinates import REFINE_BYTES_PER_EDGE, CircularCoordinates, unwrap
 from .cycle import TypicalCycle, check_bandwidth, typical_cycle
@@ -160,7 +167,10 @@ class ExtractionResult:
         """JSON-ready summary (see the CLI's ``--report``)."""
         return {
             "source": self.motion.source,
-            "frames": [int(self.motion.start_frame), int(self.motion.start_frame + self.motion.n_frames)],
+            "frames": [
+                int(self.motion.start_frame),
+                int(self.motion.start_frame + self.motion.n_frames),
+            ],
             "n_frames": int(self.motion.n_frames),
             "fps": self.motion.fps,
             "dims": int(self.prepared.points.shape[1]),
@@ -169,7 +179,11 @@ class ExtractionResult:
             "prime": int(self.barcode.prime),
             "barcode": self.barcode.to_dict(),
             "selected": self.selection.to_dict(),
-            "clear_criterion": {"min_ratio": CLEAR_RATIO, "min_gap": CLEAR_GAP, "min_fraction_of_threshold": CLEAR_MIN_FRACTION},
+            "clear_criterion": {
+                "min_ratio": CLEAR_RATIO,
+                "min_gap": CLEAR_GAP,
+                "min_fraction_of_threshold": CLEAR_MIN_FRACTION,
+            },
             "coordinate": _nullable(self.coordinate),
             "phase": _nullable(self.phase),
             "used_frames": [[int(a), int(b)] for a, b in self.used_frames],
@@ -178,18 +192,28 @@ class ExtractionResult:
             "period_seconds": float(self.period_frames / self.motion.fps),
             "cycle_frames": [float(v) for v in self.cycle_frames],
             "period_spread": None if self.windings is None else float(self.windings.spread),
-            "heading_per_cycle_degrees": None if not np.isfinite(self.heading_per_cycle) else float(self.heading_per_cycle),
+            "heading_per_cycle_degrees": None
+            if not np.isfinite(self.heading_per_cycle)
+            else float(self.heading_per_cycle),
             "cycle_length": int(self.cycle.n_frames),
             "jerk": self.jerk,
             "loop_closure": float(self.loop_closure),
-            "bandwidth_frames": float(self.typical.bandwidth) if np.isfinite(self.typical.bandwidth) else None,
+            "bandwidth_frames": float(self.typical.bandwidth)
+            if np.isfinite(self.typical.bandwidth)
+            else None,
             "foot_skating": _cycle_skating(self.cycle),
             "distance_to_cycle": self.distance,
             "landmarks": _landmark_report(self.estimator),
             "cocycle_check": {
-                "triangles": int(self.estimator.cocycle_check_.n_triangles) if self.estimator else None,
-                "violations": int(self.estimator.cocycle_check_.n_violations) if self.estimator else None,
-                "primes_tried": [int(p) for p, _ in self.estimator.primes_tried_] if self.estimator else [],
+                "triangles": int(self.estimator.cocycle_check_.n_triangles)
+                if self.estimator
+                else None,
+                "violations": int(self.estimator.cocycle_check_.n_violations)
+                if self.estimator
+                else None,
+                "primes_tried": [int(p) for p, _ in self.estimator.primes_tried_]
+                if self.estimator
+                else [],
             },
             "timings": {k: round(float(v), 6) for k, v in self.timings.items()},
             "warnings": list(self.warnings),
@@ -219,11 +243,15 @@ def _landmark_report(est: CircularCoordinates | None) -> dict | None:
         "reason": est.landmark_reason_,
         "covering_radius": float(getattr(est, "covering_radius_", 0.0)),
         "complex_estimate": est.complex_estimate_.to_dict(),
-        "frames_outside_landmark_balls": int(np.sum(~est.covered_)) if hasattr(est, "covered_") else None,
+        "frames_outside_landmark_balls": int(np.sum(~est.covered_))
+        if hasattr(est, "covered_")
+        else None,
     }
 
 
-def _first_clear(est: CircularCoordinates, points: np.ndarray, class_index: int, scale, scale_fraction: float):
+def _first_clear(
+    est: CircularCoordinates, points: np.ndarray, class_index: int, scale, scale_fraction: float
+):
     """Barcode of ``points`` and the chosen bar, judged by its real death.
 
     A bar still alive at the threshold reads a death/birth ratio and a gap cut by the
@@ -253,7 +281,11 @@ def _first_clear(est: CircularCoordinates, points: np.ndarray, class_index: int,
             longer = est.fit_barcode(points)
         finally:
             est.max_scale = old
-        match = np.flatnonzero(np.isclose(longer.h1[:, 0], birth, rtol=1e-9, atol=1e-12)) if len(longer.h1) else []
+        match = (
+            np.flatnonzero(np.isclose(longer.h1[:, 0], birth, rtol=1e-9, atol=1e-12))
+            if len(longer.h1)
+            else []
+        )
         if not len(match):
             break
         barcode = longer
@@ -270,12 +302,16 @@ def _not_clear_reason(sel: BarSelection, barcode: Barcode) -> str:
     if sel.gap < CLEAR_GAP:
         why.append(f"persistence only {sel.gap:.2f}x the next bar's (< {CLEAR_GAP}x)")
     if not why:
-        why.append(f"persistence under {CLEAR_MIN_FRACTION:.0%} of the threshold {barcode.threshold:.4g}")
+        why.append(
+            f"persistence under {CLEAR_MIN_FRACTION:.0%} of the threshold {barcode.threshold:.4g}"
+        )
     ds = "inf" if not np.isfinite(sel.death) else f"{sel.death:.4g}"
     return f"H1 bar #{sel.index} [{sel.birth:.4g}, {ds}) does not stand clear ({'; '.join(why)})"
 
 
-def _unwrap_runs(theta: np.ndarray, rows: np.ndarray, runs: list[tuple[int, int]], n: int) -> np.ndarray:
+def _unwrap_runs(
+    theta: np.ndarray, rows: np.ndarray, runs: list[tuple[int, int]], n: int
+) -> np.ndarray:
     """The coordinate of ``rows`` unwrapped inside each run, NaN elsewhere (length ``n``)."""
     full = np.full(n, np.nan)
     full[rows] = theta
@@ -422,7 +458,9 @@ def extract(
     """
     if isinstance(delay, str):
         if delay != "auto":
-            raise ParameterError(f"delay must be 'auto', a number of seconds or None, got {delay!r}")
+            raise ParameterError(
+                f"delay must be 'auto', a number of seconds or None, got {delay!r}"
+            )
         options = {k: v for k, v in locals().items() if k not in ("motion", "frames", "delay")}
         try:
             return extract(motion, frames=frames, delay=None, **options)
@@ -431,23 +469,54 @@ def extract(
                 res = extract(motion, frames=frames, delay=AUTO_DELAY, **options)
             except NoPeriodicMotionError:
                 raise first from None
-            res.warnings.insert(0, f"read with a {AUTO_DELAY:g} s delay embedding: the poses alone show no "
-                                   "periodic motion (an out-and-back movement, such as a squat)")
+            res.warnings.insert(
+                0,
+                f"read with a {AUTO_DELAY:g} s delay embedding: the poses alone show no "
+                "periodic motion (an out-and-back movement, such as a squat)",
+            )
             return res
     opts = _check_options(
-        motion, weighting=weighting, sampling=sampling, cycle_start=cycle_start, n_samples=n_samples,
-        n_neighbors=n_neighbors, bandwidth=bandwidth, timing=timing, travel=travel, min_turns=min_turns,
+        motion,
+        weighting=weighting,
+        sampling=sampling,
+        cycle_start=cycle_start,
+        n_samples=n_samples,
+        n_neighbors=n_neighbors,
+        bandwidth=bandwidth,
+        timing=timing,
+        travel=travel,
+        min_turns=min_turns,
     )
     bandwidth = opts["bandwidth"]
     timings: dict[str, float] = {}
     notes: list[str] = []
     params = dict(
-        frames=None if frames is None else list(frames), pca=pca, normalize=normalize, temporal=temporal,
-        delay=delay, difference_root=difference_root, root=root, prime=prime, max_scale=max_scale, scale=scale,
-        class_index=class_index, scale_fraction=scale_fraction, n_samples=n_samples,
-        n_neighbors=n_neighbors, bandwidth=bandwidth, weighting=weighting, sampling=sampling, n_components=n_components,
-        cycle_start=cycle_start, landmarks=landmarks, memory_limit=memory_limit, random_state=random_state,
-        steady=steady, timing=timing, travel=travel, min_turns=min_turns,
+        frames=None if frames is None else list(frames),
+        pca=pca,
+        normalize=normalize,
+        temporal=temporal,
+        delay=delay,
+        difference_root=difference_root,
+        root=root,
+        prime=prime,
+        max_scale=max_scale,
+        scale=scale,
+        class_index=class_index,
+        scale_fraction=scale_fraction,
+        n_samples=n_samples,
+        n_neighbors=n_neighbors,
+        bandwidth=bandwidth,
+        weighting=weighting,
+        sampling=sampling,
+        n_components=n_components,
+        cycle_start=cycle_start,
+        landmarks=landmarks,
+        memory_limit=memory_limit,
+        random_state=random_state,
+        steady=steady,
+        timing=timing,
+        travel=travel,
+        min_turns=min_turns,
     )
     motion = motion.window(frames)
     if motion.n_frames < 2 * n_neighbors or motion.n_frames < 10:
@@ -458,10 +527,16 @@ def extract(
     T = motion.n_frames
     t0 = time.perf_counter()
     lag = int(round(delay * motion.fps)) if delay else None
-    prep = Preprocessor(difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=lag)
+    prep = Preprocessor(
+        difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=lag
+    )
     prepared = prep.fit_transform(motion)
     joints = joint_columns(motion, prepared)
-    moving = moving_mask(prepared.poses, motion.fps, columns=joints) if steady else np.ones(T, dtype=bool)
+    moving = (
+        moving_mask(prepared.poses, motion.fps, columns=joints)
+        if steady
+        else np.ones(T, dtype=bool)
+    )
     if not steady or moving.sum() >= 0.95 * T or moving.sum() < max(10, 2 * n_neighbors):
         moving = np.ones(T, dtype=bool)
     timings["prepare"] = time.perf_counter() - t0
@@ -471,19 +546,42 @@ def extract(
         if first_pass and isinstance(landmarks, str) and landmarks == "auto":
             lm = FIRST_PASS_LANDMARKS
         return CircularCoordinates(
-            max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
-            scale_fraction=scale_fraction, temporal=temporal, landmarks=lm, refine_birth=False,
+            max_scale=max_scale,
+            scale=scale,
+            class_index=class_index,
+            prime=prime,
+            scale_fraction=scale_fraction,
+            temporal=temporal,
+            landmarks=lm,
+            refine_birth=False,
             memory_limit=memory_limit,
-            memory_reserved=8.0 * max(0, prepared.poses.size - prepared.points.size),  # poses beyond the points
+            memory_reserved=8.0
+            * max(0, prepared.poses.size - prepared.points.size),  # poses beyond the points
         )
 
-    def fail(msg: str, fit: _Fit | None = None, barcode: Barcode | None = None) -> NoPeriodicMotionError:
+    def fail(
+        msg: str, fit: _Fit | None = None, barcode: Barcode | None = None
+    ) -> NoPeriodicMotionError:
         partial = ExtractionResult(
-            motion=motion, prepared=prepared, barcode=barcode if fit is None else fit.barcode,
-            selection=None if fit is None else fit.selection, coordinate=None,
-            unwrapped=None, cycles=float("nan"), period_frames=float("nan"), cycle_frames=np.zeros(0),
-            density=None, typical=None, cycle=None, jerk={}, loop_closure=float("nan"), distance={},
-            timings=timings, parameters=params, warnings=notes, estimator=None if fit is None else fit.est,
+            motion=motion,
+            prepared=prepared,
+            barcode=barcode if fit is None else fit.barcode,
+            selection=None if fit is None else fit.selection,
+            coordinate=None,
+            unwrapped=None,
+            cycles=float("nan"),
+            period_frames=float("nan"),
+            cycle_frames=np.zeros(0),
+            density=None,
+            typical=None,
+            cycle=None,
+            jerk={},
+            loop_closure=float("nan"),
+            distance={},
+            timings=timings,
+            parameters=params,
+            warnings=notes,
+            estimator=None if fit is None else fit.est,
             preprocessor=prep,
         )
         where = motion.source or "capture"
@@ -492,13 +590,19 @@ def extract(
     def fit_rows(rows: np.ndarray, stage: str, first_pass: bool = False) -> _Fit:
         est = make_estimator(first_pass)
         t0 = time.perf_counter()
-        barcode, sel = _first_clear(est, _rows_of(prepared.points, rows), class_index, scale, scale_fraction)
+        barcode, sel = _first_clear(
+            est, _rows_of(prepared.points, rows), class_index, scale, scale_fraction
+        )
         timings[f"barcode{stage}"] = time.perf_counter() - t0
         if sel is None:
             if len(barcode.h1) and class_index >= len(barcode.h1):
-                raise ParameterError(f"class index {class_index} out of range: the barcode has {len(barcode.h1)} H1 bars")
-            raise fail(f"no periodic motion found: the barcode has no H1 bar up to scale {barcode.threshold:.4g}",
-                       barcode=barcode)
+                raise ParameterError(
+                    f"class index {class_index} out of range: the barcode has {len(barcode.h1)} H1 bars"
+                )
+            raise fail(
+                f"no periodic motion found: the barcode has no H1 bar up to scale {barcode.threshold:.4g}",
+                barcode=barcode,
+            )
         # a bar that is clear but for its gap to the next one (long takes hold several
         # loops) is judged by its coordinate's windings instead (see _finish)
         gap_only = sel.ratio >= CLEAR_RATIO and sel.gap < CLEAR_GAP and (
@@ -513,7 +617,9 @@ def extract(
             # circuit, a drift); a later clear class that winds regularly is the motion's
             wind = complete_windings(fit.unwrapped, _row_runs(rows))
             j = 1
-            while (wind.turns < min_turns or not wind.spread <= MAX_SPREAD) and j < min(4, len(barcode.h1)):
+            while (wind.turns < min_turns or not wind.spread <= MAX_SPREAD) and j < min(
+                4, len(barcode.h1)
+            ):
                 other = select_bar(barcode, j, None, scale_fraction)
                 if other.ratio >= CLEAR_RATIO:
                     alt_est = est.with_coordinate_params(class_index=j)
@@ -521,21 +627,41 @@ def extract(
                         alt = coordinate_of(alt_est, other, rows)
                     except ParameterError:
                         alt = None
-                    alt_wind = complete_windings(alt.unwrapped, _row_runs(rows)) if alt is not None else None
-                    if alt_wind is not None and alt_wind.turns >= min_turns and alt_wind.spread <= MAX_SPREAD:
+                    alt_wind = (
+                        complete_windings(alt.unwrapped, _row_runs(rows))
+                        if alt is not None
+                        else None
+                    )
+                    if (
+                        alt_wind is not None
+                        and alt_wind.turns >= min_turns
+                        and alt_wind.spread <= MAX_SPREAD
+                    ):
                         alt.notes.append(
                             f"H1 class #{j} chosen: the most persistent class turns {wind.turns:.2f} times over "
-                            f"the frames (spread {wind.spread:.0%}), class #{j} {alt_wind.turns:.2f} times, regularly")
+                            f"the frames (spread {wind.spread:.0%}), class #{j} {alt_wind.turns:.2f} times, regularly"
+                        )
                         fit, wind = alt, alt_wind
                         break
                 j += 1
         if not first_pass and fit.est.landmarks_ is not None and not temporal:
             # the class's birth on every frame, for the report (landmarks are born later)
             budget = getattr(fit.est, "memory_budget_", None)
-            max_edges = 3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
-            full = refine_birth(_rows_of(prepared.points, rows), fit.selection.birth, fit.est.prime_, max_edges=max_edges,
-                                covering_radius=fit.est.covering_radius_,
-                                coordinate=fit.est.coordinates_) if max_edges > 0 else None
+            max_edges = (
+                3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
+            )
+            full = (
+                refine_birth(
+                    _rows_of(prepared.points, rows),
+                    fit.selection.birth,
+                    fit.est.prime_,
+                    max_edges=max_edges,
+                    covering_radius=fit.est.covering_radius_,
+                    coordinate=fit.est.coordinates_,
+                )
+                if max_edges > 0
+                else None
+            )
             fit.selection = BarSelection(**{**fit.selection.__dict__, "full_birth": full})
             fit.est.selection_ = fit.selection
         timings[f"coordinate{stage}"] = time.perf_counter() - t0
@@ -560,7 +686,9 @@ def extract(
         t0 = time.perf_counter()
         first = complete_windings(fit.unwrapped, stretches(moving))
         if np.isfinite(first.period_frames):
-            used = _steady_frames(motion, prepared, joints, fit.unwrapped, moving, first.period_frames)
+            used = _steady_frames(
+                motion, prepared, joints, fit.unwrapped, moving, first.period_frames
+            )
         if used.sum() >= 0.95 * moving.sum():
             used = moving
         refit = rough or used.sum() < moving.sum()
@@ -573,17 +701,36 @@ def extract(
         if first.turns < min_turns:
             raise fail(_too_few_turns(first.turns, int(moving.sum()), min_turns), fit)
         if not used.any():
-            raise fail("no periodic motion found: no stretch of the take repeats steadily for a whole period "
-                       f"(the coordinate turns {first.turns:.2f} times over the moving frames); "
-                       "check the coordinate figure (--plot), or try --no-steady or --frames", fit)
+            raise fail(
+                "no periodic motion found: no stretch of the take repeats steadily for a whole period "
+                f"(the coordinate turns {first.turns:.2f} times over the moving frames); "
+                "check the coordinate figure (--plot), or try --no-steady or --frames",
+                fit,
+            )
         if refit:
             fit = fit_rows(np.flatnonzero(used), "")
     notes.extend(fit.notes)
     return _finish(
-        motion, prepared, prep, fit, used, notes, timings, params, fail,
-        n_components=n_components, n_samples=n_samples, n_neighbors=n_neighbors, weighting=weighting,
-        sampling=sampling, bandwidth=bandwidth, random_state=random_state, cycle_start=cycle_start,
-        timing=timing, travel=travel, min_turns=min_turns,
+        motion,
+        prepared,
+        prep,
+        fit,
+        used,
+        notes,
+        timings,
+        params,
+        fail,
+        n_components=n_components,
+        n_samples=n_samples,
+        n_neighbors=n_neighbors,
+        weighting=weighting,
+        sampling=sampling,
+        bandwidth=bandwidth,
+        random_state=random_state,
+        cycle_start=cycle_start,
+        timing=timing,
+        travel=travel,
+        min_turns=min_turns,
     )
 
 
@@ -598,7 +745,9 @@ def _check_options(motion, **o) -> dict:
     if not isinstance(motion, Motion):
         raise ParameterError(f"extract() takes a Motion, got {type(motion).__name__}")
     if o["weighting"] not in ("kernel", "mean", "gaussian"):
-        raise ParameterError(f"weighting must be 'kernel', 'mean' or 'gaussian', got {o['weighting']!r}")
+        raise ParameterError(
+            f"weighting must be 'kernel', 'mean' or 'gaussian', got {o['weighting']!r}"
+        )
     if o["sampling"] not in ("quantile", "random"):
         raise ParameterError(f"sampling must be 'quantile' or 'random', got {o['sampling']!r}")
     if o["cycle_start"] not in ("slowest", "first"):
@@ -607,7 +756,11 @@ def _check_options(motion, **o) -> dict:
         raise ParameterError(f"timing must be one of {TIMINGS}, got {o['timing']!r}")
     if o["travel"] not in TRAVELS:
         raise ParameterError(f"travel must be one of {TRAVELS}, got {o['travel']!r}")
-    if not (isinstance(o["min_turns"], (int, float)) and np.isfinite(o["min_turns"]) and o["min_turns"] > 0):
+    if not (
+        isinstance(o["min_turns"], (int, float))
+        and np.isfinite(o["min_turns"])
+        and o["min_turns"] > 0
+    ):
         raise ParameterError(f"min_turns must be a positive number, got {o['min_turns']!r}")
     if o["n_samples"] < 10:
         raise ParameterError(f"n_samples must be at least 10, got {o['n_samples']}")
@@ -638,9 +791,11 @@ def _steady_frames(motion, prepared, joints, unwrapped, moving, period) -> np.nd
 
 
 def _too_few_turns(turns: float, n_frames: int, min_turns: float) -> str:
-    return (f"no periodic motion found: the coordinate turns only {turns:.2f} times over the {n_frames} "
-            f"steady frames (at least {min_turns:g} are needed to call a motion periodic); a longer take, "
-            "--frames around the repeated part, or --pca 3 may help")
+    return (
+        f"no periodic motion found: the coordinate turns only {turns:.2f} times over the {n_frames} "
+        f"steady frames (at least {min_turns:g} are needed to call a motion periodic); a longer take, "
+        "--frames around the repeated part, or --pca 3 may help"
+    )
 
 
 def _run_jerk(poses: np.ndarray, runs: list[tuple[int, int]], fps: float) -> float:
@@ -653,7 +808,9 @@ def _run_jerk(poses: np.ndarray, runs: list[tuple[int, int]], fps: float) -> flo
     return float(np.average(vals, weights=weights)) if vals else float("nan")
 
 
-def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o) -> ExtractionResult:
+def _finish(
+    motion, prepared, prep, fit, used, notes, timings, params, fail, **o
+) -> ExtractionResult:
     """Windings, period, cycle and figures of a fitted coordinate on the used frames."""
     T = motion.n_frames
     runs = stretches(used)
@@ -666,7 +823,9 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
             raise fail(
                 f"no periodic motion found: {_not_clear_reason(fit.selection, fit.barcode)}, and its coordinate "
                 f"winds irregularly (complete windings spread {wind.spread:.0%} of the period); "
-                "try --max-scale, --pca or --frames", fit)
+                "try --max-scale, --pca or --frames",
+                fit,
+            )
         notes.append(
             f"the H1 bar stands only {fit.selection.gap:.2f}x the next bar's persistence (under {CLEAR_GAP}x); "
             f"accepted because its coordinate winds {wind.turns:.1f} times, regularly (spread {wind.spread:.0%})"
@@ -689,7 +848,9 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     theta[~used] = np.nan
     rows = np.flatnonzero(used)
     t0 = time.perf_counter()
-    density = PeriodicDensity(n_components=o["n_components"], random_state=o["random_state"]).fit(theta[rows])
+    density = PeriodicDensity(n_components=o["n_components"], random_state=o["random_state"]).fit(
+        theta[rows]
+    )
     timings["density"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     phase = np.full(T, np.nan)
@@ -697,8 +858,15 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     if o["timing"] == "coordinate":
         k = min(o["n_neighbors"], rows.size)
         typ = typical_cycle(
-            theta[rows], prepared.poses[rows], period, density=density, n_samples=o["n_samples"], k=k,
-            weighting=o["weighting"], sampling=o["sampling"], random_state=o["random_state"],
+            theta[rows],
+            prepared.poses[rows],
+            period,
+            density=density,
+            n_samples=o["n_samples"],
+            k=k,
+            weighting=o["weighting"],
+            sampling=o["sampling"],
+            random_state=o["random_state"],
             bandwidth=o["bandwidth"],
         )
         typ, cycle_motion = loop_cycle(
@@ -708,8 +876,15 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     else:
         phase = retime(u, runs, wind)
         typ, cycle_motion, heading_change = capture_cycle(
-            phase, motion, prepared, prep, period, bandwidth=o["bandwidth"], cycle_start=o["cycle_start"],
-            travel=o["travel"], k=o["n_neighbors"],
+            phase,
+            motion,
+            prepared,
+            prep,
+            period,
+            bandwidth=o["bandwidth"],
+            cycle_start=o["cycle_start"],
+            travel=o["travel"],
+            k=o["n_neighbors"],
             metadata={"period_frames": period, "cycles_in_source": wind.turns},
         )
     timings["cycle"] = time.perf_counter() - t0
@@ -731,11 +906,30 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     timings["metrics"] = time.perf_counter() - t0
     timings["total"] = sum(v for k, v in timings.items())
     return ExtractionResult(
-        motion=motion, prepared=prepared, barcode=fit.barcode, selection=fit.selection, coordinate=theta,
-        unwrapped=u, cycles=float(wind.turns), period_frames=float(period), cycle_frames=wind.lengths,
-        density=density, typical=typ, cycle=cycle_motion, jerk=jerk, loop_closure=closure, distance=distance,
-        timings=timings, parameters=params, warnings=notes, estimator=fit.est, preprocessor=prep,
-        used=used, phase=phase, windings=wind, heading_per_cycle=heading_change,
+        motion=motion,
+        prepared=prepared,
+        barcode=fit.barcode,
+        selection=fit.selection,
+        coordinate=theta,
+        unwrapped=u,
+        cycles=float(wind.turns),
+        period_frames=float(period),
+        cycle_frames=wind.lengths,
+        density=density,
+        typical=typ,
+        cycle=cycle_motion,
+        jerk=jerk,
+        loop_closure=closure,
+        distance=distance,
+        timings=timings,
+        parameters=params,
+        warnings=notes,
+        estimator=fit.est,
+        preprocessor=prep,
+        used=used,
+        phase=phase,
+        windings=wind,
+        heading_per_cycle=heading_change,
     )
 
 

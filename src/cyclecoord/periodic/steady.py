@@ -26,7 +26,14 @@ from scipy.ndimage import gaussian_filter1d, uniform_filter1d
 
 from .windings import stretches
 
-__all__ = ["moving_mask", "recurrence", "steady_mask", "period_speed", "clean_runs", "centred_window"]
+__all__ = [
+    "moving_mask",
+    "recurrence",
+    "steady_mask",
+    "period_speed",
+    "clean_runs",
+    "centred_window",
+]
 
 
 def _smooth(x: np.ndarray, width: int) -> np.ndarray:
@@ -46,7 +53,9 @@ def clean_runs(mask: np.ndarray, min_run: int, max_gap: int) -> np.ndarray:
     return m
 
 
-def _smoothed_steps(joints: np.ndarray, sigma: float, columns: np.ndarray | None, block: int = 32768) -> np.ndarray:
+def _smoothed_steps(
+    joints: np.ndarray, sigma: float, columns: np.ndarray | None, block: int = 32768
+) -> np.ndarray:
     """Norm of each frame step of the Gaussian-smoothed poses, computed in blocks of frames.
 
     Each block is smoothed with a margin of the kernel's radius, so the steps equal those
@@ -101,7 +110,9 @@ def moving_mask(
         return np.ones(len(j), dtype=bool)
     # measurement noise adds a constant to the norm of raw frame steps (0.5 degrees of noise
     # on 56 channels reads as 5 degrees a frame); steps of lightly smoothed poses do not
-    step = _smoothed_steps(j, max(1.0, 0.04 * fps), None if columns is None else np.asarray(columns))
+    step = _smoothed_steps(
+        j, max(1.0, 0.04 * fps), None if columns is None else np.asarray(columns)
+    )
     step = np.concatenate([step, step[-1:]])
     speed = _smooth(step, round(smooth_seconds * fps))
     level = np.percentile(speed, 80)
@@ -112,7 +123,12 @@ def moving_mask(
 
 
 def recurrence(
-    poses: np.ndarray, period: float, *, shortest: float = 0.7, longest: float = 1.45, chunk: int = 2048
+    poses: np.ndarray,
+    period: float,
+    *,
+    shortest: float = 0.7,
+    longest: float = 1.45,
+    chunk: int = 2048,
 ) -> np.ndarray:
     """Distance from each pose to its nearest pose one period earlier or later.
 
@@ -151,13 +167,17 @@ def recurrence(
     return best
 
 
-def period_speed(poses: np.ndarray, fps: float, period: float, columns: np.ndarray | None = None) -> np.ndarray:
+def period_speed(
+    poses: np.ndarray, fps: float, period: float, columns: np.ndarray | None = None
+) -> np.ndarray:
     """Joint speed (norm of the lightly smoothed frame steps) averaged over one period
     around each frame, shape (T,); the steps of :func:`moving_mask`."""
     x = np.asarray(poses)
     if len(x) < 3:
         return np.ones(len(x))
-    step = _smoothed_steps(x, max(1.0, 0.04 * fps), None if columns is None else np.asarray(columns))
+    step = _smoothed_steps(
+        x, max(1.0, 0.04 * fps), None if columns is None else np.asarray(columns)
+    )
     return _smooth(np.concatenate([step, step[-1:]]), max(1, int(round(period))))
 
 
