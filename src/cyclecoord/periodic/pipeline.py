@@ -7,6 +7,7 @@ typical cycle as a loopable :class:`~cyclecoord.motion.Motion`.
 
 from __future__ import annotations
 
+import numbers
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -15,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from .._blas import one_blas_thread
+from .._validation import Interval, Options, check_params
 from .barcode import (
     CLEAR_GAP,
     CLEAR_MIN_FRACTION,
@@ -486,6 +488,14 @@ def extract(
         timing=timing,
         travel=travel,
         min_turns=min_turns,
+        normalize=normalize,
+        temporal=temporal,
+        difference_root=difference_root,
+        steady=steady,
+        pca=pca,
+        class_index=class_index,
+        scale_fraction=scale_fraction,
+        random_state=random_state,
     )
     bandwidth = opts["bandwidth"]
     timings: dict[str, float] = {}
@@ -741,31 +751,32 @@ def _rows_of(x: np.ndarray, rows: np.ndarray) -> np.ndarray:
     return x[rows]
 
 
+#: What :func:`extract`'s options may be (:mod:`cyclecoord._validation`); the scale and
+#: landmark options are checked where they are used (their messages name the data).
+EXTRACT_CONSTRAINTS = {
+    "weighting": [Options("kernel", "mean", "gaussian")],
+    "sampling": [Options("quantile", "random")],
+    "cycle_start": [Options("slowest", "first")],
+    "timing": [Options(*TIMINGS)],
+    "travel": [Options(*TRAVELS)],
+    "min_turns": [Interval(numbers.Real, 0, None, closed="neither")],
+    "n_samples": [Interval(numbers.Integral, 10, None)],
+    "n_neighbors": [Interval(numbers.Integral, 1, None)],
+    "normalize": ["boolean"],
+    "temporal": ["boolean"],
+    "difference_root": ["boolean"],
+    "steady": ["boolean"],
+    "pca": [Interval(numbers.Integral, 1, None), None],
+    "class_index": [Interval(numbers.Integral, 0, None)],
+    "scale_fraction": [Interval(numbers.Real, 0, 1, closed="right")],
+    "random_state": [Interval(numbers.Integral, 0, None), None],
+}
+
+
 def _check_options(motion, **o) -> dict:
     if not isinstance(motion, Motion):
         raise ParameterError(f"extract() takes a Motion, got {type(motion).__name__}")
-    if o["weighting"] not in ("kernel", "mean", "gaussian"):
-        raise ParameterError(
-            f"weighting must be 'kernel', 'mean' or 'gaussian', got {o['weighting']!r}"
-        )
-    if o["sampling"] not in ("quantile", "random"):
-        raise ParameterError(f"sampling must be 'quantile' or 'random', got {o['sampling']!r}")
-    if o["cycle_start"] not in ("slowest", "first"):
-        raise ParameterError(f"cycle_start must be 'slowest' or 'first', got {o['cycle_start']!r}")
-    if o["timing"] not in TIMINGS:
-        raise ParameterError(f"timing must be one of {TIMINGS}, got {o['timing']!r}")
-    if o["travel"] not in TRAVELS:
-        raise ParameterError(f"travel must be one of {TRAVELS}, got {o['travel']!r}")
-    if not (
-        isinstance(o["min_turns"], (int, float))
-        and np.isfinite(o["min_turns"])
-        and o["min_turns"] > 0
-    ):
-        raise ParameterError(f"min_turns must be a positive number, got {o['min_turns']!r}")
-    if o["n_samples"] < 10:
-        raise ParameterError(f"n_samples must be at least 10, got {o['n_samples']}")
-    if o["n_neighbors"] < 1:
-        raise ParameterError(f"n_neighbors must be at least 1, got {o['n_neighbors']}")
+    check_params(o, EXTRACT_CONSTRAINTS, "extract()")
     weighting = o["weighting"] if o["timing"] == "coordinate" else "kernel"
     o["bandwidth"] = check_bandwidth(o["bandwidth"], weighting)  # before any work is done
     return o

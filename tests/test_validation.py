@@ -1,0 +1,74 @@
+"""Parameter validation from a constraint table (cyclecoord._validation) and extract's table."""
+
+import numbers
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord._validation import Interval, Options, check_params, describe
+from cyclecoord.errors import ParameterError
+
+TABLE = {
+    "mode": [Options("a", "b", "c")],
+    "side": [Options("left", "right")],
+    "k": [Interval(numbers.Integral, 1, None)],
+    "frac": [Interval(numbers.Real, 0, 1, closed="right")],
+    "limit": [Interval(numbers.Real, 0, None, closed="neither"), None],
+    "flag": ["boolean"],
+}
+
+
+def test_values_inside_their_constraints_pass():
+    check_params(
+        {"mode": "b", "side": "left", "k": np.int64(3), "frac": 1.0, "limit": None, "flag": np.True_,
+         "other": object()},
+        TABLE,
+        "f()",
+    )
+
+
+@pytest.mark.parametrize(
+    ("name", "value", "message"),
+    [
+        ("mode", "d", "f(): mode must be one of 'a', 'b', 'c', got 'd'"),
+        ("side", 1, "f(): side must be 'left' or 'right', got 1"),
+        ("k", 0, "f(): k must be an integer >= 1, got 0"),
+        ("k", 2.0, "f(): k must be an integer >= 1, got 2.0"),
+        ("k", True, "f(): k must be an integer >= 1, got True"),
+        ("frac", 0.0, "f(): frac must be a number > 0 and <= 1, got 0.0"),
+        ("frac", float("nan"), "f(): frac must be a number > 0 and <= 1, got nan"),
+        ("limit", -1, "f(): limit must be a number > 0 or None, got -1"),
+        ("flag", 1, "f(): flag must be True or False, got 1"),
+    ],
+)
+def test_a_value_outside_gets_one_line_naming_it(name, value, message):
+    with pytest.raises(ParameterError) as info:
+        check_params({name: value}, TABLE, "f()")
+    assert str(info.value) == message
+
+
+def test_describe_reads_like_the_docs():
+    assert describe([Interval(numbers.Real, 0, 1), None]) == "a number >= 0 and <= 1 or None"
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "words"),
+    [
+        ("travel", "sideways", "travel must be one of 'keep', 'straight', 'in_place'"),
+        ("n_samples", 5, "n_samples must be an integer >= 10"),
+        ("min_turns", 0, "min_turns must be a number > 0"),
+        ("steady", "yes", "steady must be True or False"),
+        ("scale_fraction", 1.5, "scale_fraction must be a number > 0 and <= 1"),
+    ],
+)
+def test_extract_checks_its_table_before_any_work(option, value, words, monkeypatch):
+    import cyclecoord.periodic.pipeline as pipeline
+
+    def never(*args, **kwargs):
+        raise AssertionError("the capture was prepared before the options were checked")
+
+    monkeypatch.setattr(pipeline, "Preprocessor", never)
+    motion = cc.datasets.make_periodic_capture(n_frames=60, random_state=0).motion
+    with pytest.raises(ParameterError, match=words):
+        cc.extract(motion, **{option: value})
