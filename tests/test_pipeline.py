@@ -97,7 +97,11 @@ def test_deterministic_for_a_seed():
 def test_nothing_periodic_is_refused(make):
     with pytest.raises(cc.NoPeriodicMotionError, match="no periodic motion") as info:
         cc.extract(make(random_state=0).motion)
-    assert info.value.result is not None and info.value.result.barcode is not None
+    partial = info.value.result
+    assert isinstance(partial, cc.PartialExtraction) and partial.barcode is not None
+    # honest about what it lacks: no coordinate, period or cycle fields to find None in
+    assert partial.reason in str(info.value)
+    assert not hasattr(partial, "coordinate") and not hasattr(partial, "cycle")
 
 
 def test_bad_arguments():

@@ -37,6 +37,7 @@ _LAZY = {
     "DEFAULT_FPS": "motion",
     "Motion": "motion",
     "ExtractionResult": "periodic.pipeline",
+    "PartialExtraction": "periodic.pipeline",
     "extract": "periodic.pipeline",
     "PreparedData": "periodic.preprocess",
     "Preprocessor": "periodic.preprocess",
@@ -91,7 +92,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
     from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
     from .io import convert, load, save
     from .motion import DEFAULT_FPS, Motion
-    from .periodic.pipeline import ExtractionResult, extract
+    from .periodic.pipeline import ExtractionResult, PartialExtraction, extract
     from .periodic.preprocess import PreparedData, Preprocessor
     from .skeleton import Joint, JointPositions, Skeleton, forward_kinematics
     from .periodic.phase_model import PhaseModel
@@ -116,6 +117,7 @@ __all__ = [
     "NoPeriodicMotionError",
     "ParameterError",
     "ParseError",
+    "PartialExtraction",
     "PeriodicDensity",
     "PhaseModel",
     "PreparedData",

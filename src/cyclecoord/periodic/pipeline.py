@@ -39,7 +39,7 @@ from .root import heading, root_layout
 from .steady import moving_mask, period_speed, recurrence, steady_mask
 from .windings import Windings, complete_windings, retime, stretches
 
-__all__ = ["extract", "ExtractionResult", "cycle_lengths", "MIN_TURNS", "TIMINGS", "TRAVELS"]
+__all__ = ["extract", "ExtractionResult", "PartialExtraction", "cycle_lengths", "MIN_TURNS", "TIMINGS", "TRAVELS"]
 
 #: Fewer turns of the coordinate over the steady frames than this is no periodic motion
 #: (the rule :func:`~cyclecoord.periodic.detection.detect` applies to its segments).
@@ -74,6 +74,43 @@ def cycle_lengths(unwrapped: np.ndarray) -> np.ndarray:
     lo, hi = m[i - 1], m[i]
     ends = i - 1 + np.where(hi > lo, (levels - lo) / np.where(hi > lo, hi - lo, 1.0), 0.0)
     return np.diff(np.concatenate([[0.0], ends]))
+
+
+@dataclass
+class PartialExtraction:
+    """What an extraction that found no periodic motion got as far as
+    (``NoPeriodicMotionError.result``).
+
+    It holds only what was computed: the capture, its preparation and, when the run got
+    that far, the barcode, the bar looked at and the estimator; there is no coordinate,
+    period or cycle.  Figures of it show the barcode (why nothing stood clear), and
+    ``cyclecoord extract --report`` writes it with ``selected: null`` and the reason.
+
+    Attributes
+    ----------
+    motion : Motion
+    prepared : PreparedData
+    reason : str
+        Why the extraction stopped (the error's message without the source).
+    barcode : Barcode or None
+    selection : BarSelection or None
+        The bar that was judged (None when no bar was).
+    timings, parameters : dict
+    warnings : list of str
+    estimator : CircularCoordinates or None
+    preprocessor : Preprocessor or None
+    """
+
+    motion: Motion
+    prepared: PreparedData
+    reason: str
+    barcode: Barcode | None = None
+    selection: BarSelection | None = None
+    timings: dict = field(default_factory=dict)
+    parameters: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    estimator: CircularCoordinates | None = None
+    preprocessor: Preprocessor | None = None
 
 
 @dataclass
@@ -454,7 +491,7 @@ def extract(
     ------
     NoPeriodicMotionError
         When no bar stands clear or the steady frames hold under ``min_turns`` turns (its
-        ``result`` attribute holds a partial :class:`ExtractionResult`).
+        ``result`` attribute holds a :class:`PartialExtraction`).
     ParameterError
         For invalid arguments.
     """
@@ -572,22 +609,12 @@ def extract(
     def fail(
         msg: str, fit: _Fit | None = None, barcode: Barcode | None = None
     ) -> NoPeriodicMotionError:
-        partial = ExtractionResult(
+        partial = PartialExtraction(
             motion=motion,
             prepared=prepared,
+            reason=msg,
             barcode=barcode if fit is None else fit.barcode,
             selection=None if fit is None else fit.selection,
-            coordinate=None,
-            unwrapped=None,
-            cycles=float("nan"),
-            period_frames=float("nan"),
-            cycle_frames=np.zeros(0),
-            density=None,
-            typical=None,
-            cycle=None,
-            jerk={},
-            loop_closure=float("nan"),
-            distance={},
             timings=timings,
             parameters=params,
             warnings=notes,

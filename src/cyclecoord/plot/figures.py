@@ -61,8 +61,13 @@ _CYCLE = "#d62728"
 
 # ------------------------------------------------------------------ helpers
 def _check_result(result: Any, what: str) -> "ExtractionResult":
-    from ..periodic.pipeline import ExtractionResult
+    from ..periodic.pipeline import ExtractionResult, PartialExtraction
 
+    if isinstance(result, PartialExtraction):
+        raise ParameterError(
+            f"{what} needs a complete extraction; this partial result has no circular "
+            f"coordinate (no periodic motion was found: {result.reason})"
+        )
     if not isinstance(result, ExtractionResult):
         raise ParameterError(
             f"{what} takes an ExtractionResult (from cyclecoord.extract), got "
@@ -411,13 +416,14 @@ def plot_density(
 def _coordinate_series(
     data: Any, start_frame: int | None
 ) -> tuple[list[tuple[str, np.ndarray]], int]:
-    from ..periodic.pipeline import ExtractionResult
+    from ..periodic.pipeline import ExtractionResult, PartialExtraction
 
+    if isinstance(data, PartialExtraction):
+        raise ParameterError(
+            f"this extraction has no circular coordinate (no periodic motion was found: "
+            f"{data.reason})"
+        )
     if isinstance(data, ExtractionResult):
-        if data.coordinate is None:
-            raise ParameterError(
-                "this extraction has no circular coordinate (no periodic motion was found)"
-            )
         start = data.motion.start_frame if start_frame is None else start_frame
         series = [("coordinate", np.asarray(data.coordinate, dtype=float))]
         phase = getattr(data, "phase", None)
@@ -867,11 +873,13 @@ def save_figures(
         ``barcode.png`` is written: the barcode shows why nothing stood clear.
     """
     from ..io import atomic_write
-    from ..periodic.pipeline import ExtractionResult
+    from ..periodic.pipeline import ExtractionResult, PartialExtraction
 
-    if not isinstance(result, ExtractionResult):
+    if not isinstance(result, (ExtractionResult, PartialExtraction)):
         raise ParameterError(f"save_figures takes an ExtractionResult, got {type(result).__name__}")
-    complete = result.coordinate is not None and result.typical is not None
+    complete = isinstance(result, ExtractionResult)
+    if not complete and result.barcode is None:
+        raise ParameterError("this partial extraction stopped before its barcode: nothing to draw")
     res = result
     out = Path(folder)
     if out.exists() and not out.is_dir():
