@@ -258,3 +258,13 @@ def test_out_and_back_motion_is_read_with_a_delay(cmu_dir):
     res = cc.extract(m, frames=(0, 456))
     assert "delay embedding" in res.warnings[0]
     assert res.period_frames == pytest.approx(autocorrelation_period(m.frames[0:456], lo=90, hi=200), rel=0.05)
+
+
+def test_a_take_of_several_motions_points_to_detect():
+    """Extract reads one motion; when most moving frames are something else it says so."""
+    chain = cc.datasets.make_motion_chain(random_state=0)
+    res = cc.extract(chain.motion)
+    assert sum(b - a for a, b in res.used_frames) < 0.5 * chain.motion.n_frames
+    assert any("cyclecoord detect" in w for w in res.warnings)
+    # one steady motion alone does not get the note
+    assert not any("cyclecoord detect" in w for w in cc.extract(cc.datasets.example_capture().motion).warnings)

@@ -234,7 +234,7 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
         lines.append(
             f"steady motion in frames {_frames_text(used, m.start_frame)} ({n_used} of "
             f"{m.n_frames} frames); "
-            "the rest (standing, starting, turning or stopping) has no phase"
+            "the rest (standing, starting, turning, stopping or another motion) has no phase"
         )
     wind = res.windings
     spread = f", spread {wind.spread:.0%}" if wind is not None and wind.pooled.size > 1 else ""

@@ -747,6 +747,15 @@ def extract(
         if refit:
             fit = fit_rows(np.flatnonzero(used), "")
     notes.extend(fit.notes)
+    other = int(moving.sum() - (used & moving).sum())
+    if steady and other > 0.5 * moving.sum():
+        # most of the moving frames are not this motion: a routine of several exercises,
+        # or a dance whose one steady figure is not the take
+        notes.append(
+            f"only {int(used.sum())} of the take's {int(moving.sum())} moving frames repeat this "
+            "motion steadily; the rest may be other motions: `cyclecoord detect` finds each "
+            "motion of a take that holds several"
+        )
     return _finish(
         motion,
         prepared,
