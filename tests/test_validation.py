@@ -72,3 +72,19 @@ def test_extract_checks_its_table_before_any_work(option, value, words, monkeypa
     motion = cc.datasets.make_periodic_capture(n_frames=60, random_state=0).motion
     with pytest.raises(ParameterError, match=words):
         cc.extract(motion, **{option: value})
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "words"),
+    [
+        ("method", "both", "method must be one of 'auto', 'global', 'windows'"),
+        ("min_consistency", 0, "min_consistency must be a number > 0 and <= 1"),
+        ("n_classes", 0, "n_classes must be an integer >= 1 or None"),
+        ("window_points", 9, "window_points must be an integer >= 10"),
+        ("window_lengths", (2.0, -1.0), "window_lengths must be positive numbers of seconds"),
+    ],
+)
+def test_detect_checks_its_table(option, value, words):
+    motion = cc.datasets.make_periodic_capture(n_frames=60, random_state=0).motion
+    with pytest.raises(ParameterError, match=words):
+        cc.detect(motion, progress=False, **{option: value})

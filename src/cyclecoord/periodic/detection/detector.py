@@ -8,11 +8,14 @@ windowed stage in :mod:`.windows`, pauses and turns taken out of segments in
 
 from __future__ import annotations
 
+import numbers
 import time
+from typing import Any
 
 import numpy as np
 
 from ..._blas import one_blas_thread
+from ..._validation import Interval, Options, check_params
 from ...errors import NoPeriodicMotionError, ParameterError
 from ...motion import Motion
 from ..barcode import DEFAULT_PRIME
@@ -137,11 +140,16 @@ def detect(
         When no class is excited anywhere (``result`` holds the partial detection).
     """
     window_lengths = _check_arguments(
-        motion, n_classes=n_classes, min_persistence=min_persistence, window=window,
-        max_period=max_period, min_consistency=min_consistency, min_cycles=min_cycles,
-        merge_overlap=merge_overlap, method=method, window_lengths=window_lengths,
-        window_stride=window_stride, window_points=window_points, window_cycles=window_cycles,
-        window_steadiness=window_steadiness, similarity=similarity,
+        motion,
+        window_lengths,
+        dict(
+            n_classes=n_classes, min_persistence=min_persistence, window=window,
+            max_period=max_period, min_consistency=min_consistency, min_cycles=min_cycles,
+            merge_overlap=merge_overlap, method=method, window_stride=window_stride,
+            window_points=window_points, window_cycles=window_cycles,
+            window_steadiness=window_steadiness, similarity=similarity, normalize=normalize,
+            temporal=temporal, difference_root=difference_root, progress=progress,
+        ),
     )
     params = dict(
         frames=None if frames is None else list(frames), pca=pca, normalize=normalize,
@@ -245,30 +253,35 @@ def detect(
     return result
 
 
-def _positive(name: str, value: float) -> None:
-    if not np.isfinite(value) or value <= 0:
-        raise ParameterError(f"{name} must be a positive number, got {value}")
+_POSITIVE = [Interval(numbers.Real, 0, None, closed="neither")]
+_FRACTION = [Interval(numbers.Real, 0, 1, closed="right")]
+
+#: What :func:`detect`'s own options may be (:mod:`cyclecoord._validation`); those shared
+#: with :func:`cyclecoord.extract` are checked as there, ``window_lengths`` below.
+DETECT_CONSTRAINTS = {
+    "window": _POSITIVE,
+    "max_period": _POSITIVE,
+    "min_cycles": _POSITIVE,
+    "min_consistency": _FRACTION,
+    "merge_overlap": _FRACTION,
+    "min_persistence": [Interval(numbers.Real, 0, 1)],
+    "n_classes": [Interval(numbers.Integral, 1, None), None],
+    "method": [Options(*METHODS)],
+    "window_stride": _POSITIVE,
+    "window_cycles": _POSITIVE,
+    "similarity": _POSITIVE,
+    "window_steadiness": [Interval(numbers.Real, 0, 1)],
+    "window_points": [Interval(numbers.Integral, 10, None)],
+    "normalize": ["boolean"],
+    "temporal": ["boolean"],
+    "difference_root": ["boolean"],
+    "progress": ["boolean"],
+}
 
 
-def _check_arguments(
-    motion: Motion,
-    *,
-    n_classes: int | None,
-    min_persistence: float,
-    window: float,
-    max_period: float,
-    min_consistency: float,
-    min_cycles: float,
-    merge_overlap: float,
-    method: str,
-    window_lengths: tuple,
-    window_stride: float,
-    window_points: int,
-    window_cycles: float,
-    window_steadiness: float,
-    similarity: float,
-) -> tuple[float, ...]:
-    """Check :func:`detect`'s arguments (ParameterError naming the first bad one).
+def _check_arguments(motion: Motion, window_lengths: Any, values: dict) -> tuple[float, ...]:
+    """Check :func:`detect`'s arguments (ParameterError naming the first bad one):
+    ``values`` against :data:`DETECT_CONSTRAINTS`, then ``window_lengths``.
 
     Returns
     -------
@@ -277,16 +290,7 @@ def _check_arguments(
     """
     if not isinstance(motion, Motion):
         raise ParameterError(f"detect() takes a Motion, got {type(motion).__name__}")
-    for name, val in (("window", window), ("max_period", max_period), ("min_cycles", min_cycles)):
-        _positive(name, val)
-    if not 0 < min_consistency <= 1 or not 0 < merge_overlap <= 1 or not 0 <= min_persistence <= 1:
-        raise ParameterError(
-            "min_consistency and merge_overlap must be in (0, 1], min_persistence in [0, 1]"
-        )
-    if n_classes is not None and n_classes < 1:
-        raise ParameterError(f"n_classes must be at least 1, got {n_classes}")
-    if method not in METHODS:
-        raise ParameterError(f"method must be one of {list(METHODS)}, got {method!r}")
+    check_params(values, DETECT_CONSTRAINTS, "detect()")
     try:
         lengths = tuple(float(v) for v in np.atleast_1d(window_lengths))
     except (TypeError, ValueError):
@@ -295,14 +299,4 @@ def _check_arguments(
         ) from None
     if not lengths or not all(np.isfinite(v) and v > 0 for v in lengths):
         raise ParameterError(f"window_lengths must be positive numbers of seconds, got {lengths}")
-    for name, val in (
-        ("window_stride", window_stride),
-        ("window_cycles", window_cycles),
-        ("similarity", similarity),
-    ):
-        _positive(name, val)
-    if not 0 <= window_steadiness <= 1:
-        raise ParameterError(f"window_steadiness must be in [0, 1], got {window_steadiness}")
-    if int(window_points) != window_points or window_points < 10:
-        raise ParameterError(f"window_points must be a whole number >= 10, got {window_points}")
     return lengths
