@@ -88,3 +88,26 @@ def test_detect_checks_its_table(option, value, words):
     motion = cc.datasets.make_periodic_capture(n_frames=60, random_state=0).motion
     with pytest.raises(ParameterError, match=words):
         cc.detect(motion, progress=False, **{option: value})
+
+
+def test_cycle_options_as_one_object():
+    """extract and motion_cycles take the cycle's options as a CycleOptions too."""
+    from cyclecoord.periodic.detection import motion_cycles
+
+    m = cc.datasets.example_capture().motion
+    opts = cc.CycleOptions(travel="straight", cycle_start="first")
+    a = cc.extract(m, travel="straight", cycle_start="first")
+    b = cc.extract(m, cycle=opts)
+    np.testing.assert_array_equal(a.cycle.frames, b.cycle.frames)
+    assert b.parameters["travel"] == "straight"
+    with pytest.raises(ParameterError, match="travel either as keyword"):
+        cc.extract(m, travel="in_place", cycle=opts)
+    with pytest.raises(ParameterError, match="cycle must be a CycleOptions"):
+        cc.extract(m, cycle={"travel": "straight"})
+    chain = cc.datasets.make_motion_chain(random_state=0)
+    res = cc.detect(chain.motion, progress=False)
+    kw = motion_cycles(res, travel="in_place", min_cycles=1.5)
+    ob = motion_cycles(res, cycle=cc.CycleOptions(travel="in_place"))
+    assert [c.motion for c in kw] == [c.motion for c in ob]
+    for x, y in zip(kw, ob):
+        np.testing.assert_array_equal(x.cycle.frames, y.cycle.frames)

@@ -38,6 +38,7 @@ _LAZY = {
     "Motion": "motion",
     "ExtractionResult": "periodic.pipeline",
     "PartialExtraction": "periodic.pipeline",
+    "CycleOptions": "periodic.pipeline",
     "extract": "periodic.pipeline",
     "PreparedData": "periodic.preprocess",
     "Preprocessor": "periodic.preprocess",
@@ -92,7 +93,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
     from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
     from .io import convert, load, save
     from .motion import DEFAULT_FPS, Motion
-    from .periodic.pipeline import ExtractionResult, PartialExtraction, extract
+    from .periodic.pipeline import CycleOptions, ExtractionResult, PartialExtraction, extract
     from .periodic.preprocess import PreparedData, Preprocessor
     from .skeleton import Joint, JointPositions, Skeleton, forward_kinematics
     from .periodic.phase_model import PhaseModel
@@ -108,6 +109,7 @@ __all__ = [
     "BarSelection",
     "CircularCoordinates",
     "CycleCoordError",
+    "CycleOptions",
     "DEFAULT_FPS",
     "DetectionResult",
     "ExtractionResult",

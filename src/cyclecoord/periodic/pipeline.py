@@ -10,7 +10,7 @@ from __future__ import annotations
 import numbers
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -39,7 +39,7 @@ from .root import heading, root_layout
 from .steady import moving_mask, period_speed, recurrence, steady_mask
 from .windings import Windings, complete_windings, retime, stretches
 
-__all__ = ["extract", "ExtractionResult", "PartialExtraction", "cycle_lengths", "MIN_TURNS", "TIMINGS", "TRAVELS"]
+__all__ = ["extract", "ExtractionResult", "PartialExtraction", "CycleOptions", "cycle_lengths", "MIN_TURNS", "TIMINGS", "TRAVELS"]
 
 #: Fewer turns of the coordinate over the steady frames than this is no periodic motion
 #: (the rule :func:`~cyclecoord.periodic.detection.detect` applies to its segments).
@@ -74,6 +74,48 @@ def cycle_lengths(unwrapped: np.ndarray) -> np.ndarray:
     lo, hi = m[i - 1], m[i]
     ends = i - 1 + np.where(hi > lo, (levels - lo) / np.where(hi > lo, hi - lo, 1.0), 0.0)
     return np.diff(np.concatenate([[0.0], ends]))
+
+
+@dataclass(frozen=True)
+class CycleOptions:
+    """How the typical cycle is made: one object for :func:`extract`,
+    :func:`~cyclecoord.periodic.detection.motion_cycles` and a pipeline's own settings.
+
+    Each field is the keyword of the same name of :func:`extract` (see there), with the
+    same default; ``extract(m, cycle=CycleOptions(travel="straight"))`` equals
+    ``extract(m, travel="straight")``.
+    """
+
+    timing: str = "capture"
+    travel: str = "keep"
+    bandwidth: str | float | None = None
+    cycle_start: str = "slowest"
+    n_samples: int = 500
+    n_neighbors: int = 10
+    weighting: str = "kernel"
+    sampling: str = "quantile"
+    min_turns: float = MIN_TURNS
+
+    def as_dict(self) -> dict[str, Any]:
+        """The options as keyword arguments."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+def _take_cycle_options(cycle: Any, given: dict[str, Any], where: str) -> dict[str, Any]:
+    """``given`` (a function's cycle keywords) overridden by ``cycle``; a keyword changed
+    from its default beside ``cycle`` is an error (which one would win is not obvious)."""
+    if cycle is None:
+        return given
+    if not isinstance(cycle, CycleOptions):
+        raise ParameterError(f"{where}: cycle must be a CycleOptions, got {type(cycle).__name__}")
+    default = CycleOptions().as_dict()
+    clash = [k for k, v in given.items() if k in default and v != default[k]]
+    if clash:
+        raise ParameterError(
+            f"{where}: give {', '.join(clash)} either as keyword(s) or in cycle=CycleOptions(...), "
+            "not both"
+        )
+    return {**given, **cycle.as_dict()}
 
 
 @dataclass
@@ -405,6 +447,7 @@ def extract(
     timing: str = "capture",
     travel: str = "keep",
     min_turns: float = MIN_TURNS,
+    cycle: CycleOptions | None = None,
 ) -> ExtractionResult:
     """Find the dominant periodic motion of a capture and its typical cycle.
 
@@ -482,6 +525,9 @@ def extract(
         (heading change per cycle removed) or stay in place.
     min_turns : float, default 1.5
         Fewer turns of the coordinate over the steady frames is no periodic motion.
+    cycle : CycleOptions, optional
+        The cycle's options as one object (timing, travel, bandwidth, cycle_start,
+        n_samples, n_neighbors, weighting, sampling, min_turns), instead of keywords.
 
     Returns
     -------
@@ -495,6 +541,14 @@ def extract(
     ParameterError
         For invalid arguments.
     """
+    if cycle is not None:
+        given = dict(timing=timing, travel=travel, bandwidth=bandwidth, cycle_start=cycle_start,
+                     n_samples=n_samples, n_neighbors=n_neighbors, weighting=weighting,
+                     sampling=sampling, min_turns=min_turns)
+        chosen = _take_cycle_options(cycle, given, "extract()")
+        options = {k: v for k, v in locals().items()
+                   if k not in ("motion", "frames", "cycle", "given", "chosen", *chosen)}
+        return extract(motion, frames=frames, **options, **chosen)
     if isinstance(delay, str):
         if delay != "auto":
             raise ParameterError(

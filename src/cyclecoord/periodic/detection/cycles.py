@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -11,6 +12,9 @@ from ...motion import Motion
 from ..coordinates import unwrap
 from ..preprocess import Preprocessor
 from .result import DetectionResult
+
+if TYPE_CHECKING:
+    from ..pipeline import CycleOptions
 
 __all__ = ["MotionCycle", "motion_cycles"]
 
@@ -58,6 +62,7 @@ def motion_cycles(
     timing: str = "capture",
     travel: str = "keep",
     min_cycles: float = 1.5,
+    cycle: CycleOptions | None = None,
 ) -> list[MotionCycle]:
     """A typical cycle for every motion :func:`detect` found, with the phase it found.
 
@@ -81,6 +86,10 @@ def motion_cycles(
     result : DetectionResult
     n_samples, n_neighbors, bandwidth, cycle_start, random_state, timing, travel
         As for :func:`cyclecoord.extract`.
+    cycle : CycleOptions, optional
+        The cycle options as one object (as :func:`cyclecoord.extract` takes them); its
+        ``min_turns`` is ``min_cycles`` here, its ``weighting`` and ``sampling`` apply to
+        ``timing="coordinate"`` only and are not used.
     min_cycles : float, default 1.5
         A motion whose longest segment holds fewer cycles gets no cycle: one repetition
         and a part is no typical cycle (the rule :func:`cyclecoord.extract` applies with
@@ -98,6 +107,18 @@ def motion_cycles(
     from ..pipeline import TIMINGS
     from ..windings import complete_windings, retime, stretches
 
+    if cycle is not None:
+        from ..pipeline import _take_cycle_options
+
+        given = dict(n_samples=n_samples, n_neighbors=n_neighbors, bandwidth=bandwidth,
+                     cycle_start=cycle_start, timing=timing, travel=travel, min_turns=min_cycles)
+        chosen = _take_cycle_options(cycle, given, "motion_cycles()")
+        return motion_cycles(
+            result, n_samples=chosen["n_samples"], n_neighbors=chosen["n_neighbors"],
+            bandwidth=chosen["bandwidth"], cycle_start=chosen["cycle_start"],
+            random_state=random_state, timing=chosen["timing"], travel=chosen["travel"],
+            min_cycles=chosen["min_turns"],
+        )
     if not isinstance(result, DetectionResult):
         raise ParameterError(
             f"motion_cycles() takes a DetectionResult, got {type(result).__name__}"
