@@ -51,6 +51,8 @@ _LAZY = {
     "DetectionResult": "periodic.detection",
     "blend": "synthesis.blend",
     "transition": "synthesis.blend",
+    "BlendResult": "synthesis.blend",
+    "TransitionResult": "synthesis.blend",
     "align": "synthesis.align",
     "run_batch": "batch",
 }
@@ -99,7 +101,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
     from .periodic.phase_model import PhaseModel
     from .periodic.detection import DetectionResult, detect
     from .synthesis.align import align
-    from .synthesis.blend import blend, transition
+    from .synthesis.blend import BlendResult, TransitionResult, blend, transition
     from .batch import run_batch
 
 __version__ = "0.1.0"
@@ -107,6 +109,7 @@ __version__ = "0.1.0"
 __all__ = [
     "Barcode",
     "BarSelection",
+    "BlendResult",
     "CircularCoordinates",
     "CycleCoordError",
     "CycleOptions",
@@ -125,6 +128,7 @@ __all__ = [
     "PreparedData",
     "Preprocessor",
     "Skeleton",
+    "TransitionResult",
     "TypicalCycle",
     "align",
     "blend",
