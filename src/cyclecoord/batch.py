@@ -351,7 +351,8 @@ def _analyse(task: _Task) -> dict[str, Any]:
             fmt = task.cycle_format
             if fmt in SKELETON_FORMATS and result.cycle.skeleton is None:
                 notes.append(
-                    f"the capture has no skeleton, so its cycle was written as .npz instead of .{fmt}"
+                    "the capture has no skeleton, so its cycle was written as .npz instead of "
+                    f".{fmt}"
                 )
                 fmt = "npz"
                 report["warnings"] = notes

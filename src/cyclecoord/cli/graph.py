@@ -215,7 +215,8 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int
         gen = synth.generate(args.frames, start, frame)
     conn = synth.graph_.connectivity()
     print(
-        f"{synth.graph_.method} graph ({synth.field_.name} field) over {conn['nodes']} frames of {len(motions)} takes: "
+        f"{synth.graph_.method} graph ({synth.field_.name} field) over {conn['nodes']} frames of "
+        f"{len(motions)} takes: "
         f"{conn['edges']} edges, "
         f"{conn['weak_components']} weak / {conn['strong_components']} strong components; "
         f"start/end graph H {'connected' if conn['H']['connected'] else 'NOT connected'}"

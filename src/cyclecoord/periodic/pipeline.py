@@ -39,7 +39,10 @@ from .root import heading, root_layout
 from .steady import moving_mask, period_speed, recurrence, steady_mask
 from .windings import Windings, complete_windings, retime, stretches
 
-__all__ = ["extract", "ExtractionResult", "PartialExtraction", "CycleOptions", "cycle_lengths", "MIN_TURNS", "TIMINGS", "TRAVELS"]
+__all__ = [
+    "extract", "ExtractionResult", "PartialExtraction", "CycleOptions", "cycle_lengths",
+    "MIN_TURNS", "TIMINGS", "TRAVELS",
+]
 
 #: Fewer turns of the coordinate over the steady frames than this is no periodic motion
 #: (the rule :func:`~cyclecoord.periodic.detection.detect` applies to its segments).
@@ -239,7 +242,8 @@ class ExtractionResult:
 
     @property
     def model(self):
-        """The fitted :class:`~cyclecoord.periodic.phase_model.PhaseModel` (phase of new frames, save/load)."""
+        """The fitted :class:`~cyclecoord.periodic.phase_model.PhaseModel` (phase of new
+        frames, save/load)."""
         from .phase_model import PhaseModel
 
         return PhaseModel.from_result(self)
@@ -688,10 +692,12 @@ def extract(
         if sel is None:
             if len(barcode.h1) and class_index >= len(barcode.h1):
                 raise ParameterError(
-                    f"class index {class_index} out of range: the barcode has {len(barcode.h1)} H1 bars"
+                    f"class index {class_index} out of range: the barcode has {len(barcode.h1)} "
+                    "H1 bars"
                 )
             raise fail(
-                f"no periodic motion found: the barcode has no H1 bar up to scale {barcode.threshold:.4g}",
+                "no periodic motion found: the barcode has no H1 bar up to scale "
+                f"{barcode.threshold:.4g}",
                 barcode=barcode,
             )
         # a bar that is clear but for its gap to the next one (long takes hold several
@@ -729,8 +735,10 @@ def extract(
                         and alt_wind.spread <= MAX_SPREAD
                     ):
                         alt.notes.append(
-                            f"H1 class #{j} chosen: the most persistent class turns {wind.turns:.2f} times over "
-                            f"the frames (spread {wind.spread:.0%}), class #{j} {alt_wind.turns:.2f} times, regularly"
+                            f"H1 class #{j} chosen: the most persistent class turns "
+                            f"{wind.turns:.2f} times over "
+                            f"the frames (spread {wind.spread:.0%}), class #{j} "
+                            f"{alt_wind.turns:.2f} times, regularly"
                         )
                         fit, wind = alt, alt_wind
                         break
@@ -793,7 +801,8 @@ def extract(
             raise fail(_too_few_turns(first.turns, int(moving.sum()), min_turns), fit)
         if not used.any():
             raise fail(
-                "no periodic motion found: no stretch of the take repeats steadily for a whole period "
+                "no periodic motion found: no stretch of the take repeats steadily for a whole "
+                "period "
                 f"(the coordinate turns {first.turns:.2f} times over the moving frames); "
                 "check the coordinate figure (--plot), or try --no-steady or --frames",
                 fit,
@@ -893,8 +902,10 @@ def _steady_frames(motion, prepared, joints, unwrapped, moving, period) -> np.nd
 
 def _too_few_turns(turns: float, n_frames: int, min_turns: float) -> str:
     return (
-        f"no periodic motion found: the coordinate turns only {turns:.2f} times over the {n_frames} "
-        f"steady frames (at least {min_turns:g} are needed to call a motion periodic); a longer take, "
+        f"no periodic motion found: the coordinate turns only {turns:.2f} times over the "
+        f"{n_frames} "
+        f"steady frames (at least {min_turns:g} are needed to call a motion periodic); a longer "
+        "take, "
         "--frames around the repeated part, or --pca 3 may help"
     )
 
@@ -922,26 +933,31 @@ def _finish(
     if fit.weak_gap:
         if wind.spread > MAX_SPREAD or not np.isfinite(wind.period_frames):
             raise fail(
-                f"no periodic motion found: {_not_clear_reason(fit.selection, fit.barcode)}, and its coordinate "
+                f"no periodic motion found: {_not_clear_reason(fit.selection, fit.barcode)}, and "
+                "its coordinate "
                 f"winds irregularly (complete windings spread {wind.spread:.0%} of the period); "
                 "try --max-scale, --pca or --frames",
                 fit,
             )
         notes.append(
-            f"the H1 bar stands only {fit.selection.gap:.2f}x the next bar's persistence (under {CLEAR_GAP}x); "
-            f"accepted because its coordinate winds {wind.turns:.1f} times, regularly (spread {wind.spread:.0%})"
+            f"the H1 bar stands only {fit.selection.gap:.2f}x the next bar's persistence (under "
+            f"{CLEAR_GAP}x); "
+            f"accepted because its coordinate winds {wind.turns:.1f} times, regularly (spread "
+            f"{wind.spread:.0%})"
         )
     period = wind.period_frames
     if not np.isfinite(period):
         period = float(np.sum(used) - len(runs)) / wind.turns
     if wind.spread > MAX_SPREAD:
         notes.append(
-            f"the complete windings vary by {wind.spread:.0%} of the period (p10-p90); the motion is not "
+            f"the complete windings vary by {wind.spread:.0%} of the period (p10-p90); the motion "
+            "is not "
             "steady: use --frames to pick one steady stretch, or check the coordinate figure"
         )
     if fit.est.n_components_ > 1:
         notes.append(
-            f"the complex at scale {fit.selection.scale:.4g} has {fit.est.n_components_} connected components: "
+            f"the complex at scale {fit.selection.scale:.4g} has {fit.est.n_components_} "
+            "connected components: "
             "frames in different components get unrelated coordinates; raise --max-scale or --scale"
         )
     theta = np.full(T, np.nan)
