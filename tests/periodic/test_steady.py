@@ -62,3 +62,14 @@ def test_recurrence_is_the_nearest_pose_one_period_away_either_way():
                     want[t] = min(want[t], np.linalg.norm(x[s] - x[t]))
     np.testing.assert_allclose(got, want, rtol=1e-12)
     assert np.isinf(recurrence(x[:30], period)).all()  # no pose a period away
+
+
+def test_recurrence_of_some_columns_reads_them_block_by_block():
+    from cyclecoord.periodic.steady import recurrence
+
+    rng = np.random.default_rng(2)
+    x = rng.normal(size=(900, 6))
+    cols = np.array([0, 2, 5])
+    np.testing.assert_array_equal(
+        recurrence(x, 40.0, columns=cols, chunk=100), recurrence(x[:, cols], 40.0, chunk=100)
+    )

@@ -893,7 +893,7 @@ def _row_runs(rows: np.ndarray) -> list[tuple[int, int]]:
 
 def _steady_frames(motion, prepared, joints, unwrapped, moving, period) -> np.ndarray:
     """Steady frames of a take (see :mod:`~cyclecoord.periodic.steady`)."""
-    rec = recurrence(prepared.poses[:, joints], period)
+    rec = recurrence(prepared.poses, period, columns=joints)
     layout = root_layout(motion)
     hd = heading(motion.frames, layout) if layout is not None else None
     speed = period_speed(prepared.poses, motion.fps, period, columns=joints)
