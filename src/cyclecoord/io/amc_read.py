@@ -86,15 +86,11 @@ def _resolve_skeleton(
     return skel, info["angle"]
 
 
-def _parse_amc(
-    text: str, path: PathLike, skel: Skeleton, default_angle: str | None, fps: float,
-    skel_file: PathLike | None = None,
-) -> Motion:
-    # where the skeleton's side of a mismatch comes from, for the messages
-    per = f" (dofs per the skeleton {skel_file})" if skel_file is not None else ""
-    if not text.strip():
-        raise ParseError("file is empty; expected an AMC header and frames", path, 1)
-    # AMC bone name -> (joint name, dofs in listing order)
+def _amc_bone_map(skel: Skeleton) -> dict[str, tuple[str, tuple[str, ...]]]:
+    """AMC bone name -> (joint name, dofs in listing order).
+
+    The ASF names of the skeleton's bones, and also its own joint names where unambiguous.
+    """
     bone_map: dict[str, tuple[str, tuple[str, ...]]] = {}
     layout = [b for b in asf_layout(skel) if b.joint is not None]
     for b in layout:
@@ -102,32 +98,47 @@ def _parse_amc(
     for b in layout:  # also accept the skeleton's own joint names where unambiguous
         if safe_name(b.joint) == b.joint:
             bone_map.setdefault(b.joint, (b.joint, b.dofs))
+    return bone_map
 
-    lines = text.split("\n")
-    header: list[str] = []
-    angle: str | None = None
-    angle_line = 0
-    frame_no: int | None = None
-    frame_line = 0
-    first_number: int | None = None
-    first_bones: list[str] | None = None
-    entries: list[tuple[str, int, list[str]]] = []
-    flat: list[str] = []
-    rec_start: list[int] = []
-    rec_info: list[tuple[int, int, str]] = []  # (line, frame, bone)
-    n_frames = 0
-    last_line = 0
 
-    def emit(frame: int, items) -> None:
+class _AmcScan:
+    """What the line-by-line scan of an AMC file has gathered so far.
+
+    The values stay text tokens in ``flat``, record after record (one record: one bone of
+    one frame, in the bone order of the first frame); ``rec_start`` is where each record
+    starts in ``flat`` and ``rec_info`` its ``(line, frame, bone)``, for the messages.
+    """
+
+    def __init__(self, path: PathLike, bone_map: dict) -> None:
+        self.path = path
+        self.bone_map = bone_map
+        self.header: list[str] = []
+        self.angle: str | None = None
+        self.angle_line = 0
+        self.frame_no: int | None = None
+        self.frame_line = 0
+        self.first_number: int | None = None
+        self.first_bones: list[str] | None = None
+        self.entries: list[tuple[str, int, list[str]]] = []
+        self.flat: list[str] = []
+        self.rec_start: list[int] = []
+        self.rec_info: list[tuple[int, int, str]] = []  # (line, frame, bone)
+        self.n_frames = 0
+        self.last_line = 0
+
+    def emit(self, frame: int, items) -> None:
+        """Append the records of one frame."""
         for bone, ln, parts in items:
-            rec_start.append(len(flat))
-            rec_info.append((ln, frame, bone))
-            flat.extend(parts[1:])
+            self.rec_start.append(len(self.flat))
+            self.rec_info.append((ln, frame, bone))
+            self.flat.extend(parts[1:])
 
-    def close_frame() -> None:
-        nonlocal first_bones, n_frames
+    def close_frame(self) -> None:
+        """Check the frame just read against the first one and append its records."""
+        path, frame_no, frame_line = self.path, self.frame_no, self.frame_line
+        entries, first_bones = self.entries, self.first_bones
         assert frame_no is not None
-        if n_frames >= MAX_FRAMES:
+        if self.n_frames >= MAX_FRAMES:
             raise ParseError(
                 f"more than {MAX_FRAMES:,} frames; at most {MAX_FRAMES:,} are supported",
                 path,
@@ -135,121 +146,130 @@ def _parse_amc(
                 frame_no,
             )
         if first_bones is None:
-            names = [e[0] for e in entries]
-            if not names:
-                raise ParseError(
-                    f"frame {frame_no} has no bone values; expected lines '<bone> <values>'",
-                    path,
-                    frame_line,
-                    frame_no,
-                )
-            owners: dict[str, str] = {}
-            for bone, ln, _ in entries:
-                joint = bone_map[bone][0]
-                if joint in owners:
-                    raise ParseError(
-                        f"bone {bone!r} appears twice in frame {frame_no}"
-                        if owners[joint] == bone
-                        else f"bones {owners[joint]!r} and {bone!r} name the same joint",
-                        path,
-                        ln,
-                        frame_no,
-                    )
-                owners[joint] = bone
-            first_bones = names
-            emit(frame_no, entries)
+            self.first_bones = self._first_frame_bones()
+            self.emit(frame_no, entries)
         elif len(entries) == len(first_bones) and all(
             e[0] == b for e, b in zip(entries, first_bones)
         ):
-            emit(frame_no, entries)
+            self.emit(frame_no, entries)
         else:
-            by_name: dict[str, tuple[str, int, list[str]]] = {}
-            wanted = set(first_bones)
-            for e in entries:
-                if e[0] in by_name:
-                    raise ParseError(
-                        f"bone {e[0]!r} appears twice in frame {frame_no}", path, e[1], frame_no
-                    )
-                if e[0] not in wanted:
-                    raise ParseError(
-                        f"bone {e[0]!r} does not appear in the first frame; every frame must "
-                        "hold the same bones",
-                        path,
-                        e[1],
-                        frame_no,
-                    )
-                by_name[e[0]] = e
-            missing = [b for b in first_bones if b not in by_name]
-            if missing:
-                listed = ", ".join(repr(b) for b in missing[:5])
-                more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
-                raise ParseError(
-                    f"frame {frame_no} (starting at line {frame_line}) is missing bone "
-                    f"{listed}{more}; expected the {len(first_bones)} bones of the first frame",
-                    path,
-                    frame_line,
-                    frame_no,
-                )
-            emit(frame_no, [by_name[b] for b in first_bones])
-        n_frames += 1
+            self.emit(frame_no, self._in_first_frame_order())
+        self.n_frames += 1
 
-    for ln, raw in enumerate(lines, 1):
-        if "#" in raw:
-            if frame_no is None and raw.lstrip().startswith("#"):
-                header.append(raw.strip())
-                continue
-            raw = raw[: raw.index("#")]
-        parts = raw.split()
-        if not parts:
-            continue
-        last_line = ln
-        head = parts[0]
-        if len(parts) == 1 and INT_RE.fullmatch(head):
-            try:
-                number = parse_int(head, "a frame number", -MAX_FRAME_NUMBER, MAX_FRAME_NUMBER)
-            except ValueError as exc:
-                raise ParseError(str(exc), path, ln, frame_no) from None
-            if frame_no is None:
-                first_number = number
-            else:
-                close_frame()
-                if number != frame_no + 1:
-                    raise ParseError(
-                        f"frame number {number} out of sequence: expected {frame_no + 1}",
-                        path,
-                        ln,
-                        number,
-                    )
-            frame_no = number
-            frame_line = ln
-            entries = []
-            continue
-        if head.startswith(":"):
-            if frame_no is not None:
+    def _first_frame_bones(self) -> list[str]:
+        """The bones of the first frame, each naming a different joint."""
+        path, frame_no, entries = self.path, self.frame_no, self.entries
+        names = [e[0] for e in entries]
+        if not names:
+            raise ParseError(
+                f"frame {frame_no} has no bone values; expected lines '<bone> <values>'",
+                path,
+                self.frame_line,
+                frame_no,
+            )
+        owners: dict[str, str] = {}
+        for bone, ln, _ in entries:
+            joint = self.bone_map[bone][0]
+            if joint in owners:
                 raise ParseError(
-                    f"header line {raw.strip()!r} after the first frame; expected a frame "
-                    "number or a bone line",
+                    f"bone {bone!r} appears twice in frame {frame_no}"
+                    if owners[joint] == bone
+                    else f"bones {owners[joint]!r} and {bone!r} name the same joint",
                     path,
                     ln,
                     frame_no,
                 )
-            key = head.upper()
-            if key in (":DEGREES", ":RADIANS"):
-                this = "deg" if key == ":DEGREES" else "rad"
-                if angle is not None and angle != this:
-                    raise ParseError(
-                        f"{head} contradicts the angle unit given at line {angle_line}",
-                        path,
-                        ln,
-                    )
-                angle, angle_line = this, ln
-            header.append(raw.strip())
-            continue
+            owners[joint] = bone
+        return names
+
+    def _in_first_frame_order(self) -> list[tuple[str, int, list[str]]]:
+        """This frame's entries in the first frame's bone order, each bone once."""
+        path, frame_no, first_bones = self.path, self.frame_no, self.first_bones
+        assert first_bones is not None
+        by_name: dict[str, tuple[str, int, list[str]]] = {}
+        wanted = set(first_bones)
+        for e in self.entries:
+            if e[0] in by_name:
+                raise ParseError(
+                    f"bone {e[0]!r} appears twice in frame {frame_no}", path, e[1], frame_no
+                )
+            if e[0] not in wanted:
+                raise ParseError(
+                    f"bone {e[0]!r} does not appear in the first frame; every frame must "
+                    "hold the same bones",
+                    path,
+                    e[1],
+                    frame_no,
+                )
+            by_name[e[0]] = e
+        missing = [b for b in first_bones if b not in by_name]
+        if missing:
+            listed = ", ".join(repr(b) for b in missing[:5])
+            more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
+            raise ParseError(
+                f"frame {frame_no} (starting at line {self.frame_line}) is missing bone "
+                f"{listed}{more}; expected the {len(first_bones)} bones of the first frame",
+                path,
+                self.frame_line,
+                frame_no,
+            )
+        return [by_name[b] for b in first_bones]
+
+    def frame_number(self, head: str, ln: int) -> None:
+        """A line holding only a frame number: close the previous frame, open this one."""
+        path = self.path
+        try:
+            number = parse_int(head, "a frame number", -MAX_FRAME_NUMBER, MAX_FRAME_NUMBER)
+        except ValueError as exc:
+            raise ParseError(str(exc), path, ln, self.frame_no) from None
+        if self.frame_no is None:
+            self.first_number = number
+        else:
+            self.close_frame()
+            if number != self.frame_no + 1:
+                raise ParseError(
+                    f"frame number {number} out of sequence: expected {self.frame_no + 1}",
+                    path,
+                    ln,
+                    number,
+                )
+        self.frame_no = number
+        self.frame_line = ln
+        self.entries = []
+
+    def header_line(self, head: str, raw: str, ln: int) -> None:
+        """A ``:keyword`` line before the first frame (``:DEGREES``/``:RADIANS`` are read)."""
+        path = self.path
+        if self.frame_no is not None:
+            raise ParseError(
+                f"header line {raw.strip()!r} after the first frame; expected a frame "
+                "number or a bone line",
+                path,
+                ln,
+                self.frame_no,
+            )
+        key = head.upper()
+        if key in (":DEGREES", ":RADIANS"):
+            this = "deg" if key == ":DEGREES" else "rad"
+            if self.angle is not None and self.angle != this:
+                raise ParseError(
+                    f"{head} contradicts the angle unit given at line {self.angle_line}",
+                    path,
+                    ln,
+                )
+            self.angle, self.angle_line = this, ln
+        self.header.append(raw.strip())
+
+    def bone_line(
+        self, parts: list[str], raw: str, ln: int, skel: Skeleton, skel_file: PathLike | None
+    ) -> None:
+        """A ``<bone> <values>`` line of the current frame."""
+        path, frame_no, head = self.path, self.frame_no, parts[0]
         if frame_no is None:
             raise ParseError(
                 f"expected a frame number before bone values, got {raw.strip()!r}", path, ln
             )
-        spec = bone_map.get(head)
+        spec = self.bone_map.get(head)
         if spec is None:
             if INT_RE.fullmatch(head):
                 raise ParseError(
@@ -269,6 +289,8 @@ def _parse_amc(
         nd = len(spec[1])
         if len(parts) - 1 != nd:
             got = len(parts) - 1
+            # where the skeleton's side of a mismatch comes from, for the messages
+            per = f" (dofs per the skeleton {skel_file})" if skel_file is not None else ""
             raise ParseError(
                 f"bone {head!r} has {nd} dof{'s' if nd != 1 else ''} "
                 f"({' '.join(spec[1]) or 'none'}), got {got} value{'s' if got != 1 else ''}{per}",
@@ -277,34 +299,61 @@ def _parse_amc(
                 frame_no,
             )
         if nd:
-            entries.append((head, ln, parts))
+            self.entries.append((head, ln, parts))
 
-    if frame_no is None:
+
+def _scan_amc(
+    text: str, path: PathLike, skel: Skeleton, bone_map: dict, skel_file: PathLike | None
+) -> _AmcScan:
+    """Read every line of an AMC into an :class:`_AmcScan`, every frame closed."""
+    scan = _AmcScan(path, bone_map)
+    for ln, raw in enumerate(text.split("\n"), 1):
+        if "#" in raw:
+            if scan.frame_no is None and raw.lstrip().startswith("#"):
+                scan.header.append(raw.strip())
+                continue
+            raw = raw[: raw.index("#")]
+        parts = raw.split()
+        if not parts:
+            continue
+        scan.last_line = ln
+        head = parts[0]
+        if len(parts) == 1 and INT_RE.fullmatch(head):
+            scan.frame_number(head, ln)
+        elif head.startswith(":"):
+            scan.header_line(head, raw, ln)
+        else:
+            scan.bone_line(parts, raw, ln, skel, skel_file)
+    if scan.frame_no is None:
         raise ParseError(
-            "no frames: expected a frame number after the header", path, last_line or 1
+            "no frames: expected a frame number after the header", path, scan.last_line or 1
         )
-    close_frame()
-    assert first_bones is not None
+    scan.close_frame()
+    assert scan.first_bones is not None
+    return scan
 
+
+def _amc_values(scan: _AmcScan, path: PathLike, unit: str) -> tuple[np.ndarray, list]:
+    """Frames ``(T, D)`` in degrees and their ``(joint, dof)`` channels, values checked."""
+    bone_map, first_bones, flat = scan.bone_map, scan.first_bones, scan.flat
     n_cols = sum(len(bone_map[b][1]) for b in first_bones)
     try:
         values = np.array(flat, dtype=float)
     except ValueError:
         values = None
     if values is None or not np.all(np.isfinite(values)):
-        _locate_bad_value(flat, rec_start, rec_info, path)
+        _locate_bad_value(flat, scan.rec_start, scan.rec_info, path)
     assert values is not None
-    frames = values.reshape(n_frames, n_cols)
+    frames = values.reshape(scan.n_frames, n_cols)
     channels = [(bone_map[b][0], d) for b in first_bones for d in bone_map[b][1]]
-    unit = angle or default_angle or "deg"
     if unit == "rad":
         rot = [i for i, (_, d) in enumerate(channels) if d.startswith("r")]
         frames[:, rot] *= DEG_PER_RAD
     big = np.abs(frames) > MAX_MAGNITUDE
     if big.any():
         k = int(np.argmax(big.reshape(-1)))
-        rec = bisect.bisect_right(rec_start, k) - 1
-        ln, frame, bone = rec_info[rec]
+        rec = bisect.bisect_right(scan.rec_start, k) - 1
+        ln, frame, bone = scan.rec_info[rec]
         raise ParseError(
             f"value {flat[k]!r} for bone {bone!r} is beyond the largest supported magnitude "
             f"{MAX_MAGNITUDE:g}" + (" degrees" if unit == "rad" else ""),
@@ -312,6 +361,18 @@ def _parse_amc(
             ln,
             frame,
         )
+    return frames, channels
+
+
+def _parse_amc(
+    text: str, path: PathLike, skel: Skeleton, default_angle: str | None, fps: float,
+    skel_file: PathLike | None = None,
+) -> Motion:
+    if not text.strip():
+        raise ParseError("file is empty; expected an AMC header and frames", path, 1)
+    scan = _scan_amc(text, path, skel, _amc_bone_map(skel), skel_file)
+    unit = scan.angle or default_angle or "deg"
+    frames, channels = _amc_values(scan, path, unit)
     return Motion(
         frames=frames,
         channels=tuple(channels),
@@ -319,7 +380,7 @@ def _parse_amc(
         skeleton=skel,
         source=str(path),
         start_frame=0,
-        metadata={"amc_header": header, "first_frame_number": first_number},
+        metadata={"amc_header": scan.header, "first_frame_number": scan.first_number},
     )
 
 

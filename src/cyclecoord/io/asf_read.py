@@ -38,6 +38,7 @@ _ASF_SECTIONS = (
     ":skin",
 )
 
+
 # --------------------------------------------------------------------------- ASF read
 @dataclass
 class _AsfBone:
@@ -107,69 +108,240 @@ def _parse_limits(text: str, path: PathLike, line: int) -> list[tuple[float, flo
     return pairs
 
 
-def parse_asf(text: str, path: PathLike) -> tuple[Skeleton, dict]:
-    """Parse ASF text into a Skeleton plus ``{"angle", "mass", "version"}``."""
-    lines = text.split("\n")
-    if not text.strip():
-        raise ParseError("file is empty; expected an ASF skeleton", path, 1)
-    last_line = len(lines)
-    while last_line > 1 and not lines[last_line - 1].strip():
-        last_line -= 1
+@dataclass
+class _AsfScan:
+    """What the line-by-line scan of an ASF file has gathered so far."""
 
-    seen: dict[str, int] = {}
+    seen: dict = field(default_factory=dict)  # section keyword -> line
     section: str | None = None
-    name = ""
-    version = ""
-    units = {"mass": 1.0, "length": 1.0, "angle": "deg"}
-    root: dict = {"order": (), "axis": "XYZ", "position": np.zeros(3), "orientation": np.zeros(3)}
-    root_seen: dict[str, int] = {}
-    bones: list[_AsfBone] = []
+    name: str = ""
+    version: str = ""
+    units: dict = field(default_factory=lambda: {"mass": 1.0, "length": 1.0, "angle": "deg"})
+    root: dict = field(
+        default_factory=lambda: {
+            "order": (),
+            "axis": "XYZ",
+            "position": np.zeros(3),
+            "orientation": np.zeros(3),
+        }
+    )
+    root_seen: dict = field(default_factory=dict)
+    bones: list = field(default_factory=list)
     block: _AsfBone | None = None
-    last_field = ""
-    hier_state = "outside"
-    hier_entries: list[tuple[int, str, list[str]]] = []
-    hier_begin = 0
+    last_field: str = ""
+    hier_state: str = "outside"
+    hier_entries: list = field(default_factory=list)  # (line, parent, children)
+    hier_begin: int = 0
 
+
+def _section_line(st: _AsfScan, s: str, toks: list[str], path: PathLike, ln: int) -> None:
+    """A ``:keyword`` line: close nothing open, then enter the section."""
+    key = toks[0]
+    low = key.lower()
+    if st.block is not None:
+        raise ParseError(
+            f"bone block opened at line {st.block.line} has no 'end' before {key}",
+            path,
+            ln,
+        )
+    if st.section == ":hierarchy" and st.hier_state == "inside":
+        raise ParseError(
+            f"hierarchy block opened at line {st.hier_begin} has no 'end' before {key}",
+            path,
+            ln,
+        )
+    if low not in _ASF_SECTIONS:
+        raise ParseError(
+            f"unknown section {key!r}; expected one of {', '.join(_ASF_SECTIONS)}",
+            path,
+            ln,
+        )
+    if low in st.seen and low != ":skin":
+        raise ParseError(
+            f"section {key} appears twice (first at line {st.seen[low]})", path, ln
+        )
+    st.seen[low] = ln
+    st.section = low
+    if low == ":version":
+        st.version = " ".join(toks[1:])
+    elif low == ":name":
+        st.name = s[len(key) :].strip()
+    elif len(toks) > 1:
+        raise ParseError(f"unexpected text after {key}: {' '.join(toks[1:])!r}", path, ln)
+
+
+def _units_line(units: dict, s: str, toks: list[str], path: PathLike, ln: int) -> None:
+    """A line under ``:units`` (mass, length and angle are read; others are ignored)."""
+    low = toks[0].lower()
+    if len(toks) != 2:
+        raise ParseError(f"expected 'unit value' under :units, got {s!r}", path, ln)
+    if low in ("mass", "length"):
+        v = parse_number(toks[1], path, ln, f"units {low}")
+        if v <= 0:
+            raise ParseError(f"units {low} must be positive, got {toks[1]!r}", path, ln)
+        units[low] = v
+    elif low == "angle":
+        a = toks[1].lower()
+        if a in ("deg", "degree", "degrees"):
+            units["angle"] = "deg"
+        elif a in ("rad", "radian", "radians"):
+            units["angle"] = "rad"
+        else:
+            raise ParseError(
+                f"units angle must be 'deg' or 'rad', got {toks[1]!r}", path, ln
+            )
+    # other unit keys carry nothing cyclecoord uses
+
+
+def _root_line(st: _AsfScan, s: str, toks: list[str], path: PathLike, ln: int) -> None:
+    """A line under ``:root``: order, axis, position or orientation."""
+    key = toks[0]
+    low = key.lower()
+    root = st.root
+    if low in st.root_seen:
+        raise ParseError(
+            f"root field {key!r} given twice (first at line {st.root_seen[low]})", path, ln
+        )
+    st.root_seen[low] = ln
+    if low == "order":
+        root["order"] = _parse_dofs(toks[1:], path, ln, "root order")
+    elif low == "axis":
+        if len(toks) != 2:
+            raise ParseError(f"root axis needs one order such as XYZ, got {s!r}", path, ln)
+        root["axis"] = _parse_axis_order(toks[1], path, ln, "root")
+    elif low == "position":
+        root["position"] = parse_numbers(toks[1:], 3, path, ln, "root position")
+    elif low == "orientation":
+        root["orientation"] = parse_numbers(toks[1:], 3, path, ln, "root orientation")
+    else:
+        raise ParseError(
+            f"unknown root field {key!r}; expected order, axis, position or orientation",
+            path,
+            ln,
+        )
+
+
+def _bonedata_line(st: _AsfScan, s: str, toks: list[str], path: PathLike, ln: int) -> None:
+    """A line under ``:bonedata``: opens or closes a bone block, or sets one of its fields."""
+    key = toks[0]
+    low = key.lower()
+    block = st.block
+    if block is None:
+        if low == "begin" and len(toks) == 1:
+            st.block = _AsfBone(line=ln)
+            st.last_field = ""
+            return
+        raise ParseError(f"expected 'begin' to open a bone block, got {s!r}", path, ln)
+    if low == "end" and len(toks) == 1:
+        st.bones.append(_finish_bone(block, path, ln))
+        st.block = None
+        if len(st.bones) >= MAX_JOINTS:
+            raise ParseError(
+                f"more than {MAX_JOINTS - 1:,} bones; at most {MAX_JOINTS:,} joints "
+                "(the root and its bones) are supported",
+                path,
+                ln,
+            )
+        return
+    if s.startswith("("):
+        if st.last_field != "limits":
+            raise ParseError(f"limits line {s!r} does not follow 'limits'", path, ln)
+        block.limits.extend(_parse_limits(s, path, ln))
+        return
+    if low in block.seen:
+        raise ParseError(
+            f"bone field {key!r} given twice (first at line {block.seen[low]})", path, ln
+        )
+    block.seen[low] = ln
+    st.last_field = low
+    _bone_field(block, s, toks, path, ln)
+
+
+def _bone_field(block: _AsfBone, s: str, toks: list[str], path: PathLike, ln: int) -> None:
+    """One field line of an open bone block (``name``, ``direction``, ``dof``, ...)."""
+    key = toks[0]
+    low = key.lower()
+    who = f"bone {block.name!r}" if block.name else "bone"
+    if low == "begin":
+        raise ParseError(
+            f"bone block opened at line {block.line} has no 'end' before a new 'begin'",
+            path,
+            ln,
+        )
+    elif low == "id":
+        pass
+    elif low == "name":
+        if len(toks) != 2:
+            raise ParseError(f"bone name must be one word, got {s!r}", path, ln)
+        block.name = toks[1]
+        block.name_line = ln
+    elif low == "direction":
+        block.direction = parse_numbers(toks[1:], 3, path, ln, f"{who} direction")
+    elif low == "length":
+        v = parse_numbers(toks[1:], 1, path, ln, f"{who} length")[0]
+        if v < 0:
+            raise ParseError(
+                f"{who} length must not be negative, got {toks[1]!r}", path, ln
+            )
+        block.length = float(v)
+    elif low == "axis":
+        if len(toks) == 5:
+            block.axis_order = _parse_axis_order(toks[4], path, ln, who)
+            block.axis_angles = parse_numbers(toks[1:4], 3, path, ln, f"{who} axis")
+        elif len(toks) == 4:
+            block.axis_angles = parse_numbers(toks[1:4], 3, path, ln, f"{who} axis")
+        else:
+            raise ParseError(
+                f"{who} axis needs 3 angles and an order such as XYZ, got {s!r}", path, ln
+            )
+    elif low == "dof":
+        block.dofs = _parse_dofs(toks[1:], path, ln, who)
+        block.dof_line = ln
+    elif low == "limits":
+        block.limits_line = ln
+        block.limits.extend(_parse_limits(s[len(key) :], path, ln))
+    elif low in ("bodymass", "cofmass"):
+        pass
+    else:
+        raise ParseError(
+            f"unknown bone field {key!r}; expected id, name, direction, length, "
+            "axis, dof or limits",
+            path,
+            ln,
+        )
+
+
+def _hierarchy_line(st: _AsfScan, s: str, toks: list[str], path: PathLike, ln: int) -> None:
+    """A line under ``:hierarchy``: ``begin``, ``end`` or ``parent child...``."""
+    low = toks[0].lower()
+    if st.hier_state == "outside":
+        if low == "begin" and len(toks) == 1:
+            st.hier_state = "inside"
+            st.hier_begin = ln
+            return
+        raise ParseError(f"expected 'begin' to open the hierarchy, got {s!r}", path, ln)
+    if st.hier_state == "inside":
+        if low == "end" and len(toks) == 1:
+            st.hier_state = "done"
+            return
+        st.hier_entries.append((ln, toks[0], toks[1:]))
+        return
+    raise ParseError(f"unexpected line after the hierarchy's 'end': {s!r}", path, ln)
+
+
+def _scan_asf(lines: list[str], path: PathLike) -> _AsfScan:
+    """Read every line into an :class:`_AsfScan`, section by section."""
+    st = _AsfScan()
     for ln, raw in enumerate(lines, 1):
         s = strip_comment(raw)
         if not s:
             continue
         toks = s.split()
         key = toks[0]
-        low = key.lower()
         if key.startswith(":"):
-            if block is not None:
-                raise ParseError(
-                    f"bone block opened at line {block.line} has no 'end' before {key}",
-                    path,
-                    ln,
-                )
-            if section == ":hierarchy" and hier_state == "inside":
-                raise ParseError(
-                    f"hierarchy block opened at line {hier_begin} has no 'end' before {key}",
-                    path,
-                    ln,
-                )
-            if low not in _ASF_SECTIONS:
-                raise ParseError(
-                    f"unknown section {key!r}; expected one of {', '.join(_ASF_SECTIONS)}",
-                    path,
-                    ln,
-                )
-            if low in seen and low != ":skin":
-                raise ParseError(
-                    f"section {key} appears twice (first at line {seen[low]})", path, ln
-                )
-            seen[low] = ln
-            section = low
-            if low == ":version":
-                version = " ".join(toks[1:])
-            elif low == ":name":
-                name = s[len(key) :].strip()
-            elif len(toks) > 1:
-                raise ParseError(f"unexpected text after {key}: {' '.join(toks[1:])!r}", path, ln)
+            _section_line(st, s, toks, path, ln)
             continue
-
+        section = st.section
         if section is None:
             raise ParseError(
                 f"expected an ASF section keyword such as ':version' or ':root', got {key!r}",
@@ -184,166 +356,46 @@ def parse_asf(text: str, path: PathLike) -> tuple[Skeleton, dict]:
                     ln,
                 )
             continue
-
         if section == ":units":
-            if len(toks) != 2:
-                raise ParseError(f"expected 'unit value' under :units, got {s!r}", path, ln)
-            if low in ("mass", "length"):
-                v = parse_number(toks[1], path, ln, f"units {low}")
-                if v <= 0:
-                    raise ParseError(f"units {low} must be positive, got {toks[1]!r}", path, ln)
-                units[low] = v
-            elif low == "angle":
-                a = toks[1].lower()
-                if a in ("deg", "degree", "degrees"):
-                    units["angle"] = "deg"
-                elif a in ("rad", "radian", "radians"):
-                    units["angle"] = "rad"
-                else:
-                    raise ParseError(
-                        f"units angle must be 'deg' or 'rad', got {toks[1]!r}", path, ln
-                    )
-            # other unit keys carry nothing cyclecoord uses
-            continue
+            _units_line(st.units, s, toks, path, ln)
+        elif section == ":root":
+            _root_line(st, s, toks, path, ln)
+        elif section == ":bonedata":
+            _bonedata_line(st, s, toks, path, ln)
+        elif section == ":hierarchy":
+            _hierarchy_line(st, s, toks, path, ln)
+    return st
 
-        if section == ":root":
-            if low in root_seen:
-                raise ParseError(
-                    f"root field {key!r} given twice (first at line {root_seen[low]})", path, ln
-                )
-            root_seen[low] = ln
-            if low == "order":
-                root["order"] = _parse_dofs(toks[1:], path, ln, "root order")
-            elif low == "axis":
-                if len(toks) != 2:
-                    raise ParseError(f"root axis needs one order such as XYZ, got {s!r}", path, ln)
-                root["axis"] = _parse_axis_order(toks[1], path, ln, "root")
-            elif low == "position":
-                root["position"] = parse_numbers(toks[1:], 3, path, ln, "root position")
-            elif low == "orientation":
-                root["orientation"] = parse_numbers(toks[1:], 3, path, ln, "root orientation")
-            else:
-                raise ParseError(
-                    f"unknown root field {key!r}; expected order, axis, position or orientation",
-                    path,
-                    ln,
-                )
-            continue
 
-        if section == ":bonedata":
-            if block is None:
-                if low == "begin" and len(toks) == 1:
-                    block = _AsfBone(line=ln)
-                    last_field = ""
-                    continue
-                raise ParseError(f"expected 'begin' to open a bone block, got {s!r}", path, ln)
-            if low == "end" and len(toks) == 1:
-                bones.append(_finish_bone(block, path, ln))
-                block = None
-                if len(bones) >= MAX_JOINTS:
-                    raise ParseError(
-                        f"more than {MAX_JOINTS - 1:,} bones; at most {MAX_JOINTS:,} joints "
-                        "(the root and its bones) are supported",
-                        path,
-                        ln,
-                    )
-                continue
-            if s.startswith("("):
-                if last_field != "limits":
-                    raise ParseError(f"limits line {s!r} does not follow 'limits'", path, ln)
-                block.limits.extend(_parse_limits(s, path, ln))
-                continue
-            if low in block.seen:
-                raise ParseError(
-                    f"bone field {key!r} given twice (first at line {block.seen[low]})", path, ln
-                )
-            block.seen[low] = ln
-            last_field = low
-            who = f"bone {block.name!r}" if block.name else "bone"
-            if low == "begin":
-                raise ParseError(
-                    f"bone block opened at line {block.line} has no 'end' before a new 'begin'",
-                    path,
-                    ln,
-                )
-            elif low == "id":
-                pass
-            elif low == "name":
-                if len(toks) != 2:
-                    raise ParseError(f"bone name must be one word, got {s!r}", path, ln)
-                block.name = toks[1]
-                block.name_line = ln
-            elif low == "direction":
-                block.direction = parse_numbers(toks[1:], 3, path, ln, f"{who} direction")
-            elif low == "length":
-                v = parse_numbers(toks[1:], 1, path, ln, f"{who} length")[0]
-                if v < 0:
-                    raise ParseError(
-                        f"{who} length must not be negative, got {toks[1]!r}", path, ln
-                    )
-                block.length = float(v)
-            elif low == "axis":
-                if len(toks) == 5:
-                    block.axis_order = _parse_axis_order(toks[4], path, ln, who)
-                    block.axis_angles = parse_numbers(toks[1:4], 3, path, ln, f"{who} axis")
-                elif len(toks) == 4:
-                    block.axis_angles = parse_numbers(toks[1:4], 3, path, ln, f"{who} axis")
-                else:
-                    raise ParseError(
-                        f"{who} axis needs 3 angles and an order such as XYZ, got {s!r}", path, ln
-                    )
-            elif low == "dof":
-                block.dofs = _parse_dofs(toks[1:], path, ln, who)
-                block.dof_line = ln
-            elif low == "limits":
-                block.limits_line = ln
-                block.limits.extend(_parse_limits(s[len(key) :], path, ln))
-            elif low in ("bodymass", "cofmass"):
-                pass
-            else:
-                raise ParseError(
-                    f"unknown bone field {key!r}; expected id, name, direction, length, "
-                    "axis, dof or limits",
-                    path,
-                    ln,
-                )
-            continue
-
-        if section == ":hierarchy":
-            if hier_state == "outside":
-                if low == "begin" and len(toks) == 1:
-                    hier_state = "inside"
-                    hier_begin = ln
-                    continue
-                raise ParseError(f"expected 'begin' to open the hierarchy, got {s!r}", path, ln)
-            if hier_state == "inside":
-                if low == "end" and len(toks) == 1:
-                    hier_state = "done"
-                    continue
-                hier_entries.append((ln, key, toks[1:]))
-                continue
-            raise ParseError(f"unexpected line after the hierarchy's 'end': {s!r}", path, ln)
-
-    if block is not None:
+def _check_complete(st: _AsfScan, path: PathLike, last_line: int) -> None:
+    """Every block closed and every needed section present once the file ends."""
+    if st.block is not None:
         raise ParseError(
-            f"bone block opened at line {block.line} has no 'end' (file ends)", path, last_line
-        )
-    if hier_state == "inside":
-        raise ParseError(
-            f"hierarchy block opened at line {hier_begin} has no 'end' (file ends)",
+            f"bone block opened at line {st.block.line} has no 'end' (file ends)",
             path,
             last_line,
         )
+    if st.hier_state == "inside":
+        raise ParseError(
+            f"hierarchy block opened at line {st.hier_begin} has no 'end' (file ends)",
+            path,
+            last_line,
+        )
+    seen = st.seen
     if ":root" not in seen:
         raise ParseError("missing :root section (reached the end of the file)", path, last_line)
     if ":bonedata" not in seen:
         raise ParseError("missing :bonedata section (reached the end of the file)", path, last_line)
-    if bones and ":hierarchy" not in seen:
+    if st.bones and ":hierarchy" not in seen:
         raise ParseError(
             "missing :hierarchy section (reached the end of the file)", path, last_line
         )
 
-    # ------------------------------------------------------------ hierarchy
+
+def _link_hierarchy(
+    bones: list[_AsfBone], hier_entries: list, path: PathLike
+) -> tuple[dict, dict, dict, list[str]]:
+    """Bones by name, children and parent (with its line) of each, depth-first order."""
     defined: dict[str, _AsfBone] = {}
     for b in bones:
         assert b.name is not None
@@ -398,9 +450,20 @@ def parse_asf(text: str, path: PathLike) -> tuple[Skeleton, dict]:
                 path,
                 parent_of[b.name][1],
             )
+    return defined, children, parent_of, order
 
-    # ------------------------------------------------------------ joints
-    scale = DEG_PER_RAD if units["angle"] == "rad" else 1.0
+
+def _build_skeleton(
+    st: _AsfScan,
+    defined: dict,
+    children: dict,
+    parent_of: dict,
+    order: list[str],
+    path: PathLike,
+) -> Skeleton:
+    """The Skeleton of the linked bones: depth and size checks, then one joint per bone."""
+    root = st.root
+    scale = DEG_PER_RAD if st.units["angle"] == "rad" else 1.0
     index = {n: i for i, n in enumerate(order)}
     level = depths([-1] + [index[parent_of[n][0]] for n in order[1:]])
     for n, lv in zip(order, level):
@@ -410,7 +473,7 @@ def parse_asf(text: str, path: PathLike) -> tuple[Skeleton, dict]:
                 path,
                 parent_of[n][1],
             )
-    for b in bones:
+    for b in st.bones:
         vec = b.direction * b.length
         if not np.all(np.abs(vec) <= MAX_MAGNITUDE):
             raise ParseError(
@@ -451,12 +514,27 @@ def parse_asf(text: str, path: PathLike) -> tuple[Skeleton, dict]:
                     limits=limits,
                 )
             )
-        skeleton = Skeleton(
-            joints=tuple(joints), name=name, length_unit=units["length"], source_format="asf"
+        return Skeleton(
+            joints=tuple(joints), name=st.name, length_unit=st.units["length"], source_format="asf"
         )
     except ParameterError as exc:  # pragma: no cover - guarded by the checks above
         raise ParseError(f"inconsistent skeleton: {exc}", path) from None
-    return skeleton, {"angle": units["angle"], "mass": units["mass"], "version": version}
+
+
+def parse_asf(text: str, path: PathLike) -> tuple[Skeleton, dict]:
+    """Parse ASF text into a Skeleton plus ``{"angle", "mass", "version"}``."""
+    lines = text.split("\n")
+    if not text.strip():
+        raise ParseError("file is empty; expected an ASF skeleton", path, 1)
+    last_line = len(lines)
+    while last_line > 1 and not lines[last_line - 1].strip():
+        last_line -= 1
+    st = _scan_asf(lines, path)
+    _check_complete(st, path, last_line)
+    defined, children, parent_of, order = _link_hierarchy(st.bones, st.hier_entries, path)
+    skeleton = _build_skeleton(st, defined, children, parent_of, order, path)
+    units = st.units
+    return skeleton, {"angle": units["angle"], "mass": units["mass"], "version": st.version}
 
 
 def _finish_bone(b: _AsfBone, path: PathLike, end_line: int) -> _AsfBone:

@@ -197,9 +197,74 @@ def render(
         For a motion without skeleton, an unknown suffix or view, a bad step or rate, or
         an ``.mp4`` request when ffmpeg is not available.
     """
+    out = Path(path)
+    suffix, view, elev_azim = _check_render_args(out, view, step, fps, max_frames)
+    tracks = [_make_track(motion, titles[0] if titles else None)]
+    if other is not None:
+        tracks.append(_make_track(other, titles[1] if titles and len(titles) > 1 else None))
+    rate = tracks[0].fps
+    duration = max(t.positions.shape[0] / t.fps for t in tracks)
+    n_total = max(1, int(round(duration * rate)))
+    if step is None:
+        step = max(1, int(np.ceil(rate / 30.0 - 1e-9)), int(np.ceil(n_total / max_frames)))
+    times = np.arange(0, n_total, step) / rate
+    play_fps = float(fps) if fps is not None else rate / step
+
+    sampled = [t.at_times(times) for t in tracks]
+    frames_used = [f for _, f in sampled]
+    st = _stage([p for p, _ in sampled], view, follow, play_fps)
+
+    n_panels = len(tracks)
+    if st.is3d:
+        width_in = size * n_panels
+    else:
+        horiz = 2 * st.half
+        aspect = horiz / st.height if view in ("side", "front") else 1.0
+        width_in = size * n_panels * float(np.clip(aspect, 0.6, 2.5))
+    # even pixel sizes: H.264 in yuv420p needs them, and GIFs do not mind
+    px_w = max(2, 2 * int(round(width_in * dpi / 2)))
+    px_h = max(2, 2 * int(round(size * dpi / 2)))
+    fig = detached_figure((px_w / dpi, px_h / dpi), dpi)
+    artists = []
+    for k, tr in enumerate(tracks):
+        if st.is3d:
+            ax, floor, bones, dots = _panel_3d(fig, k, n_panels, tr, st, elev_azim)
+        else:
+            ax, floor, bones, dots = _panel_2d(fig, k, n_panels, tr, st)
+        text = ax.set_title(tr.title, fontsize=9)
+        artists.append((floor, bones, dots, text))
+
+    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.92, wspace=0.02)
+    spacing = _grid_spacing(st.body)
+    child = [np.flatnonzero(tr.parents >= 0) for tr in tracks]
+
+    def draw_frame(i: int) -> None:
+        for k, tr in enumerate(tracks):
+            floor, bones, dots, text = artists[k]
+            q = st.project(k, i)
+            bones.set_segments(np.stack([q[tr.parents[child[k]]], q[child[k]]], axis=1))
+            if st.follow or i == 0:
+                floor.set_segments(st.floor_lines(st.centres[k][i], spacing))
+            if st.is3d:
+                dots.set_data_3d(q[:, 0], q[:, 1], q[:, 2])
+            else:
+                dots.set_data(q[:, 0], q[:, 1])
+            text.set_text(f"{tr.title}  frame {tr.start_frame + int(frames_used[k][i])}")
+
+    _write_frames(fig, out, suffix, play_fps, dpi, len(times), draw_frame)
+    return out
+
+
+def _check_render_args(
+    out: Path,
+    view: str | tuple[float, float],
+    step: int | None,
+    fps: float | None,
+    max_frames: int,
+) -> tuple[str, str, tuple[float, float] | None]:
+    """Validate :func:`render`'s arguments; the suffix, the view name and ``(elev, azim)``."""
     from matplotlib import animation
 
-    out = Path(path)
     suffix = out.suffix.lower()
     if suffix not in (".gif", ".mp4"):
         raise ParameterError(
@@ -237,21 +302,47 @@ def render(
         raise ParameterError(f"fps must be a positive number, got {fps!r}")
     if not isinstance(max_frames, (int, np.integer)) or max_frames < 1:
         raise ParameterError(f"max_frames must be a whole number >= 1, got {max_frames!r}")
+    return suffix, view, elev_azim
 
-    tracks = [_make_track(motion, titles[0] if titles else None)]
-    if other is not None:
-        tracks.append(_make_track(other, titles[1] if titles and len(titles) > 1 else None))
-    rate = tracks[0].fps
-    duration = max(t.positions.shape[0] / t.fps for t in tracks)
-    n_total = max(1, int(round(duration * rate)))
-    if step is None:
-        step = max(1, int(np.ceil(rate / 30.0 - 1e-9)), int(np.ceil(n_total / max_frames)))
-    times = np.arange(0, n_total, step) / rate
-    play_fps = float(fps) if fps is not None else rate / step
 
-    sampled = [t.at_times(times) for t in tracks]
-    pos_list = [p for p, _ in sampled]
-    frames_used = [f for _, f in sampled]
+@dataclass
+class _Stage:
+    """Where the drawn motions sit: floor, height, panel half-width and the camera centres."""
+
+    pos_list: list  # per motion: world positions (K, P, 3) at the drawn times
+    hpos: list  # per motion: drawing floor coordinates (K, P, 2 in 3-D, 1 in 2-D)
+    centres: list  # per motion: panel centre (K, h) in drawing floor coordinates
+    body: float
+    floor_y: float
+    height: float
+    pad: float
+    half: float
+    perp: np.ndarray
+    is3d: bool
+    follow: bool
+
+    def project(self, k: int, i: int) -> np.ndarray:
+        """Drawing coordinates (P, 2 or 3) of panel ``k`` at drawn frame ``i``."""
+        h = self.hpos[k][i] - self.centres[k][i]
+        return np.concatenate([h, self.pos_list[k][i][:, 1:2]], axis=1)
+
+    def floor_lines(self, centre: np.ndarray, spacing: float) -> list:
+        """Floor grid lines inside the panel at round world positions, moving with the world."""
+        half, floor_y = self.half, self.floor_y
+        offsets = []
+        for c in centre:
+            m = np.arange(np.ceil((c - half) / spacing), np.floor((c + half) / spacing) + 1)
+            offsets.append(m * spacing - c)
+        if self.is3d:
+            lines = [[(o, -half, floor_y), (o, half, floor_y)] for o in offsets[0]]
+            lines += [[(-half, o, floor_y), (half, o, floor_y)] for o in offsets[1]]
+            return lines
+        tick = 0.04 * self.body
+        return [[(o, floor_y), (o - tick, floor_y - tick)] for o in offsets[0]]
+
+
+def _stage(pos_list: list, view: str, follow: bool | None, play_fps: float) -> _Stage:
+    """Body size, floor, the drawing's floor coordinates and the camera centres per frame."""
     body = max(float(np.median(np.ptp(p[..., 1], axis=1))) for p in pos_list) or 1.0
     floor_y = min(float(p[..., 1].min()) for p in pos_list)
     top_y = max(float(p[..., 1].max()) for p in pos_list)
@@ -290,110 +381,84 @@ def render(
             max(float(np.max(np.abs(h - c[:, None, :]))) for h, c in zip(hpos, centres))
             + 0.1 * body
         )
-    height = (top_y - floor_y) + 0.15 * body
-    pad = 0.05 * body
+    return _Stage(
+        pos_list=pos_list,
+        hpos=hpos,
+        centres=centres,
+        body=body,
+        floor_y=floor_y,
+        height=(top_y - floor_y) + 0.15 * body,
+        pad=0.05 * body,
+        half=half,
+        perp=perp,
+        is3d=is3d,
+        follow=bool(follow),
+    )
 
-    n_panels = len(tracks)
-    if is3d:
-        width_in = size * n_panels
+
+def _panel_3d(fig, k: int, n_panels: int, tr: _Track, st: _Stage, elev_azim) -> tuple:
+    """Axes, floor grid, bones and joint dots of 3-D panel ``k``."""
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+    half, floor_y, height, pad, perp = st.half, st.floor_y, st.height, st.pad, st.perp
+    ax = fig.add_subplot(1, n_panels, k + 1, projection="3d")
+    ax.set_axis_off()
+    ax.set_xlim(-half, half)
+    ax.set_ylim(-half, half)
+    ax.set_zlim(floor_y - pad, floor_y + height)
+    ax.set_box_aspect((2 * half, 2 * half, height + pad), zoom=1.35)
+    if elev_azim is not None:
+        ax.view_init(*elev_azim)
     else:
-        horiz = 2 * half
-        aspect = horiz / height if view in ("side", "front") else 1.0
-        width_in = size * n_panels * float(np.clip(aspect, 0.6, 2.5))
-    # even pixel sizes: H.264 in yuv420p needs them, and GIFs do not mind
-    px_w = max(2, 2 * int(round(width_in * dpi / 2)))
-    px_h = max(2, 2 * int(round(size * dpi / 2)))
-    fig = detached_figure((px_w / dpi, px_h / dpi), dpi)
-    axes = []
-    artists = []
-    spacing = _grid_spacing(body)
-    for k, tr in enumerate(tracks):
-        if is3d:
-            ax = fig.add_subplot(1, n_panels, k + 1, projection="3d")
-            ax.set_axis_off()
-            ax.set_xlim(-half, half)
-            ax.set_ylim(-half, half)
-            ax.set_zlim(floor_y - pad, floor_y + height)
-            ax.set_box_aspect((2 * half, 2 * half, height + pad), zoom=1.35)
-            if elev_azim is not None:
-                ax.view_init(*elev_azim)
-            else:
-                # look from the side of the travel, a little from the front and above
-                ang = np.degrees(np.arctan2(-perp[1], perp[0]))
-                ax.view_init(elev=12.0, azim=ang - 25.0)
-            from mpl_toolkits.mplot3d.art3d import Line3DCollection
+        # look from the side of the travel, a little from the front and above
+        ang = np.degrees(np.arctan2(-perp[1], perp[0]))
+        ax.view_init(elev=12.0, azim=ang - 25.0)
+    dummy = [[(0.0, 0.0, floor_y), (0.0, 0.0, floor_y)]]
+    floor = Line3DCollection(dummy, colors="0.75", linewidths=0.6)
+    ax.add_collection3d(floor)
+    bones = Line3DCollection(
+        dummy,
+        colors=[tr.colours[i] for i in range(len(tr.parents)) if tr.parents[i] >= 0],
+        linewidths=2.0,
+    )
+    ax.add_collection3d(bones)
+    (dots,) = ax.plot(
+        [], [], [], linestyle="none", marker="o", markersize=2.5, color="#222222"
+    )
+    return ax, floor, bones, dots
 
-            dummy = [[(0.0, 0.0, floor_y), (0.0, 0.0, floor_y)]]
-            floor = Line3DCollection(dummy, colors="0.75", linewidths=0.6)
-            ax.add_collection3d(floor)
-            bones = Line3DCollection(
-                dummy,
-                colors=[tr.colours[i] for i in range(len(tr.parents)) if tr.parents[i] >= 0],
-                linewidths=2.0,
-            )
-            ax.add_collection3d(bones)
-            (dots,) = ax.plot(
-                [], [], [], linestyle="none", marker="o", markersize=2.5, color="#222222"
-            )
-        else:
-            from matplotlib.collections import LineCollection
 
-            ax = fig.add_subplot(1, n_panels, k + 1)
-            ax.set_axis_off()
-            ax.set_xlim(-half, half)
-            ax.set_ylim(floor_y - pad - 0.02 * body, floor_y + height)
-            ax.set_aspect("equal")
-            ax.axhline(floor_y, color="0.45", linewidth=1.2)
-            floor = LineCollection([], colors="0.7", linewidths=0.8)
-            ax.add_collection(floor)
-            bones = LineCollection(
-                [],
-                colors=[tr.colours[i] for i in range(len(tr.parents)) if tr.parents[i] >= 0],
-                linewidths=2.2,
-                capstyle="round",
-            )
-            ax.add_collection(bones)
-            (dots,) = ax.plot([], [], linestyle="none", marker="o", markersize=2.5, color="#222222")
-        text = ax.set_title(tr.title, fontsize=9)
-        axes.append(ax)
-        artists.append((floor, bones, dots, text))
+def _panel_2d(fig, k: int, n_panels: int, tr: _Track, st: _Stage) -> tuple:
+    """Axes, floor ticks, bones and joint dots of 2-D (side or front) panel ``k``."""
+    from matplotlib.collections import LineCollection
 
-    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.92, wspace=0.02)
+    half, floor_y, body = st.half, st.floor_y, st.body
+    ax = fig.add_subplot(1, n_panels, k + 1)
+    ax.set_axis_off()
+    ax.set_xlim(-half, half)
+    ax.set_ylim(floor_y - st.pad - 0.02 * body, floor_y + st.height)
+    ax.set_aspect("equal")
+    ax.axhline(floor_y, color="0.45", linewidth=1.2)
+    floor = LineCollection([], colors="0.7", linewidths=0.8)
+    ax.add_collection(floor)
+    bones = LineCollection(
+        [],
+        colors=[tr.colours[i] for i in range(len(tr.parents)) if tr.parents[i] >= 0],
+        linewidths=2.2,
+        capstyle="round",
+    )
+    ax.add_collection(bones)
+    (dots,) = ax.plot([], [], linestyle="none", marker="o", markersize=2.5, color="#222222")
+    return ax, floor, bones, dots
 
-    def project(k: int, i: int) -> np.ndarray:
-        """Drawing coordinates (P, 2 or 3) of panel ``k`` at drawn frame ``i``."""
-        h = hpos[k][i] - centres[k][i]
-        return np.concatenate([h, pos_list[k][i][:, 1:2]], axis=1)
 
-    def floor_lines(centre: np.ndarray) -> list:
-        """Floor grid lines inside the panel at round world positions, moving with the world."""
-        offsets = []
-        for c in centre:
-            m = np.arange(np.ceil((c - half) / spacing), np.floor((c + half) / spacing) + 1)
-            offsets.append(m * spacing - c)
-        if is3d:
-            lines = [[(o, -half, floor_y), (o, half, floor_y)] for o in offsets[0]]
-            lines += [[(-half, o, floor_y), (half, o, floor_y)] for o in offsets[1]]
-            return lines
-        tick = 0.04 * body
-        return [[(o, floor_y), (o - tick, floor_y - tick)] for o in offsets[0]]
-
-    child = [np.flatnonzero(tr.parents >= 0) for tr in tracks]
-
-    def draw_frame(i: int) -> None:
-        for k, tr in enumerate(tracks):
-            floor, bones, dots, text = artists[k]
-            q = project(k, i)
-            bones.set_segments(np.stack([q[tr.parents[child[k]]], q[child[k]]], axis=1))
-            if follow or i == 0:
-                floor.set_segments(floor_lines(centres[k][i]))
-            if is3d:
-                dots.set_data_3d(q[:, 0], q[:, 1], q[:, 2])
-            else:
-                dots.set_data(q[:, 0], q[:, 1])
-            text.set_text(f"{tr.title}  frame {tr.start_frame + int(frames_used[k][i])}")
-
+def _write_frames(fig, out: Path, suffix: str, play_fps: float, dpi: float, n: int,
+                  draw_frame) -> None:
+    """Draw the ``n`` frames one by one into a GIF or MP4 written atomically at ``out``."""
+    import matplotlib as mpl
     from matplotlib import animation as anim
+
+    from ..io import atomic_path
 
     if suffix == ".gif":
         writer = anim.PillowWriter(fps=play_fps)
@@ -401,15 +466,11 @@ def render(
         writer = anim.FFMpegWriter(
             fps=play_fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"]
         )
-    import matplotlib as mpl
-
-    from ..io import atomic_path
-
     with atomic_path(out, suffix=f".tmp{suffix}") as tmp, mpl.rc_context({"savefig.bbox": None}):
         # (a 'tight' bbox would change the frame size)
         writer.setup(fig, str(tmp), dpi)
         try:
-            for i in range(len(times)):
+            for i in range(n):
                 draw_frame(i)
                 writer.grab_frame()
         except BaseException:
@@ -419,7 +480,6 @@ def render(
                 writer.finish()
             raise
         writer.finish()
-    return out
 
 
 def _grid_spacing(body: float) -> float:
