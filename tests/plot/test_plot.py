@@ -23,7 +23,7 @@ from cyclecoord.quality.metrics import jerk  # noqa: E402
 
 Image = pytest.importorskip("PIL.Image", reason="image checks need Pillow (ships with matplotlib)")
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
 
 
