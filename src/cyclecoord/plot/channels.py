@@ -149,8 +149,6 @@ def plot_channels(
         ``"<joint>.<dof>"`` and a dashed one (cycle) labelled ``"<joint>.<dof> (cycle)"``.
         Jerk axes: lines labelled ``"original"`` and ``"cycle"``.
     """
-    from ..quality.metrics import jerk
-
     res = check_result(result, "plot_channels")
     if not np.isfinite(periods) or periods <= 0:
         raise ParameterError(f"periods must be a positive number, got {periods!r}")
@@ -160,7 +158,6 @@ def plot_channels(
     cols = _resolve_channels(motion, channels, root, max_channels)
     names = [f"{motion.channels[c][0]}.{motion.channels[c][1]}" for c in cols]
     ccols = [cycle.channel_index(*motion.channels[c]) for c in cols]
-    fps = motion.fps
     period = float(res.period_frames)
     # the capture from its first steady frame (a whole take's standing start is not the cycle's)
     used = getattr(res, "used_frames", None) or [(0, motion.n_frames)]
@@ -210,6 +207,18 @@ def plot_channels(
         ax_c.legend(handles=[h for h in ax_c.get_lines() if not h.get_label().endswith("(cycle)")],
                     fontsize=7, loc="upper right", ncol=2)
 
+    _draw_jerk(ax_j, res, s0, j0, P, period)
+    return fig
+
+def _draw_jerk(
+    ax_j: "Axes", res: "ExtractionResult", s0: int, j0: int, P: int, period: float
+) -> None:
+    """The jerk panel: one period of the capture from frame ``s0`` and of the cycle from its
+    frame ``j0`` (of ``P``), in the space ``result.jerk`` is measured in."""
+    from ..quality.metrics import jerk
+
+    motion = res.motion
+    fps = motion.fps
     # jerk in the space result.jerk is measured in (one definition everywhere), one period
     n_j = int(min(motion.n_frames - s0, max(8, round(period))))
     stencil = 7
@@ -247,4 +256,3 @@ def plot_channels(
     ax_j.legend(fontsize=8, loc="upper right")
     if jo.size and jc.size and min(jo.min(), jc.min()) > 0:
         ax_j.set_yscale("log")
-    return fig

@@ -97,8 +97,6 @@ def plot_barcode(
         ``"H0"`` and ``"H1"`` with one segment per bar; the highlighted bar and scale
         line are labelled ``"selected class"`` and ``"scale"``.
     """
-    from matplotlib.collections import LineCollection
-
     from ..periodic.barcode import Barcode
 
     if not isinstance(barcode, Barcode):
@@ -114,71 +112,13 @@ def plot_barcode(
     # H0 in decreasing death order (the infinite bar on top), H1 as stored (by persistence)
     h0 = h0[np.argsort(-np.minimum(h0[:, 1], thr), kind="stable")] if len(h0) else h0
 
-    if ax is None:
-        fig = new_figure((7.0, 5.0), fig)
-        n0, n1 = max(len(h0), 1), max(len(h1), 1)
-        w0 = float(np.clip(np.log1p(n0), 1.0, 3.0))
-        w1 = float(np.clip(np.log1p(n1), 1.0, 3.0))
-        ax0, ax1 = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [w0, w1]})
-        shared = False
-    elif isinstance(ax, (list, tuple)):
-        if len(ax) != 2:
-            raise ParameterError(f"ax must be one Axes or a pair (H0, H1), got {len(ax)} axes")
-        ax0, ax1 = ax
-        fig = ax0.figure
-        shared = False
-    else:
-        ax0 = ax1 = ax
-        fig = ax.figure
-        shared = True
-
+    fig, ax0, ax1, shared = _barcode_axes(ax, fig, len(h0), len(h1))
     sel_index = None if selection is None else int(selection.index)
     n0 = len(h0)
     offset1 = n0 + 1 if shared else 0  # rows of H1 above H0 on a shared axes
 
-    def draw(a: "Axes", bars: np.ndarray, label: str, base: int, highlight: int | None) -> None:
-        n = len(bars)
-        if n == 0:
-            a.text(
-                0.5,
-                0.5,
-                f"no {label} bars",
-                transform=a.transAxes,
-                ha="center",
-                va="center",
-                color="0.4",
-            )
-            return
-        ends = np.minimum(bars[:, 1], thr)
-        rows = base + (n - 1 - np.arange(n))  # first bar on top
-        segs = np.stack([np.c_[bars[:, 0], rows], np.c_[ends, rows]], axis=1)
-        colors = np.tile(np.array([[0.12, 0.31, 0.47, 1.0]]), (n, 1))
-        widths = np.full(n, 1.2 if n > 60 else 2.5)
-        if highlight is not None and 0 <= highlight < n:
-            from matplotlib.colors import to_rgba
-
-            colors[highlight] = to_rgba(_HIGHLIGHT)
-            widths[highlight] = max(4.0, widths[highlight] * 2)
-        lc = LineCollection(segs, colors=colors, linewidths=widths, label=label, capstyle="butt")
-        a.add_collection(lc)
-        inf = ~np.isfinite(bars[:, 1])
-        if inf.any():
-            a.plot(np.full(inf.sum(), thr), rows[inf], linestyle="none", marker=">", markersize=6,
-                   color=_BAR, label=f"{label} alive at threshold")
-        if highlight is not None and 0 <= highlight < n:
-            b, d = bars[highlight]
-            a.plot(
-                [b, min(d, thr)],
-                [rows[highlight]] * 2,
-                color=_HIGHLIGHT,
-                linewidth=widths[highlight],
-                solid_capstyle="butt",
-                label="selected class",
-                zorder=3,
-            )
-
-    draw(ax0, h0, "H0", 0, None)
-    draw(ax1, h1, "H1", offset1, sel_index)
+    _draw_bars(ax0, h0, "H0", 0, None, thr)
+    _draw_bars(ax1, h1, "H1", offset1, sel_index, thr)
     if shared:
         ax0.set_ylim(-1, n0 + len(h1) + 1)
     else:
@@ -209,6 +149,77 @@ def plot_barcode(
     if keep:
         ax1.legend(*zip(*keep), loc="lower right", fontsize=8)
     return fig
+
+
+def _barcode_axes(
+    ax: Any, fig: "Figure | None", n_h0: int, n_h1: int
+) -> tuple["Figure", "Axes", "Axes", bool]:
+    """The figure and the (H0, H1) axes of :func:`plot_barcode`; True when both are one axes."""
+    if ax is None:
+        fig = new_figure((7.0, 5.0), fig)
+        n0, n1 = max(n_h0, 1), max(n_h1, 1)
+        w0 = float(np.clip(np.log1p(n0), 1.0, 3.0))
+        w1 = float(np.clip(np.log1p(n1), 1.0, 3.0))
+        ax0, ax1 = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [w0, w1]})
+        shared = False
+    elif isinstance(ax, (list, tuple)):
+        if len(ax) != 2:
+            raise ParameterError(f"ax must be one Axes or a pair (H0, H1), got {len(ax)} axes")
+        ax0, ax1 = ax
+        fig = ax0.figure
+        shared = False
+    else:
+        ax0 = ax1 = ax
+        fig = ax.figure
+        shared = True
+    return fig, ax0, ax1, shared
+
+
+def _draw_bars(
+    a: "Axes", bars: np.ndarray, label: str, base: int, highlight: int | None, thr: float
+) -> None:
+    """One barcode's bars as a LineCollection, rows from ``base`` up, ``highlight`` in red."""
+    from matplotlib.collections import LineCollection
+
+    n = len(bars)
+    if n == 0:
+        a.text(
+            0.5,
+            0.5,
+            f"no {label} bars",
+            transform=a.transAxes,
+            ha="center",
+            va="center",
+            color="0.4",
+        )
+        return
+    ends = np.minimum(bars[:, 1], thr)
+    rows = base + (n - 1 - np.arange(n))  # first bar on top
+    segs = np.stack([np.c_[bars[:, 0], rows], np.c_[ends, rows]], axis=1)
+    colors = np.tile(np.array([[0.12, 0.31, 0.47, 1.0]]), (n, 1))
+    widths = np.full(n, 1.2 if n > 60 else 2.5)
+    if highlight is not None and 0 <= highlight < n:
+        from matplotlib.colors import to_rgba
+
+        colors[highlight] = to_rgba(_HIGHLIGHT)
+        widths[highlight] = max(4.0, widths[highlight] * 2)
+    lc = LineCollection(segs, colors=colors, linewidths=widths, label=label, capstyle="butt")
+    a.add_collection(lc)
+    inf = ~np.isfinite(bars[:, 1])
+    if inf.any():
+        a.plot(np.full(inf.sum(), thr), rows[inf], linestyle="none", marker=">", markersize=6,
+               color=_BAR, label=f"{label} alive at threshold")
+    if highlight is not None and 0 <= highlight < n:
+        b, d = bars[highlight]
+        a.plot(
+            [b, min(d, thr)],
+            [rows[highlight]] * 2,
+            color=_HIGHLIGHT,
+            linewidth=widths[highlight],
+            solid_capstyle="butt",
+            label="selected class",
+            zorder=3,
+        )
 
 
 # ---------------------------------------------------------------------- PCA
