@@ -27,12 +27,13 @@ Outputs are never written inside the input folder: the output folder may not be 
 input folder or lie inside it (captures written there would be picked up by the next
 scan), and an input folder inside the output folder is allowed only when no output
 falls inside it.  Every file is written atomically (temporary file, then rename).
+
+The folder scan lives in :mod:`cyclecoord.batch_discovery` and the summary (its type, rows
+and ``summary.csv``) in :mod:`cyclecoord.batch_summary`; both are re-exported here.
 """
 
 from __future__ import annotations
 
-import csv
-import fnmatch
 import hashlib
 import inspect
 import json
@@ -44,12 +45,20 @@ import traceback
 from collections import Counter, deque
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
+from .batch_discovery import DEFAULT_PATTERNS, as_patterns, find_captures
+from .batch_summary import (
+    STATUSES,
+    SUMMARY_COLUMNS,
+    SUMMARY_NAME,
+    BatchSummary,
+    summary_row,
+    write_summary,
+)
 from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
-from .io import atomic_write
 from .io import refuse_clobber
 from .report import clean, partial_report, write_json
 
@@ -62,19 +71,6 @@ __all__ = [
     "STATUSES",
 ]
 
-#: File-name patterns scanned by default (matched case-insensitively).
-DEFAULT_PATTERNS = ("*.amc", "*.bvh", "*.npz", "*.csv")
-#: Columns of ``summary.csv``.  ``birth``/``death``/``scale`` describe the selected H1 bar
-#: (for ``no_periodic``: the most persistent bar, no scale); ``death`` ``inf`` means the
-#: bar lives past the filtration threshold; ``jerk_ratio`` is the cycle's mean jerk over
-#: the capture's; ``seconds`` is the wall time of load + extract + writing.
-SUMMARY_COLUMNS = (
-    "file", "status", "frames", "dims", "cycles", "period_frames", "period_seconds",
-    "birth", "death", "scale", "loop_closure", "jerk_ratio", "seconds", "cycle_file", "message",
-)
-#: Possible statuses of a capture.
-STATUSES = ("ok", "no_periodic", "error")
-SUMMARY_NAME = "summary.csv"
 REPORT_SUFFIX = ".report.json"
 #: Formats a cycle can be written in (the suffix, as for ``extract -o``).  The ones in
 #: :data:`SKELETON_FORMATS` need a skeleton: a capture without one gets ``.npz``.
@@ -108,150 +104,6 @@ class _Task:
     @property
     def report(self) -> Path:
         return Path(self.base + REPORT_SUFFIX)
-
-
-@dataclass
-class BatchSummary:
-    """What :func:`run_batch` did.
-
-    Attributes
-    ----------
-    folder, out_dir : Path
-        The resolved input and output folders.
-    rows : list of dict
-        One row per capture, sorted by file, keyed by :data:`SUMMARY_COLUMNS` (numbers as
-        floats/ints, ``None`` where not applicable) -- the content of ``summary.csv``.
-    processed : list of str
-        Captures analysed in this run (relative paths).
-    skipped : list of str
-        Captures whose report was up to date.
-    seconds : float
-        Wall time of the whole run.
-    summary_path : Path
-        The ``summary.csv`` written.
-    patterns : tuple of str
-        The file-name patterns scanned.
-    """
-
-    folder: Path
-    out_dir: Path
-    rows: list[dict]
-    processed: list[str]
-    skipped: list[str]
-    seconds: float
-    summary_path: Path
-    patterns: tuple[str, ...] = DEFAULT_PATTERNS
-    counts: dict = field(init=False)
-
-    def __post_init__(self) -> None:
-        c = Counter(r["status"] for r in self.rows)
-        self.counts = {s: int(c.get(s, 0)) for s in STATUSES}
-
-    @property
-    def n_ok(self) -> int:
-        """Captures with a cycle."""
-        return self.counts["ok"]
-
-    @property
-    def n_no_periodic(self) -> int:
-        """Captures with nothing periodic."""
-        return self.counts["no_periodic"]
-
-    @property
-    def n_error(self) -> int:
-        """Captures that failed."""
-        return self.counts["error"]
-
-    @property
-    def errors(self) -> list[dict]:
-        """Rows of the failed captures."""
-        return [r for r in self.rows if r["status"] == "error"]
-
-    def row(self, file: str) -> dict:
-        """The summary row of one capture (relative path as in ``rows``)."""
-        for r in self.rows:
-            if r["file"] == file:
-                return r
-        raise KeyError(file)
-
-    def describe(self) -> str:
-        """Human-readable summary: counts, failures, time and where summary.csv is."""
-        if not self.rows:
-            return (
-                f"no captures matching {' '.join(self.patterns)} under {self.folder}\n"
-                f"summary: {self.summary_path}"
-            )
-        n = len(self.rows)
-        parts = [f"{self.n_ok} ok", f"{self.n_no_periodic} no periodic motion",
-                 f"{self.n_error} error" + ("s" if self.n_error != 1 else "")]
-        lines = [
-            f"{n} capture{'s' if n != 1 else ''} under {self.folder}: "
-            + ", ".join(parts)
-            + f" ({len(self.processed)} analysed, {len(self.skipped)} up to date)"
-            + f" in {self.seconds:.1f} s"
-        ]
-        for r in self.errors:
-            lines.append(f"error: {r['file']}: {r['message']}")
-        lines.append(f"summary: {self.summary_path}")
-        return "\n".join(lines)
-
-
-# ---------------------------------------------------------------- discovery
-def _as_patterns(pattern: str | Sequence[str]) -> tuple[str, ...]:
-    pats = (pattern,) if isinstance(pattern, str) else tuple(pattern)
-    if not pats or not all(isinstance(p, str) and p for p in pats):
-        raise ParameterError(
-            f"pattern must be a glob or a non-empty list of globs, got {pattern!r}"
-        )
-    return pats
-
-
-def _matches(rel: str, name: str, patterns: Sequence[str]) -> bool:
-    for pat in patterns:
-        subject = rel if "/" in pat else name
-        if fnmatch.fnmatchcase(subject.lower(), pat.lower()):
-            return True
-    return False
-
-
-def find_captures(
-    folder: str | os.PathLike[str],
-    pattern: str | Sequence[str] = DEFAULT_PATTERNS,
-    recursive: bool = True,
-) -> list[str]:
-    """Captures under ``folder`` whose names match a pattern, sorted.
-
-    Parameters
-    ----------
-    folder : path-like
-        Folder to scan.
-    pattern : str or sequence of str
-        Globs matched case-insensitively against the file name (or, for a glob holding
-        ``/``, against the path relative to ``folder``).
-    recursive : bool, default True
-        Descend into subfolders.  Hidden files and folders (name starting with ``.``)
-        are skipped; symbolic links to folders are not followed.
-
-    Returns
-    -------
-    list of str
-        Paths relative to ``folder`` with ``/`` separators, in sorted order.
-    """
-    root = Path(folder)
-    if not root.is_dir():
-        raise ParameterError(f"{folder}: not a folder")
-    pats = _as_patterns(pattern)
-    found: list[str] = []
-    for here, dirs, files in os.walk(root):
-        dirs[:] = sorted(d for d in dirs if not d.startswith(".")) if recursive else []
-        rel_dir = Path(here).relative_to(root)
-        for name in files:
-            if name.startswith("."):
-                continue
-            rel = (rel_dir / name).as_posix()
-            if _matches(rel, name, pats) and (Path(here) / name).is_file():
-                found.append(rel)
-    return sorted(found)
 
 
 # ------------------------------------------------------------------ options
@@ -375,7 +227,7 @@ def _write_report(task: _Task, report: dict) -> dict[str, Any]:
     report = clean(report)
     task.report.parent.mkdir(parents=True, exist_ok=True)
     write_json(str(task.report), report)
-    return _row(report)
+    return summary_row(report)
 
 
 def _process_one(task: _Task) -> dict[str, Any]:
@@ -393,7 +245,7 @@ def _process_one(task: _Task) -> dict[str, Any]:
     try:
         return _write_report(task, report)
     except Exception as exc:  # noqa: BLE001 -- e.g. disk full: still report it
-        row = _row(_failure_report(task, exc))
+        row = summary_row(_failure_report(task, exc))
         row["message"] = f"could not write {task.report}: {row['message']}"
         return row
 
@@ -405,58 +257,7 @@ def _record_failure(task: _Task, exc: BaseException | str) -> dict[str, Any]:
     try:
         return _write_report(task, report)
     except Exception:  # noqa: BLE001
-        return _row(report)
-
-
-def _num(v: Any) -> float | None:
-    if v is None or isinstance(v, bool):
-        return None
-    try:
-        f = float(v)
-    except (TypeError, ValueError):
-        return None
-    return None if math.isnan(f) else f
-
-
-def _row(report: dict) -> dict[str, Any]:
-    """Summary row (:data:`SUMMARY_COLUMNS`) of one capture's report."""
-    b = report["batch"]
-    row: dict[str, Any] = dict.fromkeys(SUMMARY_COLUMNS)
-    status = b["status"]
-    if status not in STATUSES:
-        raise ValueError(f"unknown status {status!r}")
-    row.update(file=b["file"], status=status, seconds=_num(b.get("seconds")),
-               cycle_file=b.get("cycle_file"), message=b.get("message") or "")
-    if status == "error":
-        return row
-    row["frames"] = report.get("n_frames")
-    row["dims"] = report.get("dims")
-    if status == "ok":
-        sel = report["selected"]
-        jerk = report.get("jerk") or {}
-        orig, cyc = _num(jerk.get("original")), _num(jerk.get("cycle"))
-        row.update(
-            cycles=_num(report.get("cycles")),
-            period_frames=_num(report.get("period_frames")),
-            period_seconds=_num(report.get("period_seconds")),
-            birth=_num(sel.get("birth")),
-            death=math.inf if sel.get("death") is None else _num(sel["death"]),
-            scale=_num(sel.get("scale")),
-            loop_closure=_num(report.get("loop_closure")),
-            jerk_ratio=cyc / orig if orig and cyc is not None else None,
-        )
-    else:  # the most persistent H1 bar, to show how far from clear it was
-        bars = (report.get("barcode") or {}).get("h1") or []
-        cap = _num(report.get("threshold"))
-        best = None
-        for birth, death in bars:
-            end = death if death is not None else (cap if cap is not None else math.inf)
-            if best is None or end - birth > best[2]:
-                best = (birth, death, end - birth)
-        if best is not None:
-            row["birth"] = _num(best[0])
-            row["death"] = math.inf if best[1] is None else _num(best[1])
-    return row
+        return summary_row(report)
 
 
 def _skeleton_signature(path: Path) -> list | None:
@@ -496,26 +297,9 @@ def _up_to_date(task: _Task) -> dict[str, Any] | None:
             cyc = b.get("cycle_file")
             if not cyc or not (Path(task.out_dir) / cyc).is_file():
                 return None
-        return _row(report)
+        return summary_row(report)
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return None
-
-
-def _write_summary(path: Path, rows: Sequence[dict]) -> None:
-    def cell(v: Any) -> str:
-        if v is None:
-            return ""
-        if isinstance(v, float):
-            if math.isinf(v):
-                return "inf" if v > 0 else "-inf"
-            return f"{v:.6g}"
-        return str(v)
-
-    with atomic_write(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(SUMMARY_COLUMNS)
-        for r in rows:
-            w.writerow([cell(r.get(c)) for c in SUMMARY_COLUMNS])
 
 
 # ---------------------------------------------------------------- executors
@@ -694,7 +478,7 @@ def run_batch(
     options = dict(extract_options or {})
     normalised = _check_options(options)
     opt_hash = _options_hash(normalised, fps, write_cycles)
-    patterns = _as_patterns(pattern)
+    patterns = as_patterns(pattern)
     src, out = _check_folders(folder, out_dir)
     files = find_captures(src, patterns, recursive)
     tasks = _plan_tasks(files, src, out, folder, options, fps, write_cycles, opt_hash)
@@ -709,7 +493,7 @@ def run_batch(
             rows[t.file] = _record_failure(t, "the capture was not analysed (lost by the executor)")
     ordered = [rows[t.file] for t in tasks]
     summary_path = out / SUMMARY_NAME
-    _write_summary(summary_path, ordered)
+    write_summary(summary_path, ordered)
     return BatchSummary(
         folder=src, out_dir=out, rows=ordered, processed=[t.file for t in todo],
         skipped=skipped, seconds=time.perf_counter() - t_start, summary_path=summary_path,

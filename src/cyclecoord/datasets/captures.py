@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -251,6 +251,65 @@ def make_motion_chain(
     ParameterError
         On an unknown kind, mismatched lengths or an argument out of range.
     """
+    kinds, lengths, pers = _chain_segments(kinds, segment_frames, periods)
+    m = len(kinds)
+    gap = check_int("transition_frames", transition_frames, 0)
+    noise = check_float("noise", noise, 0.0)
+    variation = check_float("speed_variation", speed_variation, 0.0, high=1.0)
+    fps = check_float("fps", fps, 0.0, low_open=True)
+    rng = check_random_state(random_state)
+
+    skeleton = cmu_skeleton()
+    style = draw_style(rng)
+    starts = [sum(lengths[:k]) + k * gap for k in range(m)]
+    ids = {k: i for i, k in enumerate(dict.fromkeys(kinds))}
+
+    # Each segment rendered on its own frames plus the neighbouring transitions (and one
+    # frame beyond, for the tz hand-over when gap == 0).
+    renders = []
+    for k in range(m):
+        law = draw_phase_law(rng, pers[k], variation, lengths[k])
+        first = starts[k] - (gap + 1 if k > 0 else 0)
+        last = starts[k] + lengths[k] + (gap + 1 if k < m - 1 else 0)
+        t = np.arange(first, last)
+        local_phase = law((t - starts[k]).astype(float))
+        renders.append((first, render_kind(kinds[k], local_phase, style, skeleton), local_phase))
+
+    clean, phase, labels = _stitch_chain(renders, starts, lengths, gap, [ids[k] for k in kinds])
+
+    noisy = add_noise(clean, noise, rng)
+    seed = seed_text(random_state)
+    source = f"synthetic:chain({','.join(kinds)}; seed={seed})"
+    boundaries = [(starts[k], starts[k] + lengths[k], kinds[k]) for k in range(m)]
+    meta = {
+        "kinds": list(kinds),
+        "periods": list(pers),
+        "boundaries": list(boundaries),
+        "noise": noise,
+    }
+    mean_period = float(np.dot(lengths, pers) / sum(lengths))
+    return SyntheticCapture(
+        motion=Motion(noisy, CHANNELS, fps=fps, skeleton=skeleton, source=source, metadata=meta),
+        clean=Motion(
+            clean,
+            CHANNELS,
+            fps=fps,
+            skeleton=skeleton,
+            source=source + ":clean",
+            metadata=dict(meta),
+        ),
+        phase=phase,
+        period=mean_period,
+        labels=labels,
+        boundaries=boundaries,
+        name="synthetic-chain(" + "+".join(kinds) + ")",
+    )
+
+
+def _chain_segments(
+    kinds: Any, segment_frames: Any, periods: Any
+) -> tuple[tuple[str, ...], list[int], list[float]]:
+    """The checked kinds of :func:`make_motion_chain` with the length and period of each."""
     if isinstance(kinds, str):
         kinds = (kinds,)
     try:
@@ -285,29 +344,20 @@ def make_motion_chain(
         if len(seq) != m:
             raise ParameterError(f"periods has {len(seq)} entries for {m} kinds")
         pers = [check_float("periods", p, 1.0, low_open=True) for p in seq]
-    gap = check_int("transition_frames", transition_frames, 0)
-    noise = check_float("noise", noise, 0.0)
-    variation = check_float("speed_variation", speed_variation, 0.0, high=1.0)
-    fps = check_float("fps", fps, 0.0, low_open=True)
-    rng = check_random_state(random_state)
+    return kinds, lengths, pers
 
-    skeleton = cmu_skeleton()
-    style = draw_style(rng)
-    starts = [sum(lengths[:k]) + k * gap for k in range(m)]
+
+def _stitch_chain(
+    renders: list, starts: list[int], lengths: list[int], gap: int, label_of: list[int]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Clean frames, phase and labels of the chain: each segment shifted along tz to meet the
+    previous one mid-transition, transitions blended by a smoothstep.
+
+    ``renders`` holds ``(first frame, frames, local phase)`` per segment and is updated with
+    the shifted frames.
+    """
+    m = len(starts)
     total = starts[-1] + lengths[-1]
-    ids = {k: i for i, k in enumerate(dict.fromkeys(kinds))}
-
-    # Each segment rendered on its own frames plus the neighbouring transitions (and one
-    # frame beyond, for the tz hand-over when gap == 0).
-    renders = []
-    for k in range(m):
-        law = draw_phase_law(rng, pers[k], variation, lengths[k])
-        first = starts[k] - (gap + 1 if k > 0 else 0)
-        last = starts[k] + lengths[k] + (gap + 1 if k < m - 1 else 0)
-        t = np.arange(first, last)
-        local_phase = law((t - starts[k]).astype(float))
-        renders.append((first, render_kind(kinds[k], local_phase, style, skeleton), local_phase))
-
     tz = COL[("root", "tz")]
     clean = np.empty((total, len(CHANNELS)))
     phase = np.full(total, np.nan)
@@ -326,7 +376,7 @@ def make_motion_chain(
         s, e = starts[k], starts[k] + lengths[k]
         clean[s:e] = frames[s - first : e - first]
         phase[s:e] = local_phase[s - first : e - first]
-        labels[s:e] = ids[kinds[k]]
+        labels[s:e] = label_of[k]
     for k in range(m - 1):
         if gap == 0:
             continue
@@ -335,34 +385,7 @@ def make_motion_chain(
         t = np.arange(starts[k] + lengths[k], starts[k + 1])
         w = smoothstep((t - t[0] + 1.0) / (gap + 1.0))[:, None]
         clean[t] = (1.0 - w) * a[t - a0] + w * b[t - b0]
-
-    noisy = add_noise(clean, noise, rng)
-    seed = seed_text(random_state)
-    source = f"synthetic:chain({','.join(kinds)}; seed={seed})"
-    boundaries = [(starts[k], starts[k] + lengths[k], kinds[k]) for k in range(m)]
-    meta = {
-        "kinds": list(kinds),
-        "periods": list(pers),
-        "boundaries": list(boundaries),
-        "noise": noise,
-    }
-    mean_period = float(np.dot(lengths, pers) / sum(lengths))
-    return SyntheticCapture(
-        motion=Motion(noisy, CHANNELS, fps=fps, skeleton=skeleton, source=source, metadata=meta),
-        clean=Motion(
-            clean,
-            CHANNELS,
-            fps=fps,
-            skeleton=skeleton,
-            source=source + ":clean",
-            metadata=dict(meta),
-        ),
-        phase=phase,
-        period=mean_period,
-        labels=labels,
-        boundaries=boundaries,
-        name="synthetic-chain(" + "+".join(kinds) + ")",
-    )
+    return clean, phase, labels
 
 
 def _non_periodic(

@@ -323,8 +323,26 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
     lines = text.splitlines()
     if not text.strip():
         raise ParseError("file is empty; expected a BVH file starting with HIERARCHY", spath)
+    builds, motion_line = _read_hierarchy(lines, spath)
+    skeleton = _bvh_skeleton(builds, path.stem, spath)
+    channels = skeleton.channels
+    body = [(i + 1, ln.strip()) for i, ln in enumerate(lines) if i > motion_line and ln.strip()]
+    n_frames, frame_time, tline = _motion_header(
+        body, len(channels), builds[0].line, motion_line, spath
+    )
+    frames = _frame_values(body[2:], n_frames, channels, tline, spath)
+    return Motion(
+        frames=frames,
+        channels=channels,
+        fps=_round_fps(1.0 / frame_time),
+        skeleton=skeleton,
+        source=spath,
+        metadata={"frame_time": frame_time},
+    )
 
-    # ---- split HIERARCHY tokens from the MOTION section
+
+def _read_hierarchy(lines: list[str], spath: str) -> tuple[list, int]:
+    """The joints of the HIERARCHY section and the 0-based index of the MOTION line."""
     tokens: list[tuple[str, int]] = []
     motion_line: int | None = None  # 0-based index of the MOTION line
     for i, raw in enumerate(lines):
@@ -347,8 +365,11 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
             spath,
             len(lines),
         )
+    return builds, motion_line
 
-    # ---- skeleton
+
+def _bvh_skeleton(builds: list, name: str, spath: str) -> Skeleton:
+    """The Skeleton of the parsed joints (identity axes, rotation order from the channels)."""
     joints = []
     for b in builds:
         dofs = b.dofs or ()
@@ -367,14 +388,15 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
         except ParameterError as exc:  # defensive: the parser checks these already
             raise ParseError(str(exc), spath, b.line) from None
     try:
-        skeleton = Skeleton(joints=tuple(joints), name=path.stem, source_format="bvh")
+        return Skeleton(joints=tuple(joints), name=name, source_format="bvh")
     except ParameterError as exc:  # defensive, as above
         raise ParseError(str(exc), spath, builds[0].line) from None
-    channels = skeleton.channels
-    n_channels = len(channels)
 
-    # ---- MOTION header
-    body = [(i + 1, ln.strip()) for i, ln in enumerate(lines) if i > motion_line and ln.strip()]
+
+def _motion_header(
+    body: list[tuple[int, str]], n_channels: int, root_line: int, motion_line: int, spath: str
+) -> tuple[int, float, int]:
+    """``Frames:`` and ``Frame Time:`` of the MOTION section: count, seconds and the line."""
     if not body:
         raise ParseError(
             "MOTION section ends early: expected 'Frames: <count>'", spath, motion_line + 1
@@ -391,7 +413,7 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
         raise ParseError(
             "the hierarchy declares no channels (every CHANNELS line is 0): nothing moves",
             spath,
-            builds[0].line,
+            root_line,
         )
     if len(body) < 2:
         raise ParseError(
@@ -414,9 +436,14 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
             spath,
             tline,
         )
+    return n_frames, frame_time, tline
 
-    # ---- frame lines
-    frame_lines = body[2:]
+
+def _frame_values(
+    frame_lines: list[tuple[int, str]], n_frames: int, channels: tuple, tline: int, spath: str
+) -> np.ndarray:
+    """Frames ``(T, D)`` from the frame lines, their count and every value checked."""
+    n_channels = len(channels)
     if len(frame_lines) < n_frames:
         where = frame_lines[-1][0] if frame_lines else tline
         raise ParseError(
@@ -472,14 +499,7 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
             spath,
             frame_lines[k][0],
         )
-    return Motion(
-        frames=frames,
-        channels=channels,
-        fps=_round_fps(1.0 / frame_time),
-        skeleton=skeleton,
-        source=spath,
-        metadata={"frame_time": frame_time},
-    )
+    return frames
 
 
 # ----------------------------------------------------------------------------- writing

@@ -615,7 +615,32 @@ def read_csv(
         raise ParseError(f"cannot read file: {exc.strerror or exc}", spath) from None
     if text.startswith("\ufeff"):
         text = text[1:]
-    lines = text.splitlines()
+    info, header, header_line, rows = _split_csv(text.splitlines(), spath)
+    frames = _csv_frames(header, header_line, rows, spath)
+    channels = _csv_channels(header, header_line, spath)
+    if fps is not None:
+        rate = _check_fps(fps)
+    else:
+        rate = float(info.get("fps", DEFAULT_FPS))
+    skel = _resolve_skeleton(skeleton)
+    try:
+        return Motion(
+            frames=frames,
+            channels=tuple(channels),
+            fps=rate,
+            skeleton=skel,
+            source=spath,
+            start_frame=int(info.get("start_frame", 0)),
+        )
+    except ParameterError as exc:
+        raise ParseError(str(exc), spath) from None
+
+
+def _split_csv(
+    lines: list[str], spath: str
+) -> tuple[dict[str, float], list[str], int, list[tuple[int, list[str]]]]:
+    """The ``key=value`` comments before the header, the header row (and its line) and the
+    value rows as ``(line, text fields)``."""
     info: dict[str, float] = {}
     header: list[str] | None = None
     header_line = 0
@@ -648,6 +673,13 @@ def read_csv(
             "no header row; expected channel names such as 'root.tx,root.ty,...'", spath,
             len(lines) or None,
         )
+    return info, header, header_line, rows
+
+
+def _csv_frames(
+    header: list[str], header_line: int, rows: list[tuple[int, list[str]]], spath: str
+) -> np.ndarray:
+    """Frames ``(T, D)`` of the value rows, their shape and every value checked."""
     D = len(header)
     if D > 6 * MAX_JOINTS:
         raise ParseError(
@@ -695,6 +727,11 @@ def read_csv(
             spath,
             rows[r][0],
         )
+    return frames
+
+
+def _csv_channels(header: list[str], header_line: int, spath: str) -> list[tuple[str, str]]:
+    """``(joint, dof)`` of each header name (``joint.dof``; no dot: ``(name, "")``), unique."""
     channels = []
     for h in header:
         if "." in h:
@@ -709,19 +746,4 @@ def read_csv(
                 f"channel {header[c]!r} appears twice in the header row", spath, header_line
             )
         seen.add(ch)
-    if fps is not None:
-        rate = _check_fps(fps)
-    else:
-        rate = float(info.get("fps", DEFAULT_FPS))
-    skel = _resolve_skeleton(skeleton)
-    try:
-        return Motion(
-            frames=frames,
-            channels=tuple(channels),
-            fps=rate,
-            skeleton=skel,
-            source=spath,
-            start_frame=int(info.get("start_frame", 0)),
-        )
-    except ParameterError as exc:
-        raise ParseError(str(exc), spath) from None
+    return channels

@@ -391,6 +391,31 @@ def select_bandwidth(
         query = _wrap01(_finite_array(query, "query", 1))
         if query.shape[0] != T:
             raise ParameterError(f"query has {query.shape[0]} values for {T} frames")
+    widths = _candidate_widths(candidates, n_candidates, max_width, k, T, period)
+    sig2 = (widths / period) ** 2  # phase units, squared
+
+    n_val = min(T, max_validation)
+    val = np.unique(np.round(np.linspace(0, T - 1, n_val)).astype(int))
+    n_val = val.size
+    err = _held_out_errors(theta, query, poses, val, sig2, exclude, chunk_elements)
+    mean = err.mean(axis=0)
+    se = err.std(axis=0, ddof=1) / np.sqrt(n_val) if n_val > 1 else np.zeros_like(mean)
+    best = int(np.argmin(mean))
+    if rule == "1se":
+        best = int(np.flatnonzero(mean <= mean[best] + se[best]).max())
+    for arr in (widths, mean, se):
+        arr.flags.writeable = False
+    return BandwidthSelection(
+        bandwidth=float(widths[best]), candidates=widths, cv_error=mean, cv_se=se,
+        rule=rule, exclude=exclude, n_validation=int(n_val),
+    )
+
+
+def _candidate_widths(
+    candidates, n_candidates: int, max_width, k: int, T: int, period: float
+) -> np.ndarray:
+    """Kernel widths (frames of one period) to try: the given ones, checked and sorted, or a
+    geometric grid from about one frame's spacing times ``k`` up to an eighth of a period."""
     if candidates is None:
         n_candidates = _positive_int(n_candidates, "n_candidates")
         lo = min(k / (T * np.sqrt(2.0 * np.pi)) * period, 0.5)
@@ -403,12 +428,23 @@ def select_bandwidth(
         if widths.size == 0 or np.any(widths <= 0):
             raise ParameterError("candidates must be positive widths in frames of one period")
         widths = np.unique(widths)
-    sig2 = (widths / period) ** 2  # phase units, squared
+    return widths
 
-    n_val = min(T, max_validation)
-    val = np.unique(np.round(np.linspace(0, T - 1, n_val)).astype(int))
+
+def _held_out_errors(
+    theta: np.ndarray,
+    query: np.ndarray,
+    poses: np.ndarray,
+    val: np.ndarray,
+    sig2: np.ndarray,
+    exclude: int,
+    chunk_elements: int,
+) -> np.ndarray:
+    """Squared error ``(len(val), len(sig2))`` of predicting each validation frame's pose from
+    the others (its ``exclude`` time neighbours left out) by a Gaussian kernel in phase."""
+    T = theta.shape[0]
     n_val = val.size
-    err = np.empty((n_val, widths.size))
+    err = np.empty((n_val, sig2.size))
     offsets = np.arange(-exclude, exclude + 1)
     poses32 = poses.astype(np.float32)
     step = max(1, chunk_elements // max(T, 1))
@@ -427,17 +463,7 @@ def select_bandwidth(
             w = np.exp(d2 * np.float32(-0.5 / s2))
             pred = (w @ poses32) / w.sum(axis=1, keepdims=True, dtype=float)
             err[a : a + step, g] = np.sum((target - pred) ** 2, axis=1)
-    mean = err.mean(axis=0)
-    se = err.std(axis=0, ddof=1) / np.sqrt(n_val) if n_val > 1 else np.zeros_like(mean)
-    best = int(np.argmin(mean))
-    if rule == "1se":
-        best = int(np.flatnonzero(mean <= mean[best] + se[best]).max())
-    for arr in (widths, mean, se):
-        arr.flags.writeable = False
-    return BandwidthSelection(
-        bandwidth=float(widths[best]), candidates=widths, cv_error=mean, cv_se=se,
-        rule=rule, exclude=exclude, n_validation=int(n_val),
-    )
+    return err
 
 
 def resample_cyclic(curve: np.ndarray, n_out: int, times: np.ndarray | None = None) -> np.ndarray:

@@ -2,17 +2,22 @@
 
 :func:`new_figure` is for the ``plot_*`` functions (a pyplot figure a notebook shows, or
 the caller's own); :func:`detached_figure` for the functions that write files (an Agg
-canvas pyplot never sees: headless, nothing left open).
+canvas pyplot never sees: headless, nothing left open); :func:`check_result` is the
+argument check of the figures that need a complete extraction.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
+
+from ..errors import ParameterError
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-__all__ = ["new_figure", "detached_figure"]
+    from ..periodic.pipeline import ExtractionResult
+
+__all__ = ["new_figure", "detached_figure", "check_result"]
 
 
 def new_figure(figsize: tuple[float, float], fig: "Figure | None" = None) -> "Figure":
@@ -48,3 +53,27 @@ def detached_figure(figsize: tuple[float, float], dpi: float = 100) -> "Figure":
     fig = Figure(figsize=figsize, dpi=dpi)
     FigureCanvasAgg(fig)
     return fig
+
+
+def check_result(result: Any, what: str) -> "ExtractionResult":
+    """``result`` itself when it is a complete ExtractionResult, else a ParameterError naming
+    ``what`` (the calling function).
+    """
+    from ..periodic.pipeline import ExtractionResult, PartialExtraction
+
+    if isinstance(result, PartialExtraction):
+        raise ParameterError(
+            f"{what} needs a complete extraction; this partial result has no circular "
+            f"coordinate (no periodic motion was found: {result.reason})"
+        )
+    if not isinstance(result, ExtractionResult):
+        raise ParameterError(
+            f"{what} takes an ExtractionResult (from cyclecoord.extract), got "
+            f"{type(result).__name__}"
+        )
+    if result.coordinate is None or result.typical is None:
+        raise ParameterError(
+            f"{what} needs a complete extraction; this result has no circular coordinate "
+            "(no periodic motion was found)"
+        )
+    return result

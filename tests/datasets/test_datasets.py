@@ -11,7 +11,7 @@ from cyclecoord import datasets as ds
 from cyclecoord.errors import ParameterError
 from cyclecoord.motion import Motion
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+SHARED = Path(__file__).resolve().parents[2].parent / "shared" / "data"
 
 CMU_ORDER = [
     ("root", ("tx", "ty", "tz", "rx", "ry", "rz")),

@@ -15,7 +15,7 @@ from cyclecoord.io.asfamc import read_amc, read_asf, write_amc, write_asf
 from cyclecoord.motion import Motion
 from cyclecoord.skeleton import Joint, Skeleton, forward_kinematics
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data"
 CMU = DATA / "cmu"
 
 CMU_TRIALS = {

@@ -15,7 +15,7 @@ from cyclecoord.motion import Motion
 from cyclecoord.conventions import continuous_euler, to_bvh_convention
 from cyclecoord.skeleton import Joint, Skeleton, forward_kinematics
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data"
 CMU69 = DATA / "cmu" / "69"
 
 

@@ -23,7 +23,7 @@ from cyclecoord.quality.metrics import jerk  # noqa: E402
 
 Image = pytest.importorskip("PIL.Image", reason="image checks need Pillow (ships with matplotlib)")
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
 
 
@@ -363,7 +363,9 @@ def test_render_side_by_side_loops_the_shorter(result, tmp_path):
     # the right half is drawn too (the looped cycle)
     right = f2[-1][:, f2[-1].shape[1] // 2 :]
     assert len(np.unique(right.reshape(-1, 3), axis=0)) > 5
-    track = plot._make_track(result.cycle[:30], None)
+    from cyclecoord.plot import animation
+
+    track = animation._make_track(result.cycle[:30], None)
     pos, idx = track.at_times(np.array([0.0, 29 / 120, 30 / 120, 45 / 120]))
     assert list(idx) == [0, 29, 0, 15]
     root = track.positions[:, 0]

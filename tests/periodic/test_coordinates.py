@@ -6,7 +6,6 @@ import pytest
 from cyclecoord.periodic.barcode import check_prime, compute_barcode, select_bar, temporal_distance_matrix
 from cyclecoord.periodic.coordinates import (
     CircularCoordinates,
-    _edge_values,
     check_cocycle,
     harmonic_coordinate,
     lift_cocycle,
@@ -15,6 +14,7 @@ from cyclecoord.periodic.coordinates import (
     unwrap,
 )
 from cyclecoord.errors import ParameterError
+from cyclecoord.periodic._cochain import cocycle_on_edges
 
 
 def circular_error(a, b):
@@ -94,7 +94,7 @@ def test_cocycle_check_finds_a_broken_lift():
     bc = compute_barcode(x, prime=47)
     sel = select_bar(bc, 0)
     edges = rips_edges(x, sel.scale)
-    z, _ = _edge_values(edges, bc.cocycles[0], lift_cocycle(bc.cocycles[0], 47).astype(float), len(x))
+    z, _ = cocycle_on_edges(edges, bc.cocycles[0], lift_cocycle(bc.cocycles[0], 47).astype(float), len(x))
     ok = check_cocycle(edges, z, len(x))
     assert ok.ok and ok.n_triangles > 0
     broken = z.copy()
@@ -167,7 +167,7 @@ def _check_by_unique(edges, z, n):
     """Reference: distinct triangles by sorting their vertex keys (the former method)."""
     import scipy.sparse as sp
 
-    from cyclecoord.periodic.coordinates import _lookup
+    from cyclecoord.periodic._cochain import _lookup
 
     support = np.flatnonzero(z)
     i, j = edges[:, 0], edges[:, 1]
@@ -228,7 +228,7 @@ def test_direct_harmonic_solve_matches_lsqr(seed, weighted):
 
 
 def test_extension_table_gives_the_binary_search_lookups_bit_for_bit(monkeypatch):
-    import cyclecoord.periodic.coordinates as co
+    import cyclecoord.periodic._cochain as co
 
     rng = np.random.default_rng(4)
     t = rng.random(2000) * 2 * np.pi
