@@ -1,0 +1,284 @@
+"""What an extraction returns: its result, a failed run's partial result, and the cycle
+options (:func:`~cyclecoord.periodic.pipeline.extract` makes them)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..motion import Motion
+from .barcode import CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, Barcode, BarSelection
+from .coordinates import CircularCoordinates
+from .cycle import TypicalCycle
+from .density import PeriodicDensity
+from .preprocess import PreparedData, Preprocessor
+from .windings import Windings, stretches
+
+__all__ = [
+    "ExtractionResult", "PartialExtraction", "CycleOptions", "MIN_TURNS", "TIMINGS", "TRAVELS",
+]
+
+#: Fewer turns of the coordinate over the steady frames than this is no periodic motion
+#: (the rule :func:`~cyclecoord.periodic.detection.detect` applies to its segments).
+MIN_TURNS = 1.5
+#: How the cycle is timed: at the capture's pace (re-timed phase) or by the coordinate.
+TIMINGS = ("capture", "coordinate")
+#: What the cycle's root does: travel and turn as captured, walk straight, stay in place.
+TRAVELS = ("keep", "straight", "in_place")
+
+@dataclass(frozen=True)
+class CycleOptions:
+    """How the typical cycle is made: one object for :func:`extract`,
+    :func:`~cyclecoord.periodic.detection.motion_cycles` and a pipeline's own settings.
+
+    Each field is the keyword of the same name of :func:`extract` (see there), with the
+    same default; ``extract(m, cycle=CycleOptions(travel="straight"))`` equals
+    ``extract(m, travel="straight")``.
+    """
+
+    timing: str = "capture"
+    travel: str = "keep"
+    bandwidth: str | float | None = None
+    cycle_start: str = "slowest"
+    n_samples: int = 500
+    n_neighbors: int = 10
+    weighting: str = "kernel"
+    sampling: str = "quantile"
+    min_turns: float = MIN_TURNS
+
+    def as_dict(self) -> dict[str, Any]:
+        """The options as keyword arguments."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+def _take_cycle_options(cycle: Any, given: dict[str, Any], where: str) -> dict[str, Any]:
+    """``given`` (a function's cycle keywords) overridden by ``cycle``; a keyword changed
+    from its default beside ``cycle`` is an error (which one would win is not obvious)."""
+    if cycle is None:
+        return given
+    if not isinstance(cycle, CycleOptions):
+        raise ParameterError(f"{where}: cycle must be a CycleOptions, got {type(cycle).__name__}")
+    default = CycleOptions().as_dict()
+    clash = [k for k, v in given.items() if k in default and v != default[k]]
+    if clash:
+        raise ParameterError(
+            f"{where}: give {', '.join(clash)} either as keyword(s) or in cycle=CycleOptions(...), "
+            "not both"
+        )
+    return {**given, **cycle.as_dict()}
+
+
+@dataclass
+class PartialExtraction:
+    """What an extraction that found no periodic motion got as far as
+    (``NoPeriodicMotionError.result``).
+
+    It holds only what was computed: the capture, its preparation and, when the run got
+    that far, the barcode, the bar looked at and the estimator; there is no coordinate,
+    period or cycle.  Figures of it show the barcode (why nothing stood clear), and
+    ``cyclecoord extract --report`` writes it with ``selected: null`` and the reason.
+
+    Attributes
+    ----------
+    motion : Motion
+    prepared : PreparedData
+    reason : str
+        Why the extraction stopped (the error's message without the source).
+    barcode : Barcode or None
+    selection : BarSelection or None
+        The bar that was judged (None when no bar was).
+    timings, parameters : dict
+    warnings : list of str
+    estimator : CircularCoordinates or None
+    preprocessor : Preprocessor or None
+    """
+
+    motion: Motion
+    prepared: PreparedData
+    reason: str
+    barcode: Barcode | None = None
+    selection: BarSelection | None = None
+    timings: dict = field(default_factory=dict)
+    parameters: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    estimator: CircularCoordinates | None = None
+    preprocessor: Preprocessor | None = None
+
+
+@dataclass
+class ExtractionResult:
+    """Everything :func:`extract` computed.
+
+    Attributes
+    ----------
+    motion : Motion
+        The analysed frames (after ``frames`` selection).
+    prepared : PreparedData
+        Points (T, K) analysed and poses (T, D) with differenced root channels.
+    barcode : Barcode
+    selection : BarSelection
+        Chosen H1 class and scale.
+    coordinate : ndarray, shape (T,)
+        Circular coordinate per analysed frame, in [0, 1), increasing with time; NaN on
+        frames outside the steady stretches (:attr:`used_frames`).
+    unwrapped : ndarray, shape (T,)
+        The coordinate unwrapped along frame order inside each steady stretch (in cycles).
+    cycles : float
+        Turns of the coordinate over the steady stretches.
+    period_frames : float
+        Median length in frames of the complete windings (:attr:`windings`).
+    cycle_frames : ndarray
+        Length in frames of each complete winding (at the sharpest level).
+    density : PeriodicDensity
+    typical : TypicalCycle
+        The cycle in the prepared space (root as differences).
+    cycle : Motion
+        The typical cycle as a motion at the capture's rate, root re-integrated so it
+        travels like the original; loops.
+    jerk : dict
+        ``{"original": ..., "cycle": ...}`` mean jerk norm (channel units / s³).
+    loop_closure : float
+        Last-to-first step of the cycle over its median step (prepared space).
+    distance : dict
+        Distance of the clip's frames to the cycle (median, 90th percentile, max), in
+        the prepared space's units, next to the median frame-to-frame step.
+    timings : dict
+        Seconds per stage.
+    warnings : list of str
+        Anything the user should know (H0 components, cocycle repairs, ...).
+    used : ndarray of bool, shape (T,)
+        The steady frames the cycle was built from.
+    phase : ndarray, shape (T,)
+        Re-timed phase (advancing at the capture's pace) on the used frames, NaN
+        elsewhere (all NaN with ``timing="coordinate"``).
+    windings : Windings
+        The complete windings: lengths, spread, anchors.
+    heading_per_cycle : float
+        Heading change of one cycle in degrees (as captured, before ``travel``).
+    """
+
+    motion: Motion
+    prepared: PreparedData
+    barcode: Barcode
+    selection: BarSelection
+    coordinate: np.ndarray
+    unwrapped: np.ndarray
+    cycles: float
+    period_frames: float
+    cycle_frames: np.ndarray
+    density: PeriodicDensity
+    typical: TypicalCycle
+    cycle: Motion
+    jerk: dict
+    loop_closure: float
+    distance: dict
+    timings: dict
+    parameters: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    estimator: CircularCoordinates | None = None
+    preprocessor: Preprocessor | None = None
+    used: np.ndarray | None = None
+    phase: np.ndarray | None = None
+    windings: Windings | None = None
+    heading_per_cycle: float = float("nan")
+
+    @property
+    def used_frames(self) -> list[tuple[int, int]]:
+        """The steady stretches the cycle was built from, ``[(start, stop), ...]`` (0-based)."""
+        return [] if self.used is None else stretches(self.used)
+
+    @property
+    def model(self):
+        """The fitted :class:`~cyclecoord.periodic.phase_model.PhaseModel` (phase of new
+        frames, save/load)."""
+        from .phase_model import PhaseModel
+
+        return PhaseModel.from_result(self)
+
+    def to_report(self) -> dict[str, Any]:
+        """JSON-ready summary (see the CLI's ``--report``)."""
+        return {
+            "source": self.motion.source,
+            "frames": [
+                int(self.motion.start_frame),
+                int(self.motion.start_frame + self.motion.n_frames),
+            ],
+            "n_frames": int(self.motion.n_frames),
+            "fps": self.motion.fps,
+            "dims": int(self.prepared.points.shape[1]),
+            "parameters": self.parameters,
+            "threshold": self.barcode.threshold,
+            "prime": int(self.barcode.prime),
+            "barcode": self.barcode.to_dict(),
+            "selected": self.selection.to_dict(),
+            "clear_criterion": {
+                "min_ratio": CLEAR_RATIO,
+                "min_gap": CLEAR_GAP,
+                "min_fraction_of_threshold": CLEAR_MIN_FRACTION,
+            },
+            "coordinate": _nullable(self.coordinate),
+            "phase": _nullable(self.phase),
+            "used_frames": [[int(a), int(b)] for a, b in self.used_frames],
+            "cycles": float(self.cycles),
+            "period_frames": float(self.period_frames),
+            "period_seconds": float(self.period_frames / self.motion.fps),
+            "cycle_frames": [float(v) for v in self.cycle_frames],
+            "period_spread": None if self.windings is None else float(self.windings.spread),
+            "heading_per_cycle_degrees": None
+            if not np.isfinite(self.heading_per_cycle)
+            else float(self.heading_per_cycle),
+            "cycle_length": int(self.cycle.n_frames),
+            "jerk": self.jerk,
+            "loop_closure": float(self.loop_closure),
+            "bandwidth_frames": float(self.typical.bandwidth)
+            if np.isfinite(self.typical.bandwidth)
+            else None,
+            "foot_skating": _cycle_skating(self.cycle),
+            "distance_to_cycle": self.distance,
+            "landmarks": _landmark_report(self.estimator),
+            "cocycle_check": {
+                "triangles": int(self.estimator.cocycle_check_.n_triangles)
+                if self.estimator
+                else None,
+                "violations": int(self.estimator.cocycle_check_.n_violations)
+                if self.estimator
+                else None,
+                "primes_tried": [int(p) for p, _ in self.estimator.primes_tried_]
+                if self.estimator
+                else [],
+            },
+            "timings": {k: round(float(v), 6) for k, v in self.timings.items()},
+            "warnings": list(self.warnings),
+        }
+
+
+def _cycle_skating(cycle: Motion) -> dict | None:
+    """Foot skating of the cycle (:func:`~cyclecoord.quality.contacts.skating_report`)."""
+    from ..quality.contacts import skating_report
+
+    return skating_report(cycle) if cycle is not None and cycle.skeleton is not None else None
+
+
+def _nullable(values: np.ndarray | None) -> list | None:
+    """A list of floats with None where a value is NaN."""
+    if values is None:
+        return None
+    return [float(v) if np.isfinite(v) else None for v in np.asarray(values, dtype=float)]
+
+
+def _landmark_report(est: CircularCoordinates | None) -> dict | None:
+    if est is None or not hasattr(est, "landmark_reason_"):
+        return None
+    lm = getattr(est, "landmarks_", None)
+    return {
+        "n_landmarks": None if lm is None else int(len(lm)),
+        "reason": est.landmark_reason_,
+        "covering_radius": float(getattr(est, "covering_radius_", 0.0)),
+        "complex_estimate": est.complex_estimate_.to_dict(),
+        "frames_outside_landmark_balls": int(np.sum(~est.covered_))
+        if hasattr(est, "covered_")
+        else None,
+    }
