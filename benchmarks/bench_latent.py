@@ -315,8 +315,9 @@ def training_stats(models: dict, tests: dict) -> dict:
 
 
 def latent_transition(models, bridges, nA, nB, p99, low):
-    """TRANSITION from A's first frame to B (through other models when no bridge joins
-    them directly); the worst blend window's statistics and the route."""
+    """TRANSITION from A's first frame to B (the cheapest route of crossings: bridges, or
+    the closest poses with a longer blend, possibly through other models); the worst
+    blend window's statistics, the whole transition's acceleration and the route."""
     from cyclecoord.errors import ParameterError
 
     syn = Synthesizer(models, fps=FPS, seed=0)
@@ -331,11 +332,17 @@ def latent_transition(models, bridges, nA, nB, p99, low):
     stats = [
         window_stats(motion, ev["start_frame"], ev["blend_frames"], p99, low) for ev in syn.events
     ]
+    acc, _ = derivatives(local_positions(motion), motion.fps)
     out = {
         "acc": max(s["acc"] for s in stats),
+        "acc_all": float(acc.max() / p99[0]),
         "jerk": max(s["jerk"] for s in stats),
         "skate": float(np.mean([s["skate"] for s in stats])),
         "route": [syn.events[0]["transition"][0]] + [ev["transition"][1] for ev in syn.events],
+        "distance_ratio": max(ev["bridge_distance"] / ev["threshold"] for ev in syn.events),
+        "bridged": all(ev["under_threshold"] for ev in syn.events),
+        "blend_frames": [ev["blend_frames"] for ev in syn.events],
+        "frames": motion.n_frames,
     }
     if "skating_frames_contacts" in stats[0]:
         out["skating_frames_contacts"] = float(

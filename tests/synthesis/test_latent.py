@@ -203,6 +203,49 @@ def test_synthesizer_transition_and_output(walk_model, jog_model):
     np.testing.assert_array_equal(again.motion().frames, motion.frames)
 
 
+def test_transition_without_bridges_crosses_at_the_closest_poses(walk_model, jog_model):
+    # a threshold no pair can meet: the transition still happens, at the closest pair
+    syn = Synthesizer({"walk": walk_model, "jog": jog_model}, fps=30, seed=1, bridge_threshold=1e-9)
+    syn.start("walk")
+    syn.transition("jog", blend=0.2)
+    (ev,) = syn.events
+    assert ev["route"] == ["walk", "jog"] and ev["under_threshold"] is False
+    c = syn.crossings("walk", "jog")
+    assert ev["bridge_distance"] <= 1.1 * c.distances.min() + 1e-12
+    assert ev["blend_frames"] >= ev["blend_asked_frames"] == 6
+    assert syn.current == "jog" and np.isfinite(syn.motion().frames).all()
+    # the reversed search (jog's training points into walk) is among the crossings
+    assert (c.target_frames >= 0).any() and (c.source_frames >= 0).any()
+
+
+def test_route_prefers_a_chain_of_bridges_to_a_far_jump(walk_model):
+    from cyclecoord.synthesis.latent.commands import Crossings
+
+    syn = Synthesizer({k: walk_model for k in "abc"}, fps=30)
+    x = walk_model.X_[:1]
+
+    def cross(s, t, d):
+        return Crossings(s, t, x, x, np.array([d]), np.array([0]), np.array([0]), 1.0)
+
+    far = {("a", "b"): 3.0, ("a", "c"): 0.5, ("c", "b"): 0.9}
+    for s in "abc":
+        for t in "abc":
+            if s != t:
+                syn._crossings[(s, t)] = cross(s, t, far.get((s, t), 5.0))
+    assert syn.route("a", "b") == ["a", "c", "b"]
+    syn._crossings[("a", "b")] = cross("a", "b", 1.2)  # 1.44 < 2 hops of cost 1
+    assert syn.route("a", "b") == ["a", "b"]
+
+
+def test_blend_lengthens_with_the_pose_gap(walk_model):
+    syn = Synthesizer({"w": walk_model, "v": walk_model}, fps=30)
+    X = walk_model.X_
+    gaps = np.linalg.norm(walk_model.pose(X) - walk_model.pose(X[:1]), axis=1)
+    far = int(np.argmax(gaps))
+    assert syn.blend_frames("w", "v", X[0], X[0]) <= 1
+    assert syn.blend_frames("w", "v", X[0], X[far]) > syn.blend_frames("w", "v", X[0], X[1])
+
+
 def test_synthesizer_errors(walk_model):
     syn = Synthesizer({"walk": walk_model}, fps=30)
     with pytest.raises(ParameterError, match="before the particle"):

@@ -139,6 +139,10 @@ class Bridges:
         Skeleton units.
     best_raw : ndarray, shape (N1,), optional
         Best distance from every source frame before the density filter.
+    best_points, raw_points : ndarray, shape (N1, q), optional
+        The model-2 point of ``best`` (NaN where no start passed the density filter)
+        and of ``best_raw``, so the closest pair can be used when no bridge is under
+        the threshold.
     """
 
     source: str
@@ -150,6 +154,8 @@ class Bridges:
     best: np.ndarray
     threshold: float
     best_raw: np.ndarray | None = None
+    best_points: np.ndarray | None = None
+    raw_points: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.frames.size)
@@ -219,6 +225,7 @@ def find_bridges(
         m1.skeleton_, m1.channels_, np.repeat(pose1, S, axis=0), m2.pose(flat)
     ).reshape(n1, S)
     raw = d_all.min(axis=1)
+    raw_points = XS[np.arange(n1), np.argmin(d_all, axis=1)]
     d_all[(m2.densities(flat) < min_density).reshape(n1, S)] = np.inf
     pick = np.argmin(d_all, axis=1)
     X2 = XS[np.arange(n1), pick]
@@ -234,4 +241,6 @@ def find_bridges(
         best=dist,
         threshold=float(threshold),
         best_raw=raw,
+        best_points=np.where(np.isfinite(dist)[:, None], X2, np.nan),
+        raw_points=raw_points,
     )
