@@ -177,6 +177,26 @@ def test_bridges_of_a_model_to_itself_match_poses(walk_model):
     assert br.to_dict()["count"] == len(br)
 
 
+def test_invert_finds_the_latent_point_of_a_pose(walk_model):
+    from cyclecoord.synthesis.latent import invert, project
+
+    X = walk_model.X_
+    mid = 0.5 * (X[3:20] + X[4:21])  # between training points: not where any start is
+    target = walk_model.pose(mid)
+    Xi, cost = invert(walk_model, target)
+    err = np.sqrt(((walk_model.pose(Xi) - target) ** 2).mean())
+    spread = np.sqrt(((target - target.mean(0)) ** 2).mean())
+    assert err < 0.05 * spread and np.allclose(cost, ((walk_model.pose(Xi) - target) ** 2).sum(1))
+    # least squares in the angles: no worse than Eq. 15's search in the scaled PCA space
+    noisy = target + np.random.default_rng(0).normal(0, 2.0, target.shape)
+    Xp, _ = project(walk_model, walk_model.pca_coordinates(noisy))
+    Xi, _ = invert(walk_model, noisy)
+    sq = lambda x: ((walk_model.pose(x) - noisy) ** 2).sum()  # noqa: E731
+    assert sq(Xi) <= sq(Xp) + 1e-9
+    with pytest.raises(ParameterError, match="channels"):
+        invert(walk_model, target[:, :5])
+
+
 def test_synthesizer_transition_and_output(walk_model, jog_model):
     syn = Synthesizer({"walk": walk_model, "jog": jog_model}, fps=30, seed=3)
     syn.start("walk")
