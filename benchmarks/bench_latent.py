@@ -281,19 +281,29 @@ def window_stats(
     }
     contacts = contacts_skating(motion)
     if contacts is not None:
-        # quality.contacts (when present): fraction of the window's frames on which a
-        # planted foot point slides, contacts found on the whole synthesised motion
-        out["skating_frames_contacts"] = float(contacts.skating[a : b + 1].any(axis=1).mean())
+        # quality.contacts: fraction of the window's frames on which a planted foot point
+        # slides, and the planted points' mean speed there (leg lengths/s), contacts found
+        # on the whole synthesised motion
+        fc, fs = contacts
+        out["skating_frames_contacts"] = float(fs.skating[a : b + 1].any(axis=1).mean())
+        planted = fc.planted[a : b + 1]
+        out["skating_speed_contacts"] = (
+            float(fc.speed[a : b + 1][planted].mean() / fc.leg_length) if planted.any() else 0.0
+        )
     return out
 
 
 def contacts_skating(motion: cc.Motion):
-    """``cyclecoord.quality.contacts.foot_skating(motion)`` when that module exists, else None."""
+    """``(foot_contacts, foot_skating)`` of ``cyclecoord.quality.contacts``, None when
+    the motion's feet cannot be found."""
+    from cyclecoord.errors import CycleCoordError
+    from cyclecoord.quality.contacts import foot_contacts, foot_skating
+
     try:
-        from cyclecoord.quality.contacts import foot_skating as skating
-    except ImportError:
+        fc = foot_contacts(motion)
+    except CycleCoordError:
         return None
-    return skating(motion)
+    return fc, foot_skating(motion, fc)
 
 
 def training_stats(models: dict, tests: dict) -> dict:
@@ -350,10 +360,9 @@ def latent_transition(models, bridges, nA, nB, p99, low):
         "blend_frames": [ev["blend_frames"] for ev in syn.events],
         "frames": motion.n_frames,
     }
-    if "skating_frames_contacts" in stats[0]:
-        out["skating_frames_contacts"] = float(
-            np.mean([s["skating_frames_contacts"] for s in stats])
-        )
+    for key in ("skating_frames_contacts", "skating_speed_contacts"):
+        if key in stats[0]:
+            out[key] = float(np.mean([s[key] for s in stats]))
     return out
 
 

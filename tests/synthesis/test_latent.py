@@ -266,6 +266,60 @@ def test_blend_lengthens_with_the_pose_gap(walk_model):
     assert syn.blend_frames("w", "v", X[0], X[far]) > syn.blend_frames("w", "v", X[0], X[1])
 
 
+def test_root_follows_planted_feet_in_blend_windows(cmu_dir):
+    from cyclecoord.quality.contacts import foot_contacts
+
+    take = cc.load(cmu_dir / "13" / "13_29.amc")
+    fit = dict(gplvm={"max_iter": 40})
+    models = {
+        "jj": LatentModel(**fit).fit([take[0:456:4]], ["JumpJack"]),
+        "tw": LatentModel(**fit).fit([take[456:1200:4]], ["Twist"]),
+    }
+
+    def run(plant, lock=False):
+        syn = Synthesizer(models, fps=30, seed=2, plant=plant, lock=lock)
+        syn.start("jj")
+        syn.idle(duration=0.4)
+        syn.transition("tw", blend=0.4)
+        syn.idle(duration=0.6)
+        return syn, syn.motion()
+
+    syn, planted = run("transitions")
+    _, free = run("off")
+    mask = syn.plant_spans(free.n_frames)
+    assert mask.any() and not mask.all()
+    cols = [free.channel_index("root", d) for d in ("tx", "tz")]
+    # outside the spans the root takes the same steps; only the ground track changes
+    np.testing.assert_allclose(
+        np.diff(planted.frames[:, cols], axis=0)[~mask],
+        np.diff(free.frames[:, cols], axis=0)[~mask],
+    )
+    other = [i for i in range(free.frames.shape[1]) if i not in cols]
+    np.testing.assert_array_equal(planted.frames[:, other], free.frames[:, other])
+    # feet planted (found on the uncorrected motion, lax speed) slide less in the spans
+    fc = foot_contacts(free, speed=2.0)
+    rows = np.r_[mask, False] | np.r_[False, mask]
+    sel = fc.planted & rows[:, None]
+    assert sel.sum() > 5
+
+    def slide(m):
+        names = m.positions().names
+        pos = m.positions().positions[:, [names.index(f) for f in fc.feet]]
+        return np.linalg.norm(np.gradient(pos[..., [0, 2]], axis=0), axis=2)[sel].mean()
+
+    assert slide(planted) < 0.8 * slide(free)
+    # the optional leg IK changes leg channels only, and only near the spans
+    _, locked = run("transitions", lock=True)
+    changed = np.abs(locked.frames - planted.frames) > 1e-9
+    legs = {"lfemur", "ltibia", "lfoot", "rfemur", "rtibia", "rfoot"}
+    assert changed.any()
+    assert all(locked.channels[i][0] in legs for i in np.flatnonzero(changed.any(axis=0)))
+    near = np.convolve(rows.astype(float), np.ones(9), "same") > 0  # lock easing: 0.1 s
+    assert not changed[~near].any()
+    with pytest.raises(ParameterError, match="plant"):
+        Synthesizer(models, plant="feet")
+
+
 def test_synthesizer_errors(walk_model):
     syn = Synthesizer({"walk": walk_model}, fps=30)
     with pytest.raises(ParameterError, match="before the particle"):
