@@ -21,9 +21,16 @@ and the 143_01 jog.  For every ordered pair of models (A, B):
   or its overall best window pair when none is under the threshold, marked ``*``): the
   largest joint acceleration and jerk (root-relative joint positions) inside the blend
   window +-2 frames, over the 99th percentile of the two models' training takes.
-* **foot skating** -- mean horizontal speed of a toe while it is low (within 1.5 units of
-  the training takes' 5th percentile toe height) in the same window, skeleton units/s.
-  A minimal measure written here: ``cyclecoord.quality.contacts`` was not on this branch.
+* **foot skating** -- with ``cyclecoord.quality.contacts`` (contacts found on the whole
+  synthesised motion): the fraction of the window's frames on which a planted foot point
+  slides and the planted points' mean speed (leg lengths/s); and a cruder toe measure,
+  the mean horizontal speed of a toe while it is low (within 1.5 units of the training
+  takes' 5th percentile toe height), skeleton units/s.
+
+The latent TRANSITION always arrives: where no bridge is under the threshold it takes the
+cheapest route of crossings over the models and crosses at the closest poses (the blend
+lengthened when they are far apart).  Its acceleration is given for the blend windows and
+for the whole transition (the approach MOVEs included).
 
 Per model: fitting time, joint-angle RMS error (degrees) of training frames rebuilt from
 their latent points and of the left-out frames, against PCA with as many components as
@@ -64,6 +71,7 @@ FPS = 30.0
 BLEND = 12
 HOLD = 0.2
 THRESHOLD = 0.015
+PLANT = "transitions"
 
 
 def default_data() -> Path:
@@ -336,7 +344,7 @@ def latent_transition(models, bridges, nA, nB, p99, low):
     blend window's statistics, the whole transition's acceleration and the route."""
     from cyclecoord.errors import ParameterError
 
-    syn = Synthesizer(models, fps=FPS, seed=0)
+    syn = Synthesizer(models, fps=FPS, seed=0, plant=PLANT)
     syn._bridges = dict(bridges)
     syn.start(nA)
     try:
@@ -471,23 +479,27 @@ def print_pairs(rows: list[dict]) -> None:
     """The pair table."""
     print("\n== transitions A -> B (threshold 1.5 % of bone length; blend 12 frames) ==")
     print(
-        f"{'A':10} {'B':10} {'bridges':>7} {'MG':>4} {'hops':>4} | coverage: {'br play':>7} "
-        f"{'br move':>7} {'MG':>5} |"
-        f" acc/p99: {'latent':>6} {'MG':>6} | jerk/p99: {'latent':>6} {'MG':>6} | skate: "
-        f"{'lat':>5} {'MG':>5} {'train':>5}"
+        f"{'A':10} {'B':10} {'bridges':>7} {'MG':>4} | {'hops':>4} {'d/thr':>5} | coverage: "
+        f"{'br play':>7} {'br move':>7} {'MG':>5} |"
+        f" acc/p99: {'latent':>6} {'whole':>5} {'MG':>6} | jerk/p99: {'latent':>6} {'MG':>6} |"
+        f" sliding: {'lat':>4} {'MG':>5} | toe skate: {'lat':>5} {'MG':>5} {'train':>5}"
     )
     for r in rows:
         lt, mg = r["latent"], r["mg"]
         star = "" if mg["under_threshold"] else "*"
         hops = "-" if lt is None else str(len(lt["route"]) - 1)
+        slide_l = lt.get("skating_frames_contacts") if lt else None
+        slide_m = mg.get("skating_frames_contacts")
         print(
-            f"{r['from'][:10]:10} {r['to'][:10]:10} {r['bridges']:7d} {r['mg_transitions']:4d} "
-            f"{hops:>4} |"
+            f"{r['from'][:10]:10} {r['to'][:10]:10} {r['bridges']:7d} {r['mg_transitions']:4d} |"
+            f" {hops:>4} {fmt(lt and lt['distance_ratio']):>5} |"
             f"           {r['bridge_cov_play']:7.0%} {r['bridge_cov_move']:7.0%} "
             f"{r['mg_cov_play']:5.0%} |"
-            f"          {fmt(lt and lt['acc']):>6} {fmt(mg['acc']) + star:>6} |"
+            f"          {fmt(lt and lt['acc']):>6} {fmt(lt and lt['acc_all']):>5} "
+            f"{fmt(mg['acc']) + star:>6} |"
             f"           {fmt(lt and lt['jerk']):>6} {fmt(mg['jerk']) + star:>6} |"
-            f"        {fmt(lt and lt['skate'], '.1f'):>5} {fmt(mg['skate'], '.1f') + star:>5} "
+            f"          {fmt(slide_l, '.0%'):>4} {fmt(slide_m, '.0%') + star:>5} |"
+            f"            {fmt(lt and lt['skate'], '.1f'):>5} {fmt(mg['skate'], '.1f') + star:>5} "
             f"{r['train_skate']:5.1f}"
         )
 
@@ -500,7 +512,15 @@ def main(argv=None) -> int:
     ap.add_argument("--data", type=Path, default=default_data())
     ap.add_argument("--json", type=Path)
     ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument(
+        "--plant",
+        choices=("transitions", "all", "off"),
+        default="transitions",
+        help="where the latent root follows the planted feet (Synthesizer plant=)",
+    )
     args = ap.parse_args(argv)
+    global PLANT
+    PLANT = args.plant
     if not (args.data / "cmu" / "13" / "13_29.amc").is_file():
         print(f"shared data not found at {args.data}; nothing to benchmark")
         return 0
@@ -565,25 +585,47 @@ def main(argv=None) -> int:
         f"bridges at twice the threshold: {with_br2}/{n} pairs, mean coverage (play) "
         f"{summary['mean_cov_bridges_play_2x']:.0%}"
     )
-    lat_c = [r["latent"]["skating_frames_contacts"] for r in rows
-             if r["latent"] and "skating_frames_contacts" in r["latent"]]
-    if lat_c:
-        mg_c = [r["mg"]["skating_frames_contacts"] for r in rows if r["latent"]]
-        summary["skating_frames_contacts"] = {
-            "latent": float(np.mean(lat_c)),
-            "mg": float(np.mean(mg_c)),
+    lat = [r["latent"] for r in rows if r["latent"]]
+    if lat and "skating_frames_contacts" in lat[0]:
+        mg_r = [r["mg"] for r in rows if r["latent"]]
+        summary["skating_contacts"] = {
+            "latent_frames": float(np.mean([x["skating_frames_contacts"] for x in lat])),
+            "mg_frames": float(np.mean([x["skating_frames_contacts"] for x in mg_r])),
+            "latent_speed_legs": float(np.mean([x["skating_speed_contacts"] for x in lat])),
+            "mg_speed_legs": float(np.mean([x["skating_speed_contacts"] for x in mg_r])),
         }
+        sc = summary["skating_contacts"]
         print(
-            f"quality.contacts: planted feet skate on {np.mean(lat_c):.0%} of the latent blend "
-            f"windows' frames, {np.mean(mg_c):.0%} of the motion graph's (same pairs)"
+            f"quality.contacts in the blend windows: planted feet slide on "
+            f"{sc['latent_frames']:.0%} of the latent frames (plant={args.plant}), "
+            f"{sc['mg_frames']:.0%} of the motion graph's; planted points' mean speed "
+            f"{sc['latent_speed_legs']:.3f} / {sc['mg_speed_legs']:.3f} leg lengths/s"
         )
-    else:
-        print("quality.contacts not available: foot skating is the minimal toe measure only")
-    print(f"latent TRANSITION reaches {reached}/{n} pairs (through other models when needed)")
+    bridged = sum(1 for x in lat if x["bridged"])
+    direct = sum(1 for x in lat if len(x["route"]) == 2)
+    summary.update(
+        {
+            "latent_pairs_bridged": bridged,
+            "latent_pairs_direct": direct,
+            "latent_worst_distance_ratio": max((x["distance_ratio"] for x in lat), default=None),
+            "latent_worst_acc_whole": max((x["acc_all"] for x in lat), default=None),
+            "latent_pairs_whole_over_1.5": sum(1 for x in lat if x["acc_all"] > 1.5),
+            "latent_longest_blend": max((max(x["blend_frames"]) for x in lat), default=None),
+        }
+    )
     print(
-        f"latent transitions over 1.5x p99 acceleration: {summary['latent_pairs_over_1.5']} of "
-        f"{reached} "
-        f"(worst {fmt(worst)}); motion graph: {summary['mg_pairs_over_1.5']} of {n}"
+        f"latent TRANSITION reaches {reached}/{n} pairs: {direct} directly, "
+        f"{reached - direct} through other models; {bridged} over bridges only, "
+        f"{reached - bridged} crossing somewhere at the closest poses above the threshold "
+        f"(worst {fmt(summary['latent_worst_distance_ratio'])}x it); longest blend "
+        f"{summary['latent_longest_blend']} frames"
+    )
+    print(
+        "target 1.5x p99 acceleration: latent blend windows over it "
+        f"{summary['latent_pairs_over_1.5']} of {reached} (worst {fmt(worst)}), whole transitions (approach MOVEs included) "
+        f"{summary['latent_pairs_whole_over_1.5']} of {reached} "
+        f"(worst {fmt(summary['latent_worst_acc_whole'])}); motion graph windows "
+        f"{summary['mg_pairs_over_1.5']} of {n}"
     )
     out = {"models": fits, "pairs": rows, "summary": summary}
     if not args.quick:
