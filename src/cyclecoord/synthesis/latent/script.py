@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import CycleCoordError, ParameterError, ParseError
+from ...quality.contacts import skating_report
 from .commands import Synthesizer
 from .model import LatentModel
 from .particle import ParticleParams
@@ -214,6 +215,7 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
         "commands": syn.segments(),
         "transitions": syn.events,
         "clamped_to_training_range": syn.clamped,
+        "foot_skating": skating_report(motion),
         "bridges": {f"{a}->{b}": br.to_dict() for (a, b), br in syn._bridges.items()},
         "timing": {
             "total_s": total,
