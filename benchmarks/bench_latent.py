@@ -276,7 +276,7 @@ def mg_transition(mA, mB, D, hits, scale) -> tuple[cc.Motion, int, bool]:
 
 
 def window_stats(
-    motion: cc.Motion, start: int, n: int, p99: tuple[float, float], low: float
+    motion: cc.Motion, start: int, n: int, p99: tuple[float, float, float], low: float
 ) -> dict:
     acc, jerk = derivatives(local_positions(motion), motion.fps)
     a = max(0, start - 2)
@@ -285,6 +285,7 @@ def window_stats(
     out = {
         "acc": float(acc[max(0, a - 1) : b].max() / p99[0]),
         "jerk": float(jerk[max(0, a - 2) : b].max() / p99[1]),
+        "root_acc": float(root_acceleration(motion)[max(0, a - 1) : b].max() / p99[2]),
         "skate": foot_skating(motion[max(0, a) : b + 1], low),
     }
     contacts = contacts_skating(motion)
@@ -314,20 +315,28 @@ def contacts_skating(motion: cc.Motion):
     return fc, foot_skating(motion, fc)
 
 
+def root_acceleration(motion: cc.Motion) -> np.ndarray:
+    """Horizontal acceleration of the root in the world, per frame (units/s^2)."""
+    p = motion.positions().positions[:, 0, [0, 2]]
+    return np.linalg.norm(np.diff(p, 2, axis=0), axis=1) * motion.fps**2
+
+
 def training_stats(models: dict, tests: dict) -> dict:
     out = {}
     for k, m in models.items():
-        accs, jerks, toes = [], [], []
+        accs, jerks, toes, roots = [], [], [], []
         for a, b in seg_bounds(m):
             mo = motion_of(m, m.frames_[a:b])
             ac, je = derivatives(local_positions(mo), FPS)
             accs.append(ac)
             jerks.append(je)
+            roots.append(root_acceleration(mo))
             toes.append(mo.positions().positions[:, toe_columns(mo), 1].ravel())
         out[k] = {
             "acc": np.concatenate(accs),
             "jerk": np.concatenate(jerks),
             "toe": np.concatenate(toes),
+            "root": np.concatenate(roots),
         }
     for k, m in models.items():
         low = float(np.percentile(out[k]["toe"], 5) + 1.5)
@@ -361,6 +370,7 @@ def latent_transition(models, bridges, nA, nB, p99, low):
         "acc": max(s["acc"] for s in stats),
         "acc_all": float(acc.max() / p99[0]),
         "jerk": max(s["jerk"] for s in stats),
+        "root_acc": max(s["root_acc"] for s in stats),
         "skate": float(np.mean([s["skate"] for s in stats])),
         "route": [syn.events[0]["transition"][0]] + [ev["transition"][1] for ev in syn.events],
         "distance_ratio": max(ev["bridge_distance"] / ev["threshold"] for ev in syn.events),
@@ -398,6 +408,7 @@ def pair_rows(models: dict, stats: dict, progress: bool) -> list[dict]:
         p99 = (
             float(np.percentile(np.r_[stats[a]["acc"], stats[b]["acc"]], 99)),
             float(np.percentile(np.r_[stats[a]["jerk"], stats[b]["jerk"]], 99)),
+            float(np.percentile(np.r_[stats[a]["root"], stats[b]["root"]], 99)),
         )
         low = stats[a]["low"]
         row = {
@@ -482,6 +493,7 @@ def print_pairs(rows: list[dict]) -> None:
         f"{'A':10} {'B':10} {'bridges':>7} {'MG':>4} | {'hops':>4} {'d/thr':>5} | coverage: "
         f"{'br play':>7} {'br move':>7} {'MG':>5} |"
         f" acc/p99: {'latent':>6} {'whole':>5} {'MG':>6} | jerk/p99: {'latent':>6} {'MG':>6} |"
+        f" root acc: {'lat':>4} {'MG':>5} |"
         f" sliding: {'lat':>4} {'MG':>5} | toe skate: {'lat':>5} {'MG':>5} {'train':>5}"
     )
     for r in rows:
@@ -498,6 +510,7 @@ def print_pairs(rows: list[dict]) -> None:
             f"          {fmt(lt and lt['acc']):>6} {fmt(lt and lt['acc_all']):>5} "
             f"{fmt(mg['acc']) + star:>6} |"
             f"           {fmt(lt and lt['jerk']):>6} {fmt(mg['jerk']) + star:>6} |"
+            f"           {fmt(lt and lt['root_acc']):>4} {fmt(mg['root_acc']) + star:>5} |"
             f"          {fmt(slide_l, '.0%'):>4} {fmt(slide_m, '.0%') + star:>5} |"
             f"            {fmt(lt and lt['skate'], '.1f'):>5} {fmt(mg['skate'], '.1f') + star:>5} "
             f"{r['train_skate']:5.1f}"
@@ -619,6 +632,14 @@ def main(argv=None) -> int:
         f"{reached - bridged} crossing somewhere at the closest poses above the threshold "
         f"(worst {fmt(summary['latent_worst_distance_ratio'])}x it); longest blend "
         f"{summary['latent_longest_blend']} frames"
+    )
+    summary["latent_pairs_root_over_1.5"] = sum(1 for x in lat if x["root_acc"] > 1.5)
+    summary["mg_pairs_root_over_1.5"] = sum(1 for r in rows if r["mg"]["root_acc"] > 1.5)
+    print(
+        "root's horizontal acceleration in the blend windows over 1.5x the takes' p99: latent "
+        f"{summary['latent_pairs_root_over_1.5']} of {reached} (worst "
+        f"{fmt(max((x['root_acc'] for x in lat), default=None))}), motion graph "
+        f"{summary['mg_pairs_root_over_1.5']} of {n}"
     )
     print(
         "target 1.5x p99 acceleration: latent blend windows over it "
