@@ -716,8 +716,8 @@ class Synthesizer:
         on the corrected motion, as the periodic cycle's anchoring does.  The planted
         track's steps are smoothed (:data:`PLANT_SMOOTH`): unsmoothed, the root copied
         the feet's frame-to-frame jitter and its horizontal acceleration exceeded 1.5x
-        the training takes' 99th percentile in 30 of the shared-data models' 56 blend
-        windows (none when smoothed, none without planting); on the same windows planted
+        the larger of the two models' training 99th percentile in 30 of the shared-data
+        models' 56 blend windows (none when smoothed, none without planting); on the same windows planted
         feet slid on 38 % of frames unsmoothed, 48 % smoothed, 56 % without planting.
         Steps outside the spans are kept.  (A first search with a lax speed limit, 1 or
         2 leg lengths per second, for the sliding feet did no better.)
