@@ -57,7 +57,7 @@ import bench_extract as bx  # noqa: E402  (table printing, JSON conversion, git 
 import cyclecoord as cc  # noqa: E402
 from cyclecoord.periodic.detection import DetectionResult, best_match_accuracy, boundary_errors, detect  # noqa: E402
 from cyclecoord.errors import NoPeriodicMotionError, ParameterError, ParseError  # noqa: E402
-from cyclecoord.io._atomic import atomic_write  # noqa: E402
+from cyclecoord.io import atomic_write  # noqa: E402
 
 #: ``../shared/data`` beside the checkout (real CMU captures; never copied into the repo).
 DATA_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "data"

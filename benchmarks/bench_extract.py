@@ -48,7 +48,7 @@ import numpy as np
 import cyclecoord as cc
 from cyclecoord.periodic.coordinates import unwrap
 from cyclecoord.errors import CycleCoordError, ParameterError
-from cyclecoord.io._atomic import atomic_write
+from cyclecoord.io import atomic_write
 from cyclecoord.quality.metrics import monotonicity
 
 #: ``../shared/data`` beside the checkout (real CMU captures; never copied into the repo).

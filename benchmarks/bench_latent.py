@@ -667,7 +667,7 @@ def main(argv=None) -> int:
             f"{s['seconds']:.2f} s wall = {s['fps']:,.0f} frames/s on this shared machine =="
         )
     if args.json:
-        from cyclecoord.io._atomic import atomic_write
+        from cyclecoord.io import atomic_write
 
         with atomic_write(args.json) as fh:
             json.dump(out, fh, indent=2, default=float)

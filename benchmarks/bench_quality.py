@@ -51,7 +51,7 @@ import numpy as np
 
 import cyclecoord as cc
 from cyclecoord.errors import CycleCoordError, NoPeriodicMotionError
-from cyclecoord.io._atomic import atomic_path, atomic_write
+from cyclecoord.io import atomic_path, atomic_write
 from cyclecoord.quality.cycle_quality import TARGETS, coverage, cycle_quality, foot_skating_speed, targets
 from cyclecoord.quality.reference import (
     autocorrelation_period,

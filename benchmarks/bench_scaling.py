@@ -68,7 +68,7 @@ import bench_extract as bx  # noqa: E402  (helpers shared with the short-capture
 
 import cyclecoord as cc  # noqa: E402
 from cyclecoord.errors import NoPeriodicMotionError, ParameterError  # noqa: E402
-from cyclecoord.io._atomic import atomic_write  # noqa: E402
+from cyclecoord.io import atomic_write  # noqa: E402
 from cyclecoord.periodic.landmarks import DEFAULT_MEMORY_LIMIT, estimate_complex  # noqa: E402
 
 #: Stages of ``result.timings`` (and "total").

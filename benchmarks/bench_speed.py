@@ -42,7 +42,7 @@ if str(_HERE) not in sys.path:
 import bench_extract as bx
 
 import cyclecoord as cc
-from cyclecoord.io._atomic import atomic_write
+from cyclecoord.io import atomic_write
 
 FRAMES = (200, 450)
 MAX_SCALE = 50.0

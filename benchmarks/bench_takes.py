@@ -130,7 +130,7 @@ def main(argv=None) -> int:
                   f"{de['wall_s']:.1f} s wall / {de['cpu_s']:.1f} s CPU")
         report[name] = entry
     if args.json:
-        from cyclecoord.io._atomic import atomic_write
+        from cyclecoord.io import atomic_write
 
         with atomic_write(args.json, "w") as fh:
             json.dump(report, fh, indent=1)

@@ -53,7 +53,7 @@ def main(argv: list[str] | None = None) -> int:
         return 3
     text = phase_table(result)
     if args.output:
-        from cyclecoord.io._atomic import atomic_write
+        from cyclecoord.io import atomic_write
 
         with atomic_write(args.output, "w") as fh:
             fh.write(text)

@@ -5,7 +5,7 @@ import stat
 
 import pytest
 
-from cyclecoord.io._atomic import atomic_path, atomic_write
+from cyclecoord.io import atomic_path, atomic_write
 
 
 @pytest.mark.skipif(os.name != "posix", reason="POSIX permissions")

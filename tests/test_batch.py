@@ -328,3 +328,49 @@ def test_a_changed_skeleton_makes_an_amc_report_stale(tmp_path):
     gone = run_batch(src, out, progress=False)
     assert gone.processed == ["07_01.amc"] and gone.row("07_01.amc")["status"] == "error"
     assert "no skeleton found" in gone.row("07_01.amc")["message"]
+
+
+def test_cycles_in_the_formats_extract_writes(tmp_path):
+    """--cycles glb/gltf/usda/csv: the cycle written by suffix as extract -o writes it; a
+    capture without a skeleton falls back to .npz; a format change removes the old file."""
+    import numpy as np
+
+    src = _build(tmp_path / "in", {"a.bvh": ("walk", 1)}, static=False, broken=False)
+    bare = _capture("jog", 3)
+    cc.save(cc.Motion(bare.frames, bare.channels, fps=bare.fps), src / "bare.npz")
+    out = tmp_path / "out"
+    opts = {"n_samples": 200}
+    ref = run_batch(src, out, extract_options=opts, write_cycles="npz", progress=False)
+    assert ref.n_ok == 2
+    cycle = cc.load(out / "a.cycle.npz")
+    want = cycle.positions()
+    for fmt in ("glb", "gltf", "usda", "csv"):
+        if fmt == "usda":
+            pytest.importorskip("pxr")
+        s = run_batch(src, out, extract_options=opts, write_cycles=fmt, progress=False)
+        assert s.processed == ["a.bvh", "bare.npz"]  # the format is part of the options
+        assert s.row("a.bvh")["cycle_file"] == f"a.cycle.{fmt}"
+        names = sorted(p.name for p in out.glob("a.cycle.*"))
+        assert names == (["a.cycle.bin", "a.cycle.gltf"] if fmt == "gltf" else [f"a.cycle.{fmt}"])
+        if fmt == "csv":
+            back = cc.load(out / "a.cycle.csv", fps=cycle.fps)
+            assert np.allclose(back.frames, cycle.frames, atol=1e-6)
+        else:
+            got = cc.load(out / f"a.cycle.{fmt}").positions()
+            assert got.positions.shape[0] == cycle.n_frames
+            for j in ("root", "lfoot", "rtoes", "head"):
+                assert np.abs(got[j] - want[j]).max() < 1e-3, (fmt, j)
+        # no skeleton: the cycle is written as .npz, and the report says why
+        no_skel = s.row("bare.npz")["cycle_file"]
+        skeleton_format = fmt != "csv"
+        assert no_skel == ("bare.cycle.npz" if skeleton_format else "bare.cycle.csv")
+        if skeleton_format:
+            assert "no skeleton" in _strict_json(out / "bare.report.json")["batch"]["message"]
+    assert run_batch(src, out, extract_options=opts, write_cycles="npz", progress=False).n_ok == 2
+    assert sorted(p.name for p in out.glob("a.cycle.*")) == ["a.cycle.npz"]
+    with pytest.raises(ParameterError, match="write_cycles must be one of"):
+        run_batch(src, out, write_cycles="fbx", progress=False)
+    from cyclecoord.cli import main
+
+    assert main(["batch", str(src), "-o", str(tmp_path / "cli"), "--cycles", "glb", "--no-progress"]) == 0
+    assert (tmp_path / "cli" / "a.cycle.glb").is_file()

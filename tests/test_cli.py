@@ -30,6 +30,29 @@ def test_extract_example_writes_cycle_and_report(tmp_path, capsys):
     assert all(v >= 0 for v in report["timings"].values())
 
 
+def test_extract_lock_feet_writes_a_cycle_whose_feet_stay(tmp_path, capsys):
+    from cyclecoord.quality.contacts import foot_skating
+
+    plain, locked, rep = tmp_path / "plain.bvh", tmp_path / "locked.bvh", tmp_path / "r.json"
+    code, out, err = run(capsys, "extract", "example", "-o", plain)
+    assert code == 0, err
+    assert "feet: planted feet slide" in out and "--lock-feet" in out
+    code, out, err = run(capsys, "extract", "example", "-o", locked, "--lock-feet", "--report", rep)
+    assert code == 0, err
+    report = json.loads(rep.read_text())
+    lock = report["foot_lock"]
+    assert lock["before"]["skating_frames"] > 0 and lock["after"]["skating_frames"] == 0
+    assert f"{lock['before']['skating_frames']} -> 0 frames skate" in out
+    a, b = cc.load(plain), cc.load(locked)
+    assert foot_skating(b).skating_frames < foot_skating(a).skating_frames
+    # only the legs moved: every channel of the other joints is as extracted
+    legs = ("femur", "tibia", "foot", "toes")
+    others = [i for i, (j, _) in enumerate(a.channels) if not j.lower().endswith(legs)]
+    np.testing.assert_allclose(b.frames[:, others], a.frames[:, others], atol=1e-4)
+    moved = {k for k, v in lock["joint_change_degrees"].items() if v > 0}
+    assert moved and all(k.lower().endswith(legs) for k in moved)
+
+
 def test_extract_options_reach_the_pipeline(tmp_path, capsys):
     rep = tmp_path / "r.json"
     code, out, err = run(capsys, "extract", "example", "--frames", "0:300", "--pca", "5", "--max-scale", "30",

@@ -46,6 +46,17 @@ def test_blend_writes_a_loop_and_a_report(cycles, tmp_path, capsys):
     assert len(report["blend"]["alignments"]) == 2
     # the jog was written in BVH conventions: the blend says how it shared channels
     assert any("conventions" in n for n in report["blend"]["notes"])
+    # foot skating of the blend and of each input, in the report and on one console line
+    from cyclecoord.quality.contacts import skating_report
+
+    sk = report["foot_skating"]
+    assert sk["skating_frames"] == skating_report(mix)["skating_frames"]
+    assert set(sk["per_foot"]) == {"lfoot", "ltoes", "rfoot", "rtoes"}
+    walk_sk = report["inputs"][0]["foot_skating"]
+    assert walk_sk["skating_frames"] == skating_report(cc.load(walk))["skating_frames"] > 0
+    line = [ln for ln in stdout.splitlines() if "foot skating" in ln]
+    assert len(line) == 1 and line[0].startswith("blend foot skating: ")
+    assert f"(inputs: {walk_sk['skating_frames']}, " in line[0]
 
 
 @pytest.mark.parametrize(
@@ -113,6 +124,12 @@ def test_transition_writes_a_continuous_clip(cycles, tmp_path, capsys):
     assert clip.n_frames == t["lead_in_frames"] + t["ramp_frames"] + t["lead_out_frames"]
     assert t["continuity"]["max_ratio"] <= t["continuity"]["limit"] == 1.5
     assert len(report["weight"]) == clip.n_frames and report["weight"][-1] == 1.0
+    from cyclecoord.quality.contacts import skating_report
+
+    sk = report["foot_skating"]
+    assert sk["skating_frames"] == skating_report(clip)["skating_frames"]
+    assert [i["foot_skating"] is not None for i in report["inputs"]] == [True, True]
+    assert "transition foot skating: " in stdout
 
 
 def test_transition_too_short_is_refused_under_strict(cycles, tmp_path, capsys):

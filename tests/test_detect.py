@@ -117,6 +117,18 @@ def test_cli_detect(tmp_path, capsys):
     assert r["n_motions"] == 3 and len(r["labels"]) == r["n_frames"]
     cycles = sorted(out.glob("motion*_cycle.bvh"))
     assert len(cycles) == 3 and all(cc.load(p).n_frames > 50 for p in cycles)
+    # each written cycle's foot skating, in the report and on one line each
+    from cyclecoord.quality.contacts import skating_report
+
+    stdout = capsys.readouterr().out
+    assert [e["path"] for e in sorted(r["extracted"], key=lambda e: e["path"])] == [
+        str(p) for p in cycles
+    ]
+    for e in r["extracted"]:
+        written = skating_report(cc.load(e["path"]))
+        assert e["foot_skating"]["skating_frames"] == written["skating_frames"]
+        assert e["frames"] == cc.load(e["path"]).n_frames
+    assert stdout.count("foot skating: ") == 3
     src = tmp_path / "still.npz"
     cc.save(cc.datasets.make_static_capture(n_frames=600, random_state=1).motion, src)
     capsys.readouterr()
@@ -250,6 +262,10 @@ def test_13_29_windows_find_the_slow_exercises(cmu_dir):
         name = spans[match[s.motion]][2]
         if name in truth_period:
             assert s.period_frames == pytest.approx(truth_period[name], rel=0.2), (name, s)
+    # the twist and the one-handed toe touch hold about one repetition each (under 1.5
+    # cycles, as extract finds too): they are segmented, but get no typical cycle
+    got = {spans[match[c.motion]][2] for c in motion_cycles(res)}
+    assert got == {"JumpJack", "ArmCircle", "KneeRaise", "Squat"}
 
 
 def test_autocorrelation_period_refines_a_window_length_guess():
@@ -265,3 +281,18 @@ def test_autocorrelation_period_refines_a_window_length_guess():
     assert autocorrelation_period(noise, 300.0) == 300.0
     assert autocorrelation_period(poses[:50], 480.0) == 480.0
     assert autocorrelation_period(poses, float("nan")) != autocorrelation_period(poses, float("nan"))
+
+
+def test_motion_cycles_need_one_and_a_half_cycles(chain):
+    """The rule extract applies (min_turns): a motion of one repetition and a part gets no
+    cycle; the CLI says which and why."""
+    _, res = chain
+    longest = {}
+    for sg in res.segments:
+        if sg.stop - sg.start > longest.get(sg.motion, (0, 0))[0]:
+            longest[sg.motion] = (sg.stop - sg.start, sg.cycles)
+    fewest = min(c for _, c in longest.values())
+    assert [c.motion for c in motion_cycles(res, min_cycles=fewest + 0.01)] == [
+        m for m, (_, c) in sorted(longest.items()) if c >= fewest + 0.01
+    ]
+    assert len(motion_cycles(res, min_cycles=fewest)) == res.n_motions

@@ -249,6 +249,29 @@ def test_transition_is_continuous_and_exports_to_bvh(walk, jog, tmp_path):
     assert np.abs(back.positions().positions - clip.positions().positions).max() < 1e-6
 
 
+def test_typed_results_carry_what_the_metadata_files(walk, jog):
+    (w, _), (j, _) = walk, jog
+    res = cc.blend([w, j], [0.25, 0.75], full_output=True)
+    assert isinstance(res, cc.BlendResult)
+    plain = cc.blend([w, j], [0.25, 0.75])
+    np.testing.assert_array_equal(res.motion.frames, plain.frames)
+    info = plain.metadata["blend"]
+    np.testing.assert_allclose(res.weights, [0.25, 0.75])
+    assert res.period_frames == plain.metadata["period_frames"] == plain.n_frames
+    np.testing.assert_allclose(res.root_displacement, plain.metadata["root_displacement"])
+    assert res.alignments == info["alignments"] and res.sources == info["sources"]
+    tr = cc.transition(w, j, cycles=2, full_output=True)
+    assert isinstance(tr, cc.TransitionResult)
+    clip = cc.transition(w, j, cycles=2)
+    t = clip.metadata["transition"]
+    np.testing.assert_array_equal(tr.motion.frames, clip.frames)
+    assert list(tr.ramp) == t["ramp"] and tr.ramp_frames == t["ramp_frames"]
+    np.testing.assert_allclose(tr.weight, t["weight"])
+    np.testing.assert_allclose(tr.phase, t["phase"])
+    assert tr.continuity["max_ratio"] == t["continuity"]["max_ratio"] <= STEP_LIMIT
+    assert tr.weight.shape == (tr.motion.n_frames,)
+
+
 def test_transition_by_frames_and_without_leads(walk, jog):
     (w, _), (j, _) = walk, jog
     clip = transition(w, j, frames=150, lead_in=0, lead_out=0)

@@ -5,7 +5,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import cyclecoord as cc
-from cyclecoord.skeleton import Joint, Skeleton, _rotation_matrices, forward_kinematics
+from cyclecoord.skeleton import Joint, Skeleton, rotation_matrices, forward_kinematics
 
 
 def two_joint():
@@ -19,7 +19,7 @@ def two_joint():
 def test_rotation_matrices_match_scipy_intrinsic(order):
     v = np.random.default_rng(1).uniform(-180, 180, (200, len(order)))
     np.testing.assert_allclose(
-        _rotation_matrices(v, order), Rotation.from_euler(order, v, degrees=True).as_matrix(), atol=1e-12
+        rotation_matrices(v, order), Rotation.from_euler(order, v, degrees=True).as_matrix(), atol=1e-12
     )
 
 

@@ -97,7 +97,11 @@ def test_deterministic_for_a_seed():
 def test_nothing_periodic_is_refused(make):
     with pytest.raises(cc.NoPeriodicMotionError, match="no periodic motion") as info:
         cc.extract(make(random_state=0).motion)
-    assert info.value.result is not None and info.value.result.barcode is not None
+    partial = info.value.result
+    assert isinstance(partial, cc.PartialExtraction) and partial.barcode is not None
+    # honest about what it lacks: no coordinate, period or cycle fields to find None in
+    assert partial.reason in str(info.value)
+    assert not hasattr(partial, "coordinate") and not hasattr(partial, "cycle")
 
 
 def test_bad_arguments():
@@ -254,3 +258,13 @@ def test_out_and_back_motion_is_read_with_a_delay(cmu_dir):
     res = cc.extract(m, frames=(0, 456))
     assert "delay embedding" in res.warnings[0]
     assert res.period_frames == pytest.approx(autocorrelation_period(m.frames[0:456], lo=90, hi=200), rel=0.05)
+
+
+def test_a_take_of_several_motions_points_to_detect():
+    """Extract reads one motion; when most moving frames are something else it says so."""
+    chain = cc.datasets.make_motion_chain(random_state=0)
+    res = cc.extract(chain.motion)
+    assert sum(b - a for a, b in res.used_frames) < 0.5 * chain.motion.n_frames
+    assert any("cyclecoord detect" in w for w in res.warnings)
+    # one steady motion alone does not get the note
+    assert not any("cyclecoord detect" in w for w in cc.extract(cc.datasets.example_capture().motion).warnings)

@@ -1,6 +1,6 @@
 """Every command and library line of the README runs as written (issue 18).
 
-The README speaks of CMU captures (69_01.amc, 143_01.amc, 13_29.amc); here they are
+The README speaks of CMU captures (69_01.amc, 143_01.amc, 13_29.amc, 01_09.amc); here they are
 stood in for by the built-in synthetic captures written under those names (walk, jog,
 a chain of three motions), so the test needs no data and checks what a reader types.
 """
@@ -56,7 +56,10 @@ def workdir(tmp_path_factory):
     jog = datasets.make_periodic_capture(kind="jog", n_frames=480, period=43.0, random_state=0).motion[:100]
     chain = datasets.make_motion_chain(("walk", "jumping_jack"), segment_frames=360,
                                        random_state=0).motion
-    for motion, name in ((walk, "69_01.amc"), (jog, "143_01.amc"), (chain, "13_29.amc")):
+    # like CMU 01_09 (a playground): nothing periodic
+    playground = datasets.make_random_walk_capture(n_frames=400, random_state=1).motion
+    for motion, name in ((walk, "69_01.amc"), (jog, "143_01.amc"), (chain, "13_29.amc"),
+                         (playground, "01_09.amc")):
         cc.save(motion, d / name)  # with 69.asf, 143.asf, 13.asf beside
     (d / "captures").mkdir()
     cc.save(walk[:360], d / "captures" / "walk.bvh")

@@ -37,6 +37,8 @@ _LAZY = {
     "DEFAULT_FPS": "motion",
     "Motion": "motion",
     "ExtractionResult": "periodic.pipeline",
+    "PartialExtraction": "periodic.pipeline",
+    "CycleOptions": "periodic.pipeline",
     "extract": "periodic.pipeline",
     "PreparedData": "periodic.preprocess",
     "Preprocessor": "periodic.preprocess",
@@ -49,11 +51,22 @@ _LAZY = {
     "DetectionResult": "periodic.detection",
     "blend": "synthesis.blend",
     "transition": "synthesis.blend",
+    "BlendResult": "synthesis.blend",
+    "TransitionResult": "synthesis.blend",
     "align": "synthesis.align",
     "run_batch": "batch",
 }
 _SUBMODULES = {
-    "batch", "cli", "conventions", "datasets", "io", "periodic", "plot", "quality", "skeleton", "synthesis",
+    "batch",
+    "cli",
+    "conventions",
+    "datasets",
+    "io",
+    "periodic",
+    "plot",
+    "quality",
+    "skeleton",
+    "synthesis",
 }
 
 
@@ -82,13 +95,13 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
     from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
     from .io import convert, load, save
     from .motion import DEFAULT_FPS, Motion
-    from .periodic.pipeline import ExtractionResult, extract
+    from .periodic.pipeline import CycleOptions, ExtractionResult, PartialExtraction, extract
     from .periodic.preprocess import PreparedData, Preprocessor
     from .skeleton import Joint, JointPositions, Skeleton, forward_kinematics
     from .periodic.phase_model import PhaseModel
     from .periodic.detection import DetectionResult, detect
     from .synthesis.align import align
-    from .synthesis.blend import blend, transition
+    from .synthesis.blend import BlendResult, TransitionResult, blend, transition
     from .batch import run_batch
 
 __version__ = "0.1.0"
@@ -96,8 +109,10 @@ __version__ = "0.1.0"
 __all__ = [
     "Barcode",
     "BarSelection",
+    "BlendResult",
     "CircularCoordinates",
     "CycleCoordError",
+    "CycleOptions",
     "DEFAULT_FPS",
     "DetectionResult",
     "ExtractionResult",
@@ -107,11 +122,13 @@ __all__ = [
     "NoPeriodicMotionError",
     "ParameterError",
     "ParseError",
+    "PartialExtraction",
     "PeriodicDensity",
     "PhaseModel",
     "PreparedData",
     "Preprocessor",
     "Skeleton",
+    "TransitionResult",
     "TypicalCycle",
     "align",
     "blend",

@@ -15,7 +15,7 @@ import numpy as np
 
 from .errors import ParameterError
 from .motion import Motion
-from .skeleton import _AXIS_INDEX, Skeleton, _rotation_matrices
+from .skeleton import AXIS_INDEX, Skeleton, rotation_matrices
 
 __all__ = ["channels_from_local", "global_transforms", "local_transforms"]
 
@@ -37,7 +37,7 @@ def local_transforms(
         t = np.broadcast_to(j.offset, (T, 3)).copy()
         for d in j.dofs:
             if d.startswith("t") and (j.name, d) in col:
-                t[:, _AXIS_INDEX[d[1]]] = frames[:, col[(j.name, d)]]
+                t[:, AXIS_INDEX[d[1]]] = frames[:, col[(j.name, d)]]
         trans[:, i] = t
         if j.rotation_order:
             vals = np.zeros((T, len(j.rotation_order)))
@@ -45,7 +45,7 @@ def local_transforms(
                 c = (j.name, "r" + ax)
                 if c in col:
                     vals[:, k] = frames[:, col[c]]
-            local = _rotation_matrices(vals, j.rotation_order)
+            local = rotation_matrices(vals, j.rotation_order)
             rots[:, i] = j.axis @ local @ j.axis.T
         else:
             rots[:, i] = np.eye(3)
@@ -108,7 +108,7 @@ def channels_from_local(
             angles = {"r" + a.lower(): eul[:, m] for m, a in enumerate(j.rotation_order)}
         for d in j.dofs:
             if d.startswith("t"):
-                out[:, k] = translations[:, i, _AXIS_INDEX[d[1]]]
+                out[:, k] = translations[:, i, AXIS_INDEX[d[1]]]
             else:
                 out[:, k] = angles[d]
             k += 1

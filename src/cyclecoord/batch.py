@@ -1,4 +1,4 @@
-"""Batch extraction: run :func:`~cyclecoord.periodic.pipeline.extract` over every capture in a folder.
+"""Batch extraction: :func:`~cyclecoord.periodic.pipeline.extract` over every capture in a folder.
 
 :func:`run_batch` finds the captures under a folder (recursively, in sorted order), runs
 load + extract on each -- in this process, in a local process pool or on a Dask
@@ -7,7 +7,8 @@ distributed cluster -- and writes, mirroring the input tree under the output fol
 * ``<relative path without suffix>.report.json`` per capture: the extraction report
   (:meth:`~cyclecoord.periodic.pipeline.ExtractionResult.to_report`) plus a ``"batch"`` block
   (status, message, input size and modification time, options and their hash, seconds);
-* ``<relative path without suffix>.cycle.bvh`` (or ``.npz``): the typical cycle;
+* ``<relative path without suffix>.cycle.bvh`` (or ``.npz``, ``.csv``, ``.glb``, ``.gltf``
+  with a ``.bin``, ``.usda``, ``.usdc``): the typical cycle;
 * ``summary.csv``: one row per capture with the key figures (see :data:`SUMMARY_COLUMNS`).
 
 When two captures in one folder share a stem (``walk.bvh`` and ``walk.npz``) their
@@ -48,8 +49,8 @@ from pathlib import Path
 from typing import Any, Iterator, Sequence
 
 from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
-from .io._atomic import atomic_write
-from .io._paths import refuse_clobber
+from .io import atomic_write
+from .io import refuse_clobber
 from .report import clean, partial_report, write_json
 
 __all__ = [
@@ -75,7 +76,10 @@ SUMMARY_COLUMNS = (
 STATUSES = ("ok", "no_periodic", "error")
 SUMMARY_NAME = "summary.csv"
 REPORT_SUFFIX = ".report.json"
-CYCLE_FORMATS = ("bvh", "npz")
+#: Formats a cycle can be written in (the suffix, as for ``extract -o``).  The ones in
+#: :data:`SKELETON_FORMATS` need a skeleton: a capture without one gets ``.npz``.
+CYCLE_FORMATS = ("bvh", "npz", "csv", "glb", "gltf", "usda", "usdc")
+SKELETON_FORMATS = ("bvh", "glb", "gltf", "usda", "usdc")
 #: Seconds to wait for a Dask scheduler given by address.
 CONNECT_TIMEOUT = 10.0
 _CRASHED = (
@@ -181,8 +185,10 @@ class BatchSummary:
         parts = [f"{self.n_ok} ok", f"{self.n_no_periodic} no periodic motion",
                  f"{self.n_error} error" + ("s" if self.n_error != 1 else "")]
         lines = [
-            f"{n} capture{'s' if n != 1 else ''} under {self.folder}: " + ", ".join(parts)
-            + f" ({len(self.processed)} analysed, {len(self.skipped)} up to date) in {self.seconds:.1f} s"
+            f"{n} capture{'s' if n != 1 else ''} under {self.folder}: "
+            + ", ".join(parts)
+            + f" ({len(self.processed)} analysed, {len(self.skipped)} up to date)"
+            + f" in {self.seconds:.1f} s"
         ]
         for r in self.errors:
             lines.append(f"error: {r['file']}: {r['message']}")
@@ -194,7 +200,9 @@ class BatchSummary:
 def _as_patterns(pattern: str | Sequence[str]) -> tuple[str, ...]:
     pats = (pattern,) if isinstance(pattern, str) else tuple(pattern)
     if not pats or not all(isinstance(p, str) and p for p in pats):
-        raise ParameterError(f"pattern must be a glob or a non-empty list of globs, got {pattern!r}")
+        raise ParameterError(
+            f"pattern must be a glob or a non-empty list of globs, got {pattern!r}"
+        )
     return pats
 
 
@@ -264,7 +272,9 @@ def _check_options(options: dict) -> dict:
     try:
         bound = sig.bind(None, **options)
     except TypeError:
-        allowed = ", ".join(p for p in params[1:] if sig.parameters[p].kind is not inspect.Parameter.VAR_KEYWORD)
+        allowed = ", ".join(
+            p for p in params[1:] if sig.parameters[p].kind is not inspect.Parameter.VAR_KEYWORD
+        )
         unknown = sorted(k for k in options if k not in sig.parameters)
         raise ParameterError(f"unknown extract option(s) {unknown}; allowed: {allowed}") from None
     bound.apply_defaults()
@@ -277,7 +287,9 @@ def _check_options(options: dict) -> dict:
 
 
 def _options_hash(normalised: dict, fps: float | None, cycle_format: str | None) -> str:
-    blob = json.dumps({"extract": normalised, "fps": fps, "cycles": cycle_format}, sort_keys=True, default=repr)
+    blob = json.dumps(
+        {"extract": normalised, "fps": fps, "cycles": cycle_format}, sort_keys=True, default=repr
+    )
     return hashlib.sha256(blob.encode("utf-8")).hexdigest()[:16]
 
 
@@ -337,9 +349,12 @@ def _analyse(task: _Task) -> dict[str, Any]:
         written = None
         if task.cycle_format is not None:
             fmt = task.cycle_format
-            if fmt == "bvh" and result.cycle.skeleton is None:
+            if fmt in SKELETON_FORMATS and result.cycle.skeleton is None:
+                notes.append(
+                    "the capture has no skeleton, so its cycle was written as .npz instead of "
+                    f".{fmt}"
+                )
                 fmt = "npz"
-                notes.append("the capture has no skeleton, so its cycle was written as .npz instead of .bvh")
                 report["warnings"] = notes
             written = _cycle_path(task, fmt)
             save(result.cycle, written)
@@ -350,6 +365,8 @@ def _analyse(task: _Task) -> dict[str, Any]:
         stale = _cycle_path(task, fmt)
         if stale != written and stale.exists():
             stale.unlink()
+            if fmt == "gltf":  # and the buffer written beside a .gltf
+                stale.with_suffix(".bin").unlink(missing_ok=True)
     return report
 
 
@@ -382,7 +399,7 @@ def _process_one(task: _Task) -> dict[str, Any]:
 
 
 def _record_failure(task: _Task, exc: BaseException | str) -> dict[str, Any]:
-    """Failure seen by the dispatcher (worker died, cluster error): report it like a worker would."""
+    """Failure seen by the dispatcher (worker died, cluster error), reported as a worker would."""
     report = _failure_report(task, exc)
     report["batch"]["seconds"] = None
     try:
@@ -467,8 +484,13 @@ def _up_to_date(task: _Task) -> dict[str, Any] | None:
         b = report["batch"]
         if b.get("status") not in ("ok", "no_periodic"):
             return None
-        if (b.get("file"), b.get("input_size"), b.get("input_mtime_ns"), b.get("options_hash"),
-                b.get("skeleton")) != (task.file, task.size, task.mtime_ns, task.options_hash, task.skeleton):
+        if (
+            b.get("file"),
+            b.get("input_size"),
+            b.get("input_mtime_ns"),
+            b.get("options_hash"),
+            b.get("skeleton"),
+        ) != (task.file, task.size, task.mtime_ns, task.options_hash, task.skeleton):
             return None
         if b["status"] == "ok" and task.cycle_format is not None:
             cyc = b.get("cycle_file")
@@ -565,7 +587,9 @@ def _dask_client(scheduler: Any) -> tuple[Any, bool]:
     try:
         return Client(scheduler, timeout=CONNECT_TIMEOUT), True
     except (OSError, ValueError, TypeError) as exc:
-        raise ParameterError(f"could not connect to the Dask scheduler at {scheduler!r}: {exc}") from None
+        raise ParameterError(
+            f"could not connect to the Dask scheduler at {scheduler!r}: {exc}"
+        ) from None
 
 
 def _run_dask(tasks: Sequence[_Task], client: Any) -> Iterator[dict]:
@@ -633,9 +657,11 @@ def run_batch(
         Keyword arguments for :func:`~cyclecoord.periodic.pipeline.extract` (``frames``, ``pca``,
         ``max_scale``, ``random_state``, ...), the same for every capture.  Checked
         against extract's signature before anything runs.
-    write_cycles : {"bvh", "npz", None}, default "bvh"
-        Format of the typical cycle written per capture, or None for reports only.  A
-        capture without a skeleton gets ``.npz`` when BVH is asked for.
+    write_cycles : {"bvh", "npz", "csv", "glb", "gltf", "usda", "usdc", None}, default "bvh"
+        Format of the typical cycle written per capture (``NAME.cycle.<format>``, written
+        by :func:`cyclecoord.save` as ``extract -o`` writes it; ``gltf`` adds
+        ``NAME.cycle.bin``), or None for reports only.  A capture without a skeleton gets
+        ``.npz`` when a format that needs one is asked for.  USD needs usd-core.
     fps : float, optional
         Frame rate overriding the files' own (AMC files carry none: 120).
     progress : bool, default True
@@ -664,13 +690,54 @@ def run_batch(
     under ``if __name__ == "__main__":``.
     """
     t_start = time.perf_counter()
+    jobs, write_cycles, fps = _check_run_arguments(jobs, write_cycles, fps)
+    options = dict(extract_options or {})
+    normalised = _check_options(options)
+    opt_hash = _options_hash(normalised, fps, write_cycles)
+    patterns = _as_patterns(pattern)
+    src, out = _check_folders(folder, out_dir)
+    files = find_captures(src, patterns, recursive)
+    tasks = _plan_tasks(files, src, out, folder, options, fps, write_cycles, opt_hash)
+    _refuse_overwrites(tasks, out, write_cycles)
+    out.mkdir(parents=True, exist_ok=True)
+    rows, skipped, todo = _split_up_to_date(tasks, force)
+    for t in todo:
+        t.report.parent.mkdir(parents=True, exist_ok=True)
+    _execute(todo, jobs, scheduler, progress, rows)
+    for t in todo:  # defensive: every capture gets a row even if an executor lost it
+        if t.file not in rows:
+            rows[t.file] = _record_failure(t, "the capture was not analysed (lost by the executor)")
+    ordered = [rows[t.file] for t in tasks]
+    summary_path = out / SUMMARY_NAME
+    _write_summary(summary_path, ordered)
+    return BatchSummary(
+        folder=src, out_dir=out, rows=ordered, processed=[t.file for t in todo],
+        skipped=skipped, seconds=time.perf_counter() - t_start, summary_path=summary_path,
+        patterns=patterns,
+    )
+
+
+def _check_run_arguments(
+    jobs: Any, write_cycles: Any, fps: Any
+) -> tuple[int, str | None, float | None]:
+    """``jobs`` (0: one per core), ``write_cycles`` ("none": None) and ``fps`` checked."""
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 0:
-        raise ParameterError(f"jobs must be a whole number >= 1 (0: one per CPU core), got {jobs!r}")
+        raise ParameterError(
+            f"jobs must be a whole number >= 1 (0: one per CPU core), got {jobs!r}"
+        )
     jobs = jobs or (os.cpu_count() or 1)
     if isinstance(write_cycles, str) and write_cycles.lower() == "none":
         write_cycles = None
+    if isinstance(write_cycles, str):
+        write_cycles = write_cycles.lower().lstrip(".")
     if write_cycles is not None and write_cycles not in CYCLE_FORMATS:
-        raise ParameterError(f"write_cycles must be 'bvh', 'npz' or None, got {write_cycles!r}")
+        raise ParameterError(
+            f"write_cycles must be one of {', '.join(CYCLE_FORMATS)} or None, got {write_cycles!r}"
+        )
+    if write_cycles in ("usda", "usdc"):
+        from .io.usd import _pxr
+
+        _pxr()  # usd-core missing: one clear error before anything runs
     if fps is not None:
         try:
             fps = float(fps)
@@ -678,11 +745,13 @@ def run_batch(
             raise ParameterError(f"fps must be a positive number, got {fps!r}") from None
         if not (0 < fps < math.inf):
             raise ParameterError(f"fps must be a positive number, got {fps!r}")
-    options = dict(extract_options or {})
-    normalised = _check_options(options)
-    opt_hash = _options_hash(normalised, fps, write_cycles)
-    patterns = _as_patterns(pattern)
+    return jobs, write_cycles, fps
 
+
+def _check_folders(
+    folder: str | os.PathLike[str], out_dir: str | os.PathLike[str]
+) -> tuple[Path, Path]:
+    """The resolved input and output folders; the output may not hold the input's files."""
     src = Path(folder)
     if not src.is_dir():
         raise ParameterError(f"{folder}: no such folder")
@@ -695,9 +764,24 @@ def run_batch(
             f"the output folder {out_dir} is the input folder or inside it; choose a folder "
             "outside the input (outputs are never written among the captures)"
         )
-    files = find_captures(src, patterns, recursive)
+    return src, out
 
-    # output names: the stem, or the full name when several captures share a stem
+
+def _plan_tasks(
+    files: Sequence[str],
+    src: Path,
+    out: Path,
+    folder: str | os.PathLike[str],
+    options: dict,
+    fps: float | None,
+    write_cycles: str | None,
+    opt_hash: str,
+) -> list[_Task]:
+    """One task per capture, its outputs mirroring the input tree under ``out``.
+
+    Outputs are named by the capture's stem, or by its full name when several captures
+    of one folder share a stem (``walk.amc`` and ``walk.bvh``).
+    """
     stems = Counter((Path(f).parent.as_posix(), Path(f).stem) for f in files)
     tasks: list[_Task] = []
     for f in files:
@@ -706,8 +790,8 @@ def run_batch(
         base = out / p.parent / name
         if _outputs_inside(base, src):
             raise ParameterError(
-                f"the outputs of {f} would go to {base.parent}, inside the input folder {folder}; "
-                "choose an output folder that does not hold the input folder's tree"
+                f"the outputs of {f} would go to {base.parent}, inside the input folder "
+                f"{folder}; choose an output folder that does not hold the input folder's tree"
             )
         st = (src / f).stat()
         tasks.append(_Task(
@@ -715,7 +799,11 @@ def run_batch(
             mtime_ns=int(st.st_mtime_ns), options=options, fps=fps, cycle_format=write_cycles,
             options_hash=opt_hash, skeleton=_skeleton_signature(src / f),
         ))
+    return tasks
 
+
+def _refuse_overwrites(tasks: Sequence[_Task], out: Path, write_cycles: str | None) -> None:
+    """ParameterError when any output (summary, report, cycle) would overwrite an input."""
     written = [("the summary", out / SUMMARY_NAME)]
     for t in tasks:
         written.append((f"the report of {t.file}", t.report))
@@ -724,7 +812,12 @@ def run_batch(
                         for fmt in sorted({write_cycles, "npz"})]
     refuse_clobber([t.input for t in tasks] + [t.skeleton[0] for t in tasks if t.skeleton],
                    written)
-    out.mkdir(parents=True, exist_ok=True)
+
+
+def _split_up_to_date(
+    tasks: Sequence[_Task], force: bool
+) -> tuple[dict[str, dict], list[str], list[_Task]]:
+    """Rows of the captures whose report is up to date, their names, and the rest to run."""
     rows: dict[str, dict] = {}
     skipped: list[str] = []
     todo: list[_Task] = []
@@ -735,9 +828,13 @@ def run_batch(
         else:
             rows[t.file] = row
             skipped.append(t.file)
-    for t in todo:
-        t.report.parent.mkdir(parents=True, exist_ok=True)
+    return rows, skipped, todo
 
+
+def _execute(
+    todo: Sequence[_Task], jobs: int, scheduler: Any, progress: bool, rows: dict[str, dict]
+) -> None:
+    """Analyse ``todo`` locally or on Dask, adding each capture's row to ``rows``."""
     client, own_client = (None, False)
     if todo and scheduler is not None:
         client, own_client = _dask_client(scheduler)  # fail on a bad address before starting
@@ -750,7 +847,8 @@ def run_batch(
             runner = _run_local(todo, jobs)
         from tqdm.auto import tqdm
 
-        with tqdm(total=len(todo), desc="batch", unit="file", disable=not progress or not todo) as bar:
+        with tqdm(total=len(todo), desc="batch", unit="file",
+                  disable=not progress or not todo) as bar:
             for row in runner:
                 rows[row["file"]] = row
                 bar.set_postfix_str(f"{row['file']}: {row['status']}", refresh=False)
@@ -758,15 +856,3 @@ def run_batch(
     finally:
         if own_client:
             client.close()
-
-    for t in todo:  # defensive: every capture gets a row even if an executor lost it
-        if t.file not in rows:
-            rows[t.file] = _record_failure(t, "the capture was not analysed (lost by the executor)")
-    ordered = [rows[t.file] for t in tasks]
-    summary_path = out / SUMMARY_NAME
-    _write_summary(summary_path, ordered)
-    return BatchSummary(
-        folder=src, out_dir=out, rows=ordered, processed=[t.file for t in todo],
-        skipped=skipped, seconds=time.perf_counter() - t_start, summary_path=summary_path,
-        patterns=patterns,
-    )

@@ -24,7 +24,7 @@ from scipy.spatial.transform import Rotation
 
 from .errors import ParameterError
 from .motion import Motion
-from .skeleton import Joint, Skeleton
+from .skeleton import AXIS_INDEX, Joint, Skeleton
 
 __all__ = [
     "to_bvh_convention",
@@ -35,8 +35,6 @@ __all__ = [
     "in_conventions_of",
     "common_channels",
 ]
-
-_AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 
 
 def check_order(order: str) -> str:
@@ -202,7 +200,7 @@ def to_bvh_convention(motion: Motion, rotation_order: str = "ZXY") -> Motion:
             if k is not None:
                 columns.append(motion.frames[:, k])
             else:
-                columns.append(np.full(T, j.offset[_AXIS_INDEX[d[1]]]))
+                columns.append(np.full(T, j.offset[AXIS_INDEX[d[1]]]))
             channels.append((j.name, d))
         for a, d in enumerate(rot_dofs):
             columns.append(angles[:, i, a])

@@ -152,7 +152,9 @@ class Motion:
                 "must be below B"
             )
         if not 0 <= a < b <= n:
-            raise ParameterError(f"frame range {a}:{b} is not inside the capture's {n} frames (0-based, half-open)")
+            raise ParameterError(
+                f"frame range {a}:{b} is not inside the capture's {n} frames (0-based, half-open)"
+            )
         return self if (a, b) == (0, n) else self[a:b]
 
     def select(self, channels: Iterable[Channel | str]) -> "Motion":
@@ -219,7 +221,9 @@ class Motion:
         """
         if self.skeleton is not None:
             root = self.skeleton.joints[0].name
-        elif self.channels and any(d.startswith("t") for j, d in self.channels if j == self.channels[0][0]):
+        elif self.channels and any(
+            d.startswith("t") for j, d in self.channels if j == self.channels[0][0]
+        ):
             root = self.channels[0][0]
         else:
             return []

@@ -18,7 +18,7 @@ __all__ = ["clean", "partial_report", "write_json"]
 
 def write_json(path: str, payload: dict) -> None:
     """Write ``payload`` as indented strict JSON, atomically (numpy scalars and arrays allowed)."""
-    from .io._atomic import atomic_write
+    from .io import atomic_write
 
     with atomic_write(path, "w") as fh:
         json.dump(payload, fh, indent=1, allow_nan=False, default=_json_default)

@@ -9,7 +9,7 @@ import pytest
 import cyclecoord as cc
 from cyclecoord.cli import main
 from cyclecoord.errors import ParameterError
-from cyclecoord.io._paths import input_files, refuse_clobber, same_file
+from cyclecoord.io import input_files, refuse_clobber, same_file
 
 
 @pytest.fixture(scope="module")

@@ -144,3 +144,12 @@ def test_skating_report(walk_69_01):
     assert 0 < rep["planted_fraction"]["lfoot"] < 1
     bare = Motion(walk_69_01.frames[:5], walk_69_01.channels, fps=120)
     assert skating_report(bare) is None
+
+
+def test_skating_line(walk_69_01):
+    from cyclecoord.quality.contacts import foot_skating, skating_line, skating_report
+
+    m = walk_69_01[200:450]
+    assert skating_line(skating_report(m)) == foot_skating(m).summary()
+    assert skating_line(skating_report(m), "blend").startswith("blend foot skating: ")
+    assert "not measured" in skating_line(None, "cycle")

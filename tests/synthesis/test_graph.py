@@ -18,6 +18,7 @@ from cyclecoord.synthesis.graph import (
     cross_validate,
     follow_field,
     h1_diagram,
+    parse_variant,
     path_errors,
     path_to_target,
     shortest_path,
@@ -156,6 +157,97 @@ def test_field_weights_and_fallback():
     assert np.allclose(w[0], expect / expect.sum())
 
 
+def test_parse_variant_names_and_errors():
+    assert parse_variant("delaunay") == ("delaunay", False, False)
+    assert parse_variant("delaunay+ring+agree") == ("delaunay", True, True)
+    assert parse_variant("union+agree") == ("union", False, True)
+    for bad, msg in (
+        ("knn+agree", "need the Delaunay triangulation"),
+        ("delaunay+ring+ring", "once each"),
+        ("delaunay+smooth", "optionally followed by"),
+        ("voronoi", "unknown graph method"),
+    ):
+        with pytest.raises(ParameterError, match=msg):
+            parse_variant(bad)
+    g = build_graph([circle(30), circle(30, 1.2, 0.1)], "knn")
+    with pytest.raises(ParameterError, match="ring and agree need"):
+        VectorField(g, agree=True)
+
+
+def test_ring_neighbourhood_is_the_simplex_and_the_vertices_across_its_facets():
+    takes = [circle(60, 1.0), circle(60, 1.3, 0.05), circle(50, 0.8, 0.1)]
+    g = build_graph(takes, "delaunay")
+    tri = g.delaunay
+    f = VectorField(g, ring=True)
+    assert f.name == "delaunay+ring"
+    x = np.array([[0.0, 1.12], [-0.7, -0.75], [5.0, 5.0]])
+    idx, w, inside = f.neighbours(x)
+    assert inside.tolist() == [True, True, False]
+    for r in range(2):
+        s = int(tri.find_simplex(x[r]))
+        expect = set(tri.simplices[s].tolist())
+        for n in tri.neighbors[s]:
+            if n >= 0:
+                expect |= set(tri.simplices[n].tolist())
+        got = idx[r][w[r] > 0]
+        assert len(got) == len(set(got.tolist())) == len(expect) > 3
+        assert set(got.tolist()) == expect
+        d2 = ((g.points[got] - x[r]) ** 2).sum(axis=1)
+        assert np.allclose(w[r][w[r] > 0], (1 / d2) / (1 / d2).sum())
+    assert (w[2] > 0).sum() == f.k  # outside the hull: k-NN, as the plain field
+
+
+def test_agree_weights_drop_neighbours_moving_against_the_heading():
+    takes = [circle(60, 1.0), circle(60, 1.3, 0.05)]
+    g = build_graph(takes, "delaunay")
+    plain, agree = VectorField(g), VectorField(g, agree=True)
+    x = np.array([[1.1, 0.05]])
+    idx, w0, _ = plain.neighbours(x)
+    v = g.velocities[idx[0]]
+    h = v[np.argmax(w0[0])]  # the heaviest neighbour's direction
+    _, w, _ = agree.neighbours(x, h)
+    cos = v @ h / (np.linalg.norm(v, axis=1) * np.linalg.norm(h))
+    expect = w0[0] * np.maximum(cos, 0)
+    assert np.allclose(w[0], expect / expect.sum())
+    # a heading against every neighbour, none, or a point outside the hull: plain weights
+    for args in ((x, -h), (x, None), (np.array([[5.0, 5.0]]), h)):
+        assert np.allclose(agree.neighbours(*args)[1], plain.neighbours(args[0])[1])
+    # one neighbour against the heading, the others with it: that one gets no weight
+    vel = g.velocities.copy()
+    vel[idx[0][0]] = -h
+    g2 = build_graph(takes, "delaunay")
+    g2.velocities = vel
+    _, w2, _ = VectorField(g2, agree=True).neighbours(x, h)
+    assert w2[0][0] == 0 and w2[0].sum() == pytest.approx(1.0)
+
+
+def hairpin_takes(sigma: float = 0.01, height: float = 0.05, seed: int = 0) -> list:
+    """Three noisy takes of a flat loop that dwells at its two tips: each tip a hairpin
+    where frames going out and frames coming back lie in one simplex (as at the CMU
+    walks' cusps in a 2-D PCA plane)."""
+    out = []
+    for i in range(3):
+        u = 0.1 * i + 2 * np.pi * np.arange(90) / 90
+        t = u - 0.45 * np.sin(2 * u)
+        p = np.stack([np.cos(t), height * np.sin(t)], axis=1)
+        out.append(p + np.random.default_rng(seed + i).normal(scale=sigma, size=p.shape))
+    return out
+
+
+def test_paper_field_stalls_at_a_noisy_hairpin_ring_agree_goes_round():
+    takes = hairpin_takes()
+    turns = {}
+    for variant in ("delaunay", "knn", "delaunay+ring+agree"):
+        method, ring, agree = parse_variant(variant)
+        f = VectorField(build_graph(takes, method), ring=ring, agree=agree)
+        p = follow_field(f, takes[0][0], 180)  # the paper's step: two loops' frames, one loop
+        ang = np.unwrap(np.arctan2(p.points[:, 1] / 0.05, p.points[:, 0]))
+        turns[variant] = (ang[-1] - ang[0]) / (2 * np.pi)
+        assert p.kind == f"field:{variant}:euler"
+    assert abs(turns["delaunay"]) < 0.25 and abs(turns["knn"]) < 0.25  # stuck at a tip
+    assert turns["delaunay+ring+agree"] > 0.9
+
+
 def test_follow_field_goes_round_the_loop():
     takes = [circle(80, 1.0), circle(80, 1.1, 0.3), circle(80, 0.9, 0.6)]
     for method in ("delaunay", "knn", "union"):
@@ -212,8 +304,10 @@ def test_path_errors_and_bottleneck():
 
 
 def test_cross_validate_report_keys(walks):
-    cv = cross_validate(walks, methods=("delaunay", "knn"), dims=2)
-    assert len(cv.folds) == 6
+    cv = cross_validate(walks, methods=("delaunay", "delaunay+ring+agree", "knn"), dims=2)
+    assert len(cv.folds) == 9
+    assert set(cv.median) == {"delaunay", "delaunay+ring+agree", "knn"}
+    assert set(cv.graph["edges"]) == {"delaunay", "knn"}  # one graph per method
     keys = {
         "held_out",
         "method",

@@ -66,7 +66,15 @@ def test_generate_writes_motion_report_and_figures(synthetic_takes, tmp_path, ca
 def test_crossval_report_keys(synthetic_takes, tmp_path, capsys):
     rep = tmp_path / "cv.json"
     rc = main(
-        ["graph", "crossval", *synthetic_takes, "--method", "delaunay,knn", "--report", str(rep)]
+        [
+            "graph",
+            "crossval",
+            *synthetic_takes,
+            "--method",
+            "delaunay,knn,delaunay+ring+agree",
+            "--report",
+            str(rep),
+        ]
     )
     assert rc == 0
     out = capsys.readouterr().out
@@ -82,8 +90,9 @@ def test_crossval_report_keys(synthetic_takes, tmp_path, capsys):
         "error_topo",
         "outside_hull_steps",
     }
-    assert len(r["folds"]) == 6 and all(fold_keys <= set(f) for f in r["folds"])
-    assert set(r["median"]) == {"delaunay", "knn"}
+    assert len(r["folds"]) == 9 and all(fold_keys <= set(f) for f in r["folds"])
+    assert set(r["median"]) == {"delaunay", "knn", "delaunay+ring+agree"}
+    assert "delaunay+ring+agree" in out
     assert {"error_a", "error_f", "error_a_deg", "error_f_deg", "error_topo"} <= set(
         r["median"]["knn"]
     )
@@ -114,6 +123,8 @@ def test_bad_input_one_line_each(synthetic_takes, tmp_path, capsys):
     # bad method
     assert main(["graph", a, b, "--method", "voronoi"]) == 1
     assert "unknown graph method 'voronoi'" in one_error_line(capsys)
+    assert main(["graph", "crossval", *synthetic_takes, "--method", "knn+agree"]) == 1
+    assert "need the Delaunay triangulation" in one_error_line(capsys)
 
 
 def test_different_skeletons_one_line(cmu_dir, capsys):
@@ -145,6 +156,13 @@ def test_w1_table_against_baselines(w1):
     # in 3 dimensions Delaunay is at most k-NN on both medians
     assert cv.median["delaunay"]["error_a"] <= cv.median["knn"]["error_a"]
     assert cv.median["delaunay"]["error_f"] <= cv.median["knn"]["error_f"]
+    # in the paper's 2 dimensions the paper's Delaunay field stalls at the loop's cusps;
+    # ours (ring + heading agreement) is at most k-NN, near the paper's w1 row
+    cv2 = cross_validate(w1, methods=("delaunay", "delaunay+ring+agree", "knn"), topo=False)
+    ours, knn = cv2.median["delaunay+ring+agree"], cv2.median["knn"]
+    assert cv2.median["delaunay"]["error_f"] > knn["error_f"]
+    assert ours["error_a"] <= knn["error_a"] and ours["error_f"] <= knn["error_f"]
+    assert ours["error_a"] < 0.03 and ours["error_f"] < 0.03
 
 
 @pytest.mark.slow

@@ -33,7 +33,7 @@ def run(args: argparse.Namespace) -> int:
 
     from .. import save
     from ..errors import ParameterError
-    from ..io._atomic import atomic_write
+    from ..io import atomic_write
     from ..synthesis.latent.script import run_script
 
     out = Path(args.output)

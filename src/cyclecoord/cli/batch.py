@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from ..batch import CYCLE_FORMATS
 from ._options import EXIT_ERROR, EXIT_OK, add_cycle_options, add_selection_options, cycle_options
 
 
@@ -13,7 +14,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="run extract on every capture in a folder, locally or on a Dask cluster",
         description=(
             "Run extract on every capture under DIR (recursively; .amc, .bvh, .npz, .csv by "
-            "default). OUTDIR mirrors DIR's tree: NAME.report.json and NAME.cycle.bvh per capture, "
+            "default). OUTDIR mirrors DIR's tree: NAME.report.json and NAME.cycle.bvh (--cycles: "
+            "another format) per capture, "
             "and summary.csv with one row per capture (status ok / no_periodic / error and the key "
             "figures). A failing capture is recorded and the batch goes on. A re-run skips "
             "captures whose report matches the input's size, modification time and the options "
@@ -52,9 +54,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     w.add_argument(
         "--cycles",
-        choices=("bvh", "npz", "none"),
+        choices=CYCLE_FORMATS + ("none",),
         default="bvh",
-        help="format of the cycle written per capture (default bvh; none: reports only)",
+        help="format of the cycle written per capture, NAME.cycle.FORMAT, as extract -o writes "
+        "it (default bvh; gltf adds NAME.cycle.bin; usda/usdc need usd-core; none: reports "
+        "only)",
     )
     w.add_argument("--no-progress", action="store_true", help="no progress bar")
     g = add_selection_options(

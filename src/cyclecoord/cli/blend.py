@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io._paths import input_files, refuse_clobber
+from ..io import input_files, refuse_clobber
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
@@ -294,18 +294,38 @@ def cmd_blend(args: argparse.Namespace) -> int:
     )
     for note in info["notes"]:
         print(f"note: {note}")
+    skating, inputs_skating = _skating(out, cycles, "blend")
     report = check_plausibility(out, cycles, margin_deg=args.margin)
     payload = {
         "inputs": [
-            dict(src.to_dict(), path=p, summary=sm)
-            for src, p, sm in zip(sources, args.inputs, summaries)
+            dict(src.to_dict(), path=p, summary=sm, foot_skating=sk)
+            for src, p, sm, sk in zip(sources, args.inputs, summaries, inputs_skating)
         ],
         "weights": info["weights"],
         "output": dict(s, path=args.output),
         "root_displacement": out.metadata["root_displacement"],
+        "foot_skating": skating,
         "blend": info,
     }
     return finish(args, out, payload, report, "blend")
+
+
+def _skating(motion, inputs: list, what: str) -> tuple[dict | None, list]:
+    """Foot skating of the result and of each input cycle (``skating_report`` dicts, None
+    where not measurable), and one console line for them."""
+    from ..quality.contacts import skating_report, skating_line
+
+    result = skating_report(motion)
+    per_input = [skating_report(c) for c in inputs]
+    line = skating_line(result, what)
+    if any(r is not None for r in per_input):
+        line += (
+            " (inputs: "
+            + ", ".join("-" if r is None else f"{r['skating_frames']}" for r in per_input)
+            + " frames)"
+        )
+    print(line)
+    return result, per_input
 
 
 def cmd_transition(args: argparse.Namespace) -> int:
@@ -345,11 +365,16 @@ def cmd_transition(args: argparse.Namespace) -> int:
     )
     for note in info["notes"]:
         print(f"note: {note}")
+    skating, inputs_skating = _skating(clip, [a, b], "transition")
     report = check_plausibility(clip, [a, b], margin_deg=args.margin)
     meta = {k: v for k, v in info.items() if k not in ("weight", "phase")}
     payload = {
-        "inputs": [dict(src.to_dict(), path=p) for src, p in zip(sources, args.inputs)],
+        "inputs": [
+            dict(src.to_dict(), path=p, foot_skating=sk)
+            for src, p, sk in zip(sources, args.inputs, inputs_skating)
+        ],
         "output": {"path": args.output, "frames": clip.n_frames, "fps": clip.fps},
+        "foot_skating": skating,
         "transition": meta,
         "weight": info["weight"],
         "phase": info["phase"],

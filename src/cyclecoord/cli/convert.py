@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..io._paths import input_files, refuse_clobber
+from ..io import input_files, refuse_clobber
 from ._options import EXIT_OK, check_output, frame_range, positive_float
 from .report import load_input
 

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io._paths import input_files, refuse_clobber
+from ..io import input_files, refuse_clobber
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
@@ -63,7 +63,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     d.add_argument(
         "--report",
         metavar="R.json",
-        help="JSON: segments, labels per frame, classes, windows, barcode",
+        help="JSON: segments, labels per frame, classes, windows, barcode (and the --extract "
+        "cycles with their foot skating)",
     )
     d.add_argument(
         "--extract", metavar="OUTDIR", help="write a typical cycle (BVH) for each detected motion"
@@ -168,21 +169,34 @@ def cmd_detect(args: argparse.Namespace) -> int:
     for sg in res.segments:
         print(
             f"  motion {sg.motion}: frames {m.start_frame + sg.start}-{m.start_frame + sg.stop} "
-            f"({sg.cycles:.1f} cycles, period {sg.period_frames:.1f} frames, classes "
+            f"({sg.cycles:.2f} cycles, period {sg.period_frames:.1f} frames, classes "
             f"{list(sg.classes)})"
         )
     for w in res.warnings:
         print(f"warning: {w}")
+    extracted = []
     if args.extract and code == EXIT_OK:
+        from ..quality.contacts import skating_line, skating_report
+
         folder = Path(args.extract)
         folder.mkdir(parents=True, exist_ok=True)
-        for mc in motion_cycles(
+        cycles = motion_cycles(
             res,
             bandwidth=args.bandwidth,
             cycle_start=args.cycle_start,
             timing=args.timing,
             travel=args.travel,
-        ):
+        )
+        have = {mc.motion for mc in cycles}
+        for mid in range(res.n_motions):
+            segs = [sg for sg in res.segments if sg.motion == mid]
+            if segs and mid not in have:
+                seg = max(segs, key=lambda sg: sg.stop - sg.start)
+                print(
+                    f"motion {mid}: no cycle written: its longest segment holds {seg.cycles:.2f} "
+                    "cycles, under the 1.5 a typical cycle needs (extract refuses such a take too)"
+                )
+        for mc in cycles:
             out = folder / f"motion{mc.motion}_cycle.{args.extract_format}"
             save(mc.cycle, out)
             how = (
@@ -195,10 +209,26 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 f"{m.start_frame + mc.start}:{m.start_frame + mc.stop} ({how}), loop closure "
                 f"{mc.loop_closure:.2f} -> {out}"
             )
+            skating = skating_report(mc.cycle)
+            print("  " + skating_line(skating))
+            extracted.append(
+                {
+                    "motion": int(mc.motion),
+                    "path": str(out),
+                    "frames": int(mc.cycle.n_frames),
+                    "source_frames": [m.start_frame + mc.start, m.start_frame + mc.stop],
+                    "loop_closure": float(mc.loop_closure),
+                    "foot_skating": skating,
+                }
+            )
     if args.plot:
         _save_plots(res, args.plot)
     if args.report:
-        write_json(args.report, clean(res.to_report()))
+        payload = res.to_report()
+        if args.extract:
+            # the cycles written by --extract, with their foot skating (as extract's report)
+            payload["extracted"] = extracted
+        write_json(args.report, clean(payload))
         print(f"wrote {args.report}")
     print("time: " + ", ".join(f"{k} {v:.3f}s" for k, v in res.timings.items()))
     return code
@@ -231,7 +261,7 @@ def _save_plots(res, folder: str) -> None:
         )
     if res.windows:
         figs["windows.png"] = plot_windows(res)
-    from ..io._atomic import atomic_write
+    from ..io import atomic_write
 
     for name, fig in figs.items():
         with atomic_write(folder / name, "wb") as fh:

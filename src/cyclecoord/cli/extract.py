@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io._paths import input_files, refuse_clobber
+from ..io import input_files, refuse_clobber
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
@@ -117,6 +117,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "channels (.png)",
     )
     o.add_argument(
+        "--lock-feet",
+        action="store_true",
+        help="pin the cycle's planted feet before writing it (a small leg IK over the loop; "
+        "the report's foot_lock gives the skating before and after and how far each leg "
+        "joint moved)",
+    )
+    o.add_argument(
         "--save-model",
         metavar="M.npz",
         help="save the fitted phase model (preparation + coordinate) to phase new frames later",
@@ -184,8 +191,13 @@ def cmd_extract(args: argparse.Namespace) -> int:
     else:
         for line in describe_extraction(res, args.input, verbose=args.verbose):
             print(line)
+        cycle, locked = res.cycle, None
+        if args.lock_feet:
+            cycle, locked = _lock(res.cycle)
+            print(locked_line(locked) if locked is not None else
+                  "feet: not locked: the cycle has no skeleton with recognisable feet")
         if args.output:
-            save(res.cycle, args.output)
+            save(cycle, args.output)
             print(f"wrote {args.output}")
         if args.save_model:
             res.model.save(args.save_model)
@@ -193,6 +205,8 @@ def cmd_extract(args: argparse.Namespace) -> int:
         if args.plot:
             _save_plots(res, args.plot)
         report_payload = res.to_report()
+        if locked is not None:
+            report_payload["foot_lock"] = lock_report(locked)
         if args.verbose:
             print("time: " + ", ".join(f"{k} {v:.3f}s" for k, v in res.timings.items()))
     if args.report and report_payload is not None:
@@ -220,7 +234,7 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
         lines.append(
             f"steady motion in frames {_frames_text(used, m.start_frame)} ({n_used} of "
             f"{m.n_frames} frames); "
-            "the rest (standing, starting, turning or stopping) has no phase"
+            "the rest (standing, starting, turning, stopping or another motion) has no phase"
         )
     wind = res.windings
     spread = f", spread {wind.spread:.0%}" if wind is not None and wind.pooled.size > 1 else ""
@@ -297,6 +311,44 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
     return lines
 
 
+def _lock(cycle):
+    """The cycle with its planted feet pinned over the loop, or ``(cycle, None)`` when it
+    has no skeleton with feet."""
+    from ..errors import ParameterError
+    from ..synthesis.footlock import lock_feet
+
+    if cycle.skeleton is None:
+        return cycle, None
+    try:
+        result = lock_feet(cycle, cyclic=True)
+    except ParameterError:
+        return cycle, None
+    return result.motion, result
+
+
+def locked_line(locked) -> str:
+    """One console line on a foot lock."""
+    legs = {k: v for k, v in locked.joint_change.items() if v > 0}
+    worst = max(legs.items(), key=lambda kv: kv[1]) if legs else ("-", 0.0)
+    return (
+        f"feet locked: {locked.before.skating_frames} -> {locked.after.skating_frames} frames "
+        f"skate ({locked.after_redetected.skating_frames} with contacts found afresh); leg "
+        f"joints move {worst[1]:.1f} degrees at most on average ({worst[0]}), the rest not at all"
+    )
+
+
+def lock_report(locked) -> dict:
+    """JSON-ready summary of a foot lock for reports."""
+    return {
+        "before": locked.before.to_dict(),
+        "after": locked.after.to_dict(),
+        "after_redetected": locked.after_redetected.to_dict(),
+        "joint_change_degrees": {k: float(v) for k, v in locked.joint_change.items()},
+        "mean_joint_change_degrees": locked.mean_joint_change,
+        "max_lock_error": float(locked.max_error),
+    }
+
+
 def _feet_line(cycle) -> str | None:
     """One line on the cycle's planted feet (the report's ``foot_skating``), or None."""
     from ..quality.contacts import skating_report
@@ -309,7 +361,7 @@ def _feet_line(cycle) -> str | None:
     return (
         f"feet: planted feet slide {sk['mean_speed_leg_lengths_per_s']:.2f} leg lengths/s on "
         f"average, {sk['skating_frames']} of {cycle.n_frames} frames skate "
-        "(`cyclecoord feet CYCLE --cycle --lock -o OUT` pins them)"
+        "(--lock-feet, or `cyclecoord feet CYCLE --cycle --lock -o OUT`, pins them)"
     )
 
 

@@ -48,8 +48,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument(
         "--method",
         default=None,
-        help="delaunay, knn or union (generation; default delaunay); crossval takes a comma list "
-        "(default delaunay,knn,union)",
+        help="delaunay, knn or union, the Delaunay ones optionally with +ring (the simplices "
+        "adjacent to the containing one) and +agree (neighbours weighted by agreement with the "
+        "path's heading), e.g. delaunay+ring+agree (generation; default delaunay, the paper's); "
+        "crossval takes a comma list (default delaunay,delaunay+ring+agree,knn,union)",
     )
     p.add_argument(
         "--dims",
@@ -153,9 +155,10 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _crossval(args: argparse.Namespace, motions: list) -> int:
-    from ..synthesis.graph import cross_validate
+    from ..synthesis.graph import DEFAULT_METHODS, cross_validate
 
-    methods = [m.strip() for m in (args.method or "delaunay,knn,union").split(",") if m.strip()]
+    methods = [m.strip() for m in (args.method or ",".join(DEFAULT_METHODS)).split(",")]
+    methods = [m for m in methods if m]
     cv = cross_validate(
         motions,
         methods=methods,
@@ -212,7 +215,8 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int
         gen = synth.generate(args.frames, start, frame)
     conn = synth.graph_.connectivity()
     print(
-        f"{synth.graph_.method} graph over {conn['nodes']} frames of {len(motions)} takes: "
+        f"{synth.graph_.method} graph ({synth.field_.name} field) over {conn['nodes']} frames of "
+        f"{len(motions)} takes: "
         f"{conn['edges']} edges, "
         f"{conn['weak_components']} weak / {conn['strong_components']} strong components; "
         f"start/end graph H {'connected' if conn['H']['connected'] else 'NOT connected'}"

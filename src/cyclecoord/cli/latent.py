@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
 
     from .. import load
     from ..errors import ParameterError
-    from ..io._atomic import atomic_write
+    from ..io import atomic_write
     from ..synthesis.latent.model import LatentModel
 
     if args.dims < 1:

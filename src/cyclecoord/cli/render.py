@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..errors import ParameterError
-from ..io._paths import input_files, refuse_clobber
+from ..io import input_files, refuse_clobber
 from ._options import EXIT_OK, frame_range, positive_float, positive_int
 from .report import load_input
 

@@ -6,6 +6,12 @@ Supported formats: ``.amc`` (Acclaim motion, with its ``.asf`` skeleton), ``.bvh
 ``.usda``/``.usdc``/``.usd`` (UsdSkel through the optional usd-core,
 :mod:`~cyclecoord.io.usd`).  The per-format readers and writers are re-exported here; the
 ASF/AMC, glTF and USD ones are imported on first use.
+
+Two helpers every writer of the package uses live here too: :func:`atomic_write` /
+:func:`atomic_path` (an output appears whole or not at all: it is written beside the
+target and renamed over it) and :func:`refuse_clobber` / :func:`input_files` /
+:func:`same_file` (no output is written over an input, however the paths are spelled).
+Import them from ``cyclecoord.io``; their modules ``_atomic`` and ``_paths`` are private.
 """
 
 from __future__ import annotations
@@ -21,6 +27,8 @@ import numpy as np
 from ..errors import ParameterError, ParseError
 from ..motion import DEFAULT_FPS, Motion
 from ..skeleton import Skeleton
+from ._atomic import atomic_path, atomic_write
+from ._paths import input_files, refuse_clobber, same_file
 from .bvh import read_bvh, write_bvh
 from .tabular import read_csv, read_npz, write_csv, write_npz
 
@@ -44,6 +52,11 @@ __all__ = [
     "write_gltf",
     "read_usd",
     "write_usd",
+    "atomic_write",
+    "atomic_path",
+    "refuse_clobber",
+    "input_files",
+    "same_file",
 ]
 
 #: Suffix -> description, in the order error messages list them.
@@ -147,7 +160,9 @@ def load(
     rate = _check_fps(fps)
     if suffix in _GLTF + _USD:
         if skeleton is not None:
-            raise ParameterError(f"{p}: a {suffix} file carries its own skeleton; do not pass skeleton=")
+            raise ParameterError(
+                f"{p}: a {suffix} file carries its own skeleton; do not pass skeleton="
+            )
         if suffix in _GLTF:
             from .gltf import read_gltf as reader
         else:
@@ -351,8 +366,6 @@ def convert(
     """
     s, d = Path(src), Path(dst)
     _suffix(d)  # fail on an unknown output format before reading anything
-    from ._paths import input_files, same_file
-
     for src in input_files(s, skeleton if isinstance(skeleton, (str, os.PathLike)) else None):
         if same_file(src, d):
             raise ParameterError(f"{d}: convert would overwrite its input {src}")

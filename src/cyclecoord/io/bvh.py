@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import ParameterError, ParseError
 from ..motion import Motion
-from ..skeleton import Joint, Skeleton, rotation_order_from_dofs
+from ..skeleton import AXIS_INDEX, Joint, Skeleton, rotation_order_from_dofs
 from ..conventions import check_order
 from ._atomic import atomic_write
 from ._limits import (
@@ -60,7 +60,6 @@ _CHANNEL_LIST = "Xposition Yposition Zposition Xrotation Yrotation Zrotation"
 _STRUCTURE_WORDS = {"offset", "channels", "joint", "end", "{", "}", "root", "hierarchy"}
 _FRAMES_RE = re.compile(r"^frames\s*:\s*(.*)$", re.IGNORECASE)
 _FRAME_TIME_RE = re.compile(r"^frame\s+time\s*:\s*(.*)$", re.IGNORECASE)
-_AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 
 
 # ----------------------------------------------------------------------------- reading
@@ -614,7 +613,7 @@ def write_bvh(
             if k is not None:
                 columns.append(motion.frames[:, k])
             elif d.startswith("t"):
-                columns.append(np.full(T, j.offset[_AXIS_INDEX[d[1]]]))
+                columns.append(np.full(T, j.offset[AXIS_INDEX[d[1]]]))
             else:
                 columns.append(np.zeros(T))
     data = np.column_stack(columns) if columns else np.zeros((T, 0))

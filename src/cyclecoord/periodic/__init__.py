@@ -5,5 +5,6 @@ the frames the filtration is built on, :mod:`.barcode` computes the persistent c
 barcode with cocycles, :mod:`.coordinates` turns a cocycle into a circular coordinate,
 :mod:`.density` and :mod:`.cycle` build the typical cycle, :mod:`.pipeline` runs them in
 order (:func:`~cyclecoord.periodic.pipeline.extract`), :mod:`.phase_model` phases new
-frames with a fitted coordinate and :mod:`.detection` finds several motions in one take.
+frames with a fitted coordinate and :mod:`.detection` (a subpackage, one module per
+stage) finds several motions in one take.
 """

@@ -105,7 +105,9 @@ def sparse_rips_cohomology(
         from scipy.sparse import coo_matrix
 
         mat = coo_matrix((data, (row, col)), shape=(int(n), int(n)))
-        return ripser.ripser(mat, maxdim=1, thresh=thresh, coeff=coeff, do_cocycles=True, distance_matrix=True)
+        return ripser.ripser(
+            mat, maxdim=1, thresh=thresh, coeff=coeff, do_cocycles=True, distance_matrix=True
+        )
 
     res = doRipsFiltrationDMSparse(
         np.asarray(row).astype(np.int32, order="C"),

@@ -168,7 +168,9 @@ def default_max_scale(points: np.ndarray, distances: np.ndarray | None = None) -
     """
     if distances is not None:
         diam = float(np.max(distances))
-        steps = np.diagonal(distances, offset=1)  # zero for the temporal metric: connected by design
+        steps = np.diagonal(
+            distances, offset=1
+        )  # zero for the temporal metric: connected by design
     else:
         from ..quality.metrics import frame_steps
 
@@ -367,7 +369,9 @@ def select_bar(
         death=death,
         scale=float(s),
         clear=bool(
-            ratio >= CLEAR_RATIO and gap >= CLEAR_GAP and pers[class_index] >= CLEAR_MIN_FRACTION * barcode.threshold
+            ratio >= CLEAR_RATIO
+            and gap >= CLEAR_GAP
+            and pers[class_index] >= CLEAR_MIN_FRACTION * barcode.threshold
         ),
         ratio=ratio,
         gap=gap,
@@ -423,7 +427,10 @@ def refine_birth(
     from .landmarks import estimate_complex
 
     n_pairs = len(x) * (len(x) - 1) / 2
-    if n_pairs > 1.25 * max_edges and estimate_complex(x, t, n_samples=20_000).edges > 1.25 * max_edges:
+    if (
+        n_pairs > 1.25 * max_edges
+        and estimate_complex(x, t, n_samples=20_000).edges > 1.25 * max_edges
+    ):
         return None  # (with fewer pairs than that the sample could never refuse)
     tree = cKDTree(x)
     # then count exactly (ordered pairs and self-pairs): query_pairs materialises every pair
@@ -439,7 +446,10 @@ def refine_birth(
     from scipy.sparse import coo_matrix
 
     n = len(x)
-    mat = coo_matrix((np.r_[d, d], (np.r_[pairs[:, 0], pairs[:, 1]], np.r_[pairs[:, 1], pairs[:, 0]])), shape=(n, n))
+    mat = coo_matrix(
+        (np.r_[d, d], (np.r_[pairs[:, 0], pairs[:, 1]], np.r_[pairs[:, 1], pairs[:, 0]])),
+        shape=(n, n),
+    )
     mat = mat.tocsr().tocoo()  # sorted by (row, col), as ripser.py hands it over
     res = sparse_rips_cohomology(mat.row, mat.col, mat.data, n, t, check_prime(prime))
     h1 = np.asarray(res["dgms"][1]).reshape(-1, 2)
@@ -477,7 +487,11 @@ def winding_birth(pairs: np.ndarray, lengths: np.ndarray, coordinate: np.ndarray
         The birth scale, or None when no loop with winding closes among the edges.
     """
     from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
+    from scipy.sparse.csgraph import (
+        breadth_first_order,
+        connected_components,
+        minimum_spanning_tree,
+    )
 
     theta = np.asarray(coordinate, dtype=float)
     n = theta.size
@@ -496,7 +510,9 @@ def winding_birth(pairs: np.ndarray, lengths: np.ndarray, coordinate: np.ndarray
     _, roots = np.unique(labels, return_index=True)
     th = theta.tolist()
     for root in roots:
-        order, pred = breadth_first_order(forest, int(root), directed=False, return_predecessors=True)
+        order, pred = breadth_first_order(
+            forest, int(root), directed=False, return_predecessors=True
+        )
         lift[root] = theta[root]
         lf = lift  # local alias; parents come before children in breadth-first order
         for v, u in zip(order[1:].tolist(), pred[order[1:]].tolist()):

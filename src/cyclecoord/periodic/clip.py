@@ -27,8 +27,16 @@ from .root import compose_root, decompose_root, heading, planted_ground, root_la
 from .windings import phase_average, stretches
 
 __all__ = [
-    "capture_cycle", "loop_cycle", "planted_weights", "anchor_to_feet", "typical_amplitude", "slowest_frame", "joint_columns",
-    "CAPTURE_WIDTH", "MAX_CYCLE_FRAMES", "MAX_AMPLITUDE_GAIN",
+    "capture_cycle",
+    "loop_cycle",
+    "planted_weights",
+    "anchor_to_feet",
+    "typical_amplitude",
+    "slowest_frame",
+    "joint_columns",
+    "CAPTURE_WIDTH",
+    "MAX_CYCLE_FRAMES",
+    "MAX_AMPLITUDE_GAIN",
 ]
 
 #: Default width (frames of time) of the kernel that averages the re-timed cycle.
@@ -51,7 +59,9 @@ def slowest_frame(frames: np.ndarray, window: int = 5) -> int:
     around = steps + np.roll(steps, 1)  # motion entering and leaving frame i
     w = max(1, min(window, len(f)))
     kernel = np.ones(w) / w
-    smooth = np.convolve(np.concatenate([around[-w:], around, around[:w]]), kernel, mode="same")[w:-w]
+    smooth = np.convolve(np.concatenate([around[-w:], around, around[:w]]), kernel, mode="same")[
+        w:-w
+    ]
     return int(np.argmin(smooth))
 
 
@@ -103,7 +113,11 @@ def loop_cycle(
         raise ParameterError(f"cycle_start must be 'slowest' or 'first', got {cycle_start!r}")
     root = prepared.root_columns
     if cycle_start == "slowest":
-        joints = np.delete(typical.frames, root, axis=1) if root.size < typical.frames.shape[1] else typical.frames
+        joints = (
+            np.delete(typical.frames, root, axis=1)
+            if root.size < typical.frames.shape[1]
+            else typical.frames
+        )
         shift = slowest_frame(joints)
         if shift:
             typical = replace(
@@ -117,9 +131,14 @@ def loop_cycle(
         used = np.arange(last) if rows is None else np.asarray(rows, dtype=int)
         used = used[used < last] if np.any(used < last) else used
         mean_delta = prepared.poses[used][:, root].mean(axis=0)
-        cyc[:, root] = preprocessor.integrate_root(typical.frames[:, root], motion.frames[int(used.min()), root], mean_delta, motion)
+        cyc[:, root] = preprocessor.integrate_root(
+            typical.frames[:, root], motion.frames[int(used.min()), root], mean_delta, motion
+        )
     clip = motion.with_frames(
-        cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}", metadata=dict(metadata or {}),
+        cyc,
+        start_frame=0,
+        source=f"cycle of {motion.source or 'capture'}",
+        metadata=dict(metadata or {}),
     )
     return typical, clip
 
@@ -128,7 +147,9 @@ def loop_cycle(
 MAX_AMPLITUDE_GAIN = 1.5
 
 
-def typical_amplitude(cycle: np.ndarray, phase: np.ndarray, poses: np.ndarray, spike: int = 5) -> np.ndarray:
+def typical_amplitude(
+    cycle: np.ndarray, phase: np.ndarray, poses: np.ndarray, spike: int = 5
+) -> np.ndarray:
     """Give each channel of an averaged cycle the median range of the capture's repetitions.
 
     Averaging repetitions whose sharp features (a toe's flick, a foot's roll) differ a
@@ -169,7 +190,9 @@ def typical_amplitude(cycle: np.ndarray, phase: np.ndarray, poses: np.ndarray, s
         return cycle
     typical = np.median(np.asarray(ranges), axis=0)
     have = np.ptp(median_filter(cycle, size=(spike, 1), mode="wrap"), axis=0)
-    gain = np.clip(np.where(have > 1e-9, typical / np.maximum(have, 1e-9), 1.0), 1.0, MAX_AMPLITUDE_GAIN)
+    gain = np.clip(
+        np.where(have > 1e-9, typical / np.maximum(have, 1e-9), 1.0), 1.0, MAX_AMPLITUDE_GAIN
+    )
     mean = cycle.mean(axis=0)
     return mean + (cycle - mean) * gain
 
@@ -324,10 +347,16 @@ def capture_cycle(
     layout = root_layout(motion) if prepared.root_columns.size else None
     feats = None
     if layout:
-        feats = phase_average(ph, decompose_root(motion.frames[lo:hi], layout)[local], P, width / float(period))
+        feats = phase_average(
+            ph, decompose_root(motion.frames[lo:hi], layout)[local], P, width / float(period)
+        )
     shift = 0
     if cycle_start == "slowest":
-        joints = np.delete(frames, prepared.root_columns, axis=1) if prepared.root_columns.size < frames.shape[1] else frames
+        joints = (
+            np.delete(frames, prepared.root_columns, axis=1)
+            if prepared.root_columns.size < frames.shape[1]
+            else frames
+        )
         shift = slowest_frame(joints)
     frames = np.roll(frames, -shift, axis=0)
     phases = np.mod((np.arange(P) + shift) / P, 1.0)
@@ -343,7 +372,9 @@ def capture_cycle(
     elif prepared.root_columns.size:
         root = prepared.root_columns
         mean_delta = frames[:, root].mean(axis=0) if travel == "keep" else np.zeros(root.size)
-        cyc[:, root] = preprocessor.integrate_root(frames[:, root], motion.frames[rows[0], root], mean_delta, motion)
+        cyc[:, root] = preprocessor.integrate_root(
+            frames[:, root], motion.frames[rows[0], root], mean_delta, motion
+        )
     clip = motion.with_frames(cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}",
                               metadata=dict(metadata or {}))
     if feats is not None and travel != "in_place":
@@ -357,8 +388,14 @@ def capture_cycle(
         # the cycle in the prepared space is the written clip's own (one definition of its
         # root changes, so its jerk and loop closure read the same from the file)
         frames = preprocessor.transform(clip).poses
-    typ = TypicalCycle(frames=frames, phases=phases, curve=frames, sample_phases=phases, bandwidth=width,
-                       bandwidth_selection=selection)
+    typ = TypicalCycle(
+        frames=frames,
+        phases=phases,
+        curve=frames,
+        sample_phases=phases,
+        bandwidth=width,
+        bandwidth_selection=selection,
+    )
     for arr in (typ.frames, typ.phases):
         arr.flags.writeable = False
     return typ, clip, heading_change

@@ -35,6 +35,7 @@ from .barcode import (
     temporal_distance_matrix,
 )
 from ..errors import ParameterError
+from ._estimator import ParamsMixin
 from .landmarks import choose_landmarks, estimate_complex, memory_budget, run_bytes
 
 __all__ = [
@@ -111,7 +112,9 @@ class CocycleCheck:
         return self.n_violations == 0
 
 
-def _edge_values(edges: np.ndarray, cocycle: np.ndarray, values: np.ndarray, n: int) -> tuple[np.ndarray, int]:
+def _edge_values(
+    edges: np.ndarray, cocycle: np.ndarray, values: np.ndarray, n: int
+) -> tuple[np.ndarray, int]:
     """Spread cocycle values onto ``edges`` (zero elsewhere); count support edges not found."""
     key = edges[:, 0] * n + edges[:, 1]
     ckey = cocycle[:, 0].astype(np.int64) * n + cocycle[:, 1].astype(np.int64)
@@ -223,11 +226,15 @@ def _least_squares_potential(
         # walk/jog/squat chain moved a boundary 16 frames); its landmarks are few (500),
         # so this costs little, and every landmark result stays as it was, bit for bit
         sw = np.sqrt(np.asarray(weights, dtype=float))
-        return lsqr(sp.diags(sw) @ delta, -sw * z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[0]
+        return lsqr(sp.diags(sw) @ delta, -sw * z, atol=1e-12, btol=1e-12, iter_lim=20 * n + 1000)[
+            0
+        ]
     wts = np.ones(len(z))
     a, b = edges[:, 0], edges[:, 1]
     wz = wts * z
-    rhs = np.bincount(a, weights=wz, minlength=n) - np.bincount(b, weights=wz, minlength=n)  # -δᵀ W z
+    rhs = np.bincount(a, weights=wz, minlength=n) - np.bincount(
+        b, weights=wz, minlength=n
+    )  # -δᵀ W z
     ncomp, label = connected_components(
         sp.csr_matrix((np.ones(len(edges)), (a, b)), shape=(n, n)), directed=False
     )
@@ -247,7 +254,9 @@ def _least_squares_potential(
         vals = np.concatenate([deg[fv], -wts[both], -wts[both]])
         lap = sp.csc_matrix((vals, (rows, cols)), shape=(fv.size, fv.size))
         w[fv] = splu(lap, permc_spec="COLAMD").solve(rhs[fv])
-    w -= (np.bincount(label, weights=w, minlength=ncomp) / np.bincount(label, minlength=ncomp))[label]
+    w -= (np.bincount(label, weights=w, minlength=ncomp) / np.bincount(label, minlength=ncomp))[
+        label
+    ]
     return w
 
 
@@ -331,7 +340,9 @@ def extend_coordinate(
         out = np.empty(len(q))
         if cov.any():
             jj = np.repeat(nearest[cov][:, None], k, axis=1)
-            kk = np.where(valid[cov], idx[cov], jj)  # padded slots point at j itself: zero increment
+            kk = np.where(
+                valid[cov], idx[cov], jj
+            )  # padded slots point at j itself: zero increment
             if table is not None:
                 inc = -table[jj, kk]
             else:
@@ -366,13 +377,27 @@ def unwrap(theta: np.ndarray) -> np.ndarray:
     return np.concatenate([[theta[0]], theta[0] + np.cumsum(steps)])
 
 
-class CircularCoordinates:
+class CircularCoordinates(ParamsMixin):
     """Circle-valued coordinate of a point cloud from its persistent cohomology.
 
-    scikit-learn style estimator: parameters in ``__init__``; :meth:`fit` computes the
-    barcode, chooses a class and a scale, and solves for the coordinate; learned state
-    lives in attributes ending in ``_``.  :meth:`transform` gives the coordinate of
-    points the model never saw; :meth:`save` / :meth:`load` keep a fitted model.
+    scikit-learn style estimator: every parameter of ``__init__`` is stored unchanged
+    under its own name (``get_params``/``set_params``/``repr`` from
+    :class:`~cyclecoord.periodic._estimator.ParamsMixin`, so :func:`sklearn.base.clone`
+    works) and checked when fitting; :meth:`fit` computes the barcode, chooses a class
+    and a scale, solves for the coordinate and returns ``self``; learned state lives in
+    attributes ending in ``_``.  :meth:`transform` gives the coordinate of points the
+    model never saw; :meth:`to_arrays` / :meth:`from_arrays` keep a fitted model.
+
+    The fit runs in two stages, :meth:`fit_barcode` then :meth:`fit_coordinate`, so a
+    caller can read several classes of one barcode: :meth:`with_coordinate_params` gives
+    a new estimator for another class (or scale) that shares this one's barcode and
+    leaves this one as it is.
+
+    There is no ``random_state``: the fit is deterministic.  Its only random draw, the
+    pairs of points sampled to estimate the filtration's size for the memory guard
+    (:func:`~cyclecoord.periodic.landmarks.estimate_complex`), is seeded with 0, the
+    package's one ``random_state`` default (as :func:`cyclecoord.extract` and
+    :class:`~cyclecoord.periodic.density.PeriodicDensity`).
 
     Parameters
     ----------
@@ -496,8 +521,9 @@ class CircularCoordinates:
             need = (8.0 + DENSE_BYTES_PER_PAIR) * T**2
             if need > budget:
                 raise ParameterError(
-                    f"the temporal metric needs a full {T} x {T} distance matrix "
-                    f"({need / 1e9:.1f} GB, over the {note}); drop --temporal or analyse fewer frames"
+                    f"the temporal metric needs a full {T} x {T} "
+                    f"distance matrix ({need / 1e9:.1f} GB, over the "
+                    f"{note}); drop --temporal or analyse fewer frames"
                 )
             self._dist_ = temporal_distance_matrix(x)
         else:
@@ -510,7 +536,7 @@ class CircularCoordinates:
         self.complex_estimate_ = est
         self._complex_deferred = est is None  # computed on first access (report)
         self.landmark_reason_ = reason
-        self.barcode_ = self._barcode(check_prime(self.prime))
+        self.barcode_ = self._stage_barcode = self._barcode(check_prime(self.prime))
         self.landmarks_ = self.barcode_.point_indices
         self.covering_radius_ = float(self.barcode_.extras.get("covering_radius", 0.0))
         return self.barcode_
@@ -520,7 +546,9 @@ class CircularCoordinates:
         """Size estimate of the filtration that was built (computed when first asked
         for if the memory guard did not need it)."""
         if getattr(self, "_complex_deferred", False):
-            self._complex_estimate = estimate_complex(self.points_, self.threshold_, n_vertices=self.n_landmarks_)
+            self._complex_estimate = estimate_complex(
+                self.points_, self.threshold_, n_vertices=self.n_landmarks_
+            )
             self._complex_deferred = False
         return self._complex_estimate
 
@@ -554,7 +582,7 @@ class CircularCoordinates:
         self.n_landmarks_ = None
         self.complex_estimate_ = None
         self.landmark_reason_ = "every frame (barcode supplied)"
-        self.barcode_ = barcode
+        self.barcode_ = self._stage_barcode = barcode
         self.landmarks_ = None
         self.covering_radius_ = 0.0
         return self
@@ -566,9 +594,68 @@ class CircularCoordinates:
         ----------
         X : array-like, shape (T, K)
             Points (one per frame, in frame order: the orientation follows it).
+        y : None
+            Ignored (scikit-learn convention).
+
+        Returns
+        -------
+        CircularCoordinates
+            ``self``, fitted.
         """
         self.fit_barcode(X)
         return self.fit_coordinate()
+
+    #: Parameters used only by :meth:`fit_coordinate` (the barcode does not depend on them).
+    COORDINATE_PARAMS = ("class_index", "scale", "scale_fraction", "refine_birth")
+    #: Fitted state of the barcode stage, shared by :meth:`with_coordinate_params`.
+    _BARCODE_STATE = (
+        "points_", "_dist_", "memory_budget_", "threshold_", "n_landmarks_", "_complex_estimate",
+        "_complex_deferred", "landmark_reason_", "_stage_barcode", "landmarks_", "covering_radius_",
+    )
+
+    def with_coordinate_params(self, **params) -> "CircularCoordinates":
+        """A new estimator with coordinate parameters changed, on this one's barcode.
+
+        The new estimator is built from this one's parameters with ``params`` replacing
+        some of them, and shares (does not copy, does not recompute) the barcode stage of
+        this one (the points, threshold, landmarks and barcode of :meth:`fit_barcode` or
+        :meth:`use_barcode`); call :meth:`fit_coordinate` on it next.  This estimator is
+        not changed, so one barcode can be read for several classes at the cost of the
+        coordinates alone (:func:`cyclecoord.detect` reads every candidate class so).
+
+        Parameters
+        ----------
+        **params
+            Any of :data:`COORDINATE_PARAMS` (``class_index``, ``scale``,
+            ``scale_fraction``, ``refine_birth``).
+
+        Returns
+        -------
+        CircularCoordinates
+            Ready for :meth:`fit_coordinate`.
+
+        Raises
+        ------
+        ParameterError
+            When this estimator has no barcode yet, or for a parameter the barcode
+            depends on (set it on a clone and fit that instead).
+        """
+        if not hasattr(self, "_stage_barcode"):
+            raise ParameterError(
+                "call fit_barcode() or use_barcode() before with_coordinate_params()"
+            )
+        other = sorted(set(params) - set(self.COORDINATE_PARAMS))
+        if other:
+            raise ParameterError(
+                f"with_coordinate_params() changes {', '.join(self.COORDINATE_PARAMS)} only; "
+                f"the barcode depends on {', '.join(other)}"
+            )
+        new = type(self)(**{**self.get_params(deep=False), **params})
+        for name in self._BARCODE_STATE:
+            if name in self.__dict__:
+                setattr(new, name, self.__dict__[name])
+        new.barcode_ = new._stage_barcode
+        return new
 
     def _centers(self) -> tuple[np.ndarray, np.ndarray | None]:
         """Points the complex is built on, and (for the temporal metric) their distances."""
@@ -596,9 +683,11 @@ class CircularCoordinates:
         """Second half of :meth:`fit`: select the class and solve for the coordinate,
         reusing the barcode from :meth:`fit_barcode` (so a caller can inspect the
         barcode first without computing it twice)."""
-        if not hasattr(self, "barcode_"):
+        if not hasattr(self, "_stage_barcode"):
             raise ParameterError("call fit_barcode() before fit_coordinate()")
-        barcode = self.barcode_
+        # the barcode of the barcode stage, not barcode_: a prime retry below replaces
+        # barcode_, and a second call (another class_index) must index the same bars
+        barcode = self._stage_barcode
         selection = select_bar(barcode, self.class_index, self.scale, self.scale_fraction)
         notes = []
         scale = selection.scale
@@ -614,9 +703,9 @@ class CircularCoordinates:
                 )
             else:
                 notes.append(
-                    f"the landmark covering radius {self.covering_radius_:.4g} exceeds half the bar's "
-                    "extent: frames far from every landmark take their nearest landmark's coordinate; "
-                    "use more landmarks"
+                    f"the landmark covering radius {self.covering_radius_:.4g} exceeds half the "
+                    "bar's extent: frames far from every landmark take their nearest landmark's "
+                    "coordinate; use more landmarks"
                 )
         selection = BarSelection(**{**selection.__dict__, "scale": float(scale)})
         centers, cdist = self._centers()
@@ -640,7 +729,9 @@ class CircularCoordinates:
                 b, d = bc.h1[idx]
                 if not b <= selection.scale < d:
                     continue
-                sel = BarSelection(**{**selection.__dict__, "index": idx, "birth": float(b), "death": float(d)})
+                sel = BarSelection(
+                    **{**selection.__dict__, "index": idx, "birth": float(b), "death": float(d)}
+                )
             cocycle = self._cocycle_on_centers(bc.cocycles[sel.index])
             z, outside = _edge_values(edges, cocycle, lift_cocycle(cocycle, p).astype(float), n)
             check = check_cocycle(edges, z, n)
@@ -653,15 +744,17 @@ class CircularCoordinates:
         p, bc, sel, check, z = best
         if not check.ok:
             warnings.warn(
-                f"the integer lift of the cocycle fails the cocycle condition on {check.n_violations} "
-                f"of {check.n_triangles} triangles for every prime tried; using p={p}",
+                "the integer lift of the cocycle fails the cocycle "
+                f"condition on {check.n_violations} of {check.n_triangles} "
+                f"triangles for every prime tried; using p={p}",
                 RuntimeWarning,
                 stacklevel=2,
             )
         for note in notes:
             warnings.warn(note, RuntimeWarning, stacklevel=2)
         ncomp, _ = connected_components(
-            sp.csr_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n)), directed=False
+            sp.csr_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n)),
+            directed=False,
         )
         if self.landmarks_ is None:
             weights = None
@@ -683,7 +776,9 @@ class CircularCoordinates:
         if self.landmarks_ is not None and not self.temporal and self.refine_birth:
             # the sparse complex within what the filtration was allowed (it is gone by now)
             budget = getattr(self, "memory_budget_", None)
-            max_edges = 3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
+            max_edges = (
+                3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
+            )
             full = (refine_birth(self.points_, sel.birth, p, max_edges=max_edges,
                                  covering_radius=self.covering_radius_) if max_edges > 0 else None)
             sel = BarSelection(**{**sel.__dict__, "full_birth": full})
@@ -717,13 +812,20 @@ class CircularCoordinates:
         """
         self._check_fitted()
         x = self._validate(X)
-        if hasattr(self, "points_") and x.shape == self.points_.shape and np.array_equal(x, self.points_):
+        if (
+            hasattr(self, "points_")
+            and x.shape == self.points_.shape
+            and np.array_equal(x, self.points_)
+        ):
             return self.coordinates_.copy()
         if x.shape[1] != self.centers_.shape[1]:
             raise ParameterError(
-                f"points have {x.shape[1]} dimensions, the model was fitted on {self.centers_.shape[1]}"
+                f"points have {x.shape[1]} dimensions, the model was fitted on "
+                f"{self.centers_.shape[1]}"
             )
-        raw, _ = extend_coordinate(x, self.centers_, self.center_theta_, self.edges_, self.harmonic_cocycle_, self.radius_)
+        raw, _ = extend_coordinate(
+            x, self.centers_, self.center_theta_, self.edges_, self.harmonic_cocycle_, self.radius_
+        )
         sign, offset = self.orientation_
         return _unit(sign * raw - offset)
 
@@ -740,7 +842,12 @@ class CircularCoordinates:
         out["radius"] = np.array(self.radius_)
         out["orientation"] = np.array(self.orientation_, dtype=float)
         out["selection"] = np.array(
-            [self.selection_.index, self.selection_.birth, self.selection_.death, self.selection_.scale]
+            [
+                self.selection_.index,
+                self.selection_.birth,
+                self.selection_.death,
+                self.selection_.scale,
+            ]
         )
         out["prime"] = np.array(self.prime_)
         return out

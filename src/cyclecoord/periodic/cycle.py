@@ -53,7 +53,9 @@ def _finite_array(x: object, name: str, ndim: int | tuple[int, ...]) -> np.ndarr
         raise ParameterError(f"{name} must be an array of numbers: {exc}") from None
     allowed = (ndim,) if isinstance(ndim, int) else ndim
     if arr.ndim not in allowed:
-        raise ParameterError(f"{name} must have {' or '.join(map(str, allowed))} dimension(s), got shape {arr.shape}")
+        raise ParameterError(
+            f"{name} must have {' or '.join(map(str, allowed))} dimension(s), got shape {arr.shape}"
+        )
     if not np.all(np.isfinite(arr)):
         raise ParameterError(f"{name} holds NaN or infinite values")
     return arr
@@ -66,7 +68,12 @@ def _positive_int(value: object, name: str, minimum: int = 1) -> int:
 
 
 def _positive_float(value: object, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, Real) or not np.isfinite(value) or value <= 0:
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, Real)
+        or not np.isfinite(value)
+        or value <= 0
+    ):
         raise ParameterError(f"{name} must be a positive finite number, got {value!r}")
     return float(value)
 
@@ -138,7 +145,10 @@ def knn_centroids(
     if weighting not in _WEIGHTINGS:
         raise ParameterError(f"weighting must be one of {_WEIGHTINGS}, got {weighting!r}")
     if bandwidth is not None and (
-        isinstance(bandwidth, bool) or not isinstance(bandwidth, Real) or not np.isfinite(bandwidth) or bandwidth <= 0
+        isinstance(bandwidth, bool)
+        or not isinstance(bandwidth, Real)
+        or not np.isfinite(bandwidth)
+        or bandwidth <= 0
     ):
         raise ParameterError(f"bandwidth must be a positive number, got {bandwidth!r}")
     k = int(k)
@@ -385,7 +395,9 @@ def select_bandwidth(
         n_candidates = _positive_int(n_candidates, "n_candidates")
         lo = min(k / (T * np.sqrt(2.0 * np.pi)) * period, 0.5)
         hi = period / 8.0 if max_width is None else _positive_float(max_width, "max_width")
-        widths = np.geomspace(lo, hi, n_candidates) if hi > lo and n_candidates > 1 else np.array([lo])
+        widths = (
+            np.geomspace(lo, hi, n_candidates) if hi > lo and n_candidates > 1 else np.array([lo])
+        )
     else:
         widths = _finite_array(candidates, "candidates", 1)
         if widths.size == 0 or np.any(widths <= 0):
@@ -613,7 +625,9 @@ def check_bandwidth(bandwidth: object, weighting: str = "kernel") -> None | str 
     """
     if bandwidth is not None and not (isinstance(bandwidth, str) and bandwidth == "auto"):
         if isinstance(bandwidth, str):
-            raise ParameterError(f"bandwidth must be None, 'auto' or a positive number of frames, got {bandwidth!r}")
+            raise ParameterError(
+                f"bandwidth must be None, 'auto' or a positive number of frames, got {bandwidth!r}"
+            )
         bandwidth = _positive_float(bandwidth, "bandwidth")
     if bandwidth is not None and weighting != "kernel":
         raise ParameterError(f"bandwidth={bandwidth!r} needs weighting='kernel', got {weighting!r}")
@@ -629,7 +643,7 @@ def typical_cycle(
     k: int = 10,
     weighting: str = "kernel",
     sampling: str = "quantile",
-    random_state: None | int | np.random.Generator = None,
+    random_state: None | int | np.random.Generator = 0,
     bandwidth: None | str | float = None,
 ) -> TypicalCycle:
     """Build the typical cycle of a motion from its circular coordinate.
@@ -659,8 +673,9 @@ def typical_cycle(
         ``"quantile"`` (default): deterministic phases ``ppf((i + 0.5) / N)``, which are
         at times ``(i + 0.5) / N`` of the period.  ``"random"``: the paper's random
         draws from the density, placed in time by the density's cdf.
-    random_state : None, int or numpy Generator
-        Seed for the density fit and the random sampling.
+    random_state : None, int or numpy Generator, default 0
+        Seed for the density fit and the random sampling (0, the package's one default,
+        as for :func:`cyclecoord.extract`; None for fresh entropy).
     bandwidth : None, "auto" or float
         Width ``σ`` of the ``"kernel"`` weighting, in frames of one period.  None:
         ``k`` frames' worth, ``k / (T √(2π))`` in phase units (a fraction of a frame
@@ -680,7 +695,11 @@ def typical_cycle(
         that is not None, ``"auto"`` or a positive number (or a number with a weighting
         other than ``"kernel"``).
     """
-    if isinstance(period_frames, bool) or not isinstance(period_frames, Real) or not np.isfinite(period_frames):
+    if (
+        isinstance(period_frames, bool)
+        or not isinstance(period_frames, Real)
+        or not np.isfinite(period_frames)
+    ):
         raise ParameterError(f"period_frames must be a finite number, got {period_frames!r}")
     n_cycle = int(round(float(period_frames)))
     if period_frames < 2 or n_cycle < 2:
@@ -692,7 +711,9 @@ def typical_cycle(
         raise ParameterError(f"weighting must be one of {_WEIGHTINGS}, got {weighting!r}")
     theta = _finite_array(theta, "theta", 1)
     if isinstance(k, bool) or not isinstance(k, Integral) or not 1 <= k <= theta.shape[0]:
-        raise ParameterError(f"k must be an integer between 1 and the number of frames ({theta.shape[0]}), got {k!r}")
+        raise ParameterError(
+            f"k must be an integer between 1 and the number of frames ({theta.shape[0]}), got {k!r}"
+        )
     bandwidth = check_bandwidth(bandwidth, weighting)
     rng = as_generator(random_state)
 

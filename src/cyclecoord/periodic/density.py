@@ -36,6 +36,7 @@ import numpy as np
 from scipy.special import ndtr
 
 from ..errors import ParameterError
+from ._estimator import ParamsMixin
 
 __all__ = ["PeriodicDensity", "as_generator"]
 
@@ -56,7 +57,8 @@ def as_generator(random_state: None | int | np.random.Generator) -> np.random.Ge
             raise ParameterError(f"random_state must be a non-negative integer, got {random_state}")
         return np.random.default_rng(random_state)
     raise ParameterError(
-        f"random_state must be None, an integer or a numpy Generator, got {type(random_state).__name__}"
+        "random_state must be None, an integer or a numpy Generator, got "
+        f"{type(random_state).__name__}"
     )
 
 
@@ -76,10 +78,10 @@ def _em_1d(x: np.ndarray, n_components: int, max_iter: int, reg_covar: float, to
     added to every variance; stop when the mean log-likelihood changes by less than
     ``tol``, 3e-4 where scikit-learn stops at 1e-3: a few more steps, and on the test
     densities a closer fit than scikit-learn's), and so is the start (responsibilities
-    of a k-means partition); only the k-means is deterministic: Lloyd's steps from ``n_components`` runs of equal size of
-    the sorted values (in 1-D every k-means cluster is such a run, so a step costs
-    ``n_components`` binary searches).  Returns weights, means, variances, whether EM
-    converged and the iterations run.
+    of a k-means partition); only the k-means is deterministic: Lloyd's steps from
+    ``n_components`` runs of equal size of the sorted values (in 1-D every k-means cluster
+    is such a run, so a step costs ``n_components`` binary searches).  Returns weights,
+    means, variances, whether EM converged and the iterations run.
     """
     x = np.sort(np.asarray(x, dtype=float))
     n, k = x.size, int(n_components)
@@ -93,7 +95,9 @@ def _em_1d(x: np.ndarray, n_components: int, max_iter: int, reg_covar: float, to
         cnt = np.diff(bounds)
         means = (csum[bounds[1:]] - csum[bounds[:-1]]) / np.maximum(cnt, 1)
         means = np.where(cnt > 0, means, x[np.minimum(bounds[:-1], n - 1)])
-        new = np.concatenate([[0], np.searchsorted(x, 0.5 * (means[:-1] + means[1:]), side="right"), [n]])
+        new = np.concatenate(
+            [[0], np.searchsorted(x, 0.5 * (means[:-1] + means[1:]), side="right"), [n]]
+        )
         new = np.maximum.accumulate(new)
         if np.array_equal(new, bounds):
             break
@@ -128,12 +132,13 @@ def _em_1d(x: np.ndarray, n_components: int, max_iter: int, reg_covar: float, to
     return weights / weights.sum(), means, var, converged, it
 
 
-class PeriodicDensity:
+class PeriodicDensity(ParamsMixin):
     """Density of circular coordinates on ``[0, 1)``, fitted as a wrapped Gaussian mixture.
 
-    A scikit-learn style estimator (with ``get_params``/``set_params``): parameters are
-    stored untouched by ``__init__`` and checked by :meth:`fit`; learned state ends in an
-    underscore.  The mixture is fitted by a deterministic EM of our own
+    A scikit-learn style estimator (``get_params``/``set_params`` and ``repr`` from
+    :class:`~cyclecoord.periodic._estimator.ParamsMixin`, so :func:`sklearn.base.clone`
+    works): parameters are stored untouched by ``__init__`` and checked by :meth:`fit`;
+    learned state ends in an underscore.  The mixture is fitted by a deterministic EM of our own
     (:func:`_em_1d`: scikit-learn's steps, started from equal-count bins instead of a
     seeded k-means; importing scikit-learn cost a fresh process 1.5-2 s).
 
@@ -151,9 +156,11 @@ class PeriodicDensity:
     n_copies : int, default 3
         Number of tiled copies of the data, centred on the original: 3 gives
         ``theta - 1, theta, theta + 1`` (paper); must be odd and at least 1.
-    random_state : None, int or numpy Generator
-        Kept for :meth:`sample` callers and compatibility: the fit itself is deterministic
-        (a Generator is advanced by one draw, as when it seeded a k-means start).
+    random_state : None, int or numpy Generator, default 0
+        Kept for compatibility: the fit itself is deterministic (a Generator is advanced
+        by one draw, as when it seeded a k-means start).  The default 0 is the package's
+        one ``random_state`` default (as :func:`cyclecoord.extract`'s): results are the
+        same run to run unless a caller asks for fresh entropy with None.
     max_samples : int or None, default 20000
         Longer inputs are fitted on this many values evenly spaced in input (time)
         order; None fits every value.  EM's cost grows with the number of values while
@@ -185,7 +192,7 @@ class PeriodicDensity:
         max_iter: int = 100,
         reg_covar: float = 1e-5,
         n_copies: int = 3,
-        random_state: None | int | np.random.Generator = None,
+        random_state: None | int | np.random.Generator = 0,
         max_samples: int | None = 20_000,
     ) -> None:
         self.n_components = n_components
@@ -195,24 +202,6 @@ class PeriodicDensity:
         self.random_state = random_state
         self.max_samples = max_samples
 
-    _PARAMS = ("n_components", "max_iter", "reg_covar", "n_copies", "random_state", "max_samples")
-
-    def get_params(self, deep: bool = True) -> dict:
-        """Parameters as given to ``__init__`` (scikit-learn convention)."""
-        return {name: getattr(self, name) for name in self._PARAMS}
-
-    def set_params(self, **params) -> "PeriodicDensity":
-        """Set parameters by name (scikit-learn convention); returns ``self``."""
-        for name, value in params.items():
-            if name not in self._PARAMS:
-                raise ParameterError(f"PeriodicDensity has no parameter {name!r}")
-            setattr(self, name, value)
-        return self
-
-    def __repr__(self) -> str:
-        changed = {k: v for k, v in self.get_params().items() if v != type(self)().get_params()[k]}
-        return f"PeriodicDensity({', '.join(f'{k}={v!r}' for k, v in changed.items())})"
-
     # ------------------------------------------------------------------ fitting
     def _check_params(self) -> None:
         for name in ("n_components", "max_iter", "n_copies"):
@@ -220,11 +209,17 @@ class PeriodicDensity:
             if isinstance(value, bool) or not isinstance(value, Integral) or value < 1:
                 raise ParameterError(f"{name} must be a positive integer, got {value!r}")
         if self.max_samples is not None and (
-            isinstance(self.max_samples, bool) or not isinstance(self.max_samples, Integral) or self.max_samples < 2
+            isinstance(self.max_samples, bool)
+            or not isinstance(self.max_samples, Integral)
+            or self.max_samples < 2
         ):
-            raise ParameterError(f"max_samples must be None or an integer >= 2, got {self.max_samples!r}")
+            raise ParameterError(
+                f"max_samples must be None or an integer >= 2, got {self.max_samples!r}"
+            )
         if self.n_copies % 2 != 1:
-            raise ParameterError(f"n_copies must be odd (copies centred on the data), got {self.n_copies}")
+            raise ParameterError(
+                f"n_copies must be odd (copies centred on the data), got {self.n_copies}"
+            )
         if (
             isinstance(self.reg_covar, bool)
             or not isinstance(self.reg_covar, Real)
@@ -298,7 +293,9 @@ class PeriodicDensity:
         self._scale = scale[keep]
         self._weight = weight[keep]
         self._cdf_at_zero = ndtr(-self._loc / self._scale)
-        self._total = float(self._weight @ (ndtr((1.0 - self._loc) / self._scale) - self._cdf_at_zero))
+        self._total = float(
+            self._weight @ (ndtr((1.0 - self._loc) / self._scale) - self._cdf_at_zero)
+        )
         self._grid = None  # cdf table for ppf, built on first use
         return self
 

@@ -148,8 +148,9 @@ def memory_budget(memory_limit: float | None, reserved: float, what: str = "") -
     run = f" ({what})" if what else ""
     if reserved >= machine:
         raise ParameterError(
-            f"not enough memory: the run's per-frame arrays{run} need about {_gb(reserved)} and this "
-            f"machine allows {_gb(machine)}; analyse fewer frames (--frames) or fewer dimensions (--pca)"
+            f"not enough memory: the run's per-frame arrays{run} need about "
+            f"{_gb(reserved)} and this machine allows {_gb(machine)}; "
+            "analyse fewer frames (--frames) or fewer dimensions (--pca)"
         )
     if memory_limit is None:
         budget = min(float(DEFAULT_MEMORY_LIMIT), machine - reserved)
@@ -157,11 +158,15 @@ def memory_budget(memory_limit: float | None, reserved: float, what: str = "") -
     else:
         if reserved >= memory_limit:
             raise ParameterError(
-                f"memory limit {_gb(memory_limit)} is too small: the run's per-frame arrays{run} need "
-                f"about {_gb(reserved)} before the filtration; raise --memory-limit or analyse fewer frames"
+                f"memory limit {_gb(memory_limit)} is too small: the run's "
+                f"per-frame arrays{run} need about {_gb(reserved)} before the "
+                "filtration; raise --memory-limit or analyse fewer frames"
             )
         budget = min(float(memory_limit), machine) - reserved
-        note = f"{_gb(budget)} for the filtration: the {_gb(memory_limit)} limit less {_gb(reserved)} of per-frame arrays"
+        note = (
+            f"{_gb(budget)} for the filtration: the {_gb(memory_limit)} limit less "
+            f"{_gb(reserved)} of per-frame arrays"
+        )
     if memory_limit is not None and memory_limit > machine:
         note += f" (the stated limit exceeds the machine's {_gb(machine)}; that is used)"
     elif memory_limit is None and machine - reserved < DEFAULT_MEMORY_LIMIT:
@@ -233,7 +238,9 @@ def greedy_landmarks(
     """
     x = np.asarray(points, dtype=float)
     if x.ndim != 2 or (distance_matrix and x.shape[0] != x.shape[1]):
-        raise ParameterError(f"points must be a (T, K) array or a (T, T) distance matrix, got shape {x.shape}")
+        raise ParameterError(
+            f"points must be a (T, K) array or a (T, T) distance matrix, got shape {x.shape}"
+        )
     T = x.shape[0]
     if isinstance(n, bool) or int(n) != n or not 1 <= n <= T:
         raise ParameterError(f"the number of landmarks must be between 1 and {T}, got {n!r}")
@@ -320,7 +327,9 @@ def estimate_complex(
     return _estimate(n, *_pair_fractions(x, threshold, n_samples, random_state))
 
 
-def _pair_fractions(x: np.ndarray, threshold: float, n_samples: int, random_state: int) -> tuple[float, float]:
+def _pair_fractions(
+    x: np.ndarray, threshold: float, n_samples: int, random_state: int
+) -> tuple[float, float]:
     """Fractions of random pairs (triples) of points within ``threshold`` (of each other)."""
     T = x.shape[0]
     rng = np.random.default_rng(random_state)
@@ -381,8 +390,12 @@ def choose_landmarks(
     """
     T = len(points)
     if memory_limit is None or not np.isfinite(memory_limit) or memory_limit <= 0:
-        raise ParameterError(f"memory budget must be a positive number of bytes, got {memory_limit}")
-    if landmarks is None or (isinstance(landmarks, str) and landmarks.lower() in ("none", "all", "full")):
+        raise ParameterError(
+            f"memory budget must be a positive number of bytes, got {memory_limit}"
+        )
+    if landmarks is None or (
+        isinstance(landmarks, str) and landmarks.lower() in ("none", "all", "full")
+    ):
         n, reason = None, "every frame (landmarks off)"
     elif isinstance(landmarks, str):
         if landmarks.lower() != "auto":
@@ -390,12 +403,17 @@ def choose_landmarks(
         if T <= AUTO_FULL_LIMIT:
             n, reason = None, f"every frame ({T} <= {AUTO_FULL_LIMIT})"
         else:
-            n, reason = AUTO_LANDMARKS, f"{AUTO_LANDMARKS} greedy landmarks of {T} frames (automatic)"
+            n, reason = (
+                AUTO_LANDMARKS,
+                f"{AUTO_LANDMARKS} greedy landmarks of {T} frames (automatic)",
+            )
     else:
         try:
             n = int(landmarks)
         except (TypeError, ValueError):
-            raise ParameterError(f"landmarks must be 'auto', 'none' or a number, got {landmarks!r}") from None
+            raise ParameterError(
+                f"landmarks must be 'auto', 'none' or a number, got {landmarks!r}"
+            ) from None
         if n < 10:
             raise ParameterError(f"need at least 10 landmarks, got {n}")
         if n >= T:
@@ -424,13 +442,14 @@ def choose_landmarks(
             est = size(m)
         if est.bytes > memory_limit:
             raise ParameterError(
-                f"not enough memory: even {m} landmarks need about {est.bytes / 1e9:.2f} GB for the "
-                f"filtration at scale {threshold:.4g}, over the {memory_limit / 1e9:.2f} GB left for it; "
-                "lower --max-scale or raise --memory-limit"
+                f"not enough memory: even {m} landmarks need about {est.bytes / 1e9:.2f} GB for "
+                f"the filtration at scale {threshold:.4g}, over the {memory_limit / 1e9:.2f} GB "
+                "left for it; lower --max-scale or raise --memory-limit"
             )
         reason = (
             f"memory guard: the complex on {before.n_points} points was estimated at "
-            f"{before.bytes / 1e9:.2f} GB ({before.edges:.3g} edges) over the {memory_limit / 1e9:.2f} GB "
+            f"{before.bytes / 1e9:.2f} GB ({before.edges:.3g} edges) over the "
+            f"{memory_limit / 1e9:.2f} GB "
             f"budget; using {m} greedy landmarks ({est.bytes / 1e9:.2f} GB)"
         )
         n = m if m < T else None

@@ -1,4 +1,4 @@
-"""A fitted phase model: the preparation and the circular coordinate, saved and applied to new frames.
+"""A fitted phase model: the preparation and the coordinate, saved and applied to new frames.
 
 :class:`PhaseModel` gives the phase of frames a fit never saw — a new take of the same
 motion, or frames arriving from a live stream — with the preparation (root
@@ -16,7 +16,7 @@ import numpy as np
 
 from .coordinates import CircularCoordinates, unwrap
 from ..errors import ParameterError, ParseError
-from ..io._atomic import atomic_write
+from ..io import atomic_write
 from ..motion import Motion
 from .preprocess import Preprocessor
 
@@ -71,7 +71,8 @@ class PhaseModel:
                 return motion.select(self.channels)
             missing = [f"{j}.{d}" for j, d in self.channels if (j, d) not in set(motion.channels)]
             raise ParameterError(
-                f"the capture lacks {len(missing)} channel(s) the model was fitted on, e.g. {missing[:3]}"
+                f"the capture lacks {len(missing)} channel(s) "
+                f"the model was fitted on, e.g. {missing[:3]}"
             )
         return motion
 
@@ -96,10 +97,12 @@ class PhaseModel:
         arrays = {f"cc_{k}": v for k, v in self.estimator.to_arrays().items()}
         arrays.update(
             pre_root_columns=np.asarray(p.root_columns_),
-            pre_rot_mask=np.asarray(p._rot_mask_),
+            pre_rot_mask=np.asarray(p.root_rotation_mask_),
             pre_mean=np.asarray(p.mean_),
             pre_scale=np.asarray(p.scale_),
-            pre_components=np.asarray(p.components_ if p.components_ is not None else np.zeros((0, len(p.mean_)))),
+            pre_components=np.asarray(
+                p.components_ if p.components_ is not None else np.zeros((0, len(p.mean_)))
+            ),
         )
         header = {
             "format": _FORMAT,
@@ -137,12 +140,15 @@ class PhaseModel:
         if header.get("version") != _VERSION:
             raise ParseError(f"model file version {header.get('version')} is not supported", path)
         pre = Preprocessor(
-            difference_root=header["difference_root"], normalize=header["normalize"], pca=header["pca"],
-            delay=header.get("delay"), root=header.get("root", "euler"),
+            difference_root=header["difference_root"],
+            normalize=header["normalize"],
+            pca=header["pca"],
+            delay=header.get("delay"),
+            root=header.get("root", "euler"),
         )
         try:
             pre.root_columns_ = arrays["pre_root_columns"].astype(int)
-            pre._rot_mask_ = arrays["pre_rot_mask"].astype(bool)
+            pre.root_rotation_mask_ = arrays["pre_rot_mask"].astype(bool)
             pre.root_mode_ = header.get("root", "euler")
             pre.mean_ = arrays["pre_mean"]
             pre.scale_ = arrays["pre_scale"]
@@ -150,7 +156,9 @@ class PhaseModel:
             pre.components_ = comp if comp.size else None
             pre.explained_variance_ratio_ = None
             pre.n_channels_ = int(header["n_channels"])
-            est = CircularCoordinates.from_arrays({k[3:]: v for k, v in arrays.items() if k.startswith("cc_")})
+            est = CircularCoordinates.from_arrays(
+                {k[3:]: v for k, v in arrays.items() if k.startswith("cc_")}
+            )
         except (KeyError, ParameterError) as exc:
             raise ParseError(f"incomplete model file ({exc})", path) from None
         return cls(

@@ -7,17 +7,25 @@ typical cycle as a loopable :class:`~cyclecoord.motion.Motion`.
 
 from __future__ import annotations
 
-import copy
+import numbers
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
 
 from .._blas import one_blas_thread
+from .._validation import Interval, Options, check_params
 from .barcode import (
-    CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, DEFAULT_PRIME, Barcode, BarSelection, refine_birth, select_bar,
+    CLEAR_GAP,
+    CLEAR_MIN_FRACTION,
+    CLEAR_RATIO,
+    DEFAULT_PRIME,
+    Barcode,
+    BarSelection,
+    refine_birth,
+    select_bar,
 )
 from .coordinates import REFINE_BYTES_PER_EDGE, CircularCoordinates, unwrap
 from .cycle import TypicalCycle, check_bandwidth, typical_cycle
@@ -28,10 +36,13 @@ from ..motion import Motion
 from .preprocess import PreparedData, Preprocessor
 from .clip import capture_cycle, joint_columns, loop_cycle
 from .root import heading, root_layout
-from .steady import moving_mask, recurrence, steady_mask
+from .steady import moving_mask, period_speed, recurrence, steady_mask
 from .windings import Windings, complete_windings, retime, stretches
 
-__all__ = ["extract", "ExtractionResult", "cycle_lengths", "MIN_TURNS", "TIMINGS", "TRAVELS"]
+__all__ = [
+    "extract", "ExtractionResult", "PartialExtraction", "CycleOptions", "cycle_lengths",
+    "MIN_TURNS", "TIMINGS", "TRAVELS",
+]
 
 #: Fewer turns of the coordinate over the steady frames than this is no periodic motion
 #: (the rule :func:`~cyclecoord.periodic.detection.detect` applies to its segments).
@@ -66,6 +77,85 @@ def cycle_lengths(unwrapped: np.ndarray) -> np.ndarray:
     lo, hi = m[i - 1], m[i]
     ends = i - 1 + np.where(hi > lo, (levels - lo) / np.where(hi > lo, hi - lo, 1.0), 0.0)
     return np.diff(np.concatenate([[0.0], ends]))
+
+
+@dataclass(frozen=True)
+class CycleOptions:
+    """How the typical cycle is made: one object for :func:`extract`,
+    :func:`~cyclecoord.periodic.detection.motion_cycles` and a pipeline's own settings.
+
+    Each field is the keyword of the same name of :func:`extract` (see there), with the
+    same default; ``extract(m, cycle=CycleOptions(travel="straight"))`` equals
+    ``extract(m, travel="straight")``.
+    """
+
+    timing: str = "capture"
+    travel: str = "keep"
+    bandwidth: str | float | None = None
+    cycle_start: str = "slowest"
+    n_samples: int = 500
+    n_neighbors: int = 10
+    weighting: str = "kernel"
+    sampling: str = "quantile"
+    min_turns: float = MIN_TURNS
+
+    def as_dict(self) -> dict[str, Any]:
+        """The options as keyword arguments."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+def _take_cycle_options(cycle: Any, given: dict[str, Any], where: str) -> dict[str, Any]:
+    """``given`` (a function's cycle keywords) overridden by ``cycle``; a keyword changed
+    from its default beside ``cycle`` is an error (which one would win is not obvious)."""
+    if cycle is None:
+        return given
+    if not isinstance(cycle, CycleOptions):
+        raise ParameterError(f"{where}: cycle must be a CycleOptions, got {type(cycle).__name__}")
+    default = CycleOptions().as_dict()
+    clash = [k for k, v in given.items() if k in default and v != default[k]]
+    if clash:
+        raise ParameterError(
+            f"{where}: give {', '.join(clash)} either as keyword(s) or in cycle=CycleOptions(...), "
+            "not both"
+        )
+    return {**given, **cycle.as_dict()}
+
+
+@dataclass
+class PartialExtraction:
+    """What an extraction that found no periodic motion got as far as
+    (``NoPeriodicMotionError.result``).
+
+    It holds only what was computed: the capture, its preparation and, when the run got
+    that far, the barcode, the bar looked at and the estimator; there is no coordinate,
+    period or cycle.  Figures of it show the barcode (why nothing stood clear), and
+    ``cyclecoord extract --report`` writes it with ``selected: null`` and the reason.
+
+    Attributes
+    ----------
+    motion : Motion
+    prepared : PreparedData
+    reason : str
+        Why the extraction stopped (the error's message without the source).
+    barcode : Barcode or None
+    selection : BarSelection or None
+        The bar that was judged (None when no bar was).
+    timings, parameters : dict
+    warnings : list of str
+    estimator : CircularCoordinates or None
+    preprocessor : Preprocessor or None
+    """
+
+    motion: Motion
+    prepared: PreparedData
+    reason: str
+    barcode: Barcode | None = None
+    selection: BarSelection | None = None
+    timings: dict = field(default_factory=dict)
+    parameters: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    estimator: CircularCoordinates | None = None
+    preprocessor: Preprocessor | None = None
 
 
 @dataclass
@@ -152,7 +242,8 @@ class ExtractionResult:
 
     @property
     def model(self):
-        """The fitted :class:`~cyclecoord.periodic.phase_model.PhaseModel` (phase of new frames, save/load)."""
+        """The fitted :class:`~cyclecoord.periodic.phase_model.PhaseModel` (phase of new
+        frames, save/load)."""
         from .phase_model import PhaseModel
 
         return PhaseModel.from_result(self)
@@ -161,7 +252,10 @@ class ExtractionResult:
         """JSON-ready summary (see the CLI's ``--report``)."""
         return {
             "source": self.motion.source,
-            "frames": [int(self.motion.start_frame), int(self.motion.start_frame + self.motion.n_frames)],
+            "frames": [
+                int(self.motion.start_frame),
+                int(self.motion.start_frame + self.motion.n_frames),
+            ],
             "n_frames": int(self.motion.n_frames),
             "fps": self.motion.fps,
             "dims": int(self.prepared.points.shape[1]),
@@ -170,7 +264,11 @@ class ExtractionResult:
             "prime": int(self.barcode.prime),
             "barcode": self.barcode.to_dict(),
             "selected": self.selection.to_dict(),
-            "clear_criterion": {"min_ratio": CLEAR_RATIO, "min_gap": CLEAR_GAP, "min_fraction_of_threshold": CLEAR_MIN_FRACTION},
+            "clear_criterion": {
+                "min_ratio": CLEAR_RATIO,
+                "min_gap": CLEAR_GAP,
+                "min_fraction_of_threshold": CLEAR_MIN_FRACTION,
+            },
             "coordinate": _nullable(self.coordinate),
             "phase": _nullable(self.phase),
             "used_frames": [[int(a), int(b)] for a, b in self.used_frames],
@@ -179,18 +277,28 @@ class ExtractionResult:
             "period_seconds": float(self.period_frames / self.motion.fps),
             "cycle_frames": [float(v) for v in self.cycle_frames],
             "period_spread": None if self.windings is None else float(self.windings.spread),
-            "heading_per_cycle_degrees": None if not np.isfinite(self.heading_per_cycle) else float(self.heading_per_cycle),
+            "heading_per_cycle_degrees": None
+            if not np.isfinite(self.heading_per_cycle)
+            else float(self.heading_per_cycle),
             "cycle_length": int(self.cycle.n_frames),
             "jerk": self.jerk,
             "loop_closure": float(self.loop_closure),
-            "bandwidth_frames": float(self.typical.bandwidth) if np.isfinite(self.typical.bandwidth) else None,
+            "bandwidth_frames": float(self.typical.bandwidth)
+            if np.isfinite(self.typical.bandwidth)
+            else None,
             "foot_skating": _cycle_skating(self.cycle),
             "distance_to_cycle": self.distance,
             "landmarks": _landmark_report(self.estimator),
             "cocycle_check": {
-                "triangles": int(self.estimator.cocycle_check_.n_triangles) if self.estimator else None,
-                "violations": int(self.estimator.cocycle_check_.n_violations) if self.estimator else None,
-                "primes_tried": [int(p) for p, _ in self.estimator.primes_tried_] if self.estimator else [],
+                "triangles": int(self.estimator.cocycle_check_.n_triangles)
+                if self.estimator
+                else None,
+                "violations": int(self.estimator.cocycle_check_.n_violations)
+                if self.estimator
+                else None,
+                "primes_tried": [int(p) for p, _ in self.estimator.primes_tried_]
+                if self.estimator
+                else [],
             },
             "timings": {k: round(float(v), 6) for k, v in self.timings.items()},
             "warnings": list(self.warnings),
@@ -220,11 +328,15 @@ def _landmark_report(est: CircularCoordinates | None) -> dict | None:
         "reason": est.landmark_reason_,
         "covering_radius": float(getattr(est, "covering_radius_", 0.0)),
         "complex_estimate": est.complex_estimate_.to_dict(),
-        "frames_outside_landmark_balls": int(np.sum(~est.covered_)) if hasattr(est, "covered_") else None,
+        "frames_outside_landmark_balls": int(np.sum(~est.covered_))
+        if hasattr(est, "covered_")
+        else None,
     }
 
 
-def _first_clear(est: CircularCoordinates, points: np.ndarray, class_index: int, scale, scale_fraction: float):
+def _first_clear(
+    est: CircularCoordinates, points: np.ndarray, class_index: int, scale, scale_fraction: float
+):
     """Barcode of ``points`` and the chosen bar, judged by its real death.
 
     A bar still alive at the threshold reads a death/birth ratio and a gap cut by the
@@ -254,7 +366,11 @@ def _first_clear(est: CircularCoordinates, points: np.ndarray, class_index: int,
             longer = est.fit_barcode(points)
         finally:
             est.max_scale = old
-        match = np.flatnonzero(np.isclose(longer.h1[:, 0], birth, rtol=1e-9, atol=1e-12)) if len(longer.h1) else []
+        match = (
+            np.flatnonzero(np.isclose(longer.h1[:, 0], birth, rtol=1e-9, atol=1e-12))
+            if len(longer.h1)
+            else []
+        )
         if not len(match):
             break
         barcode = longer
@@ -271,12 +387,16 @@ def _not_clear_reason(sel: BarSelection, barcode: Barcode) -> str:
     if sel.gap < CLEAR_GAP:
         why.append(f"persistence only {sel.gap:.2f}x the next bar's (< {CLEAR_GAP}x)")
     if not why:
-        why.append(f"persistence under {CLEAR_MIN_FRACTION:.0%} of the threshold {barcode.threshold:.4g}")
+        why.append(
+            f"persistence under {CLEAR_MIN_FRACTION:.0%} of the threshold {barcode.threshold:.4g}"
+        )
     ds = "inf" if not np.isfinite(sel.death) else f"{sel.death:.4g}"
     return f"H1 bar #{sel.index} [{sel.birth:.4g}, {ds}) does not stand clear ({'; '.join(why)})"
 
 
-def _unwrap_runs(theta: np.ndarray, rows: np.ndarray, runs: list[tuple[int, int]], n: int) -> np.ndarray:
+def _unwrap_runs(
+    theta: np.ndarray, rows: np.ndarray, runs: list[tuple[int, int]], n: int
+) -> np.ndarray:
     """The coordinate of ``rows`` unwrapped inside each run, NaN elsewhere (length ``n``)."""
     full = np.full(n, np.nan)
     full[rows] = theta
@@ -331,6 +451,7 @@ def extract(
     timing: str = "capture",
     travel: str = "keep",
     min_turns: float = MIN_TURNS,
+    cycle: CycleOptions | None = None,
 ) -> ExtractionResult:
     """Find the dominant periodic motion of a capture and its typical cycle.
 
@@ -408,6 +529,9 @@ def extract(
         (heading change per cycle removed) or stay in place.
     min_turns : float, default 1.5
         Fewer turns of the coordinate over the steady frames is no periodic motion.
+    cycle : CycleOptions, optional
+        The cycle's options as one object (timing, travel, bandwidth, cycle_start,
+        n_samples, n_neighbors, weighting, sampling, min_turns), instead of keywords.
 
     Returns
     -------
@@ -417,13 +541,23 @@ def extract(
     ------
     NoPeriodicMotionError
         When no bar stands clear or the steady frames hold under ``min_turns`` turns (its
-        ``result`` attribute holds a partial :class:`ExtractionResult`).
+        ``result`` attribute holds a :class:`PartialExtraction`).
     ParameterError
         For invalid arguments.
     """
+    if cycle is not None:
+        given = dict(timing=timing, travel=travel, bandwidth=bandwidth, cycle_start=cycle_start,
+                     n_samples=n_samples, n_neighbors=n_neighbors, weighting=weighting,
+                     sampling=sampling, min_turns=min_turns)
+        chosen = _take_cycle_options(cycle, given, "extract()")
+        options = {k: v for k, v in locals().items()
+                   if k not in ("motion", "frames", "cycle", "given", "chosen", *chosen)}
+        return extract(motion, frames=frames, **options, **chosen)
     if isinstance(delay, str):
         if delay != "auto":
-            raise ParameterError(f"delay must be 'auto', a number of seconds or None, got {delay!r}")
+            raise ParameterError(
+                f"delay must be 'auto', a number of seconds or None, got {delay!r}"
+            )
         options = {k: v for k, v in locals().items() if k not in ("motion", "frames", "delay")}
         try:
             return extract(motion, frames=frames, delay=None, **options)
@@ -432,23 +566,62 @@ def extract(
                 res = extract(motion, frames=frames, delay=AUTO_DELAY, **options)
             except NoPeriodicMotionError:
                 raise first from None
-            res.warnings.insert(0, f"read with a {AUTO_DELAY:g} s delay embedding: the poses alone show no "
-                                   "periodic motion (an out-and-back movement, such as a squat)")
+            res.warnings.insert(
+                0,
+                f"read with a {AUTO_DELAY:g} s delay embedding: the poses alone show no "
+                "periodic motion (an out-and-back movement, such as a squat)",
+            )
             return res
     opts = _check_options(
-        motion, weighting=weighting, sampling=sampling, cycle_start=cycle_start, n_samples=n_samples,
-        n_neighbors=n_neighbors, bandwidth=bandwidth, timing=timing, travel=travel, min_turns=min_turns,
+        motion,
+        weighting=weighting,
+        sampling=sampling,
+        cycle_start=cycle_start,
+        n_samples=n_samples,
+        n_neighbors=n_neighbors,
+        bandwidth=bandwidth,
+        timing=timing,
+        travel=travel,
+        min_turns=min_turns,
+        normalize=normalize,
+        temporal=temporal,
+        difference_root=difference_root,
+        steady=steady,
+        pca=pca,
+        class_index=class_index,
+        scale_fraction=scale_fraction,
+        random_state=random_state,
     )
     bandwidth = opts["bandwidth"]
     timings: dict[str, float] = {}
     notes: list[str] = []
     params = dict(
-        frames=None if frames is None else list(frames), pca=pca, normalize=normalize, temporal=temporal,
-        delay=delay, difference_root=difference_root, root=root, prime=prime, max_scale=max_scale, scale=scale,
-        class_index=class_index, scale_fraction=scale_fraction, n_samples=n_samples,
-        n_neighbors=n_neighbors, bandwidth=bandwidth, weighting=weighting, sampling=sampling, n_components=n_components,
-        cycle_start=cycle_start, landmarks=landmarks, memory_limit=memory_limit, random_state=random_state,
-        steady=steady, timing=timing, travel=travel, min_turns=min_turns,
+        frames=None if frames is None else list(frames),
+        pca=pca,
+        normalize=normalize,
+        temporal=temporal,
+        delay=delay,
+        difference_root=difference_root,
+        root=root,
+        prime=prime,
+        max_scale=max_scale,
+        scale=scale,
+        class_index=class_index,
+        scale_fraction=scale_fraction,
+        n_samples=n_samples,
+        n_neighbors=n_neighbors,
+        bandwidth=bandwidth,
+        weighting=weighting,
+        sampling=sampling,
+        n_components=n_components,
+        cycle_start=cycle_start,
+        landmarks=landmarks,
+        memory_limit=memory_limit,
+        random_state=random_state,
+        steady=steady,
+        timing=timing,
+        travel=travel,
+        min_turns=min_turns,
     )
     motion = motion.window(frames)
     if motion.n_frames < 2 * n_neighbors or motion.n_frames < 10:
@@ -459,10 +632,16 @@ def extract(
     T = motion.n_frames
     t0 = time.perf_counter()
     lag = int(round(delay * motion.fps)) if delay else None
-    prep = Preprocessor(difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=lag)
+    prep = Preprocessor(
+        difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=lag
+    )
     prepared = prep.fit_transform(motion)
     joints = joint_columns(motion, prepared)
-    moving = moving_mask(prepared.poses, motion.fps, columns=joints) if steady else np.ones(T, dtype=bool)
+    moving = (
+        moving_mask(prepared.poses, motion.fps, columns=joints)
+        if steady
+        else np.ones(T, dtype=bool)
+    )
     if not steady or moving.sum() >= 0.95 * T or moving.sum() < max(10, 2 * n_neighbors):
         moving = np.ones(T, dtype=bool)
     timings["prepare"] = time.perf_counter() - t0
@@ -472,19 +651,32 @@ def extract(
         if first_pass and isinstance(landmarks, str) and landmarks == "auto":
             lm = FIRST_PASS_LANDMARKS
         return CircularCoordinates(
-            max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
-            scale_fraction=scale_fraction, temporal=temporal, landmarks=lm, refine_birth=False,
+            max_scale=max_scale,
+            scale=scale,
+            class_index=class_index,
+            prime=prime,
+            scale_fraction=scale_fraction,
+            temporal=temporal,
+            landmarks=lm,
+            refine_birth=False,
             memory_limit=memory_limit,
-            memory_reserved=8.0 * max(0, prepared.poses.size - prepared.points.size),  # poses beyond the points
+            memory_reserved=8.0
+            * max(0, prepared.poses.size - prepared.points.size),  # poses beyond the points
         )
 
-    def fail(msg: str, fit: _Fit | None = None, barcode: Barcode | None = None) -> NoPeriodicMotionError:
-        partial = ExtractionResult(
-            motion=motion, prepared=prepared, barcode=barcode if fit is None else fit.barcode,
-            selection=None if fit is None else fit.selection, coordinate=None,
-            unwrapped=None, cycles=float("nan"), period_frames=float("nan"), cycle_frames=np.zeros(0),
-            density=None, typical=None, cycle=None, jerk={}, loop_closure=float("nan"), distance={},
-            timings=timings, parameters=params, warnings=notes, estimator=None if fit is None else fit.est,
+    def fail(
+        msg: str, fit: _Fit | None = None, barcode: Barcode | None = None
+    ) -> NoPeriodicMotionError:
+        partial = PartialExtraction(
+            motion=motion,
+            prepared=prepared,
+            reason=msg,
+            barcode=barcode if fit is None else fit.barcode,
+            selection=None if fit is None else fit.selection,
+            timings=timings,
+            parameters=params,
+            warnings=notes,
+            estimator=None if fit is None else fit.est,
             preprocessor=prep,
         )
         where = motion.source or "capture"
@@ -493,13 +685,21 @@ def extract(
     def fit_rows(rows: np.ndarray, stage: str, first_pass: bool = False) -> _Fit:
         est = make_estimator(first_pass)
         t0 = time.perf_counter()
-        barcode, sel = _first_clear(est, _rows_of(prepared.points, rows), class_index, scale, scale_fraction)
+        barcode, sel = _first_clear(
+            est, _rows_of(prepared.points, rows), class_index, scale, scale_fraction
+        )
         timings[f"barcode{stage}"] = time.perf_counter() - t0
         if sel is None:
             if len(barcode.h1) and class_index >= len(barcode.h1):
-                raise ParameterError(f"class index {class_index} out of range: the barcode has {len(barcode.h1)} H1 bars")
-            raise fail(f"no periodic motion found: the barcode has no H1 bar up to scale {barcode.threshold:.4g}",
-                       barcode=barcode)
+                raise ParameterError(
+                    f"class index {class_index} out of range: the barcode has {len(barcode.h1)} "
+                    "H1 bars"
+                )
+            raise fail(
+                "no periodic motion found: the barcode has no H1 bar up to scale "
+                f"{barcode.threshold:.4g}",
+                barcode=barcode,
+            )
         # a bar that is clear but for its gap to the next one (long takes hold several
         # loops) is judged by its coordinate's windings instead (see _finish)
         gap_only = sel.ratio >= CLEAR_RATIO and sel.gap < CLEAR_GAP and (
@@ -514,30 +714,53 @@ def extract(
             # circuit, a drift); a later clear class that winds regularly is the motion's
             wind = complete_windings(fit.unwrapped, _row_runs(rows))
             j = 1
-            while (wind.turns < min_turns or not wind.spread <= MAX_SPREAD) and j < min(4, len(barcode.h1)):
+            while (wind.turns < min_turns or not wind.spread <= MAX_SPREAD) and j < min(
+                4, len(barcode.h1)
+            ):
                 other = select_bar(barcode, j, None, scale_fraction)
                 if other.ratio >= CLEAR_RATIO:
-                    alt_est = copy.copy(est)
-                    alt_est.class_index = j
+                    alt_est = est.with_coordinate_params(class_index=j)
                     try:
                         alt = coordinate_of(alt_est, other, rows)
                     except ParameterError:
                         alt = None
-                    alt_wind = complete_windings(alt.unwrapped, _row_runs(rows)) if alt is not None else None
-                    if alt_wind is not None and alt_wind.turns >= min_turns and alt_wind.spread <= MAX_SPREAD:
+                    alt_wind = (
+                        complete_windings(alt.unwrapped, _row_runs(rows))
+                        if alt is not None
+                        else None
+                    )
+                    if (
+                        alt_wind is not None
+                        and alt_wind.turns >= min_turns
+                        and alt_wind.spread <= MAX_SPREAD
+                    ):
                         alt.notes.append(
-                            f"H1 class #{j} chosen: the most persistent class turns {wind.turns:.2f} times over "
-                            f"the frames (spread {wind.spread:.0%}), class #{j} {alt_wind.turns:.2f} times, regularly")
+                            f"H1 class #{j} chosen: the most persistent class turns "
+                            f"{wind.turns:.2f} times over "
+                            f"the frames (spread {wind.spread:.0%}), class #{j} "
+                            f"{alt_wind.turns:.2f} times, regularly"
+                        )
                         fit, wind = alt, alt_wind
                         break
                 j += 1
         if not first_pass and fit.est.landmarks_ is not None and not temporal:
             # the class's birth on every frame, for the report (landmarks are born later)
             budget = getattr(fit.est, "memory_budget_", None)
-            max_edges = 3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
-            full = refine_birth(_rows_of(prepared.points, rows), fit.selection.birth, fit.est.prime_, max_edges=max_edges,
-                                covering_radius=fit.est.covering_radius_,
-                                coordinate=fit.est.coordinates_) if max_edges > 0 else None
+            max_edges = (
+                3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
+            )
+            full = (
+                refine_birth(
+                    _rows_of(prepared.points, rows),
+                    fit.selection.birth,
+                    fit.est.prime_,
+                    max_edges=max_edges,
+                    covering_radius=fit.est.covering_radius_,
+                    coordinate=fit.est.coordinates_,
+                )
+                if max_edges > 0
+                else None
+            )
             fit.selection = BarSelection(**{**fit.selection.__dict__, "full_birth": full})
             fit.est.selection_ = fit.selection
         timings[f"coordinate{stage}"] = time.perf_counter() - t0
@@ -562,7 +785,9 @@ def extract(
         t0 = time.perf_counter()
         first = complete_windings(fit.unwrapped, stretches(moving))
         if np.isfinite(first.period_frames):
-            used = _steady_frames(motion, prepared, joints, fit.unwrapped, moving, first.period_frames)
+            used = _steady_frames(
+                motion, prepared, joints, fit.unwrapped, moving, first.period_frames
+            )
         if used.sum() >= 0.95 * moving.sum():
             used = moving
         refit = rough or used.sum() < moving.sum()
@@ -575,17 +800,46 @@ def extract(
         if first.turns < min_turns:
             raise fail(_too_few_turns(first.turns, int(moving.sum()), min_turns), fit)
         if not used.any():
-            raise fail("no periodic motion found: no stretch of the take repeats steadily for a whole period "
-                       f"(the coordinate turns {first.turns:.2f} times over the moving frames); "
-                       "check the coordinate figure (--plot), or try --no-steady or --frames", fit)
+            raise fail(
+                "no periodic motion found: no stretch of the take repeats steadily for a whole "
+                "period "
+                f"(the coordinate turns {first.turns:.2f} times over the moving frames); "
+                "check the coordinate figure (--plot), or try --no-steady or --frames",
+                fit,
+            )
         if refit:
             fit = fit_rows(np.flatnonzero(used), "")
     notes.extend(fit.notes)
+    other = int(moving.sum() - (used & moving).sum())
+    if steady and other > 0.5 * moving.sum():
+        # most of the moving frames are not this motion: a routine of several exercises,
+        # or a dance whose one steady figure is not the take
+        notes.append(
+            f"only {int(used.sum())} of the take's {int(moving.sum())} moving frames repeat this "
+            "motion steadily; the rest may be other motions: `cyclecoord detect` finds each "
+            "motion of a take that holds several"
+        )
     return _finish(
-        motion, prepared, prep, fit, used, notes, timings, params, fail,
-        n_components=n_components, n_samples=n_samples, n_neighbors=n_neighbors, weighting=weighting,
-        sampling=sampling, bandwidth=bandwidth, random_state=random_state, cycle_start=cycle_start,
-        timing=timing, travel=travel, min_turns=min_turns,
+        motion,
+        prepared,
+        prep,
+        fit,
+        used,
+        notes,
+        timings,
+        params,
+        fail,
+        n_components=n_components,
+        n_samples=n_samples,
+        n_neighbors=n_neighbors,
+        weighting=weighting,
+        sampling=sampling,
+        bandwidth=bandwidth,
+        random_state=random_state,
+        cycle_start=cycle_start,
+        timing=timing,
+        travel=travel,
+        min_turns=min_turns,
     )
 
 
@@ -596,25 +850,32 @@ def _rows_of(x: np.ndarray, rows: np.ndarray) -> np.ndarray:
     return x[rows]
 
 
+#: What :func:`extract`'s options may be (:mod:`cyclecoord._validation`); the scale and
+#: landmark options are checked where they are used (their messages name the data).
+EXTRACT_CONSTRAINTS = {
+    "weighting": [Options("kernel", "mean", "gaussian")],
+    "sampling": [Options("quantile", "random")],
+    "cycle_start": [Options("slowest", "first")],
+    "timing": [Options(*TIMINGS)],
+    "travel": [Options(*TRAVELS)],
+    "min_turns": [Interval(numbers.Real, 0, None, closed="neither")],
+    "n_samples": [Interval(numbers.Integral, 10, None)],
+    "n_neighbors": [Interval(numbers.Integral, 1, None)],
+    "normalize": ["boolean"],
+    "temporal": ["boolean"],
+    "difference_root": ["boolean"],
+    "steady": ["boolean"],
+    "pca": [Interval(numbers.Integral, 1, None), None],
+    "class_index": [Interval(numbers.Integral, 0, None)],
+    "scale_fraction": [Interval(numbers.Real, 0, 1, closed="right")],
+    "random_state": [Interval(numbers.Integral, 0, None), None],
+}
+
+
 def _check_options(motion, **o) -> dict:
     if not isinstance(motion, Motion):
         raise ParameterError(f"extract() takes a Motion, got {type(motion).__name__}")
-    if o["weighting"] not in ("kernel", "mean", "gaussian"):
-        raise ParameterError(f"weighting must be 'kernel', 'mean' or 'gaussian', got {o['weighting']!r}")
-    if o["sampling"] not in ("quantile", "random"):
-        raise ParameterError(f"sampling must be 'quantile' or 'random', got {o['sampling']!r}")
-    if o["cycle_start"] not in ("slowest", "first"):
-        raise ParameterError(f"cycle_start must be 'slowest' or 'first', got {o['cycle_start']!r}")
-    if o["timing"] not in TIMINGS:
-        raise ParameterError(f"timing must be one of {TIMINGS}, got {o['timing']!r}")
-    if o["travel"] not in TRAVELS:
-        raise ParameterError(f"travel must be one of {TRAVELS}, got {o['travel']!r}")
-    if not (isinstance(o["min_turns"], (int, float)) and np.isfinite(o["min_turns"]) and o["min_turns"] > 0):
-        raise ParameterError(f"min_turns must be a positive number, got {o['min_turns']!r}")
-    if o["n_samples"] < 10:
-        raise ParameterError(f"n_samples must be at least 10, got {o['n_samples']}")
-    if o["n_neighbors"] < 1:
-        raise ParameterError(f"n_neighbors must be at least 1, got {o['n_neighbors']}")
+    check_params(o, EXTRACT_CONSTRAINTS, "extract()")
     weighting = o["weighting"] if o["timing"] == "coordinate" else "kernel"
     o["bandwidth"] = check_bandwidth(o["bandwidth"], weighting)  # before any work is done
     return o
@@ -635,13 +896,18 @@ def _steady_frames(motion, prepared, joints, unwrapped, moving, period) -> np.nd
     rec = recurrence(prepared.poses[:, joints], period)
     layout = root_layout(motion)
     hd = heading(motion.frames, layout) if layout is not None else None
-    return steady_mask(unwrapped, moving, period, recurrence_distance=rec, heading=hd)
+    speed = period_speed(prepared.poses, motion.fps, period, columns=joints)
+    return steady_mask(unwrapped, moving, period, recurrence_distance=rec, heading=hd, speed=speed)
 
 
 def _too_few_turns(turns: float, n_frames: int, min_turns: float) -> str:
-    return (f"no periodic motion found: the coordinate turns only {turns:.2f} times over the {n_frames} "
-            f"steady frames (at least {min_turns:g} are needed to call a motion periodic); a longer take, "
-            "--frames around the repeated part, or --pca 3 may help")
+    return (
+        f"no periodic motion found: the coordinate turns only {turns:.2f} times over the "
+        f"{n_frames} "
+        f"steady frames (at least {min_turns:g} are needed to call a motion periodic); a longer "
+        "take, "
+        "--frames around the repeated part, or --pca 3 may help"
+    )
 
 
 def _run_jerk(poses: np.ndarray, runs: list[tuple[int, int]], fps: float) -> float:
@@ -654,7 +920,9 @@ def _run_jerk(poses: np.ndarray, runs: list[tuple[int, int]], fps: float) -> flo
     return float(np.average(vals, weights=weights)) if vals else float("nan")
 
 
-def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o) -> ExtractionResult:
+def _finish(
+    motion, prepared, prep, fit, used, notes, timings, params, fail, **o
+) -> ExtractionResult:
     """Windings, period, cycle and figures of a fitted coordinate on the used frames."""
     T = motion.n_frames
     runs = stretches(used)
@@ -665,24 +933,31 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     if fit.weak_gap:
         if wind.spread > MAX_SPREAD or not np.isfinite(wind.period_frames):
             raise fail(
-                f"no periodic motion found: {_not_clear_reason(fit.selection, fit.barcode)}, and its coordinate "
+                f"no periodic motion found: {_not_clear_reason(fit.selection, fit.barcode)}, and "
+                "its coordinate "
                 f"winds irregularly (complete windings spread {wind.spread:.0%} of the period); "
-                "try --max-scale, --pca or --frames", fit)
+                "try --max-scale, --pca or --frames",
+                fit,
+            )
         notes.append(
-            f"the H1 bar stands only {fit.selection.gap:.2f}x the next bar's persistence (under {CLEAR_GAP}x); "
-            f"accepted because its coordinate winds {wind.turns:.1f} times, regularly (spread {wind.spread:.0%})"
+            f"the H1 bar stands only {fit.selection.gap:.2f}x the next bar's persistence (under "
+            f"{CLEAR_GAP}x); "
+            f"accepted because its coordinate winds {wind.turns:.1f} times, regularly (spread "
+            f"{wind.spread:.0%})"
         )
     period = wind.period_frames
     if not np.isfinite(period):
         period = float(np.sum(used) - len(runs)) / wind.turns
     if wind.spread > MAX_SPREAD:
         notes.append(
-            f"the complete windings vary by {wind.spread:.0%} of the period (p10-p90); the motion is not "
+            f"the complete windings vary by {wind.spread:.0%} of the period (p10-p90); the motion "
+            "is not "
             "steady: use --frames to pick one steady stretch, or check the coordinate figure"
         )
     if fit.est.n_components_ > 1:
         notes.append(
-            f"the complex at scale {fit.selection.scale:.4g} has {fit.est.n_components_} connected components: "
+            f"the complex at scale {fit.selection.scale:.4g} has {fit.est.n_components_} "
+            "connected components: "
             "frames in different components get unrelated coordinates; raise --max-scale or --scale"
         )
     theta = np.full(T, np.nan)
@@ -690,7 +965,9 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     theta[~used] = np.nan
     rows = np.flatnonzero(used)
     t0 = time.perf_counter()
-    density = PeriodicDensity(n_components=o["n_components"], random_state=o["random_state"]).fit(theta[rows])
+    density = PeriodicDensity(n_components=o["n_components"], random_state=o["random_state"]).fit(
+        theta[rows]
+    )
     timings["density"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     phase = np.full(T, np.nan)
@@ -698,8 +975,15 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     if o["timing"] == "coordinate":
         k = min(o["n_neighbors"], rows.size)
         typ = typical_cycle(
-            theta[rows], prepared.poses[rows], period, density=density, n_samples=o["n_samples"], k=k,
-            weighting=o["weighting"], sampling=o["sampling"], random_state=o["random_state"],
+            theta[rows],
+            prepared.poses[rows],
+            period,
+            density=density,
+            n_samples=o["n_samples"],
+            k=k,
+            weighting=o["weighting"],
+            sampling=o["sampling"],
+            random_state=o["random_state"],
             bandwidth=o["bandwidth"],
         )
         typ, cycle_motion = loop_cycle(
@@ -709,8 +993,15 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     else:
         phase = retime(u, runs, wind)
         typ, cycle_motion, heading_change = capture_cycle(
-            phase, motion, prepared, prep, period, bandwidth=o["bandwidth"], cycle_start=o["cycle_start"],
-            travel=o["travel"], k=o["n_neighbors"],
+            phase,
+            motion,
+            prepared,
+            prep,
+            period,
+            bandwidth=o["bandwidth"],
+            cycle_start=o["cycle_start"],
+            travel=o["travel"],
+            k=o["n_neighbors"],
             metadata={"period_frames": period, "cycles_in_source": wind.turns},
         )
     timings["cycle"] = time.perf_counter() - t0
@@ -732,11 +1023,30 @@ def _finish(motion, prepared, prep, fit, used, notes, timings, params, fail, **o
     timings["metrics"] = time.perf_counter() - t0
     timings["total"] = sum(v for k, v in timings.items())
     return ExtractionResult(
-        motion=motion, prepared=prepared, barcode=fit.barcode, selection=fit.selection, coordinate=theta,
-        unwrapped=u, cycles=float(wind.turns), period_frames=float(period), cycle_frames=wind.lengths,
-        density=density, typical=typ, cycle=cycle_motion, jerk=jerk, loop_closure=closure, distance=distance,
-        timings=timings, parameters=params, warnings=notes, estimator=fit.est, preprocessor=prep,
-        used=used, phase=phase, windings=wind, heading_per_cycle=heading_change,
+        motion=motion,
+        prepared=prepared,
+        barcode=fit.barcode,
+        selection=fit.selection,
+        coordinate=theta,
+        unwrapped=u,
+        cycles=float(wind.turns),
+        period_frames=float(period),
+        cycle_frames=wind.lengths,
+        density=density,
+        typical=typ,
+        cycle=cycle_motion,
+        jerk=jerk,
+        loop_closure=closure,
+        distance=distance,
+        timings=timings,
+        parameters=params,
+        warnings=notes,
+        estimator=fit.est,
+        preprocessor=prep,
+        used=used,
+        phase=phase,
+        windings=wind,
+        heading_per_cycle=heading_change,
     )
 
 

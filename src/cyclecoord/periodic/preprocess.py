@@ -54,7 +54,9 @@ def _wrap_degrees(x: np.ndarray) -> np.ndarray:
     return (x + 180.0) % 360.0 - 180.0
 
 
-def difference_root(frames: np.ndarray, root_columns: np.ndarray, rotation_mask: np.ndarray) -> np.ndarray:
+def difference_root(
+    frames: np.ndarray, root_columns: np.ndarray, rotation_mask: np.ndarray
+) -> np.ndarray:
     """Replace root channels by forward differences, keeping one row per frame.
 
     ``out[t] = x[t+1] - x[t]`` for ``t < T-1`` and the last row repeats the previous
@@ -95,13 +97,18 @@ def _root_layout(motion: Motion, cols: np.ndarray):
         return None
     root = sk.joints[0]
     dofs = [motion.channels[c][1] for c in cols]
-    if sorted(dofs) != sorted(["tx", "ty", "tz", "rx", "ry", "rz"]) or len(root.rotation_order) != 3:
+    if (
+        sorted(dofs) != sorted(["tx", "ty", "tz", "rx", "ry", "rz"])
+        or len(root.rotation_order) != 3
+    ):
         return None
     return root, dofs
 
 
 def _root_rotations(frames: np.ndarray, cols: np.ndarray, root, dofs) -> np.ndarray:
-    vals = np.column_stack([frames[:, cols[dofs.index("r" + a.lower())]] for a in root.rotation_order])
+    vals = np.column_stack(
+        [frames[:, cols[dofs.index("r" + a.lower())]] for a in root.rotation_order]
+    )
     local = Rotation.from_euler(root.rotation_order, vals, degrees=True).as_matrix()
     return root.axis @ local @ root.axis.T
 
@@ -163,15 +170,17 @@ class Preprocessor:
         Project onto the first ``pca`` principal components.
     delay : int, sequence of int, or None, default None
         Delay embedding: each point becomes ``[p(t), p(t - d1), p(t - d2), ...]`` for the
-        given delays in frames (frames before the first repeat it).  A motion that goes out and back along the same path (a squat,
-        a jumping jack) is a segment in pose space, not a loop; paired with its past it
-        becomes a loop (Takens; paper §4.2).  The typical cycle is still averaged from
-        the poses themselves.
+        given delays in frames (frames before the first repeat it).  A motion that goes
+        out and back along the same path (a squat, a jumping jack) is a segment in pose
+        space, not a loop; paired with its past it becomes a loop (Takens; paper §4.2).
+        The typical cycle is still averaged from the poses themselves.
 
     Attributes
     ----------
     root_columns_ : ndarray of int
         Root channels that were differenced.
+    root_rotation_mask_ : ndarray of bool, shape (len(root_columns_),)
+        Which of them are rotations (differenced as angles, wrapped into [-180, 180)).
     mean_ : ndarray, shape (D,)
         Channel means of the prepared poses (used by PCA).
     scale_ : ndarray, shape (D,)
@@ -201,7 +210,8 @@ class Preprocessor:
         if not np.all(np.isfinite(frames)):
             bad = np.argwhere(~np.isfinite(frames))[0]
             raise ParameterError(
-                f"frame {motion.start_frame + bad[0]} channel {motion.channels[bad[1]]} is not a finite number"
+                f"frame {motion.start_frame + bad[0]} channel "
+                f"{motion.channels[bad[1]]} is not a finite number"
             )
         if not self.difference_root:
             return np.array(frames, dtype=float)
@@ -215,21 +225,31 @@ class Preprocessor:
             out = np.array(frames, dtype=float)
             out[:, self.root_columns_] = body_frame_differences(frames, self.root_columns_, *layout)
             return out
-        return difference_root(frames, self.root_columns_, self._rot_mask_)
+        return difference_root(frames, self.root_columns_, self.root_rotation_mask_)
 
     def fit(self, motion: Motion) -> "Preprocessor":
         """Learn root columns, scaling and principal axes from ``motion``."""
+        self._setup(motion)
+        self._fit_poses(self._poses(motion), motion)
+        return self
+
+    def _setup(self, motion: Motion) -> None:
         if not isinstance(motion, Motion):
             raise ParameterError(f"expected a Motion, got {type(motion).__name__}")
         if motion.n_frames < 3:
             raise ParameterError(f"need at least 3 frames, got {motion.n_frames}")
         cols = np.asarray(motion.root_channels() if self.difference_root else [], dtype=int)
         self.root_columns_ = cols
-        self._rot_mask_ = np.array([motion.channels[c][1].startswith("r") for c in cols], dtype=bool)
+        self.root_rotation_mask_ = np.array(
+            [motion.channels[c][1].startswith("r") for c in cols], dtype=bool
+        )
         if self.root not in ("body", "euler"):
             raise ParameterError(f"root must be 'body' or 'euler', got {self.root!r}")
-        self.root_mode_ = "body" if (self.root == "body" and _root_layout(motion, cols) is not None) else "euler"
-        poses = self._poses(motion)
+        self.root_mode_ = (
+            "body" if (self.root == "body" and _root_layout(motion, cols) is not None) else "euler"
+        )
+
+    def _fit_poses(self, poses: np.ndarray, motion: Motion) -> None:
         self.mean_ = poses.mean(axis=0)
         if self.normalize:
             sd = poses.std(axis=0)
@@ -253,7 +273,6 @@ class Preprocessor:
         if self.delay is not None:
             _delays(self.delay)  # validates
         self.n_channels_ = motion.n_channels
-        return self
 
     def transform(self, motion: Motion) -> PreparedData:
         """Prepare ``motion`` with the learned settings."""
@@ -261,9 +280,12 @@ class Preprocessor:
             raise ParameterError("this Preprocessor is not fitted yet; call fit() first")
         if motion.n_channels != self.n_channels_:
             raise ParameterError(
-                f"motion has {motion.n_channels} channels, the preprocessor was fitted on {self.n_channels_}"
+                f"motion has {motion.n_channels} channels, the "
+                f"preprocessor was fitted on {self.n_channels_}"
             )
-        poses = self._poses(motion)
+        return self._transform_poses(self._poses(motion))
+
+    def _transform_poses(self, poses: np.ndarray) -> PreparedData:
         if self.components_ is not None:
             points = ((poses - self.mean_) / self.scale_) @ self.components_.T
         elif self.normalize:
@@ -274,12 +296,21 @@ class Preprocessor:
             parts = [points]
             for k in _delays(self.delay):
                 k = min(k, len(points))
-                parts.append(np.concatenate([np.repeat(points[:1], k, axis=0), points[: len(points) - k]]))
+                parts.append(
+                    np.concatenate([np.repeat(points[:1], k, axis=0), points[: len(points) - k]])
+                )
             points = np.hstack(parts)
-        return PreparedData(points=np.ascontiguousarray(points), poses=poses, root_columns=self.root_columns_)
+        return PreparedData(
+            points=np.ascontiguousarray(points), poses=poses, root_columns=self.root_columns_
+        )
 
     def fit_transform(self, motion: Motion) -> PreparedData:
-        return self.fit(motion).transform(motion)
+        """``fit(motion).transform(motion)``, preparing the poses once (the root's
+        rotations of a long take are the costliest part of preparing it)."""
+        self._setup(motion)
+        poses = self._poses(motion)
+        self._fit_poses(poses, motion)
+        return self._transform_poses(poses)
 
     def integrate_root(
         self, deltas: np.ndarray, start: np.ndarray, mean_delta: np.ndarray | None, motion: Motion

@@ -25,7 +25,9 @@ __all__ = ["register"]
 _BLOCK = 256
 
 
-def _align_run(poses: np.ndarray, psi: np.ndarray, template: np.ndarray, band: int, penalty: float) -> np.ndarray:
+def _align_run(
+    poses: np.ndarray, psi: np.ndarray, template: np.ndarray, band: int, penalty: float
+) -> np.ndarray:
     """Template sample index (unwrapped, integer) of every frame of one run."""
     P = template.shape[0]
     n = poses.shape[0]

@@ -26,7 +26,14 @@ from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
 
-__all__ = ["RootLayout", "root_layout", "root_rotations", "decompose_root", "compose_root", "heading"]
+__all__ = [
+    "RootLayout",
+    "root_layout",
+    "root_rotations",
+    "decompose_root",
+    "compose_root",
+    "heading",
+]
 
 _AXES = "xyz"
 
@@ -64,9 +71,14 @@ def root_layout(motion: Motion) -> RootLayout | None:
         return None
     root = sk.joints[0]
     dofs = [motion.channels[c][1] for c in cols]
-    if sorted(dofs) != sorted(["tx", "ty", "tz", "rx", "ry", "rz"]) or len(root.rotation_order) != 3:
+    if (
+        sorted(dofs) != sorted(["tx", "ty", "tz", "rx", "ry", "rz"])
+        or len(root.rotation_order) != 3
+    ):
         return None
-    return RootLayout(columns=cols, dofs=dofs, order=root.rotation_order, axis=np.asarray(root.axis, dtype=float))
+    return RootLayout(
+        columns=cols, dofs=dofs, order=root.rotation_order, axis=np.asarray(root.axis, dtype=float)
+    )
 
 
 def root_rotations(frames: np.ndarray, layout: RootLayout) -> np.ndarray:
@@ -173,7 +185,9 @@ def compose_root(
     h = float(start_heading) + np.concatenate([[0.0], np.cumsum(dh[:-1])])
     yaw = _yaw_matrices(h)
     world = np.einsum("tij,tj->ti", yaw, np.column_stack([step[:, 0], np.zeros(P), step[:, 1]]))
-    ground = np.asarray(start_ground, dtype=float) + np.vstack([[0.0, 0.0], np.cumsum(world[:-1][:, [0, 2]], axis=0)])
+    ground = np.asarray(start_ground, dtype=float) + np.vstack(
+        [[0.0, 0.0], np.cumsum(world[:-1][:, [0, 2]], axis=0)]
+    )
     R = yaw @ Rotation.from_rotvec(x[:, 1:4], degrees=True).as_matrix()
     local = np.einsum("ji,tjk,kl->til", layout.axis, R, layout.axis)
     ang = Rotation.from_matrix(local).as_euler(layout.order, degrees=True)

@@ -26,7 +26,14 @@ from scipy.ndimage import gaussian_filter1d, uniform_filter1d
 
 from .windings import stretches
 
-__all__ = ["moving_mask", "recurrence", "steady_mask", "clean_runs", "centred_window"]
+__all__ = [
+    "moving_mask",
+    "recurrence",
+    "steady_mask",
+    "period_speed",
+    "clean_runs",
+    "centred_window",
+]
 
 
 def _smooth(x: np.ndarray, width: int) -> np.ndarray:
@@ -46,7 +53,9 @@ def clean_runs(mask: np.ndarray, min_run: int, max_gap: int) -> np.ndarray:
     return m
 
 
-def _smoothed_steps(joints: np.ndarray, sigma: float, columns: np.ndarray | None, block: int = 32768) -> np.ndarray:
+def _smoothed_steps(
+    joints: np.ndarray, sigma: float, columns: np.ndarray | None, block: int = 32768
+) -> np.ndarray:
     """Norm of each frame step of the Gaussian-smoothed poses, computed in blocks of frames.
 
     Each block is smoothed with a margin of the kernel's radius, so the steps equal those
@@ -101,7 +110,9 @@ def moving_mask(
         return np.ones(len(j), dtype=bool)
     # measurement noise adds a constant to the norm of raw frame steps (0.5 degrees of noise
     # on 56 channels reads as 5 degrees a frame); steps of lightly smoothed poses do not
-    step = _smoothed_steps(j, max(1.0, 0.04 * fps), None if columns is None else np.asarray(columns))
+    step = _smoothed_steps(
+        j, max(1.0, 0.04 * fps), None if columns is None else np.asarray(columns)
+    )
     step = np.concatenate([step, step[-1:]])
     speed = _smooth(step, round(smooth_seconds * fps))
     level = np.percentile(speed, 80)
@@ -112,7 +123,12 @@ def moving_mask(
 
 
 def recurrence(
-    poses: np.ndarray, period: float, *, shortest: float = 0.7, longest: float = 1.45, chunk: int = 20000
+    poses: np.ndarray,
+    period: float,
+    *,
+    shortest: float = 0.7,
+    longest: float = 1.45,
+    chunk: int = 2048,
 ) -> np.ndarray:
     """Distance from each pose to its nearest pose one period earlier or later.
 
@@ -131,18 +147,38 @@ def recurrence(
         The smallest distance over the lags, both directions; ``inf`` for a frame with
         no pose at those lags (a take shorter than a period).
     """
-    x = np.asarray(poses, dtype=float)
+    x = np.ascontiguousarray(poses, dtype=float)
     T = len(x)
     lo = max(1, int(np.floor(shortest * period)))
     hi = max(lo, int(np.ceil(longest * period)))
     best = np.full(T, np.inf)
-    for lag in range(lo, min(hi, T - 1) + 1):
-        for a in range(0, T - lag, chunk):
-            b = min(T - lag, a + chunk)
-            d = np.linalg.norm(x[a + lag : b + lag] - x[a:b], axis=1)
-            np.minimum(best[a:b], d, out=best[a:b])  # forward partner
-            np.minimum(best[a + lag : b + lag], d, out=best[a + lag : b + lag])  # backward partner
+    # blocks of frames outside, lags inside: a block and its partners stay in cache
+    # (2.6x faster than lags outside at 250k frames), einsum without a squared temporary
+    for a in range(0, T, chunk):
+        b = min(T, a + chunk)
+        for lag in range(lo, min(hi, T - 1) + 1):
+            e = min(b, T - lag)
+            if e <= a:
+                break
+            diff = x[a + lag : e + lag] - x[a:e]
+            d = np.sqrt(np.einsum("ij,ij->i", diff, diff))
+            np.minimum(best[a:e], d, out=best[a:e])  # forward partner
+            np.minimum(best[a + lag : e + lag], d, out=best[a + lag : e + lag])  # backward partner
     return best
+
+
+def period_speed(
+    poses: np.ndarray, fps: float, period: float, columns: np.ndarray | None = None
+) -> np.ndarray:
+    """Joint speed (norm of the lightly smoothed frame steps) averaged over one period
+    around each frame, shape (T,); the steps of :func:`moving_mask`."""
+    x = np.asarray(poses)
+    if len(x) < 3:
+        return np.ones(len(x))
+    step = _smoothed_steps(
+        x, max(1.0, 0.04 * fps), None if columns is None else np.asarray(columns)
+    )
+    return _smooth(np.concatenate([step, step[-1:]]), max(1, int(round(period))))
 
 
 def centred_window(n: int, half: int) -> tuple[np.ndarray, np.ndarray]:
@@ -164,6 +200,8 @@ def steady_mask(
     pace_window: float = 2.0,
     max_recurrence: float = 2.0,
     max_turn: float = 30.0,
+    speed: np.ndarray | None = None,
+    max_speed_ratio: float = 1.3,
 ) -> np.ndarray:
     """Frames where the periodic motion is steady.
 
@@ -188,6 +226,15 @@ def steady_mask(
         A second, longer window the pace is also measured over, in periods; a frame is
         at pace when either window says so (a coordinate that stalls for part of a
         cycle and then jumps reads its true pace over two periods).
+    speed : ndarray, shape (T,), optional
+        Joint speed averaged over a period around each frame (:func:`period_speed`).  Where
+        a stretch of candidate frames meets still frames, the frames slower than the median
+        over all candidates by more than a factor ``max_speed_ratio`` are not steady: the
+        first steps out of a standing start (69_01: 35-75 % of the walk's speed over its
+        first 90 moving frames) and the last into a stop repeat the gait's shape at a pace
+        of their own.  Inside a stretch, and at the take's first and last frames, the
+        speed is not judged (arm circles that grow in a window cut from a routine).
+    max_speed_ratio : float
 
     Returns
     -------
@@ -210,6 +257,23 @@ def steady_mask(
             turn = np.abs(h[hi] - h[lo]) / np.maximum(hi - lo, 1) * period
             good &= turn <= max_turn
         ok[a:b] &= good
+    if speed is not None:
+        v = np.asarray(speed, dtype=float)
+        ref = np.median(v[cand]) if cand.any() else np.nan
+        if np.isfinite(ref) and ref > 0:
+            slow = v < ref / max_speed_ratio
+            for a, b in stretches(cand):
+                # trim the ramps where a moving stretch meets still frames (speeding up out
+                # of a standing start, slowing into a stop or a pause); the take's own ends
+                # and the speed inside a stretch are the motion's own
+                i = a
+                while a > 0 and i < b and slow[i]:
+                    i += 1
+                j = b
+                while b < cand.size and j > i and slow[j - 1]:
+                    j -= 1
+                ok[a:i] = False
+                ok[j:b] = False
     if recurrence_distance is not None:
         r = np.asarray(recurrence_distance, dtype=float)
         ref = np.median(r[cand & np.isfinite(r)]) if np.any(cand & np.isfinite(r)) else np.inf

@@ -28,7 +28,14 @@ import numpy as np
 
 from ..errors import ParameterError
 
-__all__ = ["Windings", "crossing_times", "complete_windings", "retime", "phase_average", "stretches"]
+__all__ = [
+    "Windings",
+    "crossing_times",
+    "complete_windings",
+    "retime",
+    "phase_average",
+    "stretches",
+]
 
 #: Levels of the coordinate examined for crossings.
 N_LEVELS = 32
@@ -136,7 +143,11 @@ def _sharpness(u: np.ndarray, times: list[np.ndarray]) -> float:
 
 
 def complete_windings(
-    unwrapped: np.ndarray, runs: list[tuple[int, int]], *, n_levels: int = N_LEVELS, min_anchor_gap: float = 0.04
+    unwrapped: np.ndarray,
+    runs: list[tuple[int, int]],
+    *,
+    n_levels: int = N_LEVELS,
+    min_anchor_gap: float = 0.04,
 ) -> Windings:
     """Complete windings of a coordinate over stretches of frames.
 
@@ -161,7 +172,9 @@ def complete_windings(
     per_run = []
     for a, b in runs:
         u = u_all[a:b] - np.floor(u_all[a]) if b - a > 1 else np.zeros(0)
-        per_run.append((a, u, crossing_times(u, levels) if u.size > 1 else [np.zeros(0)] * n_levels))
+        per_run.append(
+            (a, u, crossing_times(u, levels) if u.size > 1 else [np.zeros(0)] * n_levels)
+        )
     turns = float(sum(u[-1] - u[0] for _, u, _ in per_run if u.size > 1))
     lengths_by_level = []
     sharp = np.zeros(n_levels)
@@ -178,13 +191,20 @@ def complete_windings(
     for j in order:
         if sharp[j] <= 0 or (anchors and sharp[j] < cutoff):
             continue
-        if all(min(abs(levels[j] - levels[k]), 1 - abs(levels[j] - levels[k])) >= min_anchor_gap for k in anchors):
+        if all(
+            min(abs(levels[j] - levels[k]), 1 - abs(levels[j] - levels[k])) >= min_anchor_gap
+            for k in anchors
+        ):
             anchors.append(int(j))
     ref = anchors[0] if anchors else 0
     pooled = np.concatenate(lengths_by_level) if anchors else np.zeros(0)
     pooled = pooled[pooled > 0]
     period = float(np.median(pooled)) if pooled.size else float("nan")
-    spread = float((np.percentile(pooled, 90) - np.percentile(pooled, 10)) / period) if pooled.size > 1 else 0.0
+    spread = (
+        float((np.percentile(pooled, 90) - np.percentile(pooled, 10)) / period)
+        if pooled.size > 1
+        else 0.0
+    )
     # where each anchor sits in the cycle: mean time fraction after the reference crossing
     positions = []
     for j in anchors:
@@ -205,9 +225,15 @@ def complete_windings(
                         fr.append(((x - before[-1]) / period) % 1.0)
         positions.append(float(np.median(fr)) if fr else (levels[j] - levels[ref]) % 1.0)
     return Windings(
-        levels=levels, anchors=np.asarray(anchors, dtype=int), reference=int(ref),
-        lengths=lengths_by_level[ref] if anchors else np.zeros(0), pooled=pooled,
-        period_frames=period, spread=spread, turns=turns, positions=np.asarray(positions, dtype=float),
+        levels=levels,
+        anchors=np.asarray(anchors, dtype=int),
+        reference=int(ref),
+        lengths=lengths_by_level[ref] if anchors else np.zeros(0),
+        pooled=pooled,
+        period_frames=period,
+        spread=spread,
+        turns=turns,
+        positions=np.asarray(positions, dtype=float),
     )
 
 
@@ -296,7 +322,9 @@ def phase_average(phase: np.ndarray, values: np.ndarray, n_out: int, width: floa
     phase = np.asarray(phase, dtype=float)
     values = np.asarray(values, dtype=float)
     if phase.ndim != 1 or values.ndim != 2 or values.shape[0] != phase.size or phase.size == 0:
-        raise ParameterError(f"phase_average needs (N,) phases and (N, D) values, got {phase.shape}, {values.shape}")
+        raise ParameterError(
+            f"phase_average needs (N,) phases and (N, D) values, got {phase.shape}, {values.shape}"
+        )
     if not (np.isfinite(width) and width > 0):
         raise ParameterError(f"width must be a positive number, got {width!r}")
     order = np.argsort(phase, kind="stable")

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any, Mapping, Sequence
 import numpy as np
 
 from ..errors import ParameterError
+from ._canvas import detached_figure, new_figure
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -59,30 +60,19 @@ _CYCLE = "#d62728"
 
 
 # ------------------------------------------------------------------ helpers
-def _new_figure(figsize: tuple[float, float], fig: "Figure | None" = None) -> "Figure":
-    """``fig`` cleared for reuse, or a new pyplot figure (shown by notebooks)."""
-    if fig is not None:
-        return fig
-    import matplotlib.pyplot as plt
-
-    return plt.figure(figsize=figsize)
-
-
-def _detached_figure(figsize: tuple[float, float], dpi: float = 100) -> "Figure":
-    """A figure with an Agg canvas that pyplot does not know about (no GUI, no leak)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize, dpi=dpi)
-    FigureCanvasAgg(fig)
-    return fig
-
-
 def _check_result(result: Any, what: str) -> "ExtractionResult":
-    from ..periodic.pipeline import ExtractionResult
+    from ..periodic.pipeline import ExtractionResult, PartialExtraction
 
+    if isinstance(result, PartialExtraction):
+        raise ParameterError(
+            f"{what} needs a complete extraction; this partial result has no circular "
+            f"coordinate (no periodic motion was found: {result.reason})"
+        )
     if not isinstance(result, ExtractionResult):
-        raise ParameterError(f"{what} takes an ExtractionResult (from cyclecoord.extract), got {type(result).__name__}")
+        raise ParameterError(
+            f"{what} takes an ExtractionResult (from cyclecoord.extract), got "
+            f"{type(result).__name__}"
+        )
     if result.coordinate is None or result.typical is None:
         raise ParameterError(
             f"{what} needs a complete extraction; this result has no circular coordinate "
@@ -146,7 +136,7 @@ def plot_barcode(
     h0 = h0[np.argsort(-np.minimum(h0[:, 1], thr), kind="stable")] if len(h0) else h0
 
     if ax is None:
-        fig = _new_figure((7.0, 5.0), fig)
+        fig = new_figure((7.0, 5.0), fig)
         n0, n1 = max(len(h0), 1), max(len(h1), 1)
         w0 = float(np.clip(np.log1p(n0), 1.0, 3.0))
         w1 = float(np.clip(np.log1p(n1), 1.0, 3.0))
@@ -170,7 +160,15 @@ def plot_barcode(
     def draw(a: "Axes", bars: np.ndarray, label: str, base: int, highlight: int | None) -> None:
         n = len(bars)
         if n == 0:
-            a.text(0.5, 0.5, f"no {label} bars", transform=a.transAxes, ha="center", va="center", color="0.4")
+            a.text(
+                0.5,
+                0.5,
+                f"no {label} bars",
+                transform=a.transAxes,
+                ha="center",
+                va="center",
+                color="0.4",
+            )
             return
         ends = np.minimum(bars[:, 1], thr)
         rows = base + (n - 1 - np.arange(n))  # first bar on top
@@ -190,8 +188,15 @@ def plot_barcode(
                    color=_BAR, label=f"{label} alive at threshold")
         if highlight is not None and 0 <= highlight < n:
             b, d = bars[highlight]
-            a.plot([b, min(d, thr)], [rows[highlight]] * 2, color=_HIGHLIGHT, linewidth=widths[highlight],
-                   solid_capstyle="butt", label="selected class", zorder=3)
+            a.plot(
+                [b, min(d, thr)],
+                [rows[highlight]] * 2,
+                color=_HIGHLIGHT,
+                linewidth=widths[highlight],
+                solid_capstyle="butt",
+                label="selected class",
+                zorder=3,
+            )
 
     draw(ax0, h0, "H0", 0, None)
     draw(ax1, h1, "H1", offset1, sel_index)
@@ -203,7 +208,9 @@ def plot_barcode(
     for a in {id(ax0): ax0, id(ax1): ax1}.values():
         a.axvline(thr, color="0.5", linestyle=":", linewidth=1, label="threshold")
         if selection is not None:
-            a.axvline(float(selection.scale), color=_SCALE, linestyle="--", linewidth=1.5, label="scale")
+            a.axvline(
+                float(selection.scale), color=_SCALE, linestyle="--", linewidth=1.5, label="scale"
+            )
         a.set_xlim(0, thr * 1.04)
         a.set_yticks([])
     if shared:
@@ -297,7 +304,7 @@ def plot_pca(
     cyc = proj(res.typical.frames)
     cyc = np.vstack([cyc, cyc[:1]])
     if ax is None:
-        fig = _new_figure((6.0, 5.0), fig)
+        fig = new_figure((6.0, 5.0), fig)
         ax = fig.add_subplot(projection="3d" if dims == 3 else None)
     else:
         fig = ax.figure
@@ -308,9 +315,24 @@ def plot_pca(
     coords = [pts[:, i] for i in range(dims)]
     if trajectory:
         ax.plot(*coords, color="0.75", linewidth=0.6, zorder=1, label="trajectory")
-    sc = ax.scatter(*coords, c=res.coordinate, cmap=cmap, vmin=0.0, vmax=1.0, s=12, zorder=2, label="frames",
-                    edgecolors="none")
-    ax.plot(*[cyc[:, i] for i in range(dims)], color="black", linewidth=2.0, zorder=3, label="typical cycle")
+    sc = ax.scatter(
+        *coords,
+        c=res.coordinate,
+        cmap=cmap,
+        vmin=0.0,
+        vmax=1.0,
+        s=12,
+        zorder=2,
+        label="frames",
+        edgecolors="none",
+    )
+    ax.plot(
+        *[cyc[:, i] for i in range(dims)],
+        color="black",
+        linewidth=2.0,
+        zorder=3,
+        label="typical cycle",
+    )
     labels = [f"PC{i + 1} ({100 * proj.explained[i]:.0f}%)" for i in range(dims)]
     ax.set_xlabel(labels[0])
     ax.set_ylabel(labels[1])
@@ -321,8 +343,11 @@ def plot_pca(
     cb = fig.colorbar(sc, ax=ax, shrink=0.8, pad=0.1 if dims == 3 else 0.04)
     cb.set_label("circular coordinate")
     ax.set_title(f"PCA of {len(pts)} poses; typical cycle of {len(cyc) - 1} frames", fontsize=10)
-    ax.legend(handles=[h for h in ax.get_legend_handles_labels()[0] if h.get_label() == "typical cycle"],
-              loc="best", fontsize=8)
+    ax.legend(
+        handles=[h for h in ax.get_legend_handles_labels()[0] if h.get_label() == "typical cycle"],
+        loc="best",
+        fontsize=8,
+    )
     return fig
 
 
@@ -357,13 +382,20 @@ def plot_density(
     if not isinstance(bins, (int, np.integer)) or bins < 2:
         raise ParameterError(f"bins must be a whole number >= 2, got {bins!r}")
     if ax is None:
-        fig = _new_figure((6.0, 3.5), fig)
+        fig = new_figure((6.0, 3.5), fig)
         ax = fig.add_subplot()
     else:
         fig = ax.figure
     theta = np.asarray(res.coordinate, dtype=float)
-    ax.hist(theta, bins=int(bins), range=(0.0, 1.0), density=True, color="#9ecae1", edgecolor="white",
-            label=f"{len(theta)} frames")
+    ax.hist(
+        theta,
+        bins=int(bins),
+        range=(0.0, 1.0),
+        density=True,
+        color="#9ecae1",
+        edgecolor="white",
+        label=f"{len(theta)} frames",
+    )
     x = np.linspace(0.0, 1.0, 501)
     pdf = res.density.pdf(np.mod(x, 1.0))
     ax.plot(x, pdf, color=_HIGHLIGHT, linewidth=2.0, label="periodic density")
@@ -381,21 +413,33 @@ def plot_density(
 
 
 # --------------------------------------------------------------- coordinate
-def _coordinate_series(data: Any, start_frame: int | None) -> tuple[list[tuple[str, np.ndarray]], int]:
-    from ..periodic.pipeline import ExtractionResult
+def _coordinate_series(
+    data: Any, start_frame: int | None
+) -> tuple[list[tuple[str, np.ndarray]], int]:
+    from ..periodic.pipeline import ExtractionResult, PartialExtraction
 
+    if isinstance(data, PartialExtraction):
+        raise ParameterError(
+            f"this extraction has no circular coordinate (no periodic motion was found: "
+            f"{data.reason})"
+        )
     if isinstance(data, ExtractionResult):
-        if data.coordinate is None:
-            raise ParameterError("this extraction has no circular coordinate (no periodic motion was found)")
         start = data.motion.start_frame if start_frame is None else start_frame
-        return [("coordinate", np.asarray(data.coordinate, dtype=float))], int(start)
+        series = [("coordinate", np.asarray(data.coordinate, dtype=float))]
+        phase = getattr(data, "phase", None)
+        if phase is not None and np.isfinite(phase).any():
+            # the phase the cycle is averaged in: the coordinate re-timed to the capture's pace
+            series.append(("phase (re-timed)", np.asarray(phase, dtype=float)))
+        return series, int(start)
     if isinstance(data, (str, bytes)):
         items = None
     elif isinstance(data, Mapping):
         items = [(str(k), v) for k, v in data.items()]
     elif isinstance(data, np.ndarray) and data.ndim == 2:
         items = [(f"coordinate {i}", row) for i, row in enumerate(data)]
-    elif isinstance(data, np.ndarray) or (isinstance(data, Sequence) and data and np.isscalar(data[0])):
+    elif isinstance(data, np.ndarray) or (
+        isinstance(data, Sequence) and data and np.isscalar(data[0])
+    ):
         items = [("coordinate", data)]
     elif isinstance(data, Sequence):
         items = [(f"coordinate {i}", v) for i, v in enumerate(data)]
@@ -403,8 +447,8 @@ def _coordinate_series(data: Any, start_frame: int | None) -> tuple[list[tuple[s
         items = None
     if items is None:
         raise ParameterError(
-            "plot_coordinate takes an ExtractionResult, an array of coordinates, a list of arrays or "
-            f"a dict of name -> array, got {type(data).__name__}"
+            "plot_coordinate takes an ExtractionResult, an array of coordinates, a "
+            f"list of arrays or a dict of name -> array, got {type(data).__name__}"
         )
     out = []
     for name, v in items:
@@ -413,7 +457,9 @@ def _coordinate_series(data: Any, start_frame: int | None) -> tuple[list[tuple[s
         except (TypeError, ValueError):
             raise ParameterError(f"coordinate {name!r} is not an array of numbers") from None
         if arr.ndim != 1 or arr.size == 0:
-            raise ParameterError(f"coordinate {name!r} must be a non-empty 1-D array, got shape {arr.shape}")
+            raise ParameterError(
+                f"coordinate {name!r} must be a non-empty 1-D array, got shape {arr.shape}"
+            )
         out.append((name, arr))
     if not out:
         raise ParameterError("no coordinates to plot")
@@ -461,7 +507,7 @@ def plot_coordinate(
     """
     series, start = _coordinate_series(data, start_frame)
     if ax is None:
-        fig = _new_figure((8.0, 1.2 + 1.3 * len(series)), fig)
+        fig = new_figure((8.0, 1.2 + 1.3 * len(series)), fig)
         ax = fig.add_subplot()
     else:
         fig = ax.figure
@@ -473,8 +519,17 @@ def plot_coordinate(
         x, yy = _break_wraps(y)
         ax.plot(x + start, yy + base, color="0.35", linewidth=0.8, label=name)
         ok = np.isfinite(y)
-        ax.scatter(np.flatnonzero(ok) + start, y[ok] + base, c=y[ok], cmap=cmap, vmin=0, vmax=1, s=6, zorder=3,
-                   edgecolors="none")
+        ax.scatter(
+            np.flatnonzero(ok) + start,
+            y[ok] + base,
+            c=y[ok],
+            cmap=cmap,
+            vmin=0,
+            vmax=1,
+            s=6,
+            zorder=3,
+            edgecolors="none",
+        )
         longest = max(longest, y.size)
     if n > 1:
         ax.set_yticks([(n - 1 - i) * gap + 0.5 for i in range(n)], [name for name, _ in series])
@@ -492,7 +547,9 @@ def plot_coordinate(
                 a, b = int(seg[0]), int(seg[1])
                 label = None if len(seg) < 3 or seg[2] is None else str(seg[2])
             except (TypeError, ValueError, IndexError):
-                raise ParameterError(f"segments must be (start, stop, label) tuples, got {seg!r}") from None
+                raise ParameterError(
+                    f"segments must be (start, stop, label) tuples, got {seg!r}"
+                ) from None
             if b <= a:
                 raise ParameterError(f"segment {seg!r} is empty: stop must exceed start")
             key = label if label is not None else f"#{len(colour_of)}"
@@ -500,8 +557,17 @@ def plot_coordinate(
                 colour_of[key] = palette(len(colour_of) % 10)
             ax.axvspan(a - 0.5, b - 0.5, color=colour_of[key], alpha=0.18, linewidth=0, label=label)
             if label:
-                ax.text((a + b - 1) / 2, 1.0, label, transform=ax.get_xaxis_transform(), ha="center",
-                        va="bottom", fontsize=8, color=colour_of[key], clip_on=False)
+                ax.text(
+                    (a + b - 1) / 2,
+                    1.0,
+                    label,
+                    transform=ax.get_xaxis_transform(),
+                    ha="center",
+                    va="bottom",
+                    fontsize=8,
+                    color=colour_of[key],
+                    clip_on=False,
+                )
     ax.set_xlim(start - 0.5, start + longest - 0.5)
     ax.set_xlabel("frame")
     ax.set_title("circular coordinate per frame", fontsize=10, pad=14 if segments else 6)
@@ -533,7 +599,7 @@ def plot_windows(result: Any, *, ax: "Axes | None" = None, fig: "Figure | None" 
     if not windows:
         raise ParameterError("the detection ran no windows (method='global'); nothing to draw")
     if ax is None:
-        fig = _new_figure((9.0, 2.6), fig)
+        fig = new_figure((9.0, 2.6), fig)
         ax = fig.add_subplot()
     else:
         fig = ax.figure
@@ -542,19 +608,30 @@ def plot_windows(result: Any, *, ax: "Axes | None" = None, fig: "Figure | None" 
     for w in windows:
         row = lengths.index(w.stop - w.start)
         colour = f"C{w.motion % 10}" if w.motion >= 0 else ("0.6" if w.looping else "0.92")
-        ax.broken_barh([(start + w.start - 0.5, w.stop - w.start)], (row + 0.15, 0.7), facecolor=colour,
-                       alpha=0.35, edgecolor="none")
-    ax.set_yticks([r + 0.5 for r in range(len(lengths))], [f"{n / motion.fps:.3g} s" for n in lengths])
+        ax.broken_barh(
+            [(start + w.start - 0.5, w.stop - w.start)],
+            (row + 0.15, 0.7),
+            facecolor=colour,
+            alpha=0.35,
+            edgecolor="none",
+        )
+    ax.set_yticks(
+        [r + 0.5 for r in range(len(lengths))], [f"{n / motion.fps:.3g} s" for n in lengths]
+    )
     ax.set_ylim(0, len(lengths))
     ax.set_xlim(start - 0.5, start + motion.n_frames - 0.5)
     ax.set_xlabel("frame")
     ax.set_ylabel("window")
-    ax.set_title("windows: coloured by motion, grey = loops but no motion, pale = no clear loop", fontsize=10)
+    ax.set_title(
+        "windows: coloured by motion, grey = loops but no motion, pale = no clear loop", fontsize=10
+    )
     return fig
 
 
 # ----------------------------------------------------------------- channels
-def _resolve_channels(motion: "Motion", channels: Any, exclude: set[int], default_count: int) -> list[int]:
+def _resolve_channels(
+    motion: "Motion", channels: Any, exclude: set[int], default_count: int
+) -> list[int]:
     if channels is None or (isinstance(channels, str) and channels == "all"):
         cols = [i for i in range(motion.n_channels) if i not in exclude]
         if not cols:
@@ -574,18 +651,24 @@ def _resolve_channels(motion: "Motion", channels: Any, exclude: set[int], defaul
     for c in channels:
         if isinstance(c, (int, np.integer)):
             if not 0 <= int(c) < motion.n_channels:
-                raise ParameterError(f"channel index {c} out of range for {motion.n_channels} channels")
+                raise ParameterError(
+                    f"channel index {c} out of range for {motion.n_channels} channels"
+                )
             cols.append(int(c))
             continue
         if isinstance(c, str):
             if "." not in c:
-                raise ParameterError(f"channel names look like 'joint.dof' (e.g. 'lfemur.rx'), got {c!r}")
+                raise ParameterError(
+                    f"channel names look like 'joint.dof' (e.g. 'lfemur.rx'), got {c!r}"
+                )
             j, d = c.rsplit(".", 1)
         else:
             try:
                 j, d = c
             except (TypeError, ValueError):
-                raise ParameterError(f"a channel is 'joint.dof', (joint, dof) or a column index, got {c!r}") from None
+                raise ParameterError(
+                    f"a channel is 'joint.dof', (joint, dof) or a column index, got {c!r}"
+                ) from None
         try:
             cols.append(motion.channel_index(str(j), str(d)))
         except KeyError:
@@ -615,6 +698,22 @@ def _best_offset(motion: "Motion", cycle: "Motion", root: set[int]) -> int:
     return int(np.argmin(costs))
 
 
+def _cycle_frames_at_phase(res: Any, s0: int, n: int, P: int) -> np.ndarray | None:
+    """Cycle frame index at the capture's phase of frames ``s0 .. s0 + n - 1`` (-1 where a
+    frame has no phase), or None when the result has no capture-timed phase."""
+    phase = getattr(res, "phase", None)
+    phases = np.asarray(getattr(res.typical, "phases", []), dtype=float)
+    if phase is None or phases.size != P or res.parameters.get("timing", "capture") != "capture":
+        return None
+    seg = np.asarray(phase, dtype=float)[s0 : s0 + n]
+    ok = np.isfinite(seg)
+    if not ok.any():
+        return None
+    k = np.full(seg.size, -1)
+    k[ok] = np.mod(np.round((seg[ok] - phases[0]) * P).astype(int), P)
+    return k
+
+
 def plot_channels(
     result: "ExtractionResult",
     channels: Any = None,
@@ -626,8 +725,10 @@ def plot_channels(
 ) -> "Figure":
     """Original channels against the typical cycle over a few periods, and their jerk.
 
-    The cycle is played at its own constant rate, looped, starting at the phase of the
-    clip's first frame, so both curves start in step (paper Fig. 6).  The right panel is
+    Each frame of the clip shows the cycle's frame at that frame's phase (the capture-timed
+    ``result.phase``), so the curves stay in step over repetitions of different lengths;
+    frames without a phase, and results timed by the coordinate, play the cycle at its
+    own constant rate from the phase of the clip's first frame (paper Fig. 6).  The right panel is
     the jerk as the console and the report give it (:func:`cyclecoord.quality.metrics.
     jerk_summary`: third derivative by 4th-order finite differences of every prepared
     channel, root as per-frame steps, norm over channels; the cycle looped so its seam
@@ -675,6 +776,11 @@ def plot_channels(
     P = cyc_frames.shape[0]
     j0 = _best_offset(motion.window((s0, None)) if s0 else motion, cycle, root)
     idx = (j0 + np.arange(n_show)) % P
+    at_phase = _cycle_frames_at_phase(res, s0, n_show, P)
+    if at_phase is not None:
+        # each frame shows the cycle's frame at its own phase: the two stay in step over
+        # repetitions of different lengths (a constant rate drifts by their differences)
+        idx = np.where(at_phase >= 0, at_phase, idx)
     cyc = cyc_frames[idx]
     # angles: the cycle and the clip may sit a whole turn apart; align each channel to the clip
     for k, c in enumerate(cols):
@@ -683,7 +789,7 @@ def plot_channels(
             cyc[:, k] += turn
 
     if ax is None:
-        fig = _new_figure((11.0, 4.2), fig)
+        fig = new_figure((11.0, 4.2), fig)
         ax_c, ax_j = fig.subplots(1, 2, gridspec_kw={"width_ratios": [2.2, 1.0]})
     else:
         if len(ax) != 2:
@@ -701,7 +807,10 @@ def plot_channels(
         ax_c.plot(t, cyc[:, k], color=colour, linewidth=lw, linestyle="--", label=f"{name} (cycle)")
     ax_c.set_xlabel("frame")
     ax_c.set_ylabel("channel value (degrees / length units)")
-    ax_c.set_title(f"original (solid) vs cycle (dashed), {n_show / period:.1f} periods", fontsize=10)
+    ax_c.set_title(
+        f"original (solid) vs cycle (dashed, at each frame's phase), {n_show / period:.1f} periods",
+        fontsize=10,
+    )
     if len(cols) <= 10:
         ax_c.legend(handles=[h for h in ax_c.get_lines() if not h.get_label().endswith("(cycle)")],
                     fontsize=7, loc="upper right", ncol=2)
@@ -712,12 +821,22 @@ def plot_channels(
     poses = np.asarray(res.prepared.poses, dtype=float)[s0:]
     typ = np.asarray(res.typical.frames, dtype=float)
     seg_o = poses[: n_j + stencil - 1]
-    jo = np.linalg.norm(jerk(seg_o, fps), axis=1)[:n_j] if seg_o.shape[0] >= stencil else np.zeros(0)
+    jo = (
+        np.linalg.norm(jerk(seg_o, fps), axis=1)[:n_j] if seg_o.shape[0] >= stencil else np.zeros(0)
+    )
     Pt = typ.shape[0]
     jc_all = np.linalg.norm(jerk(typ, fps, cyclic=True), axis=1) if Pt >= stencil else np.zeros(Pt)
     jc = jc_all[(j0 * Pt // max(P, 1) + np.arange(min(n_j, Pt))) % Pt] if Pt else np.zeros(0)
-    ax_j.plot(np.arange(jo.size) + motion.start_frame + s0, jo, color=_ORIGINAL, linewidth=1.2, label="original")
-    ax_j.plot(np.arange(jc.size) + motion.start_frame + s0, jc, color=_CYCLE, linewidth=1.2, label="cycle")
+    ax_j.plot(
+        np.arange(jo.size) + motion.start_frame + s0,
+        jo,
+        color=_ORIGINAL,
+        linewidth=1.2,
+        label="original",
+    )
+    ax_j.plot(
+        np.arange(jc.size) + motion.start_frame + s0, jc, color=_CYCLE, linewidth=1.2, label="cycle"
+    )
     ax_j.set_xlabel("frame")
     ax_j.set_ylabel("jerk norm, all channels (units / s³)")
     jr = res.jerk
@@ -733,7 +852,9 @@ def plot_channels(
 
 
 # ----------------------------------------------------------- save figures
-def save_figures(result: "ExtractionResult", folder: str | os.PathLike[str], *, dpi: float = 100) -> list[Path]:
+def save_figures(
+    result: "ExtractionResult", folder: str | os.PathLike[str], *, dpi: float = 100
+) -> list[Path]:
     """Write the standard figures of an extraction as PNG files.
 
     Parameters
@@ -751,12 +872,14 @@ def save_figures(result: "ExtractionResult", folder: str | os.PathLike[str], *, 
         extraction (``NoPeriodicMotionError.result``, no coordinate) only
         ``barcode.png`` is written: the barcode shows why nothing stood clear.
     """
-    from ..io._atomic import atomic_write
-    from ..periodic.pipeline import ExtractionResult
+    from ..io import atomic_write
+    from ..periodic.pipeline import ExtractionResult, PartialExtraction
 
-    if not isinstance(result, ExtractionResult):
+    if not isinstance(result, (ExtractionResult, PartialExtraction)):
         raise ParameterError(f"save_figures takes an ExtractionResult, got {type(result).__name__}")
-    complete = result.coordinate is not None and result.typical is not None
+    complete = isinstance(result, ExtractionResult)
+    if not complete and result.barcode is None:
+        raise ParameterError("this partial extraction stopped before its barcode: nothing to draw")
     res = result
     out = Path(folder)
     if out.exists() and not out.is_dir():
@@ -772,7 +895,7 @@ def save_figures(result: "ExtractionResult", folder: str | os.PathLike[str], *, 
     written = []
     for name in FIGURE_NAMES if complete else FIGURE_NAMES[:1]:
         size, make = makers[name]
-        fig = _detached_figure(size, dpi)
+        fig = detached_figure(size, dpi)
         make(fig)
         fig.tight_layout()
         path = out / name
@@ -839,21 +962,30 @@ def _make_track(motion: "Motion", title: str | None) -> _Track:
         raise ParameterError(f"render takes a Motion, got {type(motion).__name__}")
     if motion.skeleton is None:
         raise ParameterError(
-            "render needs a skeleton to pose the figure; this motion has none (load an AMC with its ASF, or a BVH)"
+            "render needs a skeleton to pose the figure; this "
+            "motion has none (load an AMC with its ASF, or a BVH)"
         )
     if motion.n_frames < 1:
         raise ParameterError("nothing to render: the motion has no frames")
     jp = motion.positions()
     pos = np.asarray(jp.positions, dtype=float)
     if not np.all(np.isfinite(pos)):
-        raise ParameterError("forward kinematics gave non-finite positions; check the motion's values")
+        raise ParameterError(
+            "forward kinematics gave non-finite positions; check the motion's values"
+        )
     if title is None:
         src = motion.source or "motion"
         title = Path(src).name if ("/" in src or os.sep in src) else src
         if len(title) > 40:
             title = title[:37] + "..."
-    return _Track(positions=pos, parents=np.asarray(jp.parents), colours=_side_colours(jp.names, jp.parents),
-                  fps=float(motion.fps), title=title, start_frame=int(motion.start_frame))
+    return _Track(
+        positions=pos,
+        parents=np.asarray(jp.parents),
+        colours=_side_colours(jp.names, jp.parents),
+        fps=float(motion.fps),
+        title=title,
+        start_frame=int(motion.start_frame),
+    )
 
 
 def _smooth_track(xz: np.ndarray, width: int) -> np.ndarray:
@@ -863,7 +995,9 @@ def _smooth_track(xz: np.ndarray, width: int) -> np.ndarray:
     w = min(width, xz.shape[0])
     kernel = np.ones(w) / w
     pad = np.pad(xz, ((w // 2, w - 1 - w // 2), (0, 0)), mode="edge")
-    return np.stack([np.convolve(pad[:, i], kernel, mode="valid") for i in range(xz.shape[1])], axis=1)
+    return np.stack(
+        [np.convolve(pad[:, i], kernel, mode="valid") for i in range(xz.shape[1])], axis=1
+    )
 
 
 def _view_basis(tracks_pos: list[np.ndarray], view: str) -> tuple[np.ndarray, np.ndarray]:
@@ -948,7 +1082,9 @@ def render(
     out = Path(path)
     suffix = out.suffix.lower()
     if suffix not in (".gif", ".mp4"):
-        raise ParameterError(f"{out}: render writes .gif or .mp4 animations, got suffix {out.suffix or '(none)'!r}")
+        raise ParameterError(
+            f"{out}: render writes .gif or .mp4 animations, got suffix {out.suffix or '(none)'!r}"
+        )
     if suffix == ".mp4" and not animation.FFMpegWriter.isAvailable():
         raise ParameterError(
             f"{out}: writing .mp4 needs ffmpeg, which matplotlib cannot find on this machine; "
@@ -959,15 +1095,23 @@ def render(
         raise ParameterError(f"{out}: folder {folder} does not exist")
     if isinstance(view, str):
         if view not in _VIEWS:
-            raise ParameterError(f"view must be one of {', '.join(_VIEWS)} or an (elevation, azimuth) pair, got {view!r}")
+            raise ParameterError(
+                f"view must be one of {', '.join(_VIEWS)} or "
+                f"an (elevation, azimuth) pair, got {view!r}"
+            )
         elev_azim = None
     else:
         try:
             elev_azim = (float(view[0]), float(view[1]))
         except (TypeError, ValueError, IndexError):
-            raise ParameterError(f"view must be one of {', '.join(_VIEWS)} or an (elevation, azimuth) pair, got {view!r}") from None
+            raise ParameterError(
+                f"view must be one of {', '.join(_VIEWS)} or "
+                f"an (elevation, azimuth) pair, got {view!r}"
+            ) from None
         view = "3d"
-    if step is not None and (isinstance(step, bool) or not isinstance(step, (int, np.integer)) or step < 1):
+    if step is not None and (
+        isinstance(step, bool) or not isinstance(step, (int, np.integer)) or step < 1
+    ):
         raise ParameterError(f"step must be a whole number >= 1, got {step!r}")
     if fps is not None and (not np.isfinite(fps) or fps <= 0):
         raise ParameterError(f"fps must be a positive number, got {fps!r}")
@@ -1015,12 +1159,17 @@ def render(
             c = _smooth_track(h[:, 0], max(1, int(round(play_fps))))
         else:
             flat = h.reshape(-1, h.shape[-1])
-            c = np.broadcast_to((flat.min(axis=0) + flat.max(axis=0)) / 2, (h.shape[0], h.shape[-1]))
+            c = np.broadcast_to(
+                (flat.min(axis=0) + flat.max(axis=0)) / 2, (h.shape[0], h.shape[-1])
+            )
         centres.append(np.asarray(c, dtype=float))
     if follow:
         half = box / 2
     else:
-        half = max(float(np.max(np.abs(h - c[:, None, :]))) for h, c in zip(hpos, centres)) + 0.1 * body
+        half = (
+            max(float(np.max(np.abs(h - c[:, None, :]))) for h, c in zip(hpos, centres))
+            + 0.1 * body
+        )
     height = (top_y - floor_y) + 0.15 * body
     pad = 0.05 * body
 
@@ -1034,7 +1183,7 @@ def render(
     # even pixel sizes: H.264 in yuv420p needs them, and GIFs do not mind
     px_w = max(2, 2 * int(round(width_in * dpi / 2)))
     px_h = max(2, 2 * int(round(size * dpi / 2)))
-    fig = _detached_figure((px_w / dpi, px_h / dpi), dpi)
+    fig = detached_figure((px_w / dpi, px_h / dpi), dpi)
     axes = []
     artists = []
     spacing = _grid_spacing(body)
@@ -1057,10 +1206,15 @@ def render(
             dummy = [[(0.0, 0.0, floor_y), (0.0, 0.0, floor_y)]]
             floor = Line3DCollection(dummy, colors="0.75", linewidths=0.6)
             ax.add_collection3d(floor)
-            bones = Line3DCollection(dummy, colors=[tr.colours[i] for i in range(len(tr.parents)) if tr.parents[i] >= 0],
-                                     linewidths=2.0)
+            bones = Line3DCollection(
+                dummy,
+                colors=[tr.colours[i] for i in range(len(tr.parents)) if tr.parents[i] >= 0],
+                linewidths=2.0,
+            )
             ax.add_collection3d(bones)
-            (dots,) = ax.plot([], [], [], linestyle="none", marker="o", markersize=2.5, color="#222222")
+            (dots,) = ax.plot(
+                [], [], [], linestyle="none", marker="o", markersize=2.5, color="#222222"
+            )
         else:
             from matplotlib.collections import LineCollection
 
@@ -1072,8 +1226,12 @@ def render(
             ax.axhline(floor_y, color="0.45", linewidth=1.2)
             floor = LineCollection([], colors="0.7", linewidths=0.8)
             ax.add_collection(floor)
-            bones = LineCollection([], colors=[tr.colours[i] for i in range(len(tr.parents)) if tr.parents[i] >= 0],
-                                   linewidths=2.2, capstyle="round")
+            bones = LineCollection(
+                [],
+                colors=[tr.colours[i] for i in range(len(tr.parents)) if tr.parents[i] >= 0],
+                linewidths=2.2,
+                capstyle="round",
+            )
             ax.add_collection(bones)
             (dots,) = ax.plot([], [], linestyle="none", marker="o", markersize=2.5, color="#222222")
         text = ax.set_title(tr.title, fontsize=9)
@@ -1120,10 +1278,12 @@ def render(
     if suffix == ".gif":
         writer = anim.PillowWriter(fps=play_fps)
     else:
-        writer = anim.FFMpegWriter(fps=play_fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
+        writer = anim.FFMpegWriter(
+            fps=play_fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"]
+        )
     import matplotlib as mpl
 
-    from ..io._atomic import atomic_path
+    from ..io import atomic_path
 
     with atomic_path(out, suffix=f".tmp{suffix}") as tmp, mpl.rc_context({"savefig.bbox": None}):
         # (a 'tight' bbox would change the frame size)
@@ -1133,7 +1293,9 @@ def render(
                 draw_frame(i)
                 writer.grab_frame()
         except BaseException:
-            with contextlib.suppress(Exception):  # stop the encoder; atomic_path removes the partial file
+            with contextlib.suppress(
+                Exception
+            ):  # stop the encoder; atomic_path removes the partial file
                 writer.finish()
             raise
         writer.finish()

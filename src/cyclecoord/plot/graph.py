@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
-from .figures import _detached_figure, _new_figure
+from ._canvas import detached_figure, new_figure
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -31,7 +31,7 @@ def _axes(
 ) -> tuple["Figure", "Axes"]:
     if ax is not None:
         return ax.figure, ax
-    f = _new_figure(size, fig)
+    f = new_figure(size, fig)
     return f, f.add_subplot(1, 1, 1)
 
 
@@ -99,7 +99,7 @@ def plot_vector_field(
         v[inside, 1],
         color="tab:blue",
         angles="xy",
-        label=f"{field.neighbourhood} field",
+        label=f"{field.name} field" + (" (no heading: plain weights)" if field.agree else ""),
     )
     if (~inside).any():
         ax.quiver(
@@ -115,7 +115,7 @@ def plot_vector_field(
     ax.set_ylabel("latent 2")
     ax.set_aspect("equal", adjustable="datalim")
     ax.legend(fontsize=8, loc="upper right")
-    ax.set_title(title or f"vector field ({field.neighbourhood})")
+    ax.set_title(title or f"vector field ({field.name})")
     return fig
 
 
@@ -148,7 +148,7 @@ def plot_generated_path(
 
 
 def _save(fig: "Figure", folder: Path, name: str, dpi: float) -> Path:
-    from ..io._atomic import atomic_path
+    from ..io import atomic_path
 
     out = folder / name
     with atomic_path(out) as tmp:
@@ -163,13 +163,13 @@ def save_graph_figures(
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     out = []
-    fig = _detached_figure((6, 5.5), dpi)
+    fig = detached_figure((6, 5.5), dpi)
     plot_graph_edges(synth.graph_, fig=fig)
     out.append(_save(fig, folder, "graph.png", dpi))
-    fig = _detached_figure((6, 5.5), dpi)
+    fig = detached_figure((6, 5.5), dpi)
     plot_vector_field(synth.field_, fig=fig)
     out.append(_save(fig, folder, "field.png", dpi))
-    fig = _detached_figure((6, 5.5), dpi)
+    fig = detached_figure((6, 5.5), dpi)
     plot_generated_path(
         synth.graph_.points,
         generation.path.points,
@@ -197,7 +197,7 @@ def save_crossval_figures(
         space = PoseSpace(cv.parameters["dims"]).fit(train)
         pts = np.vstack([space.transform(m) for m in train])
         true = space.transform(motions[i])
-        fig = _detached_figure((5.0 * len(methods), 5.0), dpi)
+        fig = detached_figure((5.0 * len(methods), 5.0), dpi)
         for c, method in enumerate(methods):
             ax = fig.add_subplot(1, len(methods), c + 1)
             plot_generated_path(

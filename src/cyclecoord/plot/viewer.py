@@ -437,7 +437,7 @@ def write_viewer(figure, path: str | os.PathLike[str], post_script: str | None =
     ``post_script`` is JavaScript run once the figure is drawn (``{plot_id}`` names its
     element), as in :meth:`plotly.graph_objects.Figure.to_html`.
     """
-    from ..io._atomic import atomic_write
+    from ..io import atomic_write
 
     p = Path(path)
     if p.suffix.lower() not in (".html", ".htm"):

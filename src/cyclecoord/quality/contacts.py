@@ -30,10 +30,12 @@ __all__ = [
     "FootContacts",
     "FootSkating",
     "contact_runs",
+    "contact_skeleton",
     "find_feet",
     "foot_contacts",
     "foot_skating",
     "leg_length",
+    "skating_line",
     "skating_report",
 ]
 
@@ -178,11 +180,16 @@ class FootSkating:
 
     def summary(self) -> str:
         """One line for reports."""
-        return (
-            f"foot skating: {self.mean_speed:.3g} units/s "
-            f"({self.mean_speed_legs:.3g} leg lengths/s) while planted, "
-            f"{self.skating_frames} frames skating ({100 * self.skating_fraction:.1f}%)"
+        return _summary_line(
+            self.mean_speed, self.mean_speed_legs, self.skating_frames, self.skating_fraction
         )
+
+
+def _summary_line(speed: float, speed_legs: float, frames: int, fraction: float) -> str:
+    return (
+        f"foot skating: {speed:.3g} units/s ({speed_legs:.3g} leg lengths/s) while planted, "
+        f"{frames} frames skating ({100 * fraction:.1f}%)"
+    )
 
 
 # ---------------------------------------------------------------- skeleton help
@@ -283,7 +290,24 @@ def leg_length(skeleton: Skeleton, feet: tuple[str, ...] | None = None) -> float
     return value
 
 
-def _check_motion(motion: Motion) -> Skeleton:
+def contact_skeleton(motion: Motion) -> Skeleton:
+    """The skeleton of a motion checked fit for foot-contact analysis.
+
+    Parameters
+    ----------
+    motion : Motion
+
+    Returns
+    -------
+    Skeleton
+        ``motion.skeleton``.
+
+    Raises
+    ------
+    ParameterError
+        When the motion has no skeleton, fewer than 2 frames, or a frame holding NaN or
+        infinite values (the message names the source and the first such frame).
+    """
     if motion.skeleton is None:
         raise ParameterError(
             f"{motion.source or 'motion'}: foot contacts need a skeleton "
@@ -370,7 +394,7 @@ def foot_contacts(
         A motion without a skeleton, fewer than 2 frames, non-finite frames, unknown
         foot joints or non-positive thresholds.
     """
-    skel = _check_motion(motion)
+    skel = contact_skeleton(motion)
     if up not in _UP:
         raise ParameterError(f"up axis must be one of x, y, z, got {up!r}")
     for label, value in (("height", height), ("speed", speed)):
@@ -466,7 +490,7 @@ def foot_skating(
     elif contact_options:
         raise ParameterError("pass either contacts or contact options, not both")
     else:
-        _check_motion(motion)
+        contact_skeleton(motion)
     if contacts.n_frames != motion.n_frames:
         raise ParameterError(
             f"contacts cover {contacts.n_frames} frames, the motion has {motion.n_frames}"
@@ -512,3 +536,19 @@ def skating_report(motion: Motion, **options) -> dict | None:
     }
     out["floor"] = contacts.floor
     return out
+
+
+def skating_line(report: dict | None, label: str = "") -> str:
+    """One console line for a :func:`skating_report` dict (``None``: not measured).
+
+    ``label`` (e.g. ``"blend"``) is put in front: ``"blend foot skating: ..."``.
+    """
+    head = f"{label} " if label else ""
+    if report is None:
+        return f"{head}foot skating: not measured (no skeleton with recognisable feet)"
+    return head + _summary_line(
+        report["mean_speed_units_per_s"],
+        report["mean_speed_leg_lengths_per_s"],
+        report["skating_frames"],
+        report["skating_fraction"],
+    )

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Motion
-from ..skeleton import _rotation_matrices
+from ..skeleton import rotation_matrices
 from .metrics import distance_to_cycle, loop_closure
 from .reference import joint_angles, joint_columns, used_mask
 
@@ -285,7 +285,7 @@ def root_orientation(motion: Motion) -> np.ndarray | None:
         hpr = motion.frames[:, [rc["ry"], rc["rx"], rc["rz"]]]
         return np.unwrap(hpr, period=360.0, axis=0)
     vals = motion.frames[:, [rc["r" + ax] for ax in root.rotation_order.lower()]]
-    R = _rotation_matrices(vals, root.rotation_order)
+    R = rotation_matrices(vals, root.rotation_order)
     if not np.allclose(root.axis, np.eye(3)):
         R = root.axis @ R @ root.axis.T
     f = R[:, :, 2]

@@ -429,7 +429,8 @@ def monotonicity(theta: np.ndarray, true_phase: np.ndarray) -> PhaseAgreement:
     ph = np.asarray(true_phase, dtype=float)
     if th.ndim != 1 or ph.ndim != 1 or th.shape != ph.shape:
         raise ParameterError(
-            f"theta and true_phase must be 1-D arrays of equal length, got {th.shape} and {ph.shape}"
+            "theta and true_phase must be 1-D arrays of "
+            f"equal length, got {th.shape} and {ph.shape}"
         )
     if th.size < 2:
         raise ParameterError("monotonicity needs at least 2 frames")

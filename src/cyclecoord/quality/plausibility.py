@@ -93,7 +93,9 @@ def bones(motion: Motion) -> Bones:
         If the motion has no skeleton or fewer than two bones.
     """
     if motion.skeleton is None:
-        raise ParameterError("plausibility checks need a skeleton (forward kinematics); this motion has none")
+        raise ParameterError(
+            "plausibility checks need a skeleton (forward kinematics); this motion has none"
+        )
     skel = motion.skeleton
     rest = Motion(np.zeros((1, 0)), (), skeleton=skel).positions()
     pos = rest.positions[0]
@@ -116,7 +118,9 @@ def bones(motion: Motion) -> Bones:
     for i in range(n):  # siblings starting at one place (CMU's neck and clavicles)
         for k in range(i + 1, n):
             if (
-                parents[i] >= 0 and parents[k] >= 0 and find(int(parents[i])) == find(int(parents[k]))
+                parents[i] >= 0
+                and parents[k] >= 0
+                and find(int(parents[i])) == find(int(parents[k]))
                 and np.linalg.norm(pos[i] - pos[k]) <= tol
             ):
                 node[find(k)] = find(i)
@@ -157,7 +161,9 @@ def bones(motion: Motion) -> Bones:
     second = near[pairs[:, 0], pairs[:, 1]]
     rest_d = segment_distances(pos[None, s[pairs[:, 0]]], pos[None, e[pairs[:, 0]]],
                                pos[None, s[pairs[:, 1]]], pos[None, e[pairs[:, 1]]])[0]
-    return Bones(names=names, start=s, end=e, pairs=pairs, rest_distance=rest_d, second_neighbours=second)
+    return Bones(
+        names=names, start=s, end=e, pairs=pairs, rest_distance=rest_d, second_neighbours=second
+    )
 
 
 def segment_distances(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
@@ -321,8 +327,13 @@ def self_intersections(
         ignored = np.zeros(bn.pairs.shape[0], dtype=bool)
     flagged = (dist < threshold) & ~ignored[None, :]
     return SelfIntersections(
-        threshold=float(threshold), bones=bn, min_distance=dist.min(axis=0) if dist.size else np.zeros(0),
-        flagged=flagged, ignored=ignored, distances=dist, start_frame=int(motion.start_frame),
+        threshold=float(threshold),
+        bones=bn,
+        min_distance=dist.min(axis=0) if dist.size else np.zeros(0),
+        flagged=flagged,
+        ignored=ignored,
+        distances=dist,
+        start_frame=int(motion.start_frame),
     )
 
 
@@ -368,7 +379,9 @@ class JointRangeViolation:
 
 def _joint_angle_columns(motion: Motion) -> list[int]:
     root = set(motion.root_channels())
-    return [i for i, (_, d) in enumerate(motion.channels) if d in ("rx", "ry", "rz") and i not in root]
+    return [
+        i for i, (_, d) in enumerate(motion.channels) if d in ("rx", "ry", "rz") and i not in root
+    ]
 
 
 def joint_range_violations(
@@ -528,7 +541,11 @@ def _reference_views(reference: Motion, motion: Motion) -> list[Motion]:
     rsize = rskel.total_length()
     if rsize > 0:
         root = skel.joints[0].name
-        cols = [i for i, (j, d) in enumerate(reference.channels) if j == root and d in ("tx", "ty", "tz")]
+        cols = [
+            i
+            for i, (j, d) in enumerate(reference.channels)
+            if j == root and d in ("tx", "ty", "tz")
+        ]
         frames[:, cols] *= skel.total_length() / rsize
     views.append(replace(reference, frames=frames, skeleton=skel))
     return views
@@ -610,22 +627,22 @@ def check_plausibility(
         })
     if inter.ignored.any():
         notes.append(
-            f"{int(inter.ignored.sum())} pairs of neighbouring bones are within the clearance {thr:.3g} "
-            "already at rest (e.g. fingers and thumb) and are not checked"
+            f"{int(inter.ignored.sum())} pairs of neighbouring bones are within the clearance "
+            f"{thr:.3g} already at rest (e.g. fingers and thumb) and are not checked"
         )
     if explained:
         notes.append(
-            f"{explained} bone pairs come within the clearance {thr:.3g}, but the inputs come as close "
-            "(their own near-contacts, not new)"
+            f"{explained} bone pairs come within the clearance {thr:.3g}, but "
+            "the inputs come as close (their own near-contacts, not new)"
         )
     n_new = sum(1 for c in contacts if c["new"])
     if n_new:
         worst = min((c for c in contacts if c["new"]), key=lambda c: c["min_distance"])
         ref = worst["reference_min_distance"]
         notes.append(
-            f"{n_new} bone pairs come closer than the inputs ever do, e.g. {worst['bones'][0]} and "
-            f"{worst['bones'][1]} at {worst['min_distance']:.3g} (clearance {thr:.3g}, inputs' closest "
-            f"{'n/a' if ref is None else f'{ref:.3g}'})"
+            f"{n_new} bone pairs come closer than the inputs ever do, e.g. "
+            f"{worst['bones'][0]} and {worst['bones'][1]} at {worst['min_distance']:.3g} "
+            f"(clearance {thr:.3g}, inputs' closest {'n/a' if ref is None else f'{ref:.3g}'})"
         )
     violations: list[JointRangeViolation] = []
     if references:
@@ -633,11 +650,14 @@ def check_plausibility(
         if violations:
             v = violations[0]
             notes.append(
-                f"{len(violations)} joint angles leave the inputs' range (+-{margin_deg:g} deg), worst "
-                f"{'.'.join(v.channel)} at {v.worst:.1f} (allowed {v.low:.1f} to {v.high:.1f})"
+                f"{len(violations)} joint angles leave the inputs' range "
+                f"(+-{margin_deg:g} deg), worst {'.'.join(v.channel)} at "
+                f"{v.worst:.1f} (allowed {v.low:.1f} to {v.high:.1f})"
             )
     if not contacts and not violations:
-        notes.append(f"no bones closer than {thr:.3g} and every joint angle within the inputs' range")
+        notes.append(
+            f"no bones closer than {thr:.3g} and every joint angle within the inputs' range"
+        )
     return PlausibilityReport(
         n_frames=motion.n_frames, threshold=thr, margin_deg=float(margin_deg), contacts=contacts,
         new_contact_frames=[int(f + motion.start_frame) for f in np.flatnonzero(new_mask)],

@@ -49,12 +49,108 @@ __all__ = [
     "blend",
     "transition",
     "transition_steps",
+    "BlendResult",
+    "TransitionResult",
     "STEP_LIMIT",
 ]
 
 
 #: A transition is continuous when no step exceeds this many typical steps.
 STEP_LIMIT = 1.5
+
+
+@dataclass(frozen=True)
+class BlendResult:
+    """A blended loop and how it was made (``blend(..., full_output=True)``).
+
+    The same figures are filed in ``motion.metadata["blend"]`` so that they travel with
+    the clip into files; this object gives them typed, without reading a dict.
+
+    Attributes
+    ----------
+    motion : Motion
+        The blended loop (as ``blend`` returns by default).
+    weights : ndarray, shape (n,)
+    sources : list of str
+        The inputs' names.
+    period_frames : float
+        The loop's length in frames.
+    periods_frames, periods_seconds : list of float
+        The inputs' periods.
+    root_displacement : ndarray, shape (R,)
+        Root channel change over one loop (the next loop starts there).
+    alignments : list of dict
+        Phase shift, direction and match of each input against the first
+        (:func:`~cyclecoord.synthesis.align.align`).
+    headings_deg : list of float or None
+        The inputs' mean headings before they were turned to the first's (None: not turned).
+    root_scales : list of float
+        Root translation scale per input (skeleton sizes).
+    notes : list of str
+    """
+
+    motion: Motion
+    weights: np.ndarray
+    sources: list
+    period_frames: float
+    periods_frames: list
+    periods_seconds: list
+    root_displacement: np.ndarray
+    alignments: list
+    headings_deg: list | None
+    root_scales: list
+    notes: list
+
+
+@dataclass(frozen=True)
+class TransitionResult:
+    """A transition clip and how it was made (``transition(..., full_output=True)``).
+
+    The same figures are filed in ``motion.metadata["transition"]``.
+
+    Attributes
+    ----------
+    motion : Motion
+        Lead-in cycles of ``a``, the ramp, lead-out cycles of ``b``.
+    sources : list of str
+    ramp : (int, int)
+        The ramp's frames, half-open.
+    ramp_cycles : float
+        Cycles of phase the ramp spans.
+    periods_frames : list of float
+        ``a``'s and ``b``'s periods at ``a``'s rate.
+    lead_in_frames, lead_out_frames : int
+    alignment : dict
+        ``b``'s phase shift and match against ``a``.
+    headings_deg : list of float or None
+    root_scales : list of float
+    continuity : dict
+        :func:`transition_steps`: the largest step over the typical step at its phase,
+        and a longer ramp that would keep every step within :data:`STEP_LIMIT` when one
+        is needed.
+    notes : list of str
+    weight, phase : ndarray, shape (T,)
+        ``b``'s weight and the phase (cycles) of every frame.
+    """
+
+    motion: Motion
+    sources: list
+    ramp: tuple
+    ramp_cycles: float
+    periods_frames: list
+    lead_in_frames: int
+    lead_out_frames: int
+    alignment: dict
+    headings_deg: list | None
+    root_scales: list
+    continuity: dict
+    notes: list
+    weight: np.ndarray
+    phase: np.ndarray
+
+    @property
+    def ramp_frames(self) -> int:
+        return int(self.ramp[1] - self.ramp[0])
 
 
 def _smoothstep(u: np.ndarray) -> np.ndarray:
@@ -248,7 +344,8 @@ def blend(
     scale_root: bool = True,
     up: str = "y",
     n_frames: int | None = None,
-) -> Motion:
+    full_output: bool = False,
+) -> Motion | BlendResult:
     """Convex combination of cycles, ``y(θ) = Σ w_i x_i(θ)`` after alignment (paper §4.5).
 
     The first cycle is the reference: the result starts at its phase 0, faces its
@@ -288,13 +385,17 @@ def blend(
         Vertical axis (``"y"`` for CMU and BVH data).
     n_frames : int, optional
         Force the output length (default from the blended period).
+    full_output : bool, default False
+        Return a :class:`BlendResult` (the loop and its figures, typed) instead of the
+        loop alone.
 
     Returns
     -------
-    Motion
+    Motion or BlendResult
         One loop, ``metadata`` holding ``cycle: True``, ``period_frames``,
         ``root_displacement`` (exact per-loop root change) and ``blend`` (weights,
-        sources, alignments, headings, scales, notes).
+        sources, alignments, headings, scales, notes); with ``full_output`` the same in
+        a :class:`BlendResult`.
 
     Raises
     ------
@@ -350,12 +451,28 @@ def blend(
         },
     }
     label = " + ".join(f"{wi:g}*{n}" for wi, n in zip(w, names))
-    return replace(
+    out = replace(
         ref,
         frames=frames,
         start_frame=0,
         source=f"blend of {label}",
         metadata=meta,
+    )
+    if not full_output:
+        return out
+    info = meta["blend"]
+    return BlendResult(
+        motion=out,
+        weights=np.array(w, dtype=float),
+        sources=list(names),
+        period_frames=float(n_out),
+        periods_frames=list(info["periods_frames"]),
+        periods_seconds=list(info["periods_seconds"]),
+        root_displacement=np.array(displacement, dtype=float),
+        alignments=list(info["alignments"]),
+        headings_deg=info["headings_deg"],
+        root_scales=list(info["root_scales"]),
+        notes=list(info["notes"]),
     )
 
 
@@ -527,7 +644,8 @@ def transition(
     align_heading: bool = True,
     scale_root: bool = True,
     up: str = "y",
-) -> Motion:
+    full_output: bool = False,
+) -> Motion | TransitionResult:
     """A clip that turns cycle ``a`` into cycle ``b`` without a hitch (the paper's homotopy).
 
     ``b`` is brought into ``a``'s frame and phase exactly as in :func:`blend`.  Over
@@ -557,12 +675,16 @@ def transition(
         Whole cycles of ``a`` before and of ``b`` after the ramp (>= 0).
     allow_reverse, align_heading, scale_root, up
         As in :func:`blend`.
+    full_output : bool, default False
+        Return a :class:`TransitionResult` (the clip and its figures, typed) instead of
+        the clip alone.
 
     Returns
     -------
-    Motion
+    Motion or TransitionResult
         At ``a``'s rate and skeleton; ``metadata["transition"]`` holds the ramp's frame
-        range, the per-frame weight and phase, the alignment and the continuity figures.
+        range, the per-frame weight and phase, the alignment and the continuity figures;
+        with ``full_output`` the same in a :class:`TransitionResult`.
 
     Raises
     ------
@@ -636,10 +758,29 @@ def transition(
             "phase": [float(v) for v in phases],
         }
     }
-    return replace(
+    out = replace(
         a,
         frames=values,
         start_frame=0,
         source=f"transition {a.source or 'a'} -> {b.source or 'b'}",
         metadata=meta,
+    )
+    if not full_output:
+        return out
+    info = meta["transition"]
+    return TransitionResult(
+        motion=out,
+        sources=list(info["sources"]),
+        ramp=(int(n_in), int(n_in + n_ramp)),
+        ramp_cycles=float(info["ramp_cycles"]),
+        periods_frames=list(info["periods_frames"]),
+        lead_in_frames=int(n_in),
+        lead_out_frames=int(n_out),
+        alignment=dict(info["alignment"]),
+        headings_deg=info["headings_deg"],
+        root_scales=list(info["root_scales"]),
+        continuity=dict(continuity),
+        notes=list(notes),
+        weight=np.array(weight, dtype=float),
+        phase=np.array(phases, dtype=float),
     )

@@ -2,13 +2,24 @@
 
 For every contact (a run of frames where a foot point is planted, from
 :func:`cyclecoord.quality.contacts.foot_contacts`) the point's horizontal position is
-fixed at its mean over the run; a window of ``blend`` seconds on each side eases the point
-from its captured path into the lock and out again (``target = orig + w (lock - orig)``
-with a smoothstep ``w``), so the foot decelerates instead of jumping.  Each leg's rotation
-channels from the hip down to the foot (thigh, shin, foot: six degrees of freedom on a CMU
-skeleton) are then solved frame by frame, all frames at once, by damped Gauss-Newton with
-a small pull towards the captured angles.  Only frames with a target are touched and only
-the leg chains change: the root, spine, arms and the toes' own rotation keep their values.
+fixed at its mean over the run, and held there on the frame either side too.  The toe's
+lock is placed where the ankle's lock carries it on the frames both rest flat, so the two
+locks fit the rigid foot between them.  Over ``blend`` seconds on each side the point's
+captured path is shifted towards the lock (``target = orig + w (lock - orig_held)`` with
+a smoothstep ``w``), so it reaches and leaves the lock at its captured speed.
+
+Each leg's rotation channels from the hip down to the foot (thigh, shin, foot: six
+degrees of freedom on a CMU skeleton) are then solved for every frame with a target, all
+frames at once, by Levenberg-Marquardt: horizontal lock errors weigh 1, the locked
+point's captured height :data:`_HEIGHT` (heights give way where the leg cannot reach a
+lock at them, e.g. the straight leg at heel strike) and the change of the angles a
+little (:data:`_REGULARISATION`), so the legs move as little as the locks need.  After
+heel strike, with heel and toe both held, the foot cannot pitch: a held toe still coming
+down is asked for the flat foot's height under the ankle (so the solver does not jump
+between pitching the foot up and down), and before its lock the toe is carried by the
+foot and lowered to that height over its ease (so the foot does not slap down in one
+frame).  Only the leg chains change: the root, spine, arms and the toes' own rotation
+keep their values.
 """
 
 from __future__ import annotations
@@ -22,19 +33,25 @@ from ..motion import Motion
 from ..quality.contacts import (
     FootContacts,
     FootSkating,
-    _check_motion,
     contact_runs,
+    contact_skeleton,
     foot_contacts,
     foot_skating,
 )
-from ..skeleton import Skeleton, _rotation_matrices
+from ..skeleton import Skeleton, rotation_matrices
 
 __all__ = ["FootLockResult", "lock_feet"]
 
-#: Weight of the captured angles (per radian) relative to target errors (per leg length).
-_REGULARISATION = 1e-3
-#: Weight of the height of a locked point, and of the horizontal position of a free one.
-_SOFT = 0.05
+#: Weight of the change of the leg's angles (per radian) relative to target errors (per leg
+#: length): small enough that locks hold to about 1e-3 leg lengths even where the leg is
+#: nearly straight, large enough to pick the smallest change among the leg poses that
+#: reach a lock (and to keep neighbouring frames on the same one).
+_REGULARISATION = 0.01
+#: Weight of a locked point's height (kept at its captured height) relative to its
+#: horizontal lock: heights give way first where heel and toe locks disagree.
+_HEIGHT = 0.1
+#: Levenberg-Marquardt iterations.
+_ITERATIONS = 50
 
 
 @dataclass(frozen=True)
@@ -89,17 +106,14 @@ def _smoothstep(x: np.ndarray) -> np.ndarray:
 
 
 def _lock_weights(planted: np.ndarray, nb: int, cyclic: bool):
-    """Weights ``(T,)`` easing into each run, the run label of each frame (-1: none), the
-    runs and the frame shift of the timeline they index.
+    """Weights, run labels (-1: none) and runs of one foot point, over the extended timeline.
 
     A frame gets the label of its nearest run within ``nb + 1`` frames, ``w = 1`` inside
     runs and on the frame either side, then a smoothstep down to 0 over ``nb`` frames.
-    A cyclic motion is tiled three times so runs and blends wrap around; the middle copy
-    is returned.
+    A cyclic motion is tiled three times (``3 T`` frames; the middle copy is the motion)
+    so runs and blends wrap around.
     """
-    T = planted.size
-    reps = 3 if cyclic else 1
-    ext = np.tile(planted, reps)
+    ext = np.tile(planted, 3 if cyclic else 1)
     runs = contact_runs(ext)
     label = -np.ones(ext.size, dtype=int)
     dist = np.full(ext.size, np.inf)
@@ -113,9 +127,7 @@ def _lock_weights(planted: np.ndarray, nb: int, cyclic: bool):
     # run's own frames see the pinned position only
     w = np.where(dist <= 1, 1.0, _smoothstep(1.0 - (dist - 1) / (nb + 1)))
     label[w <= 0] = -1
-    if cyclic:
-        return w[T : 2 * T], label[T : 2 * T], runs, T
-    return w, label, runs, 0
+    return w, label, runs
 
 
 def _next_loop(points: np.ndarray, loop, shift) -> np.ndarray:
@@ -164,37 +176,73 @@ def _loop_shift(root: np.ndarray, rot: np.ndarray, up: int) -> tuple:
     return root[0].astype(float), step, turn, up
 
 
-def _targets(
-    points: np.ndarray, planted: np.ndarray, up: int, nb: int, cyclic: bool, loop_shift: tuple | None = None
-):
-    """Targets ``(T, 3)`` (horizontal components eased into locks), weights ``(T,)`` and run
-    labels for one foot point.
+def _extended(points: np.ndarray, cyclic: bool, loop_shift: tuple | None) -> np.ndarray:
+    """Positions ``(T, 3)`` over the extended timeline of :func:`_lock_weights`: a cyclic
+    motion's loop before and after it, moved by ``loop_shift`` when it travels."""
+    if not cyclic:
+        return points
+    T = points.shape[0]
+    ext = np.tile(points, (3, 1))
+    if loop_shift is None:
+        return ext
+    return _next_loop(ext, np.repeat([-1, 0, 1], T), loop_shift)
 
-    A cyclic motion that travels moves by ``loop_shift`` from one loop to the next: a
-    contact that runs across the seam reads the frames of the neighbouring loop there
-    (its own frames shifted by it), not the far end of this one.
+
+def _targets(
+    points: np.ndarray,
+    planted: np.ndarray,
+    up: int,
+    nb: int,
+    cyclic: bool,
+    loop_shift: tuple | None = None,
+    carry: np.ndarray | None = None,
+):
+    """Targets ``(T, 3)`` (horizontal components eased into locks), ease weights ``(T,)``,
+    run labels (-1: free) and the side of the contact ``(T,)`` (-1 before it, held frame
+    included; 0 on it; 1 after it) for one foot point.
+
+    Each contact is pinned at its mean horizontal position; with ``carry`` ``(T, 3)``
+    (finite on some frames of the contact) at the mean of ``points + carry`` over those
+    frames instead (the toe carried by the ankle's correction).  Around a lock the point
+    keeps its captured velocity: its path is shifted by ``w`` times the offset between
+    the lock and the held frame beside it, so it leaves and reaches the lock at the speed
+    it was captured with (easing the position itself would leave slow, low frames that a
+    fresh contact search calls skating).  A cyclic motion that travels moves by
+    ``loop_shift`` from one loop to the next: a contact that runs across the seam reads
+    the frames of the neighbouring loop there (its own frames shifted by it), not the
+    far end of this one.
     """
     T = planted.size
     horiz = [k for k in range(3) if k != up]
-    w, label, runs, shift = _lock_weights(planted, nb, cyclic)
-    target = points.copy()
-    locks = {}
-    for k in np.unique(label[label >= 0]):
+    w, label, runs = _lock_weights(planted, nb, cyclic)
+    mid = slice(T, 2 * T) if cyclic else slice(0, T)
+    pts = _extended(points, cyclic, loop_shift)
+    if carry is not None:
+        car = np.tile(carry, (3, 1)) if cyclic else carry
+        if cyclic and loop_shift is not None:  # displacements turn with the loops
+            turn_only = (np.zeros(3), np.zeros(3), loop_shift[2], loop_shift[3])
+            car = _next_loop(car, np.repeat([-1, 0, 1], T), turn_only)
+    target = pts.copy()
+    side = np.zeros(pts.shape[0], dtype=int)
+    for k in np.unique(label[mid][label[mid] >= 0]):
         a, b = runs[k]
-        frames = np.arange(a, b) - shift
-        if cyclic:
-            loop = np.floor_divide(frames, T)  # -1, 0 or 1: the loop before, this one, the next
-            frames = np.mod(frames, T)
-            pos = points[frames]
-            if loop_shift is not None:
-                pos = _next_loop(pos, loop, loop_shift)
-            locks[k] = pos[:, horiz].mean(axis=0)
-        else:
-            locks[k] = points[frames][:, horiz].mean(axis=0)
-    for t in np.flatnonzero(label >= 0):
-        lock = locks[label[t]]
-        target[t, horiz] = points[t, horiz] + w[t] * (lock - points[t, horiz])
-    return target, np.where(label >= 0, w, 0.0), label
+        lock = pts[a:b][:, horiz].mean(axis=0)
+        if carry is not None:
+            flat = np.isfinite(car[a:b, 0])
+            if flat.any():
+                lock = (pts[a:b][flat] + car[a:b][flat])[:, horiz].mean(axis=0)
+        rows = np.flatnonzero(label == k)
+        n_ext = pts.shape[0]
+        before, after = rows < a - 1, rows > b
+        off = np.zeros((rows.size, len(horiz)))
+        off[before] = lock - pts[max(a - 1, 0), horiz]
+        off[after] = lock - pts[min(b, n_ext - 1), horiz]
+        eased = pts[rows][:, horiz] + w[rows, None] * off
+        eased[~(before | after)] = lock
+        side[rows[rows < a]] = -1
+        side[rows[rows >= b]] = 1
+        target[rows[:, None], horiz] = eased
+    return target[mid], np.where(label >= 0, w, 0.0)[mid], label[mid], side[mid]
 
 
 def _chain(skel: Skeleton, ankle: int, deepest: int) -> list[int]:
@@ -254,7 +302,7 @@ class _LegIK:
                 if cj == ci:
                     vals[:, k] = q[:, v]
             if joint.rotation_order:
-                local = joint.axis @ _rotation_matrices(vals, joint.rotation_order) @ joint.axis.T
+                local = joint.axis @ rotation_matrices(vals, joint.rotation_order) @ joint.axis.T
                 rot = rot @ local
             out[j] = (pos, rot)
         res = []
@@ -268,31 +316,53 @@ class _LegIK:
         return np.stack(res, axis=1)
 
 
-def _solve(ik: _LegIK, rows, targets, weights, scale, iterations=30):
-    """Damped Gauss-Newton on all ``rows`` at once; returns the new variables (n, V)."""
+def _solve(ik: _LegIK, rows, targets, weights, scale, iterations=_ITERATIONS):
+    """Levenberg-Marquardt on all ``rows`` at once; returns the new variables (n, V).
+
+    Minimises, per frame, ``sum (weights * (p(q) - targets) / scale)^2 +
+    (_REGULARISATION * |q - q0| in radians)^2``: the weighted target errors in leg lengths
+    and the change of the chain's angles.  Each frame keeps its own damping, raised when a
+    step would not lower its cost (steps are only taken downhill, also near a straight
+    knee where the linearisation is poor).
+    """
     q0 = ik.values()[rows]
     q = q0.copy()
-    reg = _REGULARISATION * scale * np.degrees(1.0) ** -1  # per degree
-    eps = 1e-3
+    reg = _REGULARISATION * np.radians(1.0)  # the variables are in degrees
+    eps = 1e-4
 
     def residual(qq):
         p = ik.positions(qq, rows)
-        r = (p - targets) * weights
+        r = (p - targets) * weights / scale
         return np.concatenate([r.reshape(len(rows), -1), reg * (qq - q0)], axis=1)
 
-    mu = 1e-6 * scale**2
+    def cost(rr):
+        return np.einsum("ij,ij->i", rr, rr)
+
+    n, V = q.shape
+    mu = np.full(n, 1e-3)
+    r = residual(q)
+    c = cost(r)
     for _ in range(iterations):
-        r = residual(q)
-        J = np.empty(r.shape + (q.shape[1],))
-        for v in range(q.shape[1]):
+        J = np.empty(r.shape + (V,))
+        for v in range(V):
             dq = q.copy()
             dq[:, v] += eps
             J[:, :, v] = (residual(dq) - r) / eps
         JT = np.swapaxes(J, 1, 2)
-        A = JT @ J + mu * np.eye(q.shape[1])
+        JTJ = JT @ J
+        diag = np.einsum("nvv->nv", JTJ)
+        A = JTJ.copy()
+        A[:, np.arange(V), np.arange(V)] += mu[:, None] * diag
         step = np.linalg.solve(A, -(JT @ r[..., None]))[..., 0]
-        q = q + step
-        if np.abs(step).max() < 1e-7:
+        trial = q + step
+        r_new = residual(trial)
+        c_new = cost(r_new)
+        better = c_new <= c
+        q = np.where(better[:, None], trial, q)
+        r = np.where(better[:, None], r_new, r)
+        c = np.where(better, c_new, c)
+        mu = np.where(better, mu * 0.3, mu * 10.0)
+        if (np.abs(step).max(axis=1) < 1e-6).all():
             break
     return q
 
@@ -324,18 +394,64 @@ def _lock_once(
         ik = _LegIK(motion, chain, pts, wrot, wpos)
         T = motion.n_frames
         targets = wpos[:, pts].copy()
-        weights = np.full((T, len(pts), 3), _SOFT)
+        # a point eased into or held at a lock: its horizontal target weighs its ease
+        # weight (1 when held), its height _HEIGHT times that; a free point has no target
+        # (the small-change term keeps it where the leg carries it)
+        weights = np.zeros((T, len(pts), 3))
         active = np.zeros(T, bool)
         horiz = [k for k in range(3) if k != contacts.up]
         loop_shift = _loop_shift(wpos[:, 0], wrot[:, 0], contacts.up) if cyclic and T > 1 else None
-        for m, i in enumerate(cols):
-            tgt, _, label = _targets(
-                wpos[:, pts[m]], contacts.planted[:, i], contacts.up, nb, cyclic, loop_shift
+        carry = None
+        first = None
+        for m in sorted(range(len(cols)), key=lambda m: depth[pts[m]]):
+            i = cols[m]
+            if first is not None:
+                # a deeper point (the toe) is locked where the ankle's lock carries it on
+                # the frames both rest flat, so the two locks fit the foot between them
+                a_col, a_tgt, a_pos = first[:3]
+                low = 0.5 * contacts.height_threshold
+                low_a = contacts.planted[:, a_col] & (contacts.height[:, a_col] < low)
+                low_here = contacts.planted[:, i] & (contacts.height[:, i] < low)
+                flat = low_a & low_here
+                carry = np.where(flat[:, None], a_tgt - a_pos, np.nan)
+            tgt, ease, label, side = _targets(
+                wpos[:, pts[m]],
+                contacts.planted[:, i],
+                contacts.up,
+                nb,
+                cyclic,
+                loop_shift,
+                carry=carry,
             )
-            targets[:, m] = tgt
             locked = label >= 0
-            for k in horiz:
-                weights[locked, m, k] = 1.0
+            weights[locked, m, horiz[0]] = weights[locked, m, horiz[1]] = ease[locked]
+            weights[locked, m, contacts.up] = _HEIGHT * ease[locked]
+            if first is not None and flat.any():
+                # the toe under an ankle with a target: held at both locks the foot cannot
+                # pitch, so the toe is asked for the flat foot's height under the ankle
+                # wherever it is held but still coming down after heel strike (its captured
+                # height would leave the solver two pitches to choose between, and it would
+                # jump between them); while it eases towards its lock it is carried by
+                # the foot and only comes down to that height, so the foot lowers over the
+                # ease instead of slapping down on the frame the lock begins
+                rel_flat = (wpos[flat, pts[m], contacts.up] - a_pos[flat, contacts.up]).mean()
+                flat_height = a_tgt[:, contacts.up] + rel_flat
+                # (the ankle held: planted low, or on the held frame before its contact)
+                a_ease, a_side = first[3], first[4]
+                a_held = (a_ease >= 1) & (low_a | (a_side < 0))
+                down = (ease >= 1) & (side <= 0) & a_held & ~low_here
+                tgt[down, contacts.up] = flat_height[down]
+                easing = (label >= 0) & (side < 0) & (ease < 1) & (a_ease > 0) & (a_side <= 0)
+                y = tgt[easing, contacts.up]
+                tgt[easing, contacts.up] = y + ease[easing] * (flat_height[easing] - y)
+                weights[easing, m, horiz[0]] = weights[easing, m, horiz[1]] = 0.0
+                weights[easing, m, contacts.up] = _HEIGHT
+            elif first is not None:
+                easing = (label >= 0) & (side < 0) & (ease < 1) & (first[3] > 0) & (first[4] <= 0)
+                weights[easing, m] = 0.0
+            targets[:, m] = tgt
+            if first is None:
+                first = (i, tgt, wpos[:, pts[m]], ease, side)
             active |= locked
         rows = np.flatnonzero(active)
         if rows.size == 0:
@@ -360,7 +476,7 @@ def lock_feet(
     *,
     blend: float = 0.1,
     cyclic: bool = False,
-    passes: int = 1,
+    passes: int = 3,
     **contact_options,
 ) -> FootLockResult:
     """Remove foot skating by pinning planted feet and re-solving the legs.
@@ -378,9 +494,11 @@ def lock_feet(
         Treat the motion as a loop (a typical cycle): a contact running over the last
         frame continues at the first, and blends wrap around.
     passes : int
-        Locking slows feet down near their contacts, so contacts found afresh on the
-        result can be longer; up to ``passes`` rounds lock those too (each round solves
-        the legs again from the previous round's result).
+        Contacts found afresh on the result can be a frame or two longer than the locked
+        ones (a foot reaching its lock is slowed or steered a little); up to ``passes``
+        rounds lock those too when they skate (each round solves the legs again from the
+        previous round's result, so the locked motion measured on its own contacts
+        skates no more than on the input's).  1 locks the input's contacts only.
 
     Returns
     -------
@@ -390,18 +508,26 @@ def lock_feet(
 
     if not (np.isfinite(blend) and blend >= 0):
         raise ParameterError(f"blend must be >= 0 seconds, got {blend!r}")
+    if isinstance(passes, bool) or not isinstance(passes, (int, np.integer)) or passes < 1:
+        raise ParameterError(f"passes must be a whole number >= 1, got {passes!r}")
     if contacts is None:
         contacts = foot_contacts(motion, **contact_options)
     else:
-        _check_motion(motion)
+        contact_skeleton(motion)
     if contacts.n_frames != motion.n_frames:
         raise ParameterError(
             f"contacts cover {contacts.n_frames} frames, the motion has {motion.n_frames}"
         )
     nb = round(blend * motion.fps)
+    if not contact_options:  # find contacts afresh with the thresholds of the given ones
+        contact_options = {
+            "height": contacts.height_threshold / contacts.leg_length,
+            "speed": contacts.speed_threshold / contacts.leg_length,
+            "up": "xyz"[contacts.up],
+        }
     out, worst = _lock_once(motion, contacts, nb, cyclic)
     locked = contacts
-    for _ in range(max(0, int(passes) - 1)):
+    for _ in range(int(passes) - 1):
         again = foot_contacts(out, contacts.feet, **contact_options)
         extra = again.planted & ~locked.planted
         if not (foot_skating(out, again).skating & extra).any():
@@ -418,7 +544,7 @@ def lock_feet(
         contacts=contacts,
         before=foot_skating(motion, contacts),
         after=foot_skating(out, contacts),
-        after_redetected=foot_skating(out),
+        after_redetected=foot_skating(out, foot_contacts(out, contacts.feet, **contact_options)),
         joint_change=dict(zip(motion.skeleton.names, angle.tolist())),
         max_error=worst,
     )

@@ -3,19 +3,32 @@
 From a few training takes: a PCA space of the joint angles (:class:`PoseSpace`), a motion
 graph over the training frames from a Delaunay triangulation, k nearest neighbours or
 both (:func:`build_graph`), the interpolated field of the takes' velocities
-(:class:`VectorField`), paths that follow it or run to a target along the graph
-(:func:`follow_field`, :func:`path_to_target`), a playable result with a root trajectory
-(:class:`MotionGraphSynth`) and the paper's leave-one-out table (:func:`cross_validate`).
+(:class:`VectorField`; the Delaunay field optionally widened to the adjacent simplices and
+weighted by agreement with the path's heading, ``"delaunay+ring+agree"``, which keeps the
+2-D paths from stalling at a walk's cusps), paths that follow it or run to a target
+along the graph (:func:`follow_field`, :func:`path_to_target`), a playable result with a
+root trajectory (:class:`MotionGraphSynth`) and the paper's leave-one-out table
+(:func:`cross_validate`).
 """
 
 from .build import METHODS, MotionGraph, build_graph, training_vectors
-from .crossval import PAPER_W1, CrossValidation, bottleneck, cross_validate, h1_diagram, path_errors
-from .field import VectorField
+from .crossval import (
+    DEFAULT_METHODS,
+    PAPER_W1,
+    CrossValidation,
+    bottleneck,
+    cross_validate,
+    h1_diagram,
+    path_errors,
+)
+from .field import FIELD_OPTIONS, VectorField, parse_variant
 from .latent import PoseSpace, check_takes
 from .model import Generation, MotionGraphSynth
 from .paths import GraphPath, follow_field, path_to_target, root_trajectory, shortest_path
 
 __all__ = [
+    "DEFAULT_METHODS",
+    "FIELD_OPTIONS",
     "METHODS",
     "PAPER_W1",
     "CrossValidation",
@@ -32,6 +45,7 @@ __all__ = [
     "follow_field",
     "h1_diagram",
     "path_errors",
+    "parse_variant",
     "path_to_target",
     "root_trajectory",
     "shortest_path",

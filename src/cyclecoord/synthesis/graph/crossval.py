@@ -2,7 +2,10 @@
 
 For each take: fit the latent space and build the graph on the other takes, start at the
 left-out take's first frame, follow the field for as many frames as the take has, and
-compare the generated path with the take.
+compare the generated path with the take.  The methods are the graph's, optionally with
+the field options of :mod:`.field` (``"delaunay+ring+agree"``); the default set
+(:data:`DEFAULT_METHODS`) holds the paper's two, that fix of the Delaunay field and
+k-Delaunay.
 
 * **Error F**: distance from the generated path to the take's final point at their
   closest approach.
@@ -40,8 +43,8 @@ from scipy.spatial.distance import cdist
 
 from ...errors import ParameterError
 from ...motion import Motion
-from .build import build_graph, check_method
-from .field import VectorField
+from .build import build_graph
+from .field import VectorField, parse_variant
 from .latent import PoseSpace, check_takes
 from ..._blas import one_blas_thread
 from .paths import follow_field
@@ -54,6 +57,7 @@ __all__ = [
     "cross_validate",
     "PAPER_W1",
     "ERROR_KEYS",
+    "DEFAULT_METHODS",
 ]
 
 #: The paper's Table II, set w1 (medians over the 4 folds; latent units).
@@ -61,6 +65,8 @@ PAPER_W1 = {
     "delaunay": {"error_a": 0.023, "error_f": 0.02},
     "knn": {"error_a": 0.022, "error_f": 0.057},
 }
+#: The paper's two, our fix of the Delaunay field (see :mod:`.field`) and k-Delaunay.
+DEFAULT_METHODS = ("delaunay", "delaunay+ring+agree", "knn", "union")
 #: Latent coordinates the H1 barcodes are computed in.
 TOPO_DIMS = 3
 ERROR_KEYS = (
@@ -270,7 +276,7 @@ def _graph_summary(takes: list, methods: list, dims: int, k: int, names: list) -
         "weak_components": {},
         "strong_components": {},
     }
-    for method in methods:
+    for method in dict.fromkeys(parse_variant(m)[0] for m in methods):
         c = build_graph(latent_all, method, k, names).connectivity()
         for key in ("edges", "weak_components", "strong_components"):
             graph[key][method] = c[key]
@@ -280,7 +286,7 @@ def _graph_summary(takes: list, methods: list, dims: int, k: int, names: list) -
 @one_blas_thread
 def cross_validate(
     motions: Sequence[Motion],
-    methods: Sequence[str] = ("delaunay", "knn", "union"),
+    methods: Sequence[str] = DEFAULT_METHODS,
     dims: int = 2,
     k: int = 16,
     integrator: str = "euler",
@@ -294,7 +300,10 @@ def cross_validate(
     ----------
     motions : sequence of Motion
         At least 3 takes of one skeleton.
-    methods : sequence of {"delaunay", "knn", "union"}
+    methods : sequence of str
+        ``"delaunay"``, ``"knn"``, ``"union"``, each optionally with the field options
+        ``+ring`` and ``+agree`` (:func:`~.field.parse_variant`); one graph per fold
+        serves every variant of a method.
     dims : int, default 2
     k : int, default 16
     integrator : {"euler", "rk4"}
@@ -309,7 +318,8 @@ def cross_validate(
     CrossValidation
     """
     takes = check_takes(motions, minimum=3)
-    methods = [check_method(m) for m in methods]
+    methods = list(dict.fromkeys(str(m).strip() for m in methods))
+    variants = {m: parse_variant(m) for m in methods}
     if not methods:
         raise ParameterError("give at least one method")
     names = [
@@ -329,17 +339,22 @@ def cross_validate(
         ev = _Evaluator(space, takes[i], topo)
         latent_train = [space.transform(m) for m in train]
         start, n = ev.latent[0], takes[i].n_frames
+        graphs: dict = {}
         for method in methods:
-            graph = build_graph(
-                latent_train, method, k, [names[j] for j in range(len(takes)) if j != i]
-            )
-            path = follow_field(VectorField(graph), start, n, integrator, step_scale)
+            kind, ring, agree = variants[method]
+            if kind not in graphs:
+                g = build_graph(
+                    latent_train, kind, k, [names[j] for j in range(len(takes)) if j != i]
+                )
+                graphs[kind] = (g, g.connectivity())
+            graph, c = graphs[kind]
+            field_ = VectorField(graph, ring=ring, agree=agree)
+            path = follow_field(field_, start, n, integrator, step_scale)
             row = {"held_out": names[i], "method": method}
             row.update(ev.errors(path.points, space.inverse_transform(path.points)))
             row["outside_hull_steps"] = path.outside_hull_steps
             folds.append(row)
             paths[(names[i], method)] = path
-            c = graph.connectivity()
             fold_graphs.append(
                 {
                     "held_out": names[i],

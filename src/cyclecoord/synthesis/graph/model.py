@@ -15,8 +15,8 @@ import numpy as np
 from ..._blas import one_blas_thread
 from ...errors import ParameterError
 from ...motion import Motion
-from .build import MotionGraph, build_graph, check_method
-from .field import VectorField
+from .build import MotionGraph, build_graph
+from .field import VectorField, parse_variant
 from .latent import PoseSpace, check_takes
 from .paths import INTEGRATORS, GraphPath, follow_field, path_to_target, root_trajectory
 
@@ -56,7 +56,10 @@ class MotionGraphSynth:
 
     Parameters
     ----------
-    method : {"delaunay", "knn", "union"}, default "delaunay"
+    method : str, default "delaunay"
+        ``"delaunay"``, ``"knn"`` or ``"union"``, optionally with the field options
+        ``+ring`` and ``+agree`` (:func:`~.field.parse_variant`), e.g.
+        ``"delaunay+ring+agree"``.
     dims : int, default 2
         Latent dimensions (the paper's 2).
     k : int, default 16
@@ -89,7 +92,7 @@ class MotionGraphSynth:
 
     @one_blas_thread
     def fit(self, takes: Sequence[Motion]) -> "MotionGraphSynth":
-        check_method(self.method)
+        method, ring, agree = parse_variant(self.method)
         if self.integrator not in INTEGRATORS:
             raise ParameterError(
                 f"unknown integrator {self.integrator!r}; choose from {', '.join(INTEGRATORS)}"
@@ -98,8 +101,8 @@ class MotionGraphSynth:
         self.names_ = [take_name(m, i) for i, m in enumerate(self.takes_)]
         self.space_ = PoseSpace(self.dims).fit(self.takes_)
         latent = [self.space_.transform(m) for m in self.takes_]
-        self.graph_: MotionGraph = build_graph(latent, self.method, self.k, self.names_)
-        self.field_ = VectorField(self.graph_)
+        self.graph_: MotionGraph = build_graph(latent, method, self.k, self.names_)
+        self.field_ = VectorField(self.graph_, ring=ring, agree=agree)
         return self
 
     def _start(self, start: Motion | int, frame: int) -> tuple[Motion, int, str]:

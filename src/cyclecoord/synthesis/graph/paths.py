@@ -64,7 +64,8 @@ class GraphPath:
     speed : float
         Latent advance per frame relative to a captured frame (0.5 for the paper's step).
     kind : str
-        ``"field:<method>:<integrator>"`` or ``"graph:<method>"``.
+        ``"field:<variant>:<integrator>"`` (e.g. ``field:delaunay+ring+agree:euler``) or
+        ``"graph:<method>"``.
     nodes : ndarray of int or None
         The graph nodes a shortest path visits.
     """
@@ -119,6 +120,11 @@ def follow_field(
     Returns
     -------
     GraphPath
+
+    Notes
+    -----
+    An ``agree`` field (:class:`VectorField`) is given the path's previous step as its
+    heading; the first step has none and takes the plain field.
     """
     x = _check_start(field, start)
     if isinstance(n_frames, bool) or not isinstance(n_frames, (int, np.integer)) or n_frames < 1:
@@ -135,24 +141,28 @@ def follow_field(
     inside = np.ones(n_frames, dtype=bool)
     nbrs, wts = [], []
     vel = field.graph.velocities
+    h = None  # the heading (previous step) an "agree" field weighs its neighbours by
     for t in range(n_frames):
         pts[t] = x
-        idx, w, ins = field.neighbours(x[None])
+        idx, w, ins = field.neighbours(x[None], h)
         nbrs.append(idx[0])
         wts.append(w[0])
         if t == n_frames - 1:
             inside[t] = bool(ins[0])
             break
-        k1 = w[0] @ vel[idx[0]]
+        k1 = np.einsum("k,kd->d", w[0], vel[idx[0]])  # no BLAS call per step
         if integrator == "euler":
             inside[t] = bool(ins[0])
-            x = x + s * k1
-            continue
-        k2, i2 = field.evaluate((x + 0.5 * s * k1)[None])
-        k3, i3 = field.evaluate((x + 0.5 * s * k2[0])[None])
-        k4, i4 = field.evaluate((x + s * k3[0])[None])
-        inside[t] = bool(ins[0] and i2[0] and i3[0] and i4[0])
-        x = x + s * (k1 + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]) / 6.0
+            step = s * k1
+        else:
+            k2, i2 = field.evaluate((x + 0.5 * s * k1)[None], h)
+            k3, i3 = field.evaluate((x + 0.5 * s * k2[0])[None], h)
+            k4, i4 = field.evaluate((x + s * k3[0])[None], h)
+            inside[t] = bool(ins[0] and i2[0] and i3[0] and i4[0])
+            step = s * (k1 + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]) / 6.0
+        x = x + step
+        if field.agree and np.any(step):
+            h = step[None]
     width = max(len(a) for a in nbrs)
     neighbours = np.zeros((n_frames, width), dtype=int)
     weights = np.zeros((n_frames, width))
@@ -165,7 +175,7 @@ def follow_field(
         weights=weights,
         inside=inside,
         speed=s / 2.0,
-        kind=f"field:{field.neighbourhood}:{integrator}",
+        kind=f"field:{field.name}:{integrator}",
     )
 
 

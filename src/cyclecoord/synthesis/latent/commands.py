@@ -189,9 +189,10 @@ class Synthesizer:
     lock : bool, default False
         Also pin the planted feet in those spans by a leg IK
         (:func:`~cyclecoord.synthesis.footlock.lock_feet`).  On the shared-data models'
-        56 transitions it leaves planted feet sliding on 9 % of the blend windows'
-        frames instead of 54 %, but the locks' easing makes joints accelerate up to 3x
-        the training 99th percentile (9 of 56 blend windows over 1.5x), so it is off.
+        56 transitions it leaves planted feet sliding on 11 % of the blend windows'
+        frames instead of 54 %, but the locks' easing makes joints accelerate up to 3.1x
+        the training 99th percentile (4 of 56 blend windows over 1.5x, 8 of 56 whole
+        transitions), so it is off.
     """
 
     models: dict[str, LatentModel]
@@ -278,7 +279,11 @@ class Synthesizer:
                 idx = np.flatnonzero(m.segments_ == s)
                 t = spec.get("time", 0.0)
                 end = float(m.times_[idx][-1])
-                if not isinstance(t, (int, float)) or isinstance(t, bool) or not 0 <= t <= end + 1e-9:
+                if (
+                    not isinstance(t, (int, float))
+                    or isinstance(t, bool)
+                    or not 0 <= t <= end + 1e-9
+                ):
                     raise ParameterError(
                         f"time {t!r} is not inside segment {spec['segment']!r} (0..{end:.3g} s)"
                     )
@@ -339,6 +344,10 @@ class Synthesizer:
             "turn": w @ r.turn,
             "tilt": np.einsum("tn,nab->tab", w, r.tilt),
         }
+
+    def bridges_found(self) -> dict[tuple[str, str], Bridges]:
+        """The bridges looked up so far (by :meth:`bridges`), by ``(from, to)`` model names."""
+        return dict(self._bridges)
 
     def bridges(self, a: str, b: str) -> Bridges:
         key = (a, b)
@@ -717,8 +726,9 @@ class Synthesizer:
         track's steps are smoothed (:data:`PLANT_SMOOTH`): unsmoothed, the root copied
         the feet's frame-to-frame jitter and its horizontal acceleration exceeded 1.5x
         the larger of the two models' training 99th percentile in 30 of the shared-data
-        models' 56 blend windows (none when smoothed, none without planting); on the same windows planted
-        feet slid on 38 % of frames unsmoothed, 48 % smoothed, 56 % without planting.
+        models' 56 blend windows (none when smoothed, none without planting); on the
+        same windows planted feet slid on 38 % of frames unsmoothed, 48 % smoothed,
+        56 % without planting.
         Steps outside the spans are kept.  (A first search with a lax speed limit, 1 or
         2 leg lengths per second, for the sliding feet did no better.)
         """
@@ -765,7 +775,7 @@ class Synthesizer:
         contacts = replace(contacts, planted=contacts.planted & span[:, None])
         if not contacts.planted.any():
             return out
-        return lock_feet(out, contacts, blend=LOCK_BLEND).motion
+        return lock_feet(out, contacts, blend=LOCK_BLEND, passes=1).motion
 
     def segments(self) -> list[dict[str, Any]]:
         """Which frames each command made and in which model."""

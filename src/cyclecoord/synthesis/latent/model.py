@@ -312,7 +312,7 @@ class LatentModel:
     # --------------------------------------------------------------- storage
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the model and its training frames to ``path`` (``.npz``, atomic)."""
-        from ...io._atomic import atomic_write
+        from ...io import atomic_write
         from ...io.tabular import read_npz, write_npz  # noqa: F401
 
         train = Motion(

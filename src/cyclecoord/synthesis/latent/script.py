@@ -216,7 +216,7 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
         "transitions": syn.events,
         "clamped_to_training_range": syn.clamped,
         "foot_skating": skating_report(motion),
-        "bridges": {f"{a}->{b}": br.to_dict() for (a, b), br in syn._bridges.items()},
+        "bridges": {f"{a}->{b}": br.to_dict() for (a, b), br in syn.bridges_found().items()},
         "timing": {
             "total_s": total,
             "particle_and_pose_s": syn.sim_seconds,

@@ -22,9 +22,28 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import datasets as _ds
-from .errors import ParameterError
-from .motion import DEFAULT_FPS, Motion
+from ..errors import ParameterError
+from ..motion import DEFAULT_FPS, Motion
+from ._body import (
+    CHANNELS,
+    COL,
+    DEFAULT_PERIODS,
+    POSES,
+    STRIDE,
+    add_noise,
+    check_float,
+    check_int,
+    check_random_state,
+    cmu_skeleton,
+    draw_phase_law,
+    draw_style,
+    ground,
+    pose_to_frames,
+    seed_text,
+    smoothstep,
+    standing_pose,
+)
+from .captures import SyntheticCapture
 
 __all__ = ["PART_NAMES", "make_whole_take"]
 
@@ -213,10 +232,6 @@ def _script_for_length(rng: np.random.Generator, n: int, period: float, fps: flo
 
 
 # --------------------------------------------------------------------- the timeline
-def _smoothstep(u: np.ndarray) -> np.ndarray:
-    return _ds._smoothstep(u)
-
-
 def _timeline(parts: list[_Part], heading0: float) -> dict[str, np.ndarray]:
     """Per-frame part code, activity, turn bump, cadence factor and heading (degrees)."""
     n = sum(p.frames for p in parts)
@@ -237,14 +252,14 @@ def _timeline(parts: list[_Part], heading0: float) -> dict[str, np.ndarray]:
             out["activity"][s:e] = 0.0
             out["cadence"][s:e] = 0.0
         elif part.name in ("start", "stop"):
-            a = _smoothstep(u) if part.name == "start" else 1.0 - _smoothstep(u)
+            a = smoothstep(u) if part.name == "start" else 1.0 - smoothstep(u)
             out["activity"][s:e] = a
             out["cadence"][s:e] = _CADENCE_FLOOR + (1.0 - _CADENCE_FLOOR) * a
         elif part.name == "turn":
             bump = (4.0 * u * (1.0 - u)) ** 2
             out["bump"][s:e] = bump
             out["cadence"][s:e] = 1.0 - _TURN_CADENCE * bump
-            out["heading"][s:e] = heading + part.degrees * _smoothstep(u)
+            out["heading"][s:e] = heading + part.degrees * smoothstep(u)
             heading += part.degrees
         s = e
     return out
@@ -281,22 +296,22 @@ def _render_take(
     """Noise-free frames ``(T, 62)`` of the take from its phase and timeline."""
     from scipy.spatial.transform import Rotation
 
-    col = _ds._COL
-    skeleton = _ds.cmu_skeleton()
+    col = COL
+    skeleton = cmu_skeleton()
     n = phase.shape[0]
     a = line["activity"][:, None]
     bump = line["bump"]
     heading = line["heading"]
     amp = style.amp * (1.0 - _TURN_STRIDE * bump)
-    gait = _ds._pose_to_frames(_ds._POSES[kind](np.mod(phase, 1.0), amp), n)
-    stand = _ds._pose_to_frames(_ds._standing_pose(n), n)
+    gait = pose_to_frames(POSES[kind](np.mod(phase, 1.0), amp), n)
+    stand = pose_to_frames(standing_pose(n), n)
     frames = stand + a * (gait - stand) + style.posture
     lift = frames[:, col[("root", "ty")]].copy()
     sway = frames[:, col[("root", "tx")]].copy()
     wobble = frames[:, col[("root", "tz")]].copy()
 
     # forward progression: one stride per cycle at full amplitude, along the heading
-    step = _ds._STRIDE[kind] * line["activity"] * (1.0 - _TURN_STRIDE * bump) * rate  # units/frame
+    step = STRIDE[kind] * line["activity"] * (1.0 - _TURN_STRIDE * bump) * rate  # units/frame
     h = np.radians(heading)
     omega = np.gradient(h)  # rad/frame
     lean = -_TURN_LEAN * np.degrees(np.arctan(step * omega / (_GRAVITY / fps**2)))
@@ -321,7 +336,7 @@ def _render_take(
     z = np.concatenate([[0.0], np.cumsum(step * cos)[:-1]])
     frames[:, col[("root", "tx")]] = x + sway * cos + wobble * sin
     frames[:, col[("root", "tz")]] = z - sway * sin + wobble * cos
-    frames[:, col[("root", "ty")]] = _ds._ground(frames, skeleton) + lift
+    frames[:, col[("root", "ty")]] = ground(frames, skeleton) + lift
     return frames
 
 
@@ -337,7 +352,7 @@ def make_whole_take(
     curve: float = 0.0,
     fps: float = DEFAULT_FPS,
     random_state: int | np.random.Generator | None = 0,
-) -> _ds.SyntheticCapture:
+) -> SyntheticCapture:
     """A whole take as people record it: standing, starting, walking, turning, pausing.
 
     The take follows a script of parts.  ``stand``: quiet standing, exactly still before
@@ -413,22 +428,22 @@ def make_whole_take(
             f"a whole take needs a gait; kind must be one of {', '.join(_GAIT_KINDS)}, got {kind!r}"
         )
     if period is None:
-        period = _ds._DEFAULT_PERIODS[kind]
-    period = _ds._check_float("period", period, 1.0, low_open=True)
-    noise = _ds._check_float("noise", noise, 0.0)
-    variation = _ds._check_float("speed_variation", speed_variation, 0.0, high=1.0)
-    curve = _ds._check_float("curve", curve, -np.inf)
-    fps = _ds._check_float("fps", fps, 0.0, low_open=True)
+        period = DEFAULT_PERIODS[kind]
+    period = check_float("period", period, 1.0, low_open=True)
+    noise = check_float("noise", noise, 0.0)
+    variation = check_float("speed_variation", speed_variation, 0.0, high=1.0)
+    curve = check_float("curve", curve, -np.inf)
+    fps = check_float("fps", fps, 0.0, low_open=True)
     if script is not None and n_frames is not None:
         raise ParameterError("give either script or n_frames, not both")
-    rng = _ds._check_random_state(random_state)
+    rng = check_random_state(random_state)
 
-    style = _ds._draw_style(rng)
+    style = draw_style(rng)
     heading0 = float(rng.uniform(-180.0, 180.0))
     if script is not None:
         parts = _parse_script(script, period, fps)
     elif n_frames is not None:
-        parts = _script_for_length(rng, _ds._check_int("n_frames", n_frames, 2), period, fps)
+        parts = _script_for_length(rng, check_int("n_frames", n_frames, 2), period, fps)
     else:
         parts = _default_script(rng, period, fps)
     line = _timeline(parts, heading0)
@@ -436,12 +451,12 @@ def make_whole_take(
         drift = curve / period * line["activity"]
         line["heading"] = line["heading"] + np.concatenate([[0.0], np.cumsum(drift)[:-1]])
     n = line["code"].shape[0]
-    law = _ds._draw_phase_law(rng, period, variation, n)
+    law = draw_phase_law(rng, period, variation, n)
     grid = law(np.arange(n + 1, dtype=float))
     rate = np.diff(grid) * line["cadence"]  # cycles from frame t to t + 1
     phase = np.concatenate([[0.0], np.cumsum(rate)[:-1]])
     clean = _render_take(kind, phase, rate, line, style, fps)
-    noisy = _ds._add_noise(clean, noise, rng)
+    noisy = add_noise(clean, noise, rng)
 
     meta = {
         "kind": kind,
@@ -452,7 +467,7 @@ def make_whole_take(
         "initial_heading": heading0,
         "curve": curve,
     }
-    source = f"synthetic:take({kind}; seed={_ds._seed_text(random_state)})"
+    source = f"synthetic:take({kind}; seed={seed_text(random_state)})"
     return _assemble(kind, parts, line, phase, rate, clean, noisy, fps, source, meta)
 
 
@@ -467,7 +482,7 @@ def _assemble(
     fps: float,
     source: str,
     meta: dict,
-) -> _ds.SyntheticCapture:
+) -> SyntheticCapture:
     """The capture and its ground truth from the rendered take."""
     bounds = np.cumsum([0] + [p.frames for p in parts])
     ranges = [(p.name, int(bounds[k]), int(bounds[k + 1])) for k, p in enumerate(parts)]
@@ -475,8 +490,8 @@ def _assemble(
     steady_mask = line["code"] == PART_NAMES.index("steady")
     moving = line["code"] != PART_NAMES.index("stand")
     true_period = float(steady_mask.sum() / rate[steady_mask].sum()) if steady else float("nan")
-    skeleton, channels = _ds.cmu_skeleton(), _ds._CHANNELS
-    return _ds.SyntheticCapture(
+    skeleton, channels = cmu_skeleton(), CHANNELS
+    return SyntheticCapture(
         motion=Motion(noisy, channels, fps=fps, skeleton=skeleton, source=source, metadata=meta),
         clean=Motion(
             clean, channels, fps=fps, skeleton=skeleton, source=source + ":clean",
