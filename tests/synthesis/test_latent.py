@@ -177,6 +177,26 @@ def test_bridges_of_a_model_to_itself_match_poses(walk_model):
     assert br.to_dict()["count"] == len(br)
 
 
+def test_invert_finds_the_latent_point_of_a_pose(walk_model):
+    from cyclecoord.synthesis.latent import invert, project
+
+    X = walk_model.X_
+    mid = 0.5 * (X[3:20] + X[4:21])  # between training points: not where any start is
+    target = walk_model.pose(mid)
+    Xi, cost = invert(walk_model, target)
+    err = np.sqrt(((walk_model.pose(Xi) - target) ** 2).mean())
+    spread = np.sqrt(((target - target.mean(0)) ** 2).mean())
+    assert err < 0.05 * spread and np.allclose(cost, ((walk_model.pose(Xi) - target) ** 2).sum(1))
+    # least squares in the angles: no worse than Eq. 15's search in the scaled PCA space
+    noisy = target + np.random.default_rng(0).normal(0, 2.0, target.shape)
+    Xp, _ = project(walk_model, walk_model.pca_coordinates(noisy))
+    Xi, _ = invert(walk_model, noisy)
+    sq = lambda x: ((walk_model.pose(x) - noisy) ** 2).sum()  # noqa: E731
+    assert sq(Xi) <= sq(Xp) + 1e-9
+    with pytest.raises(ParameterError, match="channels"):
+        invert(walk_model, target[:, :5])
+
+
 def test_synthesizer_transition_and_output(walk_model, jog_model):
     syn = Synthesizer({"walk": walk_model, "jog": jog_model}, fps=30, seed=3)
     syn.start("walk")
@@ -201,6 +221,116 @@ def test_synthesizer_transition_and_output(walk_model, jog_model):
     again.transition("jog", blend=0.3)
     again.play("jog", 0.0, 0.5)
     np.testing.assert_array_equal(again.motion().frames, motion.frames)
+
+
+def test_transition_without_bridges_crosses_at_the_closest_poses(walk_model, jog_model):
+    # a threshold no pair can meet: the transition still happens, at the closest pair
+    syn = Synthesizer({"walk": walk_model, "jog": jog_model}, fps=30, seed=1, bridge_threshold=1e-9)
+    syn.start("walk")
+    syn.transition("jog", blend=0.2)
+    (ev,) = syn.events
+    assert ev["route"] == ["walk", "jog"] and ev["under_threshold"] is False
+    c = syn.crossings("walk", "jog")
+    assert ev["bridge_distance"] <= 1.1 * c.distances.min() + 1e-12
+    assert ev["blend_frames"] >= ev["blend_asked_frames"] == 6
+    assert syn.current == "jog" and np.isfinite(syn.motion().frames).all()
+    # the reversed search (jog's training points into walk) is among the crossings
+    assert (c.target_frames >= 0).any() and (c.source_frames >= 0).any()
+
+
+def test_route_prefers_a_chain_of_bridges_to_a_far_jump(walk_model):
+    from cyclecoord.synthesis.latent.commands import Crossings
+
+    syn = Synthesizer({k: walk_model for k in "abc"}, fps=30)
+    x = walk_model.X_[:1]
+
+    def cross(s, t, d):
+        return Crossings(s, t, x, x, np.array([d]), np.array([0]), np.array([0]), 1.0)
+
+    far = {("a", "b"): 3.0, ("a", "c"): 0.5, ("c", "b"): 0.9}
+    for s in "abc":
+        for t in "abc":
+            if s != t:
+                syn._crossings[(s, t)] = cross(s, t, far.get((s, t), 5.0))
+    assert syn.route("a", "b") == ["a", "c", "b"]
+    syn._crossings[("a", "b")] = cross("a", "b", 1.2)  # 1.44 < 2 hops of cost 1
+    assert syn.route("a", "b") == ["a", "b"]
+
+
+def test_blend_lengthens_with_the_pose_gap(walk_model):
+    syn = Synthesizer({"w": walk_model, "v": walk_model}, fps=30)
+    X = walk_model.X_
+    gaps = np.linalg.norm(walk_model.pose(X) - walk_model.pose(X[:1]), axis=1)
+    far = int(np.argmax(gaps))
+    assert syn.blend_frames("w", "v", X[0], X[0]) <= 1
+    assert syn.blend_frames("w", "v", X[0], X[far]) > syn.blend_frames("w", "v", X[0], X[1])
+
+
+def test_root_follows_planted_feet_in_blend_windows(cmu_dir):
+    from cyclecoord.quality.contacts import foot_contacts
+
+    take = cc.load(cmu_dir / "13" / "13_29.amc")
+    fit = dict(gplvm={"max_iter": 40})
+    models = {
+        "jj": LatentModel(**fit).fit([take[0:456:4]], ["JumpJack"]),
+        "tw": LatentModel(**fit).fit([take[456:1200:4]], ["Twist"]),
+    }
+
+    def run(plant, lock=False):
+        syn = Synthesizer(models, fps=30, seed=2, plant=plant, lock=lock)
+        syn.start("jj")
+        syn.idle(duration=0.4)
+        syn.transition("tw", blend=0.4)
+        syn.idle(duration=0.6)
+        return syn, syn.motion()
+
+    syn, planted = run("transitions")
+    _, free = run("off")
+    share = syn.plant_spans(free.n_frames)
+    mask = share > 0
+    assert mask.any() and not mask.all() and share.max() == 1.0
+    assert np.all((share >= 0) & (share <= 1)) and np.abs(np.diff(share)).max() < 0.5
+    cols = [free.channel_index("root", d) for d in ("tx", "tz")]
+    # outside the spans the root takes the same steps; only the ground track changes
+    np.testing.assert_allclose(
+        np.diff(planted.frames[:, cols], axis=0)[~mask],
+        np.diff(free.frames[:, cols], axis=0)[~mask],
+    )
+    other = [i for i in range(free.frames.shape[1]) if i not in cols]
+    np.testing.assert_array_equal(planted.frames[:, other], free.frames[:, other])
+    # feet planted (found on the uncorrected motion, lax speed) slide less in the spans
+    fc = foot_contacts(free, speed=2.0)
+    rows = np.r_[mask, False] | np.r_[False, mask]
+    sel = fc.planted & rows[:, None]
+    assert sel.sum() > 5
+
+    def slide(m):
+        names = m.positions().names
+        pos = m.positions().positions[:, [names.index(f) for f in fc.feet]]
+        return np.linalg.norm(np.gradient(pos[..., [0, 2]], axis=0), axis=2)[sel].mean()
+
+    assert slide(planted) < 0.8 * slide(free)
+
+    def root_acc(m):
+        p = m.positions().positions[:, 0, [0, 2]]
+        return np.linalg.norm(np.diff(p, 2, axis=0), axis=1) * m.fps**2
+
+    # the root following the feet does not shake: within the takes' own accelerations
+    train = np.concatenate(
+        [root_acc(cc.Motion(frames=m.frames_, channels=m.all_channels_, fps=m.fps_,
+                            skeleton=m.skeleton_)) for m in models.values()]
+    )
+    assert root_acc(planted).max() < np.percentile(train, 99)
+    # the optional leg IK changes leg channels only, and only near the spans
+    _, locked = run("transitions", lock=True)
+    changed = np.abs(locked.frames - planted.frames) > 1e-9
+    legs = {"lfemur", "ltibia", "lfoot", "rfemur", "rtibia", "rfoot"}
+    assert changed.any()
+    assert all(locked.channels[i][0] in legs for i in np.flatnonzero(changed.any(axis=0)))
+    near = np.convolve(rows.astype(float), np.ones(9), "same") > 0  # lock easing: 0.1 s
+    assert not changed[~near].any()
+    with pytest.raises(ParameterError, match="plant"):
+        Synthesizer(models, plant="feet")
 
 
 def test_synthesizer_errors(walk_model):

@@ -114,6 +114,7 @@ def test_animate_writes_bvh_and_report_reproducibly(workdir):
             r"commands\[0\] \(IDLE\): unknown key",
         ),
         ({"start": {"model": "ghost"}}, "start: unknown model"),
+        ({"plant": "feet"}, "plant: must be"),
         (
             {"commands": [{"command": "PLAY", "segment": "zz"}]},
             r"commands\[0\] \(PLAY\): model 'walk' has no segment",
@@ -133,6 +134,17 @@ def test_bad_scripts_fail_with_one_line_and_no_output(workdir, capsys, changes, 
 
     assert re.search(message, err[0]), err[0]
     assert not out.exists() and not rep.exists()
+
+
+def test_transition_without_bridges_still_arrives_and_says_how(workdir, capsys):
+    s = _script(workdir, "far.json", bridge_threshold=1e-9)
+    out, rep = workdir / "far.bvh", workdir / "far.json.report"
+    assert main(["animate", str(s), "-o", str(out), "--report", str(rep), "--no-check"]) == 0
+    printed = capsys.readouterr().out
+    assert "TRANSITION walk -> other" in printed and "closest poses" in printed
+    (ev,) = json.loads(rep.read_text())["transitions"]
+    assert ev["under_threshold"] is False and ev["bridge_distance"] > ev["threshold"]
+    assert "skating_fraction" in json.loads(rep.read_text())["foot_skating"]
 
 
 def test_models_of_different_skeletons_cannot_transition(workdir, capsys):

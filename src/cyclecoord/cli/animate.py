@@ -72,6 +72,22 @@ def run(args: argparse.Namespace) -> int:
         "fps), "
         f"{len(report['transitions'])} transitions{speed}"
     )
+    for ev in report["transitions"]:
+        if ev["route"][1:] != ev["transition"][1:] or not ev["under_threshold"]:
+            a, b = ev["transition"]
+            kind = (
+                "over a bridge"
+                if ev["under_threshold"]
+                else f"at the closest poses, {ev['bridge_distance'] / ev['threshold']:.2f}x the "
+                "bridge threshold"
+            )
+            print(
+                f"commands[{ev['command']}] TRANSITION {' -> '.join(ev['route'])}: {a} -> {b} "
+                f"{kind} (pose distance {ev['bridge_distance']:.3g}, blend {ev['blend_frames']} "
+                "frames)"
+            )
+    if report.get("foot_skating"):
+        print(f"foot skating: {report['foot_skating']['skating_fraction']:.0%} of frames")
     if "plausibility" in report:
         pl = report["plausibility"]
         print("plausibility: " + ("clean" if pl["clean"] else "; ".join(pl["notes"])))

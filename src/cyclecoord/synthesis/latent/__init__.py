@@ -6,7 +6,7 @@ steered through a model's latent space (:mod:`.particle`), bridges between model
 (:mod:`.bridges`), commands (:mod:`.commands`) and JSON scripts of them (:mod:`.script`).
 """
 
-from .bridges import Bridges, find_bridges, project
+from .bridges import Bridges, find_bridges, invert, project
 from .commands import CommandGraph, Synthesizer
 from .gplvm import GPLVM
 from .model import LatentModel
@@ -21,6 +21,7 @@ __all__ = [
     "RandomForce",
     "Synthesizer",
     "find_bridges",
+    "invert",
     "project",
     "simulate",
 ]

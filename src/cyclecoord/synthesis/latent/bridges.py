@@ -21,7 +21,14 @@ from ...errors import ParameterError
 from .gplvm import sqdist
 from .influence import pose_points
 
-__all__ = ["DEFAULT_THRESHOLD", "Bridges", "find_bridges", "pose_distance", "project"]
+__all__ = [
+    "DEFAULT_THRESHOLD",
+    "Bridges",
+    "find_bridges",
+    "invert",
+    "pose_distance",
+    "project",
+]
 
 #: Default bridge threshold: RMS joint distance as a fraction of the skeleton's total
 #: bone length (about 1.4 units, 8 cm, on a CMU skeleton).
@@ -85,10 +92,58 @@ def project(
     k_near = max(1, min(n_starts - 1, N))
     near = np.argsort(sqdist(Y, model.Y_), axis=1)[:, :k_near]
     starts = np.concatenate([near, rng.integers(0, N, size=(B, 1))], axis=1)
-    S = starts.shape[1]
+    X, f = _descend(model, Y, model.gp_.alpha_, starts, n_iter, max_step)
+    if every_start:
+        return X, f
+    best = np.argmin(f, axis=1)
+    return X[np.arange(B), best], f[np.arange(B), best]
+
+
+def invert(
+    model, angles: np.ndarray, n_starts: int = 8, n_iter: int = 200, max_step: float = 0.1
+) -> tuple[np.ndarray, np.ndarray]:
+    """Latent points whose pose (Eq. 8's mean) is nearest joint angles, least squares.
+
+    The inverse mapping of frames the model has not seen: :func:`project` measures in
+    the model's influence-scaled PCA space (Eq. 15, what bridges compare), this in the
+    joint angles themselves, as PCA's own projection does, so the two reconstructions
+    are compared on the same footing.  Starts: the training frames whose angles are
+    nearest.
+
+    Parameters
+    ----------
+    model : LatentModel
+    angles : ndarray, shape (B, C)
+        Modelled joint-angle channels, degrees.
+    n_starts, n_iter, max_step
+        As :func:`project`.
+
+    Returns
+    -------
+    X : ndarray, shape (B, q)
+    cost : ndarray, shape (B,)
+        ``||angles - pose(x)||^2``, degrees squared.
+    """
+    A = np.atleast_2d(np.asarray(angles, dtype=float))
+    if A.shape[1] != len(model.channels_):
+        raise ParameterError(
+            f"angles have {A.shape[1]} channels, the model {len(model.channels_)}"
+        )
+    train = model.angles(model.frames_)
+    k = max(1, min(int(n_starts), train.shape[0]))
+    starts = np.argsort(sqdist(A, train), axis=1)[:, :k]
+    X, f = _descend(model, A - model.mean_, model._B, starts, n_iter, max_step)
+    best = np.argmin(f, axis=1)
+    B = A.shape[0]
+    return X[np.arange(B), best], f[np.arange(B), best]
+
+
+def _descend(model, Y, A, starts, n_iter, max_step):
+    """Minimise ``||y - k(x) A||^2`` from training points ``starts`` (B, S) by a batched
+    descent with capped steps; the ends ``(B, S, q)`` and their costs ``(B, S)``."""
+    B, S = starts.shape
     Yr = np.repeat(Y, S, axis=0)
     X = model.X_[starts.reshape(-1)].copy()
-    A = model.gp_.alpha_
     l2 = model.gp_.lengthscale_**2
     cap = max_step * model.gp_.lengthscale_
 
@@ -111,12 +166,7 @@ def project(
         X[ok] += step[ok]
         f[ok], g[ok] = fn[ok], gn[ok]
         eta = np.where(ok, eta * 1.3, eta * 0.5)
-    f = f.reshape(B, S)
-    if every_start:
-        return X.reshape(B, S, -1), f
-    best = np.argmin(f, axis=1)
-    Xb = X.reshape(B, S, -1)[np.arange(B), best]
-    return Xb, f[np.arange(B), best]
+    return X.reshape(B, S, -1), f.reshape(B, S)
 
 
 @dataclass(frozen=True)
@@ -139,6 +189,10 @@ class Bridges:
         Skeleton units.
     best_raw : ndarray, shape (N1,), optional
         Best distance from every source frame before the density filter.
+    best_points, raw_points : ndarray, shape (N1, q), optional
+        The model-2 point of ``best`` (NaN where no start passed the density filter)
+        and of ``best_raw``, so the closest pair can be used when no bridge is under
+        the threshold.
     """
 
     source: str
@@ -150,6 +204,8 @@ class Bridges:
     best: np.ndarray
     threshold: float
     best_raw: np.ndarray | None = None
+    best_points: np.ndarray | None = None
+    raw_points: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.frames.size)
@@ -219,6 +275,7 @@ def find_bridges(
         m1.skeleton_, m1.channels_, np.repeat(pose1, S, axis=0), m2.pose(flat)
     ).reshape(n1, S)
     raw = d_all.min(axis=1)
+    raw_points = XS[np.arange(n1), np.argmin(d_all, axis=1)]
     d_all[(m2.densities(flat) < min_density).reshape(n1, S)] = np.inf
     pick = np.argmin(d_all, axis=1)
     X2 = XS[np.arange(n1), pick]
@@ -234,4 +291,6 @@ def find_bridges(
         best=dist,
         threshold=float(threshold),
         best_raw=raw,
+        best_points=np.where(np.isfinite(dist)[:, None], X2, np.nan),
+        raw_points=raw_points,
     )

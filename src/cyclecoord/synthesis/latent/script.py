@@ -8,6 +8,7 @@ A script is a JSON object::
       "start": {"model": "jumpjack", "at": {"frame": 0}},
       "particle": {"radius": 0.15, "random": 6},
       "bridge_threshold": null,
+      "plant": "transitions", "lock_feet": false,
       "commands": [
         {"command": "IDLE", "duration": 1.5},
         {"command": "MOVE", "to": {"segment": "JumpJack", "time": 2.0}, "path": "graph"},
@@ -32,13 +33,24 @@ from typing import Any
 import numpy as np
 
 from ...errors import CycleCoordError, ParameterError, ParseError
+from ...quality.contacts import skating_report
 from .commands import Synthesizer
 from .model import LatentModel
 from .particle import ParticleParams
 
 __all__ = ["COMMANDS", "TOP_KEYS", "load_script", "run_script"]
 
-TOP_KEYS = {"fps", "seed", "models", "start", "particle", "bridge_threshold", "commands"}
+TOP_KEYS = {
+    "fps",
+    "seed",
+    "models",
+    "start",
+    "particle",
+    "bridge_threshold",
+    "plant",
+    "lock_feet",
+    "commands",
+}
 #: Each command's allowed keys (besides "command").
 COMMANDS = {
     "MOVE": {"to", "path", "duration", "speed", "radius"},
@@ -110,6 +122,10 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
         raise _fail(
             p, "bridge_threshold", f"must be a positive number of skeleton units, got {thr!r}"
         )
+    if spec.get("plant", "transitions") not in ("transitions", "all", "off"):
+        raise _fail(p, "plant", f"must be transitions, all or off, got {spec['plant']!r}")
+    if not isinstance(spec.get("lock_feet", False), bool):
+        raise _fail(p, "lock_feet", f"must be true or false, got {spec['lock_feet']!r}")
     commands = spec.get("commands")
     if not isinstance(commands, list) or not commands:
         raise _fail(p, "commands", "must be a non-empty list")
@@ -155,6 +171,8 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
         seed=int(spec.get("seed", 0)),
         params=params,
         bridge_threshold=spec.get("bridge_threshold"),
+        plant=spec.get("plant", "transitions"),
+        lock=spec.get("lock_feet", False),
     )
     start = spec.get("start", {"model": next(iter(models))})
     t0 = time.perf_counter()
@@ -197,6 +215,7 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
         "commands": syn.segments(),
         "transitions": syn.events,
         "clamped_to_training_range": syn.clamped,
+        "foot_skating": skating_report(motion),
         "bridges": {f"{a}->{b}": br.to_dict() for (a, b), br in syn.bridges_found().items()},
         "timing": {
             "total_s": total,
