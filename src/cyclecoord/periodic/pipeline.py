@@ -45,15 +45,8 @@ __all__ = [
 ]
 
 # the result types live in .results; re-exported here, where they have always been imported
-from .results import (  # noqa: E402
-    MIN_TURNS,
-    TIMINGS,
-    TRAVELS,
-    CycleOptions,
-    ExtractionResult,
-    PartialExtraction,
-    _take_cycle_options,
-)
+from .results import MIN_TURNS, TIMINGS, TRAVELS, CycleOptions, ExtractionResult  # noqa: E402
+from .results import PartialExtraction, _take_cycle_options  # noqa: E402
 
 #: Complete windings varying by more than this (p10-p90 over the median) are not steady.
 MAX_SPREAD = 0.25
