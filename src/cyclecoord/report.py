@@ -16,6 +16,16 @@ from .errors import NoPeriodicMotionError
 __all__ = ["clean", "partial_report", "write_json"]
 
 
+def capture_header(motion: Any) -> dict[str, Any]:
+    """The first keys of every report: the capture's source, frame range, length and rate."""
+    return {
+        "source": motion.source,
+        "frames": [int(motion.start_frame), int(motion.start_frame + motion.n_frames)],
+        "n_frames": int(motion.n_frames),
+        "fps": motion.fps,
+    }
+
+
 def write_json(path: str, payload: dict) -> None:
     """Write ``payload`` as indented strict JSON, atomically (numpy scalars and arrays allowed)."""
     from .io import atomic_write
@@ -57,12 +67,8 @@ def partial_report(exc: NoPeriodicMotionError) -> dict[str, Any]:
     partial = exc.result
     if partial is None:
         return {"selected": None, "error": str(exc)}
-    m = partial.motion
     return {
-        "source": m.source,
-        "frames": [int(m.start_frame), int(m.start_frame + m.n_frames)],
-        "n_frames": int(m.n_frames),
-        "fps": m.fps,
+        **capture_header(partial.motion),
         "dims": int(partial.prepared.points.shape[1]),
         "parameters": partial.parameters,
         "threshold": partial.barcode.threshold,

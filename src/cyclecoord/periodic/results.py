@@ -200,14 +200,10 @@ class ExtractionResult:
 
     def to_report(self) -> dict[str, Any]:
         """JSON-ready summary (see the CLI's ``--report``)."""
+        from ..report import capture_header
+
         return {
-            "source": self.motion.source,
-            "frames": [
-                int(self.motion.start_frame),
-                int(self.motion.start_frame + self.motion.n_frames),
-            ],
-            "n_frames": int(self.motion.n_frames),
-            "fps": self.motion.fps,
+            **capture_header(self.motion),
             "dims": int(self.prepared.points.shape[1]),
             "parameters": self.parameters,
             "threshold": self.barcode.threshold,

@@ -197,14 +197,10 @@ class DetectionResult:
     def to_report(self) -> dict[str, Any]:
         bc = self.barcode.to_dict()
         chosen = {c.index: c.motion for c in self.classes if c.motion >= 0}
+        from ...report import capture_header
+
         return {
-            "source": self.motion.source,
-            "frames": [
-                int(self.motion.start_frame),
-                int(self.motion.start_frame + self.motion.n_frames),
-            ],
-            "n_frames": int(self.motion.n_frames),
-            "fps": self.motion.fps,
+            **capture_header(self.motion),
             "parameters": self.parameters,
             "threshold": self.barcode.threshold,
             "barcode": bc,
