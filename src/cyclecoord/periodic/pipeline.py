@@ -12,6 +12,7 @@ import numbers
 import time
 import warnings
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -335,35 +336,14 @@ def extract(
         random_state=random_state,
     )
     bandwidth = opts["bandwidth"]
-    timings: dict[str, float] = {}
-    notes: list[str] = []
     params = dict(
-        frames=None if frames is None else list(frames),
-        pca=pca,
-        normalize=normalize,
-        temporal=temporal,
-        delay=delay,
-        difference_root=difference_root,
-        root=root,
-        prime=prime,
-        max_scale=max_scale,
-        scale=scale,
-        class_index=class_index,
-        scale_fraction=scale_fraction,
-        n_samples=n_samples,
-        n_neighbors=n_neighbors,
-        bandwidth=bandwidth,
-        weighting=weighting,
-        sampling=sampling,
-        n_components=n_components,
-        cycle_start=cycle_start,
-        landmarks=landmarks,
-        memory_limit=memory_limit,
-        random_state=random_state,
-        steady=steady,
-        timing=timing,
-        travel=travel,
-        min_turns=min_turns,
+        frames=None if frames is None else list(frames), pca=pca, normalize=normalize,
+        temporal=temporal, delay=delay, difference_root=difference_root, root=root, prime=prime,
+        max_scale=max_scale, scale=scale, class_index=class_index, scale_fraction=scale_fraction,
+        n_samples=n_samples, n_neighbors=n_neighbors, bandwidth=bandwidth, weighting=weighting,
+        sampling=sampling, n_components=n_components, cycle_start=cycle_start,
+        landmarks=landmarks, memory_limit=memory_limit, random_state=random_state, steady=steady,
+        timing=timing, travel=travel, min_turns=min_turns,
     )
     motion = motion.window(frames)
     if motion.n_frames < 2 * n_neighbors or motion.n_frames < 10:
@@ -371,73 +351,100 @@ def extract(
             f"{motion.source or 'capture'}: {motion.n_frames} frames are too few to find a cycle "
             f"(need at least {max(10, 2 * n_neighbors)})"
         )
-    T = motion.n_frames
-    t0 = time.perf_counter()
-    lag = int(round(delay * motion.fps)) if delay else None
-    prep = Preprocessor(
-        difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=lag
+    run = _Run(motion, params, require_clear)
+    fit, used = run.fit_steady()
+    return _finish(
+        motion, run.prepared, run.prep, fit, used, run.notes, run.timings, params, run.fail,
+        n_components=n_components, n_samples=n_samples, n_neighbors=n_neighbors,
+        weighting=weighting, sampling=sampling, bandwidth=bandwidth, random_state=random_state,
+        cycle_start=cycle_start, timing=timing, travel=travel, min_turns=min_turns,
     )
-    prepared = prep.fit_transform(motion)
-    joints = joint_columns(motion, prepared)
-    moving = (
-        moving_mask(prepared.poses, motion.fps, columns=joints)
-        if steady
-        else np.ones(T, dtype=bool)
-    )
-    if not steady or moving.sum() >= 0.95 * T or moving.sum() < max(10, 2 * n_neighbors):
-        moving = np.ones(T, dtype=bool)
-    timings["prepare"] = time.perf_counter() - t0
 
-    def make_estimator(first_pass: bool = False) -> CircularCoordinates:
-        lm = landmarks
-        if first_pass and isinstance(landmarks, str) and landmarks == "auto":
+
+class _Run:
+    """One extraction's fitting steps on a windowed capture: preparation, the barcode and
+    coordinate on some rows, the steady frames.  ``params`` are :func:`extract`'s (checked).
+    """
+
+    def __init__(self, motion: Motion, params: dict[str, Any], require_clear: bool) -> None:
+        self.motion, self.p, self.require_clear = motion, params, require_clear
+        self.T = motion.n_frames
+        self.timings: dict[str, float] = {}
+        self.notes: list[str] = []
+        t0 = time.perf_counter()
+        p = params
+        lag = int(round(p["delay"] * motion.fps)) if p["delay"] else None
+        self.prep = Preprocessor(difference_root=p["difference_root"], normalize=p["normalize"],
+                                 pca=p["pca"], root=p["root"], delay=lag)
+        self.prepared = self.prep.fit_transform(motion)
+        self.joints = joint_columns(motion, self.prepared)
+        T, steady = self.T, p["steady"]
+        moving = (
+            moving_mask(self.prepared.poses, motion.fps, columns=self.joints)
+            if steady
+            else np.ones(T, dtype=bool)
+        )
+        if not steady or moving.sum() >= 0.95 * T or moving.sum() < max(10, 2 * p["n_neighbors"]):
+            moving = np.ones(T, dtype=bool)
+        self.moving = moving
+        self.timings["prepare"] = time.perf_counter() - t0
+
+    def make_estimator(self, first_pass: bool = False) -> CircularCoordinates:
+        p = self.p
+        lm = p["landmarks"]
+        if first_pass and isinstance(lm, str) and lm == "auto":
             lm = FIRST_PASS_LANDMARKS
         return CircularCoordinates(
-            max_scale=max_scale,
-            scale=scale,
-            class_index=class_index,
-            prime=prime,
-            scale_fraction=scale_fraction,
-            temporal=temporal,
-            landmarks=lm,
-            refine_birth=False,
-            memory_limit=memory_limit,
-            memory_reserved=8.0
-            * max(0, prepared.poses.size - prepared.points.size),  # poses beyond the points
+            max_scale=p["max_scale"], scale=p["scale"], class_index=p["class_index"],
+            prime=p["prime"], scale_fraction=p["scale_fraction"], temporal=p["temporal"],
+            landmarks=lm, refine_birth=False, memory_limit=p["memory_limit"],
+            # poses beyond the points
+            memory_reserved=8.0 * max(0, self.prepared.poses.size - self.prepared.points.size),
         )
 
     def fail(
-        msg: str, fit: _Fit | None = None, barcode: Barcode | None = None
+        self, msg: str, fit: _Fit | None = None, barcode: Barcode | None = None
     ) -> NoPeriodicMotionError:
         partial = PartialExtraction(
-            motion=motion,
-            prepared=prepared,
+            motion=self.motion,
+            prepared=self.prepared,
             reason=msg,
             barcode=barcode if fit is None else fit.barcode,
             selection=None if fit is None else fit.selection,
-            timings=timings,
-            parameters=params,
-            warnings=notes,
+            timings=self.timings,
+            parameters=self.p,
+            warnings=self.notes,
             estimator=None if fit is None else fit.est,
-            preprocessor=prep,
+            preprocessor=self.prep,
         )
-        where = motion.source or "capture"
+        where = self.motion.source or "capture"
         return NoPeriodicMotionError(f"{where}: {msg}", result=partial)
 
-    def fit_rows(rows: np.ndarray, stage: str, first_pass: bool = False) -> _Fit:
-        est = make_estimator(first_pass)
+    def coordinate_of(self, est: CircularCoordinates, rows: np.ndarray) -> _Fit:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            est.fit_coordinate()
+        u = _unwrap_runs(est.coordinates_, rows, _row_runs(rows), self.T)
+        return _Fit(est=est, barcode=est.barcode_, selection=est.selection_, rows=rows,
+                    unwrapped=u, notes=[str(w.message) for w in caught])
+
+    def fit_rows(self, rows: np.ndarray, stage: str, first_pass: bool = False) -> _Fit:
+        """Barcode and coordinate on ``rows``; refuses a barcode with no clear bar."""
+        p = self.p
+        class_index, scale = p["class_index"], p["scale"]
+        est = self.make_estimator(first_pass)
         t0 = time.perf_counter()
         barcode, sel = _first_clear(
-            est, _rows_of(prepared.points, rows), class_index, scale, scale_fraction
+            est, _rows_of(self.prepared.points, rows), class_index, scale, p["scale_fraction"]
         )
-        timings[f"barcode{stage}"] = time.perf_counter() - t0
+        self.timings[f"barcode{stage}"] = time.perf_counter() - t0
         if sel is None:
             if len(barcode.h1) and class_index >= len(barcode.h1):
                 raise ParameterError(
                     f"class index {class_index} out of range: the barcode has {len(barcode.h1)} "
                     "H1 bars"
                 )
-            raise fail(
+            raise self.fail(
                 "no periodic motion found: the barcode has no H1 bar up to scale "
                 f"{barcode.threshold:.4g}",
                 barcode=barcode,
@@ -446,143 +453,122 @@ def extract(
         # loops) is judged by its coordinate's windings instead (see _finish)
         gap_only = sel.ratio >= CLEAR_RATIO and sel.gap < CLEAR_GAP and (
             barcode.persistence(1)[sel.index] >= CLEAR_MIN_FRACTION * barcode.threshold)
-        if require_clear and not sel.clear and not first_pass and not gap_only:
-            raise fail(f"no periodic motion found: {_not_clear_reason(sel, barcode)}; "
-                       "try --max-scale, --pca or --frames", barcode=barcode)
+        if self.require_clear and not sel.clear and not first_pass and not gap_only:
+            raise self.fail(f"no periodic motion found: {_not_clear_reason(sel, barcode)}; "
+                            "try --max-scale, --pca or --frames", barcode=barcode)
         t0 = time.perf_counter()
-        fit = coordinate_of(est, sel, rows)
+        fit = self.coordinate_of(est, rows)
         if class_index == 0 and scale is None and len(barcode.h1) > 1:
-            # the most persistent class of a long take can be a loop of the whole take (a
-            # circuit, a drift); a later clear class that winds regularly is the motion's
-            wind = complete_windings(fit.unwrapped, _row_runs(rows))
-            j = 1
-            while (wind.turns < min_turns or not wind.spread <= MAX_SPREAD) and j < min(
-                4, len(barcode.h1)
-            ):
-                other = select_bar(barcode, j, None, scale_fraction)
-                if other.ratio >= CLEAR_RATIO:
-                    alt_est = est.with_coordinate_params(class_index=j)
-                    try:
-                        alt = coordinate_of(alt_est, other, rows)
-                    except ParameterError:
-                        alt = None
-                    alt_wind = (
-                        complete_windings(alt.unwrapped, _row_runs(rows))
-                        if alt is not None
-                        else None
-                    )
-                    if (
-                        alt_wind is not None
-                        and alt_wind.turns >= min_turns
-                        and alt_wind.spread <= MAX_SPREAD
-                    ):
-                        alt.notes.append(
-                            f"H1 class #{j} chosen: the most persistent class turns "
-                            f"{wind.turns:.2f} times over "
-                            f"the frames (spread {wind.spread:.0%}), class #{j} "
-                            f"{alt_wind.turns:.2f} times, regularly"
-                        )
-                        fit, wind = alt, alt_wind
-                        break
-                j += 1
-        if not first_pass and fit.est.landmarks_ is not None and not temporal:
-            # the class's birth on every frame, for the report (landmarks are born later)
-            budget = getattr(fit.est, "memory_budget_", None)
-            max_edges = (
-                3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
-            )
-            full = (
-                refine_birth(
-                    _rows_of(prepared.points, rows),
-                    fit.selection.birth,
-                    fit.est.prime_,
-                    max_edges=max_edges,
-                    covering_radius=fit.est.covering_radius_,
-                    coordinate=fit.est.coordinates_,
-                )
-                if max_edges > 0
-                else None
-            )
-            fit.selection = BarSelection(**{**fit.selection.__dict__, "full_birth": full})
-            fit.est.selection_ = fit.selection
-        timings[f"coordinate{stage}"] = time.perf_counter() - t0
-        fit.weak_gap = bool(require_clear and not fit.selection.clear)
+            fit = self._other_class(fit, est, barcode, rows)
+        if not first_pass and fit.est.landmarks_ is not None and not p["temporal"]:
+            self._refine_birth(fit, rows)
+        self.timings[f"coordinate{stage}"] = time.perf_counter() - t0
+        fit.weak_gap = bool(self.require_clear and not fit.selection.clear)
         return fit
 
-    def coordinate_of(est: CircularCoordinates, sel: BarSelection, rows: np.ndarray) -> _Fit:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            est.fit_coordinate()
-        runs = _row_runs(rows)
-        u = _unwrap_runs(est.coordinates_, rows, runs, T)
-        return _Fit(est=est, barcode=est.barcode_, selection=est.selection_, rows=rows, unwrapped=u,
-                    notes=[str(w.message) for w in caught])
+    def _other_class(self, fit: _Fit, est: CircularCoordinates, barcode: Barcode,
+                     rows: np.ndarray) -> _Fit:
+        """The most persistent class of a long take can be a loop of the whole take (a
+        circuit, a drift); a later clear class that winds regularly is the motion's."""
+        min_turns = self.p["min_turns"]
+        wind = complete_windings(fit.unwrapped, _row_runs(rows))
+        j = 1
+        while (wind.turns < min_turns or not wind.spread <= MAX_SPREAD) and j < min(
+            4, len(barcode.h1)
+        ):
+            other = select_bar(barcode, j, None, self.p["scale_fraction"])
+            if other.ratio >= CLEAR_RATIO:
+                try:
+                    alt = self.coordinate_of(est.with_coordinate_params(class_index=j), rows)
+                except ParameterError:
+                    alt = None
+                alt_wind = (
+                    complete_windings(alt.unwrapped, _row_runs(rows)) if alt is not None else None
+                )
+                if alt_wind is not None and alt_wind.turns >= min_turns and (
+                    alt_wind.spread <= MAX_SPREAD
+                ):
+                    alt.notes.append(
+                        f"H1 class #{j} chosen: the most persistent class turns "
+                        f"{wind.turns:.2f} times over the frames (spread {wind.spread:.0%}), "
+                        f"class #{j} {alt_wind.turns:.2f} times, regularly"
+                    )
+                    return alt
+            j += 1
+        return fit
 
-    rows = np.flatnonzero(moving)
-    # a long take is first read on a few landmarks: enough to find its steady frames
-    rough = steady and rows.size > FIRST_PASS_LANDMARKS * 2
-    fit = fit_rows(rows, " (first pass)" if steady else "", first_pass=rough)
-    used = moving
-    if steady:
-        t0 = time.perf_counter()
-        first = complete_windings(fit.unwrapped, stretches(moving))
-        if np.isfinite(first.period_frames):
-            used = _steady_frames(
-                motion, prepared, joints, fit.unwrapped, moving, first.period_frames
-            )
-        if used.sum() >= 0.95 * moving.sum():
-            used = moving
-        refit = rough or used.sum() < moving.sum()
-        first_pass = [timings.pop(k) for k in ("barcode (first pass)", "coordinate (first pass)")]
-        # stages: "steady" is the time spent finding the steady frames (a first pass when
-        # the coordinate is fitted again on them); "barcode" and "coordinate" the final fit
-        timings["steady"] = time.perf_counter() - t0 + (sum(first_pass) if refit else 0.0)
-        if not refit:
-            timings["barcode"], timings["coordinate"] = first_pass
-        if first.turns < min_turns:
-            raise fail(_too_few_turns(first.turns, int(moving.sum()), min_turns), fit)
-        if not used.any():
-            raise fail(
-                "no periodic motion found: no stretch of the take repeats steadily for a whole "
-                "period "
-                f"(the coordinate turns {first.turns:.2f} times over the moving frames); "
-                "check the coordinate figure (--plot), or try --no-steady or --frames",
-                fit,
-            )
-        if refit:
-            fit = fit_rows(np.flatnonzero(used), "")
-    notes.extend(fit.notes)
-    other = int(moving.sum() - (used & moving).sum())
-    if steady and other > 0.5 * moving.sum():
-        # most of the moving frames are not this motion: a routine of several exercises,
-        # or a dance whose one steady figure is not the take
-        notes.append(
-            f"only {int(used.sum())} of the take's {int(moving.sum())} moving frames repeat this "
-            "motion steadily; the rest may be other motions: `cyclecoord detect` finds each "
-            "motion of a take that holds several"
+    def _refine_birth(self, fit: _Fit, rows: np.ndarray) -> None:
+        """The class's birth on every frame, for the report (landmarks are born later)."""
+        budget = getattr(fit.est, "memory_budget_", None)
+        max_edges = (
+            3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
         )
-    return _finish(
-        motion,
-        prepared,
-        prep,
-        fit,
-        used,
-        notes,
-        timings,
-        params,
-        fail,
-        n_components=n_components,
-        n_samples=n_samples,
-        n_neighbors=n_neighbors,
-        weighting=weighting,
-        sampling=sampling,
-        bandwidth=bandwidth,
-        random_state=random_state,
-        cycle_start=cycle_start,
-        timing=timing,
-        travel=travel,
-        min_turns=min_turns,
-    )
+        full = (
+            refine_birth(
+                _rows_of(self.prepared.points, rows),
+                fit.selection.birth,
+                fit.est.prime_,
+                max_edges=max_edges,
+                covering_radius=fit.est.covering_radius_,
+                coordinate=fit.est.coordinates_,
+            )
+            if max_edges > 0
+            else None
+        )
+        fit.selection = BarSelection(**{**fit.selection.__dict__, "full_birth": full})
+        fit.est.selection_ = fit.selection
+
+    def fit_steady(self) -> tuple[_Fit, np.ndarray]:
+        """The coordinate fitted on the take's steady frames, and those frames.
+
+        A long take is first read on a few landmarks (enough to find its steady frames);
+        the coordinate is fitted again on the steady frames when they are not all the
+        moving frames.
+        """
+        steady, moving, timings = self.p["steady"], self.moving, self.timings
+        min_turns = self.p["min_turns"]
+        rows = np.flatnonzero(moving)
+        rough = steady and rows.size > FIRST_PASS_LANDMARKS * 2
+        fit = self.fit_rows(rows, " (first pass)" if steady else "", first_pass=rough)
+        used = moving
+        if steady:
+            t0 = time.perf_counter()
+            first = complete_windings(fit.unwrapped, stretches(moving))
+            if np.isfinite(first.period_frames):
+                used = _steady_frames(self.motion, self.prepared, self.joints, fit.unwrapped,
+                                      moving, first.period_frames)
+            if used.sum() >= 0.95 * moving.sum():
+                used = moving
+            refit = rough or used.sum() < moving.sum()
+            first_pass = [
+                timings.pop(k) for k in ("barcode (first pass)", "coordinate (first pass)")
+            ]
+            # stages: "steady" is the time spent finding the steady frames (a first pass when
+            # the coordinate is fitted again on them); "barcode" and "coordinate" the final fit
+            timings["steady"] = time.perf_counter() - t0 + (sum(first_pass) if refit else 0.0)
+            if not refit:
+                timings["barcode"], timings["coordinate"] = first_pass
+            if first.turns < min_turns:
+                raise self.fail(_too_few_turns(first.turns, int(moving.sum()), min_turns), fit)
+            if not used.any():
+                raise self.fail(
+                    "no periodic motion found: no stretch of the take repeats steadily for a "
+                    f"whole period (the coordinate turns {first.turns:.2f} times over the moving "
+                    "frames); check the coordinate figure (--plot), or try --no-steady or --frames",
+                    fit,
+                )
+            if refit:
+                fit = self.fit_rows(np.flatnonzero(used), "")
+        self.notes.extend(fit.notes)
+        if steady and moving.sum() - (used & moving).sum() > 0.5 * moving.sum():
+            # most of the moving frames are not this motion: a routine of several exercises,
+            # or a dance whose one steady figure is not the take
+            self.notes.append(
+                f"only {int(used.sum())} of the take's {int(moving.sum())} moving frames repeat "
+                "this motion steadily; the rest may be other motions: `cyclecoord detect` finds "
+                "each motion of a take that holds several"
+            )
+        return fit, used
 
 
 def _rows_of(x: np.ndarray, rows: np.ndarray) -> np.ndarray:
