@@ -38,7 +38,7 @@ from .preprocess import Preprocessor
 from .clip import capture_cycle, joint_columns, loop_cycle
 from .root import heading, root_layout
 from .steady import moving_mask, period_speed, recurrence, steady_mask
-from .windings import complete_windings, retime, stretches
+from .windings import Windings, complete_windings, retime, stretches
 
 __all__ = [
     "extract", "ExtractionResult", "PartialExtraction", "CycleOptions", "cycle_lengths",
@@ -655,39 +655,7 @@ def _finish(
     T = motion.n_frames
     runs = stretches(used)
     u = np.where(used, fit.unwrapped, np.nan)
-    wind = complete_windings(u, runs)
-    if wind.turns < o["min_turns"]:
-        raise fail(_too_few_turns(wind.turns, int(used.sum()), o["min_turns"]), fit)
-    if fit.weak_gap:
-        if wind.spread > MAX_SPREAD or not np.isfinite(wind.period_frames):
-            raise fail(
-                f"no periodic motion found: {_not_clear_reason(fit.selection, fit.barcode)}, and "
-                "its coordinate "
-                f"winds irregularly (complete windings spread {wind.spread:.0%} of the period); "
-                "try --max-scale, --pca or --frames",
-                fit,
-            )
-        notes.append(
-            f"the H1 bar stands only {fit.selection.gap:.2f}x the next bar's persistence (under "
-            f"{CLEAR_GAP}x); "
-            f"accepted because its coordinate winds {wind.turns:.1f} times, regularly (spread "
-            f"{wind.spread:.0%})"
-        )
-    period = wind.period_frames
-    if not np.isfinite(period):
-        period = float(np.sum(used) - len(runs)) / wind.turns
-    if wind.spread > MAX_SPREAD:
-        notes.append(
-            f"the complete windings vary by {wind.spread:.0%} of the period (p10-p90); the motion "
-            "is not "
-            "steady: use --frames to pick one steady stretch, or check the coordinate figure"
-        )
-    if fit.est.n_components_ > 1:
-        notes.append(
-            f"the complex at scale {fit.selection.scale:.4g} has {fit.est.n_components_} "
-            "connected components: "
-            "frames in different components get unrelated coordinates; raise --max-scale or --scale"
-        )
+    wind, period = _windings(fit, used, u, runs, notes, fail, o["min_turns"])
     theta = np.full(T, np.nan)
     theta[fit.rows] = fit.est.coordinates_
     theta[~used] = np.nan
@@ -698,56 +666,12 @@ def _finish(
     )
     timings["density"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    phase = np.full(T, np.nan)
-    heading_change = float("nan")
-    if o["timing"] == "coordinate":
-        k = min(o["n_neighbors"], rows.size)
-        typ = typical_cycle(
-            theta[rows],
-            prepared.poses[rows],
-            period,
-            density=density,
-            n_samples=o["n_samples"],
-            k=k,
-            weighting=o["weighting"],
-            sampling=o["sampling"],
-            random_state=o["random_state"],
-            bandwidth=o["bandwidth"],
-        )
-        typ, cycle_motion = loop_cycle(
-            typ, motion, prepared, prep, cycle_start=o["cycle_start"], rows=rows,
-            metadata={"period_frames": period, "cycles_in_source": wind.turns},
-        )
-    else:
-        phase = retime(u, runs, wind)
-        typ, cycle_motion, heading_change = capture_cycle(
-            phase,
-            motion,
-            prepared,
-            prep,
-            period,
-            bandwidth=o["bandwidth"],
-            cycle_start=o["cycle_start"],
-            travel=o["travel"],
-            k=o["n_neighbors"],
-            metadata={"period_frames": period, "cycles_in_source": wind.turns},
-        )
+    typ, cycle_motion, phase, heading_change = _make_cycle(
+        motion, prepared, prep, theta, rows, u, runs, wind, period, density, o
+    )
     timings["cycle"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    fps = motion.fps
-    jerk = {
-        "original": _run_jerk(prepared.poses, runs, fps),
-        "cycle": float(jerk_summary(typ.frames, fps, cyclic=True)),
-    }
-    closure = float(loop_closure(typ.frames))
-    dist = distance_to_cycle(_rows_of(prepared.poses, rows), typ.frames)
-    step = np.concatenate([frame_steps(prepared.poses[a:b]) for a, b in runs])
-    distance = {
-        "median": float(np.median(dist)),
-        "p90": float(np.percentile(dist, 90)),
-        "max": float(np.max(dist)),
-        "median_frame_step": float(np.median(step)) if step.size else float("nan"),
-    }
+    jerk, closure, distance = _cycle_figures(prepared, typ, runs, rows, motion.fps)
     timings["metrics"] = time.perf_counter() - t0
     timings["total"] = sum(v for k, v in timings.items())
     return ExtractionResult(
@@ -778,3 +702,98 @@ def _finish(
     )
 
 
+def _windings(fit, used, u, runs, notes, fail, min_turns) -> tuple[Windings, float]:
+    """The complete windings on the used frames and the period; refuses too few turns and a
+    bar clear only but for its gap whose coordinate winds irregularly."""
+    wind = complete_windings(u, runs)
+    if wind.turns < min_turns:
+        raise fail(_too_few_turns(wind.turns, int(used.sum()), min_turns), fit)
+    if fit.weak_gap:
+        if wind.spread > MAX_SPREAD or not np.isfinite(wind.period_frames):
+            raise fail(
+                f"no periodic motion found: {_not_clear_reason(fit.selection, fit.barcode)}, and "
+                "its coordinate "
+                f"winds irregularly (complete windings spread {wind.spread:.0%} of the period); "
+                "try --max-scale, --pca or --frames",
+                fit,
+            )
+        notes.append(
+            f"the H1 bar stands only {fit.selection.gap:.2f}x the next bar's persistence (under "
+            f"{CLEAR_GAP}x); "
+            f"accepted because its coordinate winds {wind.turns:.1f} times, regularly (spread "
+            f"{wind.spread:.0%})"
+        )
+    period = wind.period_frames
+    if not np.isfinite(period):
+        period = float(np.sum(used) - len(runs)) / wind.turns
+    if wind.spread > MAX_SPREAD:
+        notes.append(
+            f"the complete windings vary by {wind.spread:.0%} of the period (p10-p90); the motion "
+            "is not "
+            "steady: use --frames to pick one steady stretch, or check the coordinate figure"
+        )
+    if fit.est.n_components_ > 1:
+        notes.append(
+            f"the complex at scale {fit.selection.scale:.4g} has {fit.est.n_components_} "
+            "connected components: "
+            "frames in different components get unrelated coordinates; raise --max-scale or --scale"
+        )
+    return wind, period
+
+
+def _make_cycle(motion, prepared, prep, theta, rows, u, runs, wind, period, density, o):
+    """The typical cycle and its clip, timed by the capture (default) or the coordinate;
+    also the re-timed phase per frame and the heading change per cycle."""
+    phase = np.full(motion.n_frames, np.nan)
+    heading_change = float("nan")
+    meta = {"period_frames": period, "cycles_in_source": wind.turns}
+    if o["timing"] == "coordinate":
+        typ = typical_cycle(
+            theta[rows],
+            prepared.poses[rows],
+            period,
+            density=density,
+            n_samples=o["n_samples"],
+            k=min(o["n_neighbors"], rows.size),
+            weighting=o["weighting"],
+            sampling=o["sampling"],
+            random_state=o["random_state"],
+            bandwidth=o["bandwidth"],
+        )
+        typ, cycle_motion = loop_cycle(
+            typ, motion, prepared, prep, cycle_start=o["cycle_start"], rows=rows, metadata=meta
+        )
+    else:
+        phase = retime(u, runs, wind)
+        typ, cycle_motion, heading_change = capture_cycle(
+            phase,
+            motion,
+            prepared,
+            prep,
+            period,
+            bandwidth=o["bandwidth"],
+            cycle_start=o["cycle_start"],
+            travel=o["travel"],
+            k=o["n_neighbors"],
+            metadata=meta,
+        )
+    return typ, cycle_motion, phase, heading_change
+
+
+def _cycle_figures(prepared, typ, runs, rows, fps) -> tuple[dict, float, dict]:
+    """Jerk (capture and cycle), loop closure and the distance of the used frames to the
+    cycle."""
+    jerk = {
+        "original": _run_jerk(prepared.poses, runs, fps),
+        "cycle": float(jerk_summary(typ.frames, fps, cyclic=True)),
+    }
+    closure = float(loop_closure(typ.frames))
+    dist = distance_to_cycle(_rows_of(prepared.poses, rows), typ.frames)
+    step = np.concatenate([frame_steps(prepared.poses[a:b]) for a, b in runs])
+    distance = {
+        "median": float(np.median(dist)),
+        "p90": float(np.percentile(dist, 90)),
+        "max": float(np.max(dist)),
+        "median_frame_step": float(np.median(step)) if step.size else float("nan"),
+    }
+    return jerk, closure, distance
