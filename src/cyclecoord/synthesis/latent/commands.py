@@ -25,6 +25,7 @@ import numpy as np
 from ...errors import ParameterError
 from ...motion import Motion
 from .bridges import Bridges, check_compatible, find_bridges
+from .easing import eased, resample, smootherstep, smoothstep
 from .gplvm import sqdist
 from .influence import pose_points
 from .model import LatentModel, heading_matrix
@@ -84,44 +85,6 @@ class Crossings:
     source_frames: np.ndarray
     target_frames: np.ndarray
     threshold: float
-
-
-def smootherstep(n: int) -> np.ndarray:
-    """Quintic blend weights ``6u^5 - 15u^4 + 10u^3`` over ``n`` frames (ends excluded): zero
-    velocity and acceleration at both ends, so a blend adds no jump in acceleration."""
-    u = (np.arange(n) + 1.0) / (n + 1.0)
-    return u * u * u * (u * (6.0 * u - 15.0) + 10.0)
-
-
-def smoothstep(n: int) -> np.ndarray:
-    """Blend weights rising smoothly from 0 to 1 over ``n`` frames (ends excluded)."""
-    u = (np.arange(n) + 1.0) / (n + 1.0)
-    return u * u * (3.0 - 2.0 * u)
-
-
-def eased(n: int, ramp: int) -> np.ndarray:
-    """Arc-length fractions ``(n + 1,)`` from 0 to 1: constant speed with smooth starts and
-    stops over ``ramp`` frames (speed rising as a smoothstep), so a MOVE does not jerk the
-    particle into motion or stop it dead."""
-    k = np.arange(n, dtype=float) + 0.5
-    r = max(1e-9, min(float(ramp), n / 2.0))
-    rise = np.clip(k / r, 0, 1)
-    fall = np.clip((n - k) / r, 0, 1)
-    v = np.minimum(rise * rise * (3 - 2 * rise), fall * fall * (3 - 2 * fall))
-    c = np.concatenate([[0.0], np.cumsum(v)])
-    return c / c[-1]
-
-
-def resample(points: np.ndarray, step: float) -> np.ndarray:
-    """A polyline ``(M, q)`` resampled at constant arc length ``step``; ends kept."""
-    seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    s = np.concatenate([[0.0], np.cumsum(seg)])
-    total = s[-1]
-    if total <= 1e-12:
-        return points[:1].copy()
-    n = max(1, int(np.ceil(total / step)))
-    u = np.linspace(0.0, total, n + 1)
-    return np.stack([np.interp(u, s, points[:, k]) for k in range(points.shape[1])], axis=1)
 
 
 class CommandGraph:
