@@ -111,3 +111,21 @@ def test_cycle_options_as_one_object():
     assert [c.motion for c in kw] == [c.motion for c in ob]
     for x, y in zip(kw, ob):
         np.testing.assert_array_equal(x.cycle.frames, y.cycle.frames)
+
+
+def test_extract_takes_a_configured_preprocessor_and_estimator():
+    m = cc.datasets.example_capture().motion
+    pre, est = cc.Preprocessor(pca=5), cc.CircularCoordinates(max_scale=30.0, prime=31)
+    before = est.get_params()
+    a = cc.extract(m, pca=5, delay=None, max_scale=30.0, prime=31)
+    b = cc.extract(m, preprocessor=pre, estimator=est)
+    np.testing.assert_array_equal(a.cycle.frames, b.cycle.frames)
+    assert b.parameters["pca"] == 5 and b.parameters["max_scale"] == 30.0
+    assert b.parameters["prime"] == 31 and b.parameters["delay"] is None
+    # neither object is fitted or changed
+    assert not hasattr(pre, "root_columns_") and not hasattr(est, "barcode_")
+    assert est.get_params() == before
+    with pytest.raises(ParameterError, match="pca either as keyword"):
+        cc.extract(m, pca=3, preprocessor=pre)
+    with pytest.raises(ParameterError, match="estimator must be a CircularCoordinates"):
+        cc.extract(m, estimator=pre)

@@ -195,6 +195,8 @@ def extract(
     travel: str = "keep",
     min_turns: float = MIN_TURNS,
     cycle: CycleOptions | None = None,
+    preprocessor: Preprocessor | None = None,
+    estimator: CircularCoordinates | None = None,
 ) -> ExtractionResult:
     """Find the dominant periodic motion of a capture and its typical cycle.
 
@@ -275,6 +277,14 @@ def extract(
     cycle : CycleOptions, optional
         The cycle's options as one object (timing, travel, bandwidth, cycle_start,
         n_samples, n_neighbors, weighting, sampling, min_turns), instead of keywords.
+    preprocessor : Preprocessor, optional
+        A configured (not necessarily fitted) :class:`Preprocessor` whose parameters
+        (difference_root, normalize, pca, root, delay in frames) replace the keywords of
+        the same meaning; its delay is used as given (no automatic retry).
+    estimator : CircularCoordinates, optional
+        A configured :class:`CircularCoordinates` whose parameters (max_scale, scale,
+        class_index, prime, scale_fraction, temporal, landmarks, memory_limit) replace
+        the keywords of the same names.  Neither object is fitted or changed.
 
     Returns
     -------
@@ -288,6 +298,15 @@ def extract(
     ParameterError
         For invalid arguments.
     """
+    if preprocessor is not None or estimator is not None:
+        chosen = _configured(motion, preprocessor, estimator, dict(
+            difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=delay,
+            max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
+            scale_fraction=scale_fraction, temporal=temporal, landmarks=landmarks,
+            memory_limit=memory_limit))
+        options = {k: v for k, v in locals().items() if k not in (
+            "motion", "frames", "preprocessor", "estimator", "chosen", *chosen)}
+        return extract(motion, frames=frames, **options, **chosen)
     if cycle is not None:
         given = dict(timing=timing, travel=travel, bandwidth=bandwidth, cycle_start=cycle_start,
                      n_samples=n_samples, n_neighbors=n_neighbors, weighting=weighting,
@@ -359,6 +378,47 @@ def extract(
         weighting=weighting, sampling=sampling, bandwidth=bandwidth, random_state=random_state,
         cycle_start=cycle_start, timing=timing, travel=travel, min_turns=min_turns,
     )
+
+
+#: extract's defaults for the settings a Preprocessor or CircularCoordinates can carry.
+_CONFIGURED_DEFAULTS = dict(
+    difference_root=True, normalize=False, pca=None, root="body", delay="auto",
+    max_scale=None, scale=None, class_index=0, prime=DEFAULT_PRIME, scale_fraction=0.9,
+    temporal=False, landmarks="auto", memory_limit=None,
+)
+
+
+def _configured(motion, preprocessor, estimator, given: dict[str, Any]) -> dict[str, Any]:
+    """extract's keywords from configured objects; a keyword changed from its default
+    beside the object that carries it is an error."""
+    chosen: dict[str, Any] = {}
+    if preprocessor is not None:
+        if not isinstance(preprocessor, Preprocessor):
+            raise ParameterError(
+                f"extract(): preprocessor must be a Preprocessor, got {type(preprocessor).__name__}"
+            )
+        lag = preprocessor.delay
+        fps = getattr(motion, "fps", None) or 1.0
+        chosen.update(difference_root=preprocessor.difference_root,
+                      normalize=preprocessor.normalize, pca=preprocessor.pca,
+                      root=preprocessor.root, delay=None if not lag else float(lag) / fps)
+    if estimator is not None:
+        if not isinstance(estimator, CircularCoordinates):
+            raise ParameterError(
+                "extract(): estimator must be a CircularCoordinates, got "
+                f"{type(estimator).__name__}"
+            )
+        params = estimator.get_params()
+        chosen.update({k: params[k] for k in (
+            "max_scale", "scale", "class_index", "prime", "scale_fraction", "temporal",
+            "landmarks", "memory_limit")})
+    clash = [k for k in chosen if given[k] != _CONFIGURED_DEFAULTS[k]]
+    if clash:
+        raise ParameterError(
+            f"extract(): give {', '.join(clash)} either as keyword(s) or in the configured "
+            "preprocessor/estimator, not both"
+        )
+    return chosen
 
 
 class _Run:
