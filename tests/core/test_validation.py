@@ -129,3 +129,14 @@ def test_extract_takes_a_configured_preprocessor_and_estimator():
         cc.extract(m, pca=3, preprocessor=pre)
     with pytest.raises(ParameterError, match="estimator must be a CircularCoordinates"):
         cc.extract(m, estimator=pre)
+
+
+def test_detect_takes_configured_objects_too():
+    chain = cc.datasets.make_motion_chain(random_state=0).motion
+    a = cc.detect(chain, pca=8, delay=None, max_scale=None, progress=False)
+    b = cc.detect(chain, preprocessor=cc.Preprocessor(pca=8), progress=False,
+                  estimator=cc.CircularCoordinates())
+    np.testing.assert_array_equal(a.labels, b.labels)
+    assert b.parameters["pca"] == 8 and b.parameters["delay"] is None
+    with pytest.raises(ParameterError, match="detect\\(\\): give pca"):
+        cc.detect(chain, pca=3, preprocessor=cc.Preprocessor(pca=8), progress=False)

@@ -388,14 +388,22 @@ _CONFIGURED_DEFAULTS = dict(
 )
 
 
-def _configured(motion, preprocessor, estimator, given: dict[str, Any]) -> dict[str, Any]:
-    """extract's keywords from configured objects; a keyword changed from its default
-    beside the object that carries it is an error."""
+def _configured(
+    motion,
+    preprocessor,
+    estimator,
+    given: dict[str, Any],
+    defaults: dict[str, Any] = _CONFIGURED_DEFAULTS,
+    where: str = "extract()",
+) -> dict[str, Any]:
+    """Keywords of ``where`` (extract or detect) from configured objects; a keyword changed
+    from its default beside the object that carries it is an error.  Only the estimator's
+    parameters named in ``given`` are taken."""
     chosen: dict[str, Any] = {}
     if preprocessor is not None:
         if not isinstance(preprocessor, Preprocessor):
             raise ParameterError(
-                f"extract(): preprocessor must be a Preprocessor, got {type(preprocessor).__name__}"
+                f"{where}: preprocessor must be a Preprocessor, got {type(preprocessor).__name__}"
             )
         lag = preprocessor.delay
         fps = getattr(motion, "fps", None) or 1.0
@@ -405,17 +413,18 @@ def _configured(motion, preprocessor, estimator, given: dict[str, Any]) -> dict[
     if estimator is not None:
         if not isinstance(estimator, CircularCoordinates):
             raise ParameterError(
-                "extract(): estimator must be a CircularCoordinates, got "
+                f"{where}: estimator must be a CircularCoordinates, got "
                 f"{type(estimator).__name__}"
             )
         params = estimator.get_params()
         chosen.update({k: params[k] for k in (
             "max_scale", "scale", "class_index", "prime", "scale_fraction", "temporal",
-            "landmarks", "memory_limit")})
-    clash = [k for k in chosen if given[k] != _CONFIGURED_DEFAULTS[k]]
+            "landmarks", "memory_limit") if k in given})
+    chosen = {k: v for k, v in chosen.items() if k in given}
+    clash = [k for k in chosen if given[k] != defaults[k]]
     if clash:
         raise ParameterError(
-            f"extract(): give {', '.join(clash)} either as keyword(s) or in the configured "
+            f"{where}: give {', '.join(clash)} either as keyword(s) or in the configured "
             "preprocessor/estimator, not both"
         )
     return chosen

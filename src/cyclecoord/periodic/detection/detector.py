@@ -63,6 +63,8 @@ def detect(
     window_steadiness: float = 0.5,
     similarity: float = 1.5,
     progress: bool = True,
+    preprocessor: Preprocessor | None = None,
+    estimator: CircularCoordinates | None = None,
 ) -> DetectionResult:
     """Find the periodic motions in a capture and the frames where each happens.
 
@@ -129,6 +131,10 @@ def detect(
         cycles' amplitudes; average linkage) are one motion.
     progress : bool, default True
         tqdm bar on stderr over the windows, shown only when they take over 2 s.
+    preprocessor, estimator : Preprocessor, CircularCoordinates, optional
+        Configured objects whose parameters replace the keywords of the same meaning
+        (difference_root, normalize, pca, delay; max_scale, prime, scale_fraction,
+        temporal, landmarks, memory_limit), as for :func:`cyclecoord.extract`.
 
     Returns
     -------
@@ -139,6 +145,18 @@ def detect(
     NoPeriodicMotionError
         When no class is excited anywhere (``result`` holds the partial detection).
     """
+    if preprocessor is not None or estimator is not None:
+        from ..pipeline import _configured
+
+        given = dict(difference_root=difference_root, normalize=normalize, pca=pca, delay=delay,
+                     max_scale=max_scale, prime=prime, scale_fraction=scale_fraction,
+                     temporal=temporal, landmarks=landmarks, memory_limit=memory_limit)
+        chosen = _configured(motion, preprocessor, estimator, given, _DETECT_CONFIGURED,
+                             "detect()")
+        rest = {k: v for k, v in locals().items() if k not in (
+            "motion", "frames", "preprocessor", "estimator", "given", "chosen", "_configured",
+            *chosen)}
+        return detect(motion, frames=frames, **rest, **chosen)
     window_lengths = _check_arguments(
         motion,
         window_lengths,
@@ -252,6 +270,12 @@ def detect(
         )
     return result
 
+
+#: detect's defaults for the settings a Preprocessor or CircularCoordinates can carry.
+_DETECT_CONFIGURED = dict(
+    difference_root=True, normalize=False, pca=None, delay=0.25, max_scale=None,
+    prime=DEFAULT_PRIME, scale_fraction=0.9, temporal=False, landmarks="auto", memory_limit=None,
+)
 
 _POSITIVE = [Interval(numbers.Real, 0, None, closed="neither")]
 _FRACTION = [Interval(numbers.Real, 0, 1, closed="right")]
