@@ -42,7 +42,7 @@ def test_extract_lock_feet_writes_a_cycle_whose_feet_stay(tmp_path, capsys):
     report = json.loads(rep.read_text())
     lock = report["foot_lock"]
     assert lock["before"]["skating_frames"] > 0 and lock["after"]["skating_frames"] == 0
-    assert f"{lock['before']['skating_frames']} -> 0 frames skate" in out
+    assert f"skating frames {lock['before']['skating_frames']} -> 0" in out
     a, b = cc.load(plain), cc.load(locked)
     assert foot_skating(b).skating_frames < foot_skating(a).skating_frames
     # only the legs moved: every channel of the other joints is as extracted

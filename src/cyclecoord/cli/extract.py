@@ -194,7 +194,7 @@ def cmd_extract(args: argparse.Namespace) -> int:
         cycle, locked = res.cycle, None
         if args.lock_feet:
             cycle, locked = _lock(res.cycle)
-            print(locked_line(locked) if locked is not None else
+            print(locked.summary() if locked is not None else
                   "feet: not locked: the cycle has no skeleton with recognisable feet")
         if args.output:
             save(cycle, args.output)
@@ -206,7 +206,7 @@ def cmd_extract(args: argparse.Namespace) -> int:
             _save_plots(res, args.plot)
         report_payload = res.to_report()
         if locked is not None:
-            report_payload["foot_lock"] = lock_report(locked)
+            report_payload["foot_lock"] = locked.to_dict()
         if args.verbose:
             print("time: " + ", ".join(f"{k} {v:.3f}s" for k, v in res.timings.items()))
     if args.report and report_payload is not None:
@@ -324,29 +324,6 @@ def _lock(cycle):
     except ParameterError:
         return cycle, None
     return result.motion, result
-
-
-def locked_line(locked) -> str:
-    """One console line on a foot lock."""
-    legs = {k: v for k, v in locked.joint_change.items() if v > 0}
-    worst = max(legs.items(), key=lambda kv: kv[1]) if legs else ("-", 0.0)
-    return (
-        f"feet locked: {locked.before.skating_frames} -> {locked.after.skating_frames} frames "
-        f"skate ({locked.after_redetected.skating_frames} with contacts found afresh); leg "
-        f"joints move {worst[1]:.1f} degrees at most on average ({worst[0]}), the rest not at all"
-    )
-
-
-def lock_report(locked) -> dict:
-    """JSON-ready summary of a foot lock for reports."""
-    return {
-        "before": locked.before.to_dict(),
-        "after": locked.after.to_dict(),
-        "after_redetected": locked.after_redetected.to_dict(),
-        "joint_change_degrees": {k: float(v) for k, v in locked.joint_change.items()},
-        "mean_joint_change_degrees": locked.mean_joint_change,
-        "max_lock_error": float(locked.max_error),
-    }
 
 
 def _feet_line(cycle) -> str | None:

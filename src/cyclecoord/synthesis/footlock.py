@@ -88,6 +88,18 @@ class FootLockResult:
         """Mean over all joints of :attr:`joint_change` (degrees)."""
         return float(np.mean(list(self.joint_change.values()))) if self.joint_change else 0.0
 
+    def to_dict(self) -> dict:
+        """JSON-ready: skating before, after and with contacts found afresh, each joint's
+        mean change (degrees) and the largest lock error."""
+        return {
+            "before": self.before.to_dict(),
+            "after": self.after.to_dict(),
+            "after_redetected": self.after_redetected.to_dict(),
+            "joint_change_degrees": {k: float(v) for k, v in self.joint_change.items()},
+            "mean_joint_change_degrees": self.mean_joint_change,
+            "max_lock_error": float(self.max_error),
+        }
+
     def summary(self) -> str:
         legs = {k: v for k, v in self.joint_change.items() if v > 0}
         worst = max(legs.items(), key=lambda kv: kv[1]) if legs else ("-", 0.0)
