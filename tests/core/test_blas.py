@@ -44,6 +44,7 @@ def test_harmonic_solve_inside_extract_runs_on_one_thread(monkeypatch):
 
 def test_every_stage_of_extract_runs_on_one_thread(monkeypatch):
     """Each stage, as extract calls it (before any inner decorator), sees the limit."""
+    import cyclecoord.periodic.fitting as fitting
     import cyclecoord.periodic.pipeline as pipe
 
     seen: dict[str, list] = {}
@@ -57,7 +58,9 @@ def test_every_stage_of_extract_runs_on_one_thread(monkeypatch):
 
     for name in ("capture_cycle", "retime", "complete_windings", "jerk_summary", "loop_closure",
                  "distance_to_cycle", "unwrap"):
-        monkeypatch.setattr(pipe, name, spy(name, getattr(pipe, name)))
+        for module in (pipe, fitting):  # the fitting steps live in periodic.fitting
+            if hasattr(module, name):
+                monkeypatch.setattr(module, name, spy(name, getattr(module, name)))
 
     class Prep(pipe.Preprocessor):
         def fit_transform(self, motion):
@@ -78,8 +81,8 @@ def test_every_stage_of_extract_runs_on_one_thread(monkeypatch):
             seen.setdefault("density", []).append(blas_threads())
             return super().fit(theta)
 
-    monkeypatch.setattr(pipe, "Preprocessor", Prep)
-    monkeypatch.setattr(pipe, "CircularCoordinates", Coords)
+    monkeypatch.setattr(fitting, "Preprocessor", Prep)
+    monkeypatch.setattr(fitting, "CircularCoordinates", Coords)
     monkeypatch.setattr(pipe, "PeriodicDensity", Density)
     before = blas_threads()
     cap = cc.datasets.make_periodic_capture(n_frames=300, noise=0.5, random_state=0)

@@ -63,12 +63,12 @@ def test_describe_reads_like_the_docs():
     ],
 )
 def test_extract_checks_its_table_before_any_work(option, value, words, monkeypatch):
-    import cyclecoord.periodic.pipeline as pipeline
+    import cyclecoord.periodic.fitting as fitting
 
     def never(*args, **kwargs):
         raise AssertionError("the capture was prepared before the options were checked")
 
-    monkeypatch.setattr(pipeline, "Preprocessor", never)
+    monkeypatch.setattr(fitting, "Preprocessor", never)
     motion = cc.datasets.make_periodic_capture(n_frames=60, random_state=0).motion
     with pytest.raises(ParameterError, match=words):
         cc.extract(motion, **{option: value})

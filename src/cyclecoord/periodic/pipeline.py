@@ -10,9 +10,6 @@ from __future__ import annotations
 
 import numbers
 import time
-import warnings
-from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -20,24 +17,16 @@ from .._blas import one_blas_thread
 from .._validation import Interval, Options, check_params
 from .barcode import (
     CLEAR_GAP,
-    CLEAR_MIN_FRACTION,
-    CLEAR_RATIO,
     DEFAULT_PRIME,
-    Barcode,
-    BarSelection,
-    refine_birth,
-    select_bar,
 )
-from .coordinates import REFINE_BYTES_PER_EDGE, CircularCoordinates, unwrap
+from .coordinates import CircularCoordinates
 from .cycle import check_bandwidth, typical_cycle
 from .density import PeriodicDensity
 from ..errors import NoPeriodicMotionError, ParameterError
 from ..quality.metrics import distance_to_cycle, frame_steps, jerk_summary, loop_closure
 from ..motion import Motion
 from .preprocess import Preprocessor
-from .clip import capture_cycle, joint_columns, loop_cycle
-from .root import heading, root_layout
-from .steady import moving_mask, period_speed, recurrence, steady_mask
+from .clip import capture_cycle, loop_cycle
 from .windings import Windings, complete_windings, retime, stretches
 
 __all__ = [
@@ -45,19 +34,13 @@ __all__ = [
     "MIN_TURNS", "TIMINGS", "TRAVELS",
 ]
 
-# the result types live in .results; re-exported here, where they have always been imported
-from .results import MIN_TURNS, TIMINGS, TRAVELS, CycleOptions, ExtractionResult  # noqa: E402
-from .results import PartialExtraction, _take_cycle_options  # noqa: E402
-
-#: Complete windings varying by more than this (p10-p90 over the median) are not steady.
-MAX_SPREAD = 0.25
-#: A bar alive at the threshold is followed until the threshold is this many times its birth.
-ALIVE_RATIO = 4.0
 #: Delay embedding (seconds) tried when a take's poses alone show no periodic motion.
 AUTO_DELAY = 0.25
-#: Landmarks of the rough first pass over a long take (which finds its steady frames).
-FIRST_PASS_LANDMARKS = 150
 
+# the result types live in .results; re-exported here, where they have always been imported
+from .results import MIN_TURNS, TIMINGS, TRAVELS, CycleOptions, ExtractionResult  # noqa: E402
+from .results import PartialExtraction, configured_keywords, take_cycle_options  # noqa: E402
+from .fitting import MAX_SPREAD, TakeFit, not_clear_reason, rows_of, too_few_turns  # noqa: E402
 
 def cycle_lengths(unwrapped: np.ndarray) -> np.ndarray:
     """Frames taken by each complete cycle counted from the first frame.
@@ -75,92 +58,6 @@ def cycle_lengths(unwrapped: np.ndarray) -> np.ndarray:
     lo, hi = m[i - 1], m[i]
     ends = i - 1 + np.where(hi > lo, (levels - lo) / np.where(hi > lo, hi - lo, 1.0), 0.0)
     return np.diff(np.concatenate([[0.0], ends]))
-
-
-def _first_clear(
-    est: CircularCoordinates, points: np.ndarray, class_index: int, scale, scale_fraction: float
-):
-    """Barcode of ``points`` and the chosen bar, judged by its real death.
-
-    A bar still alive at the threshold reads a death/birth ratio and a gap cut by the
-    threshold, and its cocycle would be read low in the bar.  While the chosen bar is
-    alive at the threshold and either fails the clear test or lives less than
-    :data:`ALIVE_RATIO` times its birth, the threshold is raised (1.6x at a time, at most
-    6 times, never past the point cloud's diameter), and the bar is judged, and read, on
-    the longer filtration.  ``--max-scale 12`` on CMU 69_01 200:450 (bar born at 9.955)
-    is so raised to 49.2 and gives the coordinate of ``--max-scale 50``.
-    """
-    from .barcode import default_max_scale
-
-    barcode = est.fit_barcode(points)
-    if len(barcode.h1) == 0 or class_index >= len(barcode.h1):
-        return barcode, None
-    sel = select_bar(barcode, class_index, scale, scale_fraction)
-    diameter = 2.0 * default_max_scale(points)
-    tries = 0
-    def cut_short(s: BarSelection, bc: Barcode) -> bool:
-        return s.death >= bc.threshold and (not s.clear or bc.threshold < ALIVE_RATIO * s.birth)
-
-    while scale is None and cut_short(sel, barcode) and tries < 6 and barcode.threshold < diameter:
-        birth = sel.birth
-        old = est.max_scale
-        est.max_scale = min(barcode.threshold * 1.6, diameter)
-        try:
-            longer = est.fit_barcode(points)
-        finally:
-            est.max_scale = old
-        match = (
-            np.flatnonzero(np.isclose(longer.h1[:, 0], birth, rtol=1e-9, atol=1e-12))
-            if len(longer.h1)
-            else []
-        )
-        if not len(match):
-            break
-        barcode = longer
-        est.class_index = int(match[0])
-        sel = select_bar(barcode, int(match[0]), scale, scale_fraction)
-        tries += 1
-    return barcode, sel
-
-
-def _not_clear_reason(sel: BarSelection, barcode: Barcode) -> str:
-    why = []
-    if sel.ratio < CLEAR_RATIO:
-        why.append(f"death/birth {sel.ratio:.2f} < {CLEAR_RATIO}")
-    if sel.gap < CLEAR_GAP:
-        why.append(f"persistence only {sel.gap:.2f}x the next bar's (< {CLEAR_GAP}x)")
-    if not why:
-        why.append(
-            f"persistence under {CLEAR_MIN_FRACTION:.0%} of the threshold {barcode.threshold:.4g}"
-        )
-    ds = "inf" if not np.isfinite(sel.death) else f"{sel.death:.4g}"
-    return f"H1 bar #{sel.index} [{sel.birth:.4g}, {ds}) does not stand clear ({'; '.join(why)})"
-
-
-def _unwrap_runs(
-    theta: np.ndarray, rows: np.ndarray, runs: list[tuple[int, int]], n: int
-) -> np.ndarray:
-    """The coordinate of ``rows`` unwrapped inside each run, NaN elsewhere (length ``n``)."""
-    full = np.full(n, np.nan)
-    full[rows] = theta
-    out = np.full(n, np.nan)
-    for a, b in runs:
-        if b > a:
-            out[a:b] = unwrap(full[a:b])
-    return out
-
-
-@dataclass
-class _Fit:
-    """One barcode + coordinate fit on some rows of a capture."""
-
-    est: CircularCoordinates
-    barcode: Barcode
-    selection: BarSelection
-    rows: np.ndarray
-    unwrapped: np.ndarray  # (T,), NaN outside rows
-    notes: list
-    weak_gap: bool = False  # clear but for the gap to the next bar
 
 
 @one_blas_thread
@@ -299,7 +196,7 @@ def extract(
         For invalid arguments.
     """
     if preprocessor is not None or estimator is not None:
-        chosen = _configured(motion, preprocessor, estimator, dict(
+        chosen = configured_keywords(motion, preprocessor, estimator, dict(
             difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=delay,
             max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
             scale_fraction=scale_fraction, temporal=temporal, landmarks=landmarks,
@@ -311,7 +208,7 @@ def extract(
         given = dict(timing=timing, travel=travel, bandwidth=bandwidth, cycle_start=cycle_start,
                      n_samples=n_samples, n_neighbors=n_neighbors, weighting=weighting,
                      sampling=sampling, min_turns=min_turns)
-        chosen = _take_cycle_options(cycle, given, "extract()")
+        chosen = take_cycle_options(cycle, given, "extract()")
         options = {k: v for k, v in locals().items()
                    if k not in ("motion", "frames", "cycle", "given", "chosen", *chosen)}
         return extract(motion, frames=frames, **options, **chosen)
@@ -370,7 +267,7 @@ def extract(
             f"{motion.source or 'capture'}: {motion.n_frames} frames are too few to find a cycle "
             f"(need at least {max(10, 2 * n_neighbors)})"
         )
-    run = _Run(motion, params, require_clear)
+    run = TakeFit(motion, params, require_clear)
     fit, used = run.fit_steady()
     return _finish(
         motion, run.prepared, run.prep, fit, used, run.notes, run.timings, params, run.fail,
@@ -378,273 +275,6 @@ def extract(
         weighting=weighting, sampling=sampling, bandwidth=bandwidth, random_state=random_state,
         cycle_start=cycle_start, timing=timing, travel=travel, min_turns=min_turns,
     )
-
-
-#: extract's defaults for the settings a Preprocessor or CircularCoordinates can carry.
-_CONFIGURED_DEFAULTS = dict(
-    difference_root=True, normalize=False, pca=None, root="body", delay="auto",
-    max_scale=None, scale=None, class_index=0, prime=DEFAULT_PRIME, scale_fraction=0.9,
-    temporal=False, landmarks="auto", memory_limit=None,
-)
-
-
-def _configured(
-    motion,
-    preprocessor,
-    estimator,
-    given: dict[str, Any],
-    defaults: dict[str, Any] = _CONFIGURED_DEFAULTS,
-    where: str = "extract()",
-) -> dict[str, Any]:
-    """Keywords of ``where`` (extract or detect) from configured objects; a keyword changed
-    from its default beside the object that carries it is an error.  Only the estimator's
-    parameters named in ``given`` are taken."""
-    chosen: dict[str, Any] = {}
-    if preprocessor is not None:
-        if not isinstance(preprocessor, Preprocessor):
-            raise ParameterError(
-                f"{where}: preprocessor must be a Preprocessor, got {type(preprocessor).__name__}"
-            )
-        lag = preprocessor.delay
-        fps = getattr(motion, "fps", None) or 1.0
-        chosen.update(difference_root=preprocessor.difference_root,
-                      normalize=preprocessor.normalize, pca=preprocessor.pca,
-                      root=preprocessor.root, delay=None if not lag else float(lag) / fps)
-    if estimator is not None:
-        if not isinstance(estimator, CircularCoordinates):
-            raise ParameterError(
-                f"{where}: estimator must be a CircularCoordinates, got "
-                f"{type(estimator).__name__}"
-            )
-        params = estimator.get_params()
-        chosen.update({k: params[k] for k in (
-            "max_scale", "scale", "class_index", "prime", "scale_fraction", "temporal",
-            "landmarks", "memory_limit") if k in given})
-    chosen = {k: v for k, v in chosen.items() if k in given}
-    clash = [k for k in chosen if given[k] != defaults[k]]
-    if clash:
-        raise ParameterError(
-            f"{where}: give {', '.join(clash)} either as keyword(s) or in the configured "
-            "preprocessor/estimator, not both"
-        )
-    return chosen
-
-
-class _Run:
-    """One extraction's fitting steps on a windowed capture: preparation, the barcode and
-    coordinate on some rows, the steady frames.  ``params`` are :func:`extract`'s (checked).
-    """
-
-    def __init__(self, motion: Motion, params: dict[str, Any], require_clear: bool) -> None:
-        self.motion, self.p, self.require_clear = motion, params, require_clear
-        self.T = motion.n_frames
-        self.timings: dict[str, float] = {}
-        self.notes: list[str] = []
-        t0 = time.perf_counter()
-        p = params
-        lag = int(round(p["delay"] * motion.fps)) if p["delay"] else None
-        self.prep = Preprocessor(difference_root=p["difference_root"], normalize=p["normalize"],
-                                 pca=p["pca"], root=p["root"], delay=lag)
-        self.prepared = self.prep.fit_transform(motion)
-        self.joints = joint_columns(motion, self.prepared)
-        T, steady = self.T, p["steady"]
-        moving = (
-            moving_mask(self.prepared.poses, motion.fps, columns=self.joints)
-            if steady
-            else np.ones(T, dtype=bool)
-        )
-        if not steady or moving.sum() >= 0.95 * T or moving.sum() < max(10, 2 * p["n_neighbors"]):
-            moving = np.ones(T, dtype=bool)
-        self.moving = moving
-        self.timings["prepare"] = time.perf_counter() - t0
-
-    def make_estimator(self, first_pass: bool = False) -> CircularCoordinates:
-        p = self.p
-        lm = p["landmarks"]
-        if first_pass and isinstance(lm, str) and lm == "auto":
-            lm = FIRST_PASS_LANDMARKS
-        return CircularCoordinates(
-            max_scale=p["max_scale"], scale=p["scale"], class_index=p["class_index"],
-            prime=p["prime"], scale_fraction=p["scale_fraction"], temporal=p["temporal"],
-            landmarks=lm, refine_birth=False, memory_limit=p["memory_limit"],
-            # poses beyond the points
-            memory_reserved=8.0 * max(0, self.prepared.poses.size - self.prepared.points.size),
-        )
-
-    def fail(
-        self, msg: str, fit: _Fit | None = None, barcode: Barcode | None = None
-    ) -> NoPeriodicMotionError:
-        partial = PartialExtraction(
-            motion=self.motion,
-            prepared=self.prepared,
-            reason=msg,
-            barcode=barcode if fit is None else fit.barcode,
-            selection=None if fit is None else fit.selection,
-            timings=self.timings,
-            parameters=self.p,
-            warnings=self.notes,
-            estimator=None if fit is None else fit.est,
-            preprocessor=self.prep,
-        )
-        where = self.motion.source or "capture"
-        return NoPeriodicMotionError(f"{where}: {msg}", result=partial)
-
-    def coordinate_of(self, est: CircularCoordinates, rows: np.ndarray) -> _Fit:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            est.fit_coordinate()
-        u = _unwrap_runs(est.coordinates_, rows, _row_runs(rows), self.T)
-        return _Fit(est=est, barcode=est.barcode_, selection=est.selection_, rows=rows,
-                    unwrapped=u, notes=[str(w.message) for w in caught])
-
-    def fit_rows(self, rows: np.ndarray, stage: str, first_pass: bool = False) -> _Fit:
-        """Barcode and coordinate on ``rows``; refuses a barcode with no clear bar."""
-        p = self.p
-        class_index, scale = p["class_index"], p["scale"]
-        est = self.make_estimator(first_pass)
-        t0 = time.perf_counter()
-        barcode, sel = _first_clear(
-            est, _rows_of(self.prepared.points, rows), class_index, scale, p["scale_fraction"]
-        )
-        self.timings[f"barcode{stage}"] = time.perf_counter() - t0
-        if sel is None:
-            if len(barcode.h1) and class_index >= len(barcode.h1):
-                raise ParameterError(
-                    f"class index {class_index} out of range: the barcode has {len(barcode.h1)} "
-                    "H1 bars"
-                )
-            raise self.fail(
-                "no periodic motion found: the barcode has no H1 bar up to scale "
-                f"{barcode.threshold:.4g}",
-                barcode=barcode,
-            )
-        # a bar that is clear but for its gap to the next one (long takes hold several
-        # loops) is judged by its coordinate's windings instead (see _finish)
-        gap_only = sel.ratio >= CLEAR_RATIO and sel.gap < CLEAR_GAP and (
-            barcode.persistence(1)[sel.index] >= CLEAR_MIN_FRACTION * barcode.threshold)
-        if self.require_clear and not sel.clear and not first_pass and not gap_only:
-            raise self.fail(f"no periodic motion found: {_not_clear_reason(sel, barcode)}; "
-                            "try --max-scale, --pca or --frames", barcode=barcode)
-        t0 = time.perf_counter()
-        fit = self.coordinate_of(est, rows)
-        if class_index == 0 and scale is None and len(barcode.h1) > 1:
-            fit = self._other_class(fit, est, barcode, rows)
-        if not first_pass and fit.est.landmarks_ is not None and not p["temporal"]:
-            self._refine_birth(fit, rows)
-        self.timings[f"coordinate{stage}"] = time.perf_counter() - t0
-        fit.weak_gap = bool(self.require_clear and not fit.selection.clear)
-        return fit
-
-    def _other_class(self, fit: _Fit, est: CircularCoordinates, barcode: Barcode,
-                     rows: np.ndarray) -> _Fit:
-        """The most persistent class of a long take can be a loop of the whole take (a
-        circuit, a drift); a later clear class that winds regularly is the motion's."""
-        min_turns = self.p["min_turns"]
-        wind = complete_windings(fit.unwrapped, _row_runs(rows))
-        j = 1
-        while (wind.turns < min_turns or not wind.spread <= MAX_SPREAD) and j < min(
-            4, len(barcode.h1)
-        ):
-            other = select_bar(barcode, j, None, self.p["scale_fraction"])
-            if other.ratio >= CLEAR_RATIO:
-                try:
-                    alt = self.coordinate_of(est.with_coordinate_params(class_index=j), rows)
-                except ParameterError:
-                    alt = None
-                alt_wind = (
-                    complete_windings(alt.unwrapped, _row_runs(rows)) if alt is not None else None
-                )
-                if alt_wind is not None and alt_wind.turns >= min_turns and (
-                    alt_wind.spread <= MAX_SPREAD
-                ):
-                    alt.notes.append(
-                        f"H1 class #{j} chosen: the most persistent class turns "
-                        f"{wind.turns:.2f} times over the frames (spread {wind.spread:.0%}), "
-                        f"class #{j} {alt_wind.turns:.2f} times, regularly"
-                    )
-                    return alt
-            j += 1
-        return fit
-
-    def _refine_birth(self, fit: _Fit, rows: np.ndarray) -> None:
-        """The class's birth on every frame, for the report (landmarks are born later)."""
-        budget = getattr(fit.est, "memory_budget_", None)
-        max_edges = (
-            3_000_000 if budget is None else int(min(3_000_000, budget / REFINE_BYTES_PER_EDGE))
-        )
-        full = (
-            refine_birth(
-                _rows_of(self.prepared.points, rows),
-                fit.selection.birth,
-                fit.est.prime_,
-                max_edges=max_edges,
-                covering_radius=fit.est.covering_radius_,
-                coordinate=fit.est.coordinates_,
-            )
-            if max_edges > 0
-            else None
-        )
-        fit.selection = BarSelection(**{**fit.selection.__dict__, "full_birth": full})
-        fit.est.selection_ = fit.selection
-
-    def fit_steady(self) -> tuple[_Fit, np.ndarray]:
-        """The coordinate fitted on the take's steady frames, and those frames.
-
-        A long take is first read on a few landmarks (enough to find its steady frames);
-        the coordinate is fitted again on the steady frames when they are not all the
-        moving frames.
-        """
-        steady, moving, timings = self.p["steady"], self.moving, self.timings
-        min_turns = self.p["min_turns"]
-        rows = np.flatnonzero(moving)
-        rough = steady and rows.size > FIRST_PASS_LANDMARKS * 2
-        fit = self.fit_rows(rows, " (first pass)" if steady else "", first_pass=rough)
-        used = moving
-        if steady:
-            t0 = time.perf_counter()
-            first = complete_windings(fit.unwrapped, stretches(moving))
-            if np.isfinite(first.period_frames):
-                used = _steady_frames(self.motion, self.prepared, self.joints, fit.unwrapped,
-                                      moving, first.period_frames)
-            if used.sum() >= 0.95 * moving.sum():
-                used = moving
-            refit = rough or used.sum() < moving.sum()
-            first_pass = [
-                timings.pop(k) for k in ("barcode (first pass)", "coordinate (first pass)")
-            ]
-            # stages: "steady" is the time spent finding the steady frames (a first pass when
-            # the coordinate is fitted again on them); "barcode" and "coordinate" the final fit
-            timings["steady"] = time.perf_counter() - t0 + (sum(first_pass) if refit else 0.0)
-            if not refit:
-                timings["barcode"], timings["coordinate"] = first_pass
-            if first.turns < min_turns:
-                raise self.fail(_too_few_turns(first.turns, int(moving.sum()), min_turns), fit)
-            if not used.any():
-                raise self.fail(
-                    "no periodic motion found: no stretch of the take repeats steadily for a "
-                    f"whole period (the coordinate turns {first.turns:.2f} times over the moving "
-                    "frames); check the coordinate figure (--plot), or try --no-steady or --frames",
-                    fit,
-                )
-            if refit:
-                fit = self.fit_rows(np.flatnonzero(used), "")
-        self.notes.extend(fit.notes)
-        if steady and moving.sum() - (used & moving).sum() > 0.5 * moving.sum():
-            # most of the moving frames are not this motion: a routine of several exercises,
-            # or a dance whose one steady figure is not the take
-            self.notes.append(
-                f"only {int(used.sum())} of the take's {int(moving.sum())} moving frames repeat "
-                "this motion steadily; the rest may be other motions: `cyclecoord detect` finds "
-                "each motion of a take that holds several"
-            )
-        return fit, used
-
-
-def _rows_of(x: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """``x[rows]``, as a view when the rows are one contiguous run (no copy of a long take)."""
-    if rows.size and rows[-1] - rows[0] + 1 == rows.size:
-        return x[rows[0] : rows[-1] + 1]
-    return x[rows]
 
 
 #: What :func:`extract`'s options may be (:mod:`cyclecoord._validation`); the scale and
@@ -676,35 +306,6 @@ def _check_options(motion, **o) -> dict:
     weighting = o["weighting"] if o["timing"] == "coordinate" else "kernel"
     o["bandwidth"] = check_bandwidth(o["bandwidth"], weighting)  # before any work is done
     return o
-
-
-def _row_runs(rows: np.ndarray) -> list[tuple[int, int]]:
-    """Runs of consecutive frame indices in a sorted index array."""
-    if rows.size == 0:
-        return []
-    breaks = np.flatnonzero(np.diff(rows) > 1)
-    starts = np.concatenate([[0], breaks + 1])
-    stops = np.concatenate([breaks + 1, [rows.size]])
-    return [(int(rows[a]), int(rows[b - 1]) + 1) for a, b in zip(starts, stops)]
-
-
-def _steady_frames(motion, prepared, joints, unwrapped, moving, period) -> np.ndarray:
-    """Steady frames of a take (see :mod:`~cyclecoord.periodic.steady`)."""
-    rec = recurrence(prepared.poses, period, columns=joints)
-    layout = root_layout(motion)
-    hd = heading(motion.frames, layout) if layout is not None else None
-    speed = period_speed(prepared.poses, motion.fps, period, columns=joints)
-    return steady_mask(unwrapped, moving, period, recurrence_distance=rec, heading=hd, speed=speed)
-
-
-def _too_few_turns(turns: float, n_frames: int, min_turns: float) -> str:
-    return (
-        f"no periodic motion found: the coordinate turns only {turns:.2f} times over the "
-        f"{n_frames} "
-        f"steady frames (at least {min_turns:g} are needed to call a motion periodic); a longer "
-        "take, "
-        "--frames around the repeated part, or --pca 3 may help"
-    )
 
 
 def _run_jerk(poses: np.ndarray, runs: list[tuple[int, int]], fps: float) -> float:
@@ -776,11 +377,11 @@ def _windings(fit, used, u, runs, notes, fail, min_turns) -> tuple[Windings, flo
     bar clear only but for its gap whose coordinate winds irregularly."""
     wind = complete_windings(u, runs)
     if wind.turns < min_turns:
-        raise fail(_too_few_turns(wind.turns, int(used.sum()), min_turns), fit)
+        raise fail(too_few_turns(wind.turns, int(used.sum()), min_turns), fit)
     if fit.weak_gap:
         if wind.spread > MAX_SPREAD or not np.isfinite(wind.period_frames):
             raise fail(
-                f"no periodic motion found: {_not_clear_reason(fit.selection, fit.barcode)}, and "
+                f"no periodic motion found: {not_clear_reason(fit.selection, fit.barcode)}, and "
                 "its coordinate "
                 f"winds irregularly (complete windings spread {wind.spread:.0%} of the period); "
                 "try --max-scale, --pca or --frames",
@@ -857,7 +458,7 @@ def _cycle_figures(prepared, typ, runs, rows, fps) -> tuple[dict, float, dict]:
         "cycle": float(jerk_summary(typ.frames, fps, cyclic=True)),
     }
     closure = float(loop_closure(typ.frames))
-    dist = distance_to_cycle(_rows_of(prepared.poses, rows), typ.frames)
+    dist = distance_to_cycle(rows_of(prepared.poses, rows), typ.frames)
     step = np.concatenate([frame_steps(prepared.poses[a:b]) for a, b in runs])
     distance = {
         "median": float(np.median(dist)),

@@ -1,5 +1,6 @@
-"""What an extraction returns: its result, a failed run's partial result, and the cycle
-options (:func:`~cyclecoord.periodic.pipeline.extract` makes them)."""
+"""What an extraction returns and how its options are given: its result, a failed run's
+partial result, the cycle options and the keywords read from configured objects
+(:func:`~cyclecoord.periodic.pipeline.extract` uses them)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,14 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Motion
-from .barcode import CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, Barcode, BarSelection
+from .barcode import (
+    CLEAR_GAP,
+    CLEAR_MIN_FRACTION,
+    CLEAR_RATIO,
+    DEFAULT_PRIME,
+    Barcode,
+    BarSelection,
+)
 from .coordinates import CircularCoordinates
 from .cycle import TypicalCycle
 from .density import PeriodicDensity
@@ -19,6 +27,7 @@ from .windings import Windings, stretches
 
 __all__ = [
     "ExtractionResult", "PartialExtraction", "CycleOptions", "MIN_TURNS", "TIMINGS", "TRAVELS",
+    "take_cycle_options", "configured_keywords", "EXTRACT_CONFIGURED_DEFAULTS",
 ]
 
 #: Fewer turns of the coordinate over the steady frames than this is no periodic motion
@@ -54,7 +63,7 @@ class CycleOptions:
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
-def _take_cycle_options(cycle: Any, given: dict[str, Any], where: str) -> dict[str, Any]:
+def take_cycle_options(cycle: Any, given: dict[str, Any], where: str) -> dict[str, Any]:
     """``given`` (a function's cycle keywords) overridden by ``cycle``; a keyword changed
     from its default beside ``cycle`` is an error (which one would win is not obvious)."""
     if cycle is None:
@@ -278,3 +287,53 @@ def _landmark_report(est: CircularCoordinates | None) -> dict | None:
         if hasattr(est, "covered_")
         else None,
     }
+
+
+#: extract's defaults for the settings a Preprocessor or CircularCoordinates can carry.
+EXTRACT_CONFIGURED_DEFAULTS = dict(
+    difference_root=True, normalize=False, pca=None, root="body", delay="auto",
+    max_scale=None, scale=None, class_index=0, prime=DEFAULT_PRIME, scale_fraction=0.9,
+    temporal=False, landmarks="auto", memory_limit=None,
+)
+
+
+def configured_keywords(
+    motion,
+    preprocessor,
+    estimator,
+    given: dict[str, Any],
+    defaults: dict[str, Any] = EXTRACT_CONFIGURED_DEFAULTS,
+    where: str = "extract()",
+) -> dict[str, Any]:
+    """Keywords of ``where`` (extract or detect) from configured objects; a keyword changed
+    from its default beside the object that carries it is an error.  Only the estimator's
+    parameters named in ``given`` are taken."""
+    chosen: dict[str, Any] = {}
+    if preprocessor is not None:
+        if not isinstance(preprocessor, Preprocessor):
+            raise ParameterError(
+                f"{where}: preprocessor must be a Preprocessor, got {type(preprocessor).__name__}"
+            )
+        lag = preprocessor.delay
+        fps = getattr(motion, "fps", None) or 1.0
+        chosen.update(difference_root=preprocessor.difference_root,
+                      normalize=preprocessor.normalize, pca=preprocessor.pca,
+                      root=preprocessor.root, delay=None if not lag else float(lag) / fps)
+    if estimator is not None:
+        if not isinstance(estimator, CircularCoordinates):
+            raise ParameterError(
+                f"{where}: estimator must be a CircularCoordinates, got "
+                f"{type(estimator).__name__}"
+            )
+        params = estimator.get_params()
+        chosen.update({k: params[k] for k in (
+            "max_scale", "scale", "class_index", "prime", "scale_fraction", "temporal",
+            "landmarks", "memory_limit") if k in given})
+    chosen = {k: v for k, v in chosen.items() if k in given}
+    clash = [k for k in chosen if given[k] != defaults[k]]
+    if clash:
+        raise ParameterError(
+            f"{where}: give {', '.join(clash)} either as keyword(s) or in the configured "
+            "preprocessor/estimator, not both"
+        )
+    return chosen

@@ -108,11 +108,11 @@ def motion_cycles(
     from ..windings import complete_windings, retime, stretches
 
     if cycle is not None:
-        from ..pipeline import _take_cycle_options
+        from ..results import take_cycle_options
 
         given = dict(n_samples=n_samples, n_neighbors=n_neighbors, bandwidth=bandwidth,
                      cycle_start=cycle_start, timing=timing, travel=travel, min_turns=min_cycles)
-        chosen = _take_cycle_options(cycle, given, "motion_cycles()")
+        chosen = take_cycle_options(cycle, given, "motion_cycles()")
         return motion_cycles(
             result, n_samples=chosen["n_samples"], n_neighbors=chosen["n_neighbors"],
             bandwidth=chosen["bandwidth"], cycle_start=chosen["cycle_start"],

@@ -146,16 +146,17 @@ def detect(
         When no class is excited anywhere (``result`` holds the partial detection).
     """
     if preprocessor is not None or estimator is not None:
-        from ..pipeline import _configured
+        from ..results import configured_keywords
 
         given = dict(difference_root=difference_root, normalize=normalize, pca=pca, delay=delay,
                      max_scale=max_scale, prime=prime, scale_fraction=scale_fraction,
                      temporal=temporal, landmarks=landmarks, memory_limit=memory_limit)
-        chosen = _configured(motion, preprocessor, estimator, given, _DETECT_CONFIGURED,
-                             "detect()")
+        chosen = configured_keywords(
+            motion, preprocessor, estimator, given, _DETECT_CONFIGURED, "detect()"
+        )
         rest = {k: v for k, v in locals().items() if k not in (
-            "motion", "frames", "preprocessor", "estimator", "given", "chosen", "_configured",
-            *chosen)}
+            "motion", "frames", "preprocessor", "estimator", "given", "chosen",
+            "configured_keywords", *chosen)}
         return detect(motion, frames=frames, **rest, **chosen)
     window_lengths = _check_arguments(
         motion,
