@@ -519,9 +519,9 @@ def _check_run_arguments(
             f"write_cycles must be one of {', '.join(CYCLE_FORMATS)} or None, got {write_cycles!r}"
         )
     if write_cycles in ("usda", "usdc"):
-        from .io.usd import _pxr
+        from .io.usd import require_usd
 
-        _pxr()  # usd-core missing: one clear error before anything runs
+        require_usd()  # usd-core missing: one clear error before anything runs
     if fps is not None:
         try:
             fps = float(fps)

@@ -30,13 +30,15 @@ from ..skeleton import Joint, Skeleton
 from ._atomic import atomic_path
 from .gltf import check_exportable, default_scale, skeleton_from_dict, skeleton_to_dict
 
-__all__ = ["USD_SUFFIXES", "read_usd", "usd_joint_positions", "write_usd"]
+__all__ = ["USD_SUFFIXES", "read_usd", "usd_joint_positions", "write_usd", "require_usd"]
 
 USD_SUFFIXES = (".usda", ".usdc", ".usd")
 _KEY = "cyclecoord"
 
 
-def _pxr():
+def require_usd():
+    """The usd-core modules (Gf, Sdf, Tf, Usd, UsdGeom, UsdSkel, Vt), or one clear
+    ParameterError saying how to install them."""
     try:
         from pxr import Gf, Sdf, Tf, Usd, UsdGeom, UsdSkel, Vt
     except ImportError:
@@ -116,7 +118,7 @@ def write_usd(
     mpu = default_scale(skel) if meters_per_unit is None else float(meters_per_unit)
     if not (np.isfinite(mpu) and mpu > 0):
         raise ParameterError(f"meters_per_unit must be a positive number, got {meters_per_unit!r}")
-    Gf, _Sdf, Tf, Usd, UsdGeom, UsdSkel, Vt = _pxr()
+    Gf, _Sdf, Tf, Usd, UsdGeom, UsdSkel, Vt = require_usd()
 
     trans, rots = local_transforms(motion)
     T, _n = trans.shape[:2]
@@ -176,7 +178,7 @@ def write_usd(
 
 
 def _open(path: Path):
-    _Gf, _Sdf, _Tf, Usd, _UsdGeom, UsdSkel, _Vt = _pxr()
+    _Gf, _Sdf, _Tf, Usd, _UsdGeom, UsdSkel, _Vt = require_usd()
     if not path.is_file():
         raise ParseError("no such USD file", str(path))
     try:

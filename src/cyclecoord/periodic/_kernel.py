@@ -10,10 +10,10 @@ __all__: list[str] = []
 
 # Weights exp(-x²/2) are exactly 0.0 in float64 beyond x = 38.6 widths: a window of 40
 # widths around each phase holds every frame with a non-zero weight.
-_KERNEL_REACH = 40.0
+KERNEL_REACH = 40.0
 
 
-def _kernel_dense(theta, poses, phases, sigma, chunk_elements):
+def kernel_dense(theta, poses, phases, sigma, chunk_elements):
     """Kernel averages with a (phases x frames) weight matrix, in chunks."""
     T = theta.shape[0]
     out = np.empty((phases.shape[0], poses.shape[1]))
@@ -34,14 +34,14 @@ def _kernel_dense(theta, poses, phases, sigma, chunk_elements):
     return out
 
 
-def _kernel_windowed(theta, poses, phases, sigma, chunk_elements):
-    """The same averages over only the frames within ``_KERNEL_REACH`` widths of each phase.
+def kernel_windowed(theta, poses, phases, sigma, chunk_elements):
+    """The same averages over only the frames within ``KERNEL_REACH`` widths of each phase.
 
     Frames sorted by phase once; each phase's window is a run of them (found by binary
     search on the sorted phases extended by one period either side), and the normalised
     weights form a sparse (phases x frames) matrix multiplied into the poses.  Cost
     O(T log T + window entries · D) instead of O(N · T · D): at a million frames the
-    windows hold a few hundred frames each.  Equal to :func:`_kernel_dense` up to the
+    windows hold a few hundred frames each.  Equal to :func:`kernel_dense` up to the
     order of summation (relative differences of order 1e-15).
     """
     import scipy.sparse as sp
@@ -50,7 +50,7 @@ def _kernel_windowed(theta, poses, phases, sigma, chunk_elements):
     order = np.argsort(theta, kind="stable")
     st = theta[order]
     ext = np.concatenate([st - 1.0, st, st + 1.0])
-    reach = _KERNEL_REACH * sigma  # < 0.5: no frame can fall in a window twice
+    reach = KERNEL_REACH * sigma  # < 0.5: no frame can fall in a window twice
     lo = np.searchsorted(ext, phases - reach, side="left")
     hi = np.searchsorted(ext, phases + reach, side="right")
     counts = (hi - lo).astype(np.int64)

@@ -26,7 +26,7 @@ from numbers import Integral, Real
 
 import numpy as np
 
-from ._kernel import _KERNEL_REACH, _kernel_dense, _kernel_windowed
+from ._kernel import KERNEL_REACH, kernel_dense, kernel_windowed
 from .density import PeriodicDensity, as_generator
 from ..errors import ParameterError
 
@@ -247,9 +247,9 @@ def kernel_centroids(
         sigma = k / (T * np.sqrt(2.0 * np.pi))
     else:
         sigma = _positive_float(bandwidth, "bandwidth")
-    if 2.0 * _KERNEL_REACH * sigma >= 1.0:  # the kernel spans the circle: every frame counts
-        return _kernel_dense(theta, poses, phases, sigma, chunk_elements)
-    return _kernel_windowed(theta, poses, phases, sigma, chunk_elements)
+    if 2.0 * KERNEL_REACH * sigma >= 1.0:  # the kernel spans the circle: every frame counts
+        return kernel_dense(theta, poses, phases, sigma, chunk_elements)
+    return kernel_windowed(theta, poses, phases, sigma, chunk_elements)
 
 
 @dataclass(frozen=True, eq=False)

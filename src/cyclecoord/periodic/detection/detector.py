@@ -146,18 +146,8 @@ def detect(
         When no class is excited anywhere (``result`` holds the partial detection).
     """
     if preprocessor is not None or estimator is not None:
-        from ..results import configured_keywords
-
-        given = dict(difference_root=difference_root, normalize=normalize, pca=pca, delay=delay,
-                     max_scale=max_scale, prime=prime, scale_fraction=scale_fraction,
-                     temporal=temporal, landmarks=landmarks, memory_limit=memory_limit)
-        chosen = configured_keywords(
-            motion, preprocessor, estimator, given, _DETECT_CONFIGURED, "detect()"
-        )
-        rest = {k: v for k, v in locals().items() if k not in (
-            "motion", "frames", "preprocessor", "estimator", "given", "chosen",
-            "configured_keywords", *chosen)}
-        return detect(motion, frames=frames, **rest, **chosen)
+        options = {k: v for k, v in locals().items() if k not in ("motion", "frames")}
+        return detect(motion, frames=frames, **_from_configured(motion, options))
     window_lengths = _check_arguments(
         motion,
         window_lengths,
@@ -277,6 +267,17 @@ _DETECT_CONFIGURED = dict(
     difference_root=True, normalize=False, pca=None, delay=0.25, max_scale=None,
     prime=DEFAULT_PRIME, scale_fraction=0.9, temporal=False, landmarks="auto", memory_limit=None,
 )
+
+def _from_configured(motion: Motion, options: dict[str, Any]) -> dict[str, Any]:
+    """detect's keyword options with the settings of its configured ``preprocessor`` and
+    ``estimator`` (both removed) in place of their keywords."""
+    from ..results import configured_keywords
+
+    pre, est = options.pop("preprocessor"), options.pop("estimator")
+    given = {k: options[k] for k in _DETECT_CONFIGURED}
+    chosen = configured_keywords(motion, pre, est, given, _DETECT_CONFIGURED, "detect()")
+    return {**options, **chosen}
+
 
 _POSITIVE = [Interval(numbers.Real, 0, None, closed="neither")]
 _FRACTION = [Interval(numbers.Real, 0, 1, closed="right")]
