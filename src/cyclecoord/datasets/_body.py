@@ -18,6 +18,7 @@ from ..motion import Motion
 from ..skeleton import Joint, Skeleton, rotation_order_from_dofs
 
 __all__ = [
+    "capture_pair",
     "TAU",
     "KINDS",
     "DEFAULT_PERIODS",
@@ -168,6 +169,26 @@ _HIERARCHY: tuple[tuple[str, str | None], ...] = (
     ("rfingers", "rhand"),
     ("rthumb", "rwrist"),
 )
+
+
+def capture_pair(
+    noisy: np.ndarray,
+    clean: np.ndarray,
+    channels,
+    skeleton: Skeleton,
+    source: str,
+    metadata: dict,
+    fps: float | None = None,
+) -> dict[str, Motion]:
+    """The noisy capture and its clean twin (``source + ":clean"``, its own copy of the
+    metadata), as the ``motion`` and ``clean`` of a synthetic capture."""
+    rate = {} if fps is None else {"fps": fps}
+    return {
+        "motion": Motion(noisy, channels, skeleton=skeleton, source=source, metadata=metadata,
+                         **rate),
+        "clean": Motion(clean, channels, skeleton=skeleton, source=source + ":clean",
+                        metadata=dict(metadata), **rate),
+    }
 
 
 def _bone(name: str) -> np.ndarray:

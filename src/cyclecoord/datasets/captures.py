@@ -11,6 +11,7 @@ from ..errors import ParameterError
 from ..motion import DEFAULT_FPS, Motion
 from ..skeleton import Skeleton
 from ._body import (
+    capture_pair,
     ANGLE_COLS,
     CHANNELS,
     COL,
@@ -180,15 +181,7 @@ def make_periodic_capture(
     source = f"synthetic:{kind}(seed={seed_text(random_state)})"
     meta = {"kind": kind, "period": period, "noise": noise, "speed_variation": variation}
     return SyntheticCapture(
-        motion=Motion(noisy, CHANNELS, fps=fps, skeleton=skeleton, source=source, metadata=meta),
-        clean=Motion(
-            clean,
-            CHANNELS,
-            fps=fps,
-            skeleton=skeleton,
-            source=source + ":clean",
-            metadata=dict(meta),
-        ),
+        **capture_pair(noisy, clean, CHANNELS, skeleton, source, meta, fps),
         phase=phase,
         period=period,
         labels=np.zeros(n, dtype=int),
@@ -289,15 +282,7 @@ def make_motion_chain(
     }
     mean_period = float(np.dot(lengths, pers) / sum(lengths))
     return SyntheticCapture(
-        motion=Motion(noisy, CHANNELS, fps=fps, skeleton=skeleton, source=source, metadata=meta),
-        clean=Motion(
-            clean,
-            CHANNELS,
-            fps=fps,
-            skeleton=skeleton,
-            source=source + ":clean",
-            metadata=dict(meta),
-        ),
+        **capture_pair(noisy, clean, CHANNELS, skeleton, source, meta, fps),
         phase=phase,
         period=mean_period,
         labels=labels,
@@ -394,10 +379,7 @@ def _non_periodic(
     n = clean.shape[0]
     source = f"synthetic:{kind}(seed={seed_text(random_state)})"
     return SyntheticCapture(
-        motion=Motion(noisy, CHANNELS, skeleton=skeleton, source=source, metadata={"kind": kind}),
-        clean=Motion(
-            clean, CHANNELS, skeleton=skeleton, source=source + ":clean", metadata={"kind": kind}
-        ),
+        **capture_pair(noisy, clean, CHANNELS, skeleton, source, {"kind": kind}),
         phase=np.full(n, np.nan),
         period=float("nan"),
         labels=np.full(n, -1, dtype=int),

@@ -23,8 +23,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..motion import DEFAULT_FPS, Motion
+from ..motion import DEFAULT_FPS
 from ._body import (
+    capture_pair,
     CHANNELS,
     COL,
     DEFAULT_PERIODS,
@@ -492,11 +493,7 @@ def _assemble(
     true_period = float(steady_mask.sum() / rate[steady_mask].sum()) if steady else float("nan")
     skeleton, channels = cmu_skeleton(), CHANNELS
     return SyntheticCapture(
-        motion=Motion(noisy, channels, fps=fps, skeleton=skeleton, source=source, metadata=meta),
-        clean=Motion(
-            clean, channels, fps=fps, skeleton=skeleton, source=source + ":clean",
-            metadata=dict(meta),
-        ),
+        **capture_pair(noisy, clean, channels, skeleton, source, meta, fps),
         phase=np.where(moving, phase, np.nan),
         period=true_period,
         labels=np.where(steady_mask, 0, -1),
