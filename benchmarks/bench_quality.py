@@ -158,9 +158,10 @@ def _coverage_outside(take: cc.Motion, clip: cc.Motion, used: list | None, start
     return coverage(take_x, cyc_x, mask) if mask.any() else float("nan")
 
 
-def run_case(case: Case, plot_dir: Path | None = None) -> dict:
+def run_case(case: Case, plot_dir: Path | None = None, bandwidth: float | None = None) -> dict:
     """Extract, build the references and measure all three cycles of one take; with
-    ``plot_dir``, also draw them (:func:`plot_cycles`)."""
+    ``plot_dir``, also draw them (:func:`plot_cycles`); ``bandwidth`` (frames) is handed to
+    ``extract`` (None: its default)."""
     take = case.take
     clips: dict[str, cc.Motion] = {}
     row: dict[str, Any] = {"take": case.name, "frames": take.n_frames, "fps": take.fps}
@@ -169,7 +170,8 @@ def run_case(case: Case, plot_dir: Path | None = None) -> dict:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            result = cc.extract(take)
+            options = {} if bandwidth is None else {"bandwidth": bandwidth}
+            result = cc.extract(take, **options)
         row["status"] = "ok"
         row["warnings"] = list(result.warnings)
     except NoPeriodicMotionError as exc:
@@ -349,6 +351,7 @@ def run_benchmark(
     progress: bool = True,
     skipped: Sequence[str] = (),
     plot_dir: Path | None = None,
+    bandwidth: float | None = None,
 ) -> dict:
     """Every case; returns ``{"machine", "skipped", "rows", "cpu_seconds", "wall_seconds"}``."""
     machine = {
@@ -356,6 +359,7 @@ def run_benchmark(
         "cyclecoord": cc.__version__,
         "git": _git_state(),
         "load_average_start": _load(),
+        "bandwidth": bandwidth,
         "cpus": len(os.sched_getaffinity(0))
         if hasattr(os, "sched_getaffinity")
         else os.cpu_count(),
@@ -368,7 +372,7 @@ def run_benchmark(
 
         it = tqdm(cases, desc="takes", unit="take", file=sys.stderr)
     for case in it:
-        rows.append(run_case(case, plot_dir))
+        rows.append(run_case(case, plot_dir, bandwidth))
     machine["load_average_end"] = _load()
     return {
         "machine": machine,
@@ -417,6 +421,7 @@ HEADERS = [
     "fem/tib",
     "seam",
     "p90/p10",
+    "pop",
     "cover",
     "cover out",
     "skate/take",
@@ -465,6 +470,7 @@ def table_rows(report: dict) -> list[list[str]]:
                     _f(q["min_femur_tibia_ratio"]),
                     _f(q["seam"]),
                     _f(q["step_spread"], "{:.1f}"),
+                    _f(q.get("largest_step")),
                     _f(q["coverage"]),
                     _f(q.get("extra", {}).get("cover_outside_cut")),
                     _f(q["skating_ratio"]),
@@ -483,7 +489,8 @@ def format_report(report: dict) -> str:
     lines = [
         f"cyclecoord {m['cyclecoord']} (git {m['git'] or 'unknown'})  {m['date']}  "
         f"cpus={m['cpus']}  "
-        f"load average {m['load_average_start']} -> {m['load_average_end']}",
+        f"load average {m['load_average_start']} -> {m['load_average_end']}"
+        + (f"  our bandwidth {m['bandwidth']} frames" if m.get("bandwidth") else ""),
         *report["skipped"],
         _table(HEADERS, table_rows(report)),
         "",
@@ -493,7 +500,8 @@ def format_report(report: dict) -> str:
         "err%: vs the autocorrelation (ac) of the used frames; jerk/cut, leg/cut (smallest ratio",
         "of a leg channel's range, channel named), fem/tib (the same over femur and tibia only):",
         "over the loop cut's; p90/p10: spread of the cycle's frame steps (hold-and-snap; no",
-        "target); cover: mean distance of the used frames to the cycle (deg); cover out: the same",
+        "target); pop: the cycle's largest step over the take's 99th-percentile step (no\n"
+        "target; above about 1.3 a jump the capture hardly makes); cover: mean distance of the used frames to the cycle (deg); cover out: the same",
         "over the used frames outside the loop cut (no target); skate/take: foot",
         "skating over the take's; root deg / st: root pitch+roll last-to-first (deg / median",
         "steps); head: heading turn per cycle (deg).",
@@ -548,6 +556,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     ap.add_argument("--no-progress", action="store_true", help="no progress bar")
     ap.add_argument(
+        "--bandwidth",
+        type=float,
+        metavar="FRAMES",
+        help="kernel width of our cycle in frames of time (extract's --bandwidth; default "
+        "its own, 1 frame): smaller keeps more of the capture's detail (coverage) at the "
+        "cost of jerk and pops",
+    )
+    ap.add_argument(
         "--plot", metavar="DIR", type=Path, help="draw leg channels of the three cycles per take"
     )
     args = ap.parse_args(argv)
@@ -565,7 +581,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             skipped.append("no real takes found: running the synthetic walk")
             cases = synthetic_cases()
     report = run_benchmark(
-        cases, progress=not args.no_progress, skipped=skipped, plot_dir=args.plot
+        cases,
+        progress=not args.no_progress,
+        skipped=skipped,
+        plot_dir=args.plot,
+        bandwidth=args.bandwidth,
     )
     print(format_report(report), flush=True)
     if args.json:

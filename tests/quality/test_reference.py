@@ -25,6 +25,7 @@ from cyclecoord.quality.cycle_quality import (
     root_closure,
     seam,
     step_spread,
+    largest_step,
     targets,
 )
 from cyclecoord.quality.reference import (
@@ -150,6 +151,12 @@ def test_figures_against_hand_computed_values():
     assert step_spread(ramp[:-1]) == pytest.approx(1.8)
     held = np.array([[0.0]] * 9 + [[1.0]])  # holds, then one snap: zero steps
     assert step_spread(held) == np.inf
+    # largest step around the loop (the seam of 9) over the take's p99 step (1)
+    assert largest_step(ramp[:-1], ramp) == pytest.approx(9.0)
+    mask = np.ones(11, dtype=bool)
+    mask[5] = False  # steps touching frame 5 are not the take's
+    assert largest_step(ramp[:-1], ramp ** 2, mask) == pytest.approx(9.0 / np.percentile(
+        [1, 3, 5, 7, 13, 15, 17, 19], 99))
     square = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
     take = np.array([[0.5, 0], [0.5, 0.5], [2, 0]])
     assert coverage(take, square) == pytest.approx(0.5)
@@ -238,6 +245,7 @@ def test_targets_thresholds():
         min_joint_range_ratio=0.85,
         min_joint="lfemur",
         step_spread=2.0,
+        largest_step=1.0,
         seam=1.5,
         coverage=1.0,
         coverage_ratio=1.0,

@@ -39,6 +39,7 @@ __all__ = [
     "leg_ranges",
     "seam",
     "step_spread",
+    "largest_step",
     "coverage",
     "foot_skating_speed",
     "root_orientation",
@@ -180,6 +181,30 @@ def step_spread(angles: np.ndarray) -> float:
     steps = np.linalg.norm(np.roll(x, -1, axis=0) - x, axis=1)
     lo, hi = np.percentile(steps, [10, 90])
     return float(hi / lo) if lo > 0 else float("inf")
+
+
+def largest_step(
+    angles: np.ndarray, take_angles: np.ndarray, mask: np.ndarray | None = None
+) -> float:
+    """Pop: a cycle's largest frame step over the take's 99th-percentile step.
+
+    Steps ``|x[t+1] - x[t]|`` around the loop (the seam included) against the steps
+    between consecutive used frames of the take.  Above about 1.3 the cycle makes a jump
+    its capture hardly ever makes: where an average switches from two repetitions to one
+    (a partial repetition starts or stops), or a seam left open.  Dimensionless; a
+    diagnostic, not one of the issue's targets (a mean jerk does not see one bad step).
+    """
+    x = np.asarray(angles, dtype=float)
+    cyc = np.linalg.norm(np.roll(x, -1, axis=0) - x, axis=1)
+    t = np.asarray(take_angles, dtype=float)
+    step = np.linalg.norm(np.diff(t, axis=0), axis=1)
+    if mask is not None:
+        m = np.asarray(mask, dtype=bool)
+        step = step[m[1:] & m[:-1]]
+    if cyc.size == 0 or step.size == 0:
+        return float("nan")
+    ref = float(np.percentile(step, 99))
+    return float(cyc.max() / ref) if ref > 0 else float("nan")
 
 
 def coverage(
@@ -365,6 +390,7 @@ class CycleQuality:
     min_joint: str | None
     seam: float
     step_spread: float
+    largest_step: float
     coverage: float
     coverage_ratio: float
     skating: float
@@ -478,6 +504,7 @@ def cycle_quality(
         min_joint_range_ratio=float(joint_ratios[low_joint]) if low_joint else float("nan"),
         min_joint=low_joint,
         step_spread=step_spread(cyc_x),
+        largest_step=largest_step(cyc_x, take_x, mask),
         seam=seam(cyc_x),
         coverage=cov,
         coverage_ratio=_ratio(cov, reference.coverage) if reference else float("nan"),
