@@ -4,7 +4,14 @@ import numpy as np
 import pytest
 
 from cyclecoord.errors import ParameterError
-from cyclecoord.periodic.windings import complete_windings, crossing_times, phase_average, retime, stretches
+from cyclecoord.periodic.windings import (
+    complete_windings,
+    crossing_times,
+    edge_taper,
+    phase_average,
+    retime,
+    stretches,
+)
 
 
 def staircase(n_frames: int, period: float, flat: float = 0.6) -> np.ndarray:
@@ -72,6 +79,53 @@ def test_phase_average_recovers_a_periodic_signal():
         phase_average(ph, vals, 50, 0.0)
 
 
+def test_edge_taper_fades_each_run_in_and_out():
+    mask = np.zeros(40, dtype=bool)
+    mask[2:30] = True
+    mask[33:36] = True
+    w = edge_taper(mask, 5.0)
+    assert np.all(w[~mask] == 0) and np.all(w[mask] > 0) and np.all(w <= 1)
+    np.testing.assert_allclose(w[2:30], w[2:30][::-1])  # symmetric in each run
+    assert w[2] < 0.05 and np.all(w[7:25] == 1.0)  # near 0 at the edge, 1 past 5 frames
+    assert np.all(np.diff(w[2:8]) > 0)  # rises monotonically
+    assert np.all(w[33:36] < 1)  # a run shorter than twice the taper never reaches 1
+    np.testing.assert_array_equal(edge_taper(mask, 0.0), mask.astype(float))
+
+
+def test_phase_average_weights_and_their_validation():
+    ph = np.tile(np.arange(100) / 100, 2)
+    vals = np.concatenate([np.zeros((100, 1)), np.ones((100, 1))])
+    np.testing.assert_allclose(phase_average(ph, vals, 50, 0.01), 0.5)
+    w = np.r_[np.ones(100), 3 * np.ones(100)]
+    np.testing.assert_allclose(phase_average(ph, vals, 50, 0.01, weights=w), 0.75)
+    for bad in (np.ones(5), -w, np.r_[np.nan, w[1:]]):
+        with pytest.raises(ParameterError, match="weights"):
+            phase_average(ph, vals, 50, 0.01, weights=bad)
+
+
+def test_tapered_average_of_a_partial_repetition_does_not_jump():
+    """1.8 repetitions of a take that drifts: with equal weights the average jumps where
+    the partial repetition starts and ends (it averages two repetitions on one side, one on
+    the other); fading the run's ends spreads those changes over several frames."""
+    P, drift = 100, 10.0
+    t = np.arange(int(1.8 * P))
+    ph = np.mod(t / P, 1.0)
+    vals = (np.sin(2 * np.pi * ph) + drift * t / t.size)[:, None]
+    width = 1.0 / P
+
+    def largest_step(cycle):
+        return np.max(np.abs(np.diff(np.r_[cycle[:, 0], cycle[0, 0]])))
+
+    capture = np.max(np.abs(np.diff(vals[:, 0])))
+    plain = phase_average(ph, vals, P, width)
+    run = np.ones(t.size, dtype=bool)
+    assert largest_step(plain) > 5 * capture  # a pop the capture never makes
+    steps = [largest_step(phase_average(ph, vals, P, width, weights=edge_taper(run, f * P)))
+             for f in (0.05, 0.25)]
+    assert steps[0] < 0.75 * largest_step(plain)  # the default taper (clip.EDGE_TAPER)
+    assert steps[1] < 0.3 * largest_step(plain)  # a longer taper spreads it further
+
+
 def test_typical_amplitude_restores_what_averaging_flattens():
     from cyclecoord.periodic.clip import MAX_AMPLITUDE_GAIN, typical_amplitude
 
@@ -90,3 +144,12 @@ def test_typical_amplitude_restores_what_averaging_flattens():
     assert np.ptp(out[:, 0]) == pytest.approx(min(30.0, MAX_AMPLITUDE_GAIN * np.ptp(avg[:, 0])), rel=0.1)
     np.testing.assert_allclose(out[:, 1], avg[:, 1])  # a constant channel stays as it is
     assert np.argmax(out[:, 0]) == np.argmax(avg[:, 0])  # the shape is kept, only widened
+
+
+def test_hold_weights_give_a_held_stretch_one_vote():
+    from cyclecoord.periodic.registration import hold_weights
+
+    ph = np.array([0.1, 0.2, 0.2, 0.2, 0.3, np.nan, 0.3, 0.3, 0.5])
+    w = hold_weights(ph)
+    np.testing.assert_allclose(w, [1, 1 / 3, 1 / 3, 1 / 3, 1, 0, 0.5, 0.5, 1])
+    assert hold_weights(np.full(4, np.nan)).sum() == 0

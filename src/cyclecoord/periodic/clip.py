@@ -22,9 +22,9 @@ from ..errors import ParameterError
 from ..motion import Motion
 from .cycle import TypicalCycle, select_bandwidth
 from .preprocess import PreparedData, Preprocessor
-from .registration import register
+from .registration import hold_weights, register
 from .root import compose_root, decompose_root, heading, planted_ground, root_layout
-from .windings import phase_average, stretches
+from .windings import edge_taper, phase_average, stretches
 
 __all__ = [
     "capture_cycle",
@@ -41,6 +41,8 @@ __all__ = [
 
 #: Default width (frames of time) of the kernel that averages the re-timed cycle.
 CAPTURE_WIDTH = 1.0
+#: Each phased run fades in and out over this fraction of a period (:func:`edge_taper`).
+EDGE_TAPER = 0.05
 #: Rounds of contacts found on the cycle itself after the capture's (:func:`anchor_to_feet`).
 ANCHOR_ROUNDS = 2
 #: At most this many phased frames are aligned and averaged into the capture-timed cycle.
@@ -294,7 +296,11 @@ def capture_cycle(
     register_iter : int
         Rounds of :func:`~cyclecoord.periodic.registration.register` (0: none), which
         align every repetition to the cycle so that sharp features are not averaged
-        away.
+        away.  Frames that registration holds on one sample share one frame's weight
+        (:func:`~cyclecoord.periodic.registration.hold_weights`), and every run of phased
+        frames fades in and out over ``EDGE_TAPER`` of a period
+        (:func:`~cyclecoord.periodic.windings.edge_taper`), so that the average does not
+        jump where a repetition dwells or a partial one starts or stops.
     amplitude : {"typical", "average"}
         ``"typical"``: each joint channel of the average is widened about its mean to the
         median range of the capture's own repetitions (:func:`typical_amplitude`);
@@ -337,18 +343,22 @@ def capture_cycle(
     rows = local + lo
     ph = phase[local]
     poses = span[local]
+    # each repetition gets one vote per cycle sample, and runs fade in and out: no pops
+    weights = edge_taper(np.isfinite(phase), EDGE_TAPER * float(period)) * hold_weights(phase)
+    taper = weights[local]
     selection = None
     if bandwidth == "auto":
         selection = select_bandwidth(ph, poses, float(period), k=min(k, rows.size))
         width = float(selection.bandwidth)
-    frames = phase_average(ph, poses, P, width / float(period))
+    frames = phase_average(ph, poses, P, width / float(period), weights=taper)
     if amplitude == "typical":
         frames[:, joints] = typical_amplitude(frames[:, joints], phase, span[:, joints])
     layout = root_layout(motion) if prepared.root_columns.size else None
     feats = None
     if layout:
         feats = phase_average(
-            ph, decompose_root(motion.frames[lo:hi], layout)[local], P, width / float(period)
+            ph, decompose_root(motion.frames[lo:hi], layout)[local], P, width / float(period),
+            weights=taper,
         )
     shift = 0
     if cycle_start == "slowest":

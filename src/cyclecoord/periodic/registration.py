@@ -7,7 +7,8 @@ phases and the average flattens them.  :func:`register` aligns every run of fram
 current typical cycle by dynamic time warping inside a band around the phase it has,
 with steps of 0, 1 or 2 cycle samples per frame (the 0 and 2 steps cost a penalty, so the
 phase keeps the capture's pace unless the poses ask otherwise), and repeats with the
-cycle averaged at the new phases.
+cycle averaged at the new phases.  Frames held on one sample share one frame's weight in
+that average (:func:`hold_weights`).
 
 Cost: O(frames x band) distances (in blocks, so memory is O(frames x band)) and one
 vectorised dynamic-programming row per frame.
@@ -19,7 +20,7 @@ import numpy as np
 
 from .windings import phase_average
 
-__all__ = ["register"]
+__all__ = ["hold_weights", "register"]
 
 #: Frames whose band of distances is computed at once.
 _BLOCK = 256
@@ -76,6 +77,39 @@ def _align_run(
     return out
 
 
+def hold_weights(phase: np.ndarray) -> np.ndarray:
+    """One vote per repetition and cycle sample: ``1 / n`` for each of ``n`` consecutive
+    frames that registration put on the same sample (a hold).
+
+    A run that dwells on one sample for a dozen frames (the take's first repetition,
+    still getting going) would otherwise outvote every other repetition at that phase, and
+    the average would jump there and back.
+
+    Parameters
+    ----------
+    phase : ndarray, shape (T,)
+        Phase per frame (NaN where there is none).
+
+    Returns
+    -------
+    ndarray, shape (T,)
+        Weight per frame in ``(0, 1]``, 0 where the phase is NaN.
+    """
+    ph = np.asarray(phase, dtype=float)
+    out = np.zeros(ph.size)
+    ok = np.isfinite(ph)
+    if not ok.any():
+        return out
+    # a new group starts at every frame whose phase differs from the previous frame's
+    # (or that follows a frame without phase)
+    same = np.zeros(ph.size, dtype=bool)
+    same[1:] = ok[1:] & ok[:-1] & (ph[1:] == ph[:-1])
+    group = np.cumsum(~same)
+    counts = np.bincount(group)
+    out[ok] = 1.0 / counts[group[ok]]
+    return out
+
+
 def register(
     phase: np.ndarray,
     poses: np.ndarray,
@@ -122,7 +156,7 @@ def register(
         rows = np.flatnonzero(np.isfinite(ph))
         if rows.size < 2:
             break
-        template = phase_average(ph[rows], x[rows], P, width)
+        template = phase_average(ph[rows], x[rows], P, width, weights=hold_weights(ph)[rows])
         new = np.full_like(ph, np.nan)
         for a, e in runs:
             if e - a < 3:

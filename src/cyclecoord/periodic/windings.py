@@ -33,6 +33,7 @@ __all__ = [
     "crossing_times",
     "complete_windings",
     "retime",
+    "edge_taper",
     "phase_average",
     "stretches",
 ]
@@ -299,7 +300,46 @@ def retime(unwrapped: np.ndarray, runs: list[tuple[int, int]], windings: Winding
     return out
 
 
-def phase_average(phase: np.ndarray, values: np.ndarray, n_out: int, width: float) -> np.ndarray:
+def edge_taper(mask: np.ndarray, length: float) -> np.ndarray:
+    """Weights that fade each run of ``mask`` in and out over ``length`` frames.
+
+    A phase averaged from several repetitions changes the number of frames it averages
+    where a run starts or stops part-way through a cycle (a take that holds two and a
+    half repetitions).  With equal weights the average jumps there, from the mean of the
+    repetitions to one of them; fading every run's first and last ``length`` frames
+    (raised cosine) spreads that change over ``length`` frames of the cycle.
+
+    Parameters
+    ----------
+    mask : ndarray of bool, shape (T,)
+        Frames that take part (each maximal run of True is one stretch).
+    length : float
+        Frames over which a run's weight rises from near 0 to 1 (``<= 0``: no taper).
+
+    Returns
+    -------
+    ndarray, shape (T,)
+        Weight per frame in ``(0, 1]`` inside the runs, 0 outside.
+    """
+    mask = np.asarray(mask, dtype=bool)
+    out = np.zeros(mask.size)
+    for a, b in stretches(mask):
+        if length <= 0:
+            out[a:b] = 1.0
+            continue
+        k = np.arange(b - a, dtype=float)
+        edge = np.minimum(k, (b - a - 1) - k) + 0.5
+        out[a:b] = 0.5 - 0.5 * np.cos(np.pi * np.minimum(1.0, edge / float(length)))
+    return out
+
+
+def phase_average(
+    phase: np.ndarray,
+    values: np.ndarray,
+    n_out: int,
+    width: float,
+    weights: np.ndarray | None = None,
+) -> np.ndarray:
     """Periodic Gaussian-kernel average of ``values`` at ``n_out`` evenly spaced phases.
 
     Parameters
@@ -311,6 +351,9 @@ def phase_average(phase: np.ndarray, values: np.ndarray, n_out: int, width: floa
         Output phases ``j / n_out``.
     width : float
         Kernel standard deviation in phase units.
+    weights : ndarray, shape (N,), optional
+        Non-negative weight of each row, multiplying its kernel weight (default 1 each;
+        see :func:`edge_taper`).
 
     Returns
     -------
@@ -327,12 +370,19 @@ def phase_average(phase: np.ndarray, values: np.ndarray, n_out: int, width: floa
         )
     if not (np.isfinite(width) and width > 0):
         raise ParameterError(f"width must be a positive number, got {width!r}")
+    if weights is not None:
+        weights = np.asarray(weights, dtype=float)
+        if weights.shape != phase.shape or not np.all(np.isfinite(weights)) or np.any(weights < 0):
+            raise ParameterError(
+                f"weights must be {phase.shape} finite non-negative numbers, got {weights.shape}"
+            )
     order = np.argsort(phase, kind="stable")
     ph = phase[order]
     val = values[order]
     # tile one copy on each side so windows that wrap read a contiguous slice
     ph3 = np.concatenate([ph - 1.0, ph, ph + 1.0])
     val3 = np.concatenate([val, val, val])
+    u3 = None if weights is None else np.tile(weights[order], 3)
     half = min(4.0 * width, 0.5)
     out = np.empty((n_out, values.shape[1]))
     for j in range(n_out):
@@ -340,6 +390,8 @@ def phase_average(phase: np.ndarray, values: np.ndarray, n_out: int, width: floa
         lo, hi = np.searchsorted(ph3, [c - half, c + half])
         d = ph3[lo:hi] - c
         w = np.exp(-0.5 * (d / width) ** 2)
+        if u3 is not None:
+            w = w * u3[lo:hi]
         if w.size == 0 or w.sum() <= 0:
             k = int(np.argmin(np.abs(ph3 - c)))
             out[j] = val3[k]
