@@ -488,7 +488,7 @@ def lock_feet(
     *,
     blend: float = 0.1,
     cyclic: bool = False,
-    passes: int = 3,
+    passes: int = 5,
     **contact_options,
 ) -> FootLockResult:
     """Remove foot skating by pinning planted feet and re-solving the legs.
@@ -508,9 +508,10 @@ def lock_feet(
     passes : int
         Contacts found afresh on the result can be a frame or two longer than the locked
         ones (a foot reaching its lock is slowed or steered a little); up to ``passes``
-        rounds lock those too when they skate (each round solves the legs again from the
-        previous round's result, so the locked motion measured on its own contacts
-        skates no more than on the input's).  1 locks the input's contacts only.
+        rounds lock those too when they skate, stopping as soon as none does (each round
+        solves the legs again from the previous round's result, so the locked motion
+        measured on its own contacts skates no more than on the input's; 69_01's cycle
+        needs 4).  1 locks the input's contacts only.
 
     Returns
     -------
