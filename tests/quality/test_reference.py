@@ -335,3 +335,20 @@ def test_leg_joint_ranges_ignore_marker_spikes_but_keep_held_extremes():
     # a joint's range spans its dofs: at least the largest single-dof range
     j = clip.channel_index("lfemur", "rx")
     assert base["lfemur"] >= np.ptp(clip.frames[:, j]) * 0.95
+
+
+def test_coverage_simulation_bounds_what_an_average_can_reach(capsys):
+    """benchmarks/sim_coverage.py: with two repetitions an average and a loop cut tie on
+    smooth deviations and the cut wins on frame noise; with six the average wins on both."""
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "sim_coverage.py"
+    spec = importlib.util.spec_from_file_location("sim_coverage", path)
+    sim = importlib.util.module_from_spec(spec)
+    sys.modules["sim_coverage"] = sim
+    spec.loader.exec_module(sim)
+    table = {k: float(np.mean(v)) for k, v in sim.ratios(takes=3, seed=1).items()}
+    assert table[(2, "smooth")] == pytest.approx(1.0, abs=0.03)
+    assert table[(2, "noise")] < 0.8
+    assert table[(6, "smooth")] > 1.15 and table[(6, "noise")] > 1.03
+    assert table[(3, "smooth")] > 1.05 and table[(3, "noise")] < 0.95
+    assert sim.main(["--takes", "1"]) == 0
+    assert "repetitions" in capsys.readouterr().out
