@@ -83,6 +83,21 @@ def test_report_has_the_documented_fields():
     assert rep["selected"]["birth"] < rep["selected"]["scale"]
     assert set(rep["jerk"]) == {"original", "cycle"}
     assert rep["barcode"]["h0"][-1][1] is None  # the infinite H0 bar
+    d = rep["distance_to_cycle"]
+    assert 0 < d["largest_cycle_step"] <= 2.0 * d["p99_frame_step"]  # no pop, no warning
+    assert not any("jumps" in w for w in res.warnings)
+
+
+def test_a_pop_in_the_cycle_is_a_warning(monkeypatch):
+    """Over MAX_POP times the capture's 99th-percentile step is said, with what to do
+    (here the threshold is lowered so that the example's largest step passes it)."""
+    import cyclecoord.periodic.pipeline as pipeline
+
+    m = cc.datasets.example_capture().motion
+    d = cc.extract(m).distance
+    monkeypatch.setattr(pipeline, "MAX_POP", 0.5 * d["largest_cycle_step"] / d["p99_frame_step"])
+    (note,) = [w for w in cc.extract(m).warnings if "jumps" in w]
+    assert "99th-percentile step" in note and "--bandwidth 2" in note
 
 
 def test_deterministic_for_a_seed():

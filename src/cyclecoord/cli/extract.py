@@ -300,6 +300,10 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
         f"frames to cycle: median distance {res.distance['median']:.3g} (median frame step "
         f"{res.distance['median_frame_step']:.3g}); kernel width {res.typical.bandwidth:.3g} frames"
     )
+    lines.append(
+        f"largest cycle step {res.distance['largest_cycle_step']:.3g} (capture's 99th "
+        f"percentile {res.distance['p99_frame_step']:.3g})"
+    )
     lm = res.estimator.landmarks_
     if lm is not None:
         fb = res.selection.full_birth

@@ -36,6 +36,8 @@ __all__ = [
 
 #: Delay embedding (seconds) tried when a take's poses alone show no periodic motion.
 AUTO_DELAY = 0.25
+#: A cycle step over this many times the capture's 99th-percentile frame step is a warning.
+MAX_POP = 2.0
 
 # the result types live in .results; re-exported here, where they have always been imported
 from .results import MIN_TURNS, TIMINGS, TRAVELS, CycleOptions, ExtractionResult  # noqa: E402
@@ -342,6 +344,13 @@ def _finish(
     timings["cycle"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     jerk, closure, distance = _cycle_figures(prepared, typ, runs, rows, motion.fps)
+    pop = distance["largest_cycle_step"] / distance["p99_frame_step"]
+    if np.isfinite(pop) and pop > MAX_POP:
+        notes.append(
+            f"the cycle jumps {distance['largest_cycle_step']:.3g} in one frame, {pop:.1f}x the "
+            "capture's 99th-percentile step (its repetitions disagree there); look at the "
+            "channels figure, and try --bandwidth 2 or --frames on a steadier stretch"
+        )
     timings["metrics"] = time.perf_counter() - t0
     timings["total"] = sum(v for k, v in timings.items())
     return ExtractionResult(
@@ -460,10 +469,13 @@ def _cycle_figures(prepared, typ, runs, rows, fps) -> tuple[dict, float, dict]:
     closure = float(loop_closure(typ.frames))
     dist = distance_to_cycle(rows_of(prepared.poses, rows), typ.frames)
     step = np.concatenate([frame_steps(prepared.poses[a:b]) for a, b in runs])
+    cyc = np.linalg.norm(np.roll(typ.frames, -1, axis=0) - typ.frames, axis=1)
     distance = {
         "median": float(np.median(dist)),
         "p90": float(np.percentile(dist, 90)),
         "max": float(np.max(dist)),
         "median_frame_step": float(np.median(step)) if step.size else float("nan"),
+        "p99_frame_step": float(np.percentile(step, 99)) if step.size else float("nan"),
+        "largest_cycle_step": float(cyc.max()) if cyc.size else float("nan"),
     }
     return jerk, closure, distance

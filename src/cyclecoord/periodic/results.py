@@ -153,7 +153,9 @@ class ExtractionResult:
         Last-to-first step of the cycle over its median step (prepared space).
     distance : dict
         Distance of the clip's frames to the cycle (median, 90th percentile, max), in
-        the prepared space's units, next to the median frame-to-frame step.
+        the prepared space's units, next to the capture's median and 99th-percentile
+        frame-to-frame steps and the cycle's largest step (the seam included; over 2x the
+        capture's 99th percentile is a warning: a pop).
     timings : dict
         Seconds per stage.
     warnings : list of str
