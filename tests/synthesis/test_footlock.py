@@ -104,3 +104,40 @@ def test_lock_passes_checked():
         lock_feet(m, passes=0)
     one = lock_feet(m, passes=1)
     assert one.after.skating_frames == 0
+
+
+def _largest_leg_step(motion, cyclic=False):
+    """Largest frame-to-frame change of a leg rotation channel (degrees, wrapped), across
+    the seam too when ``cyclic``."""
+    x = motion.frames[:, _leg_columns(motion)]
+    d = np.diff(np.concatenate([x, x[:1]]) if cyclic else x, axis=0)
+    return float(np.abs((d + 180.0) % 360.0 - 180.0).max())
+
+
+def test_lock_toe_first_landing_no_pop(cmu_dir):
+    """Jumping jacks land on the balls of the feet: the toe's contact starts about ten frames
+    before the heel's.  The toe used to be let go of (no horizontal target, pulled up to the
+    flat foot's height) where the heel's ease began inside its own ease, then snapped to its
+    lock on the held frame: rfoot.rx stepped 23 degrees in one frame on this stretch of
+    the capture (rtibia.rx 17.7 on the cycle) against captured steps of at most 4."""
+    import cyclecoord as cc
+
+    take = cc.load(cmu_dir / "13" / "13_29.amc")[0:200]
+    r = lock_feet(take)
+    assert r.after.skating_frames == 0 and r.after_redetected.skating_frames == 0
+    captured = _largest_leg_step(take)  # 4.0
+    assert _largest_leg_step(r.motion) < 2.5 * captured  # 23.3 before the fix, 8.0 after
+
+
+@pytest.mark.slow
+def test_lock_jumping_jack_cycle_no_pop(cmu_dir):
+    """The jumping-jack cycle: the locked legs step at most 1.5 times the cycle's own
+    largest leg step (3.45 times before the toe-first fix, 1.39 after), nothing skates."""
+    import cyclecoord as cc
+
+    cycle = cc.extract(cc.load(cmu_dir / "13" / "13_29.amc"), frames=(0, 456)).cycle
+    r = lock_feet(cycle, cyclic=True)
+    assert r.after.skating_frames == 0 and r.after_redetected.skating_frames == 0
+    assert r.mean_joint_change < 1.0
+    own = _largest_leg_step(cycle, cyclic=True)  # 5.1
+    assert _largest_leg_step(r.motion, cyclic=True) < 1.5 * own  # 17.7 before, 7.1 after

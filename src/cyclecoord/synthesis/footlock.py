@@ -18,8 +18,9 @@ heel strike, with heel and toe both held, the foot cannot pitch: a held toe stil
 down is asked for the flat foot's height under the ankle (so the solver does not jump
 between pitching the foot up and down), and before its lock the toe is carried by the
 foot and lowered to that height over its ease (so the foot does not slap down in one
-frame).  Only the leg chains change: the root, spine, arms and the toes' own rotation
-keep their values.
+frame); a toe that lands before its heel (jumping, hopping) keeps its own ease, since its
+lock does not begin with that height.  Only the leg chains change: the root, spine,
+arms and the toes' own rotation keep their values.
 """
 
 from __future__ import annotations
@@ -257,6 +258,25 @@ def _targets(
     return target[mid], np.where(label >= 0, w, 0.0)[mid], label[mid], side[mid]
 
 
+def _lock_start(ease: np.ndarray, side: np.ndarray, cyclic: bool) -> np.ndarray:
+    """For each frame ``(T,)`` on the way into a lock (``side < 0``), the held frame its lock
+    begins with: the first frame at or after it with ``ease >= 1``, wrapping round a
+    cyclic motion; -1 elsewhere (or where no held frame follows)."""
+    T = ease.size
+    out = -np.ones(T, dtype=int)
+    nxt = -1
+    # backwards, twice round a loop so an ease before the seam sees the lock after it
+    for t in range(2 * T - 1 if cyclic else T - 1, -1, -1):
+        f = t % T
+        if side[f] >= 0:
+            nxt = -1
+        elif ease[f] >= 1:
+            nxt = f
+        if t < T and side[f] < 0:
+            out[f] = nxt
+    return out
+
+
 def _chain(skel: Skeleton, ankle: int, deepest: int) -> list[int]:
     """Joints from the thigh (the ankle's grandparent) down to ``deepest``'s parent."""
     path = []
@@ -438,6 +458,16 @@ def _lock_once(
             locked = label >= 0
             weights[locked, m, horiz[0]] = weights[locked, m, horiz[1]] = ease[locked]
             weights[locked, m, contacts.up] = _HEIGHT * ease[locked]
+            if first is not None:
+                # (the ankle held: planted low, or on the held frame before its contact)
+                a_ease, a_side = first[3], first[4]
+                a_held = (a_ease >= 1) & (low_a | (a_side < 0))
+                # the frame each ease reaches its lock: the toe is carried by the foot over
+                # its ease only where the ankle is already held when its own lock begins
+                # (heel strike); a toe landing first keeps its own ease, or it would be
+                # let go of and then snapped to its lock on the held frame
+                start = _lock_start(ease, side, cyclic)
+                easing = (label >= 0) & (side < 0) & (ease < 1) & (a_ease > 0) & (a_side <= 0)
             if first is not None and flat.any():
                 # the toe under an ankle with a target: held at both locks the foot cannot
                 # pitch, so the toe is asked for the flat foot's height under the ankle
@@ -448,18 +478,15 @@ def _lock_once(
                 # ease instead of slapping down on the frame the lock begins
                 rel_flat = (wpos[flat, pts[m], contacts.up] - a_pos[flat, contacts.up]).mean()
                 flat_height = a_tgt[:, contacts.up] + rel_flat
-                # (the ankle held: planted low, or on the held frame before its contact)
-                a_ease, a_side = first[3], first[4]
-                a_held = (a_ease >= 1) & (low_a | (a_side < 0))
                 down = (ease >= 1) & (side <= 0) & a_held & ~low_here
                 tgt[down, contacts.up] = flat_height[down]
-                easing = (label >= 0) & (side < 0) & (ease < 1) & (a_ease > 0) & (a_side <= 0)
+                easing &= (start >= 0) & down[np.maximum(start, 0)]
                 y = tgt[easing, contacts.up]
                 tgt[easing, contacts.up] = y + ease[easing] * (flat_height[easing] - y)
                 weights[easing, m, horiz[0]] = weights[easing, m, horiz[1]] = 0.0
                 weights[easing, m, contacts.up] = _HEIGHT
             elif first is not None:
-                easing = (label >= 0) & (side < 0) & (ease < 1) & (first[3] > 0) & (first[4] <= 0)
+                easing &= (start >= 0) & a_held[np.maximum(start, 0)]
                 weights[easing, m] = 0.0
             targets[:, m] = tgt
             if first is None:
