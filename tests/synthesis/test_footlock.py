@@ -141,3 +141,24 @@ def test_lock_jumping_jack_cycle_no_pop(cmu_dir):
     assert r.mean_joint_change < 1.0
     own = _largest_leg_step(cycle, cyclic=True)  # 5.1
     assert _largest_leg_step(r.motion, cyclic=True) < 1.5 * own  # 17.7 before, 7.1 after
+
+
+def test_targets_close_contacts_hand_over_smoothly():
+    """Two contacts 6 frames apart (a toe re-touching after toe-off): the ease out of the
+    first runs into the ease into the second.  The target used to jump where the nearer
+    contact changes (1.15 of the 1.63 between the locks in one frame; on the 69_01
+    200:450 cycle a 6.3 degree rfoot.rx step, 5.7 after); now it moves from one lock to
+    the other over the frames between them (at most 0.41 a frame)."""
+    from cyclecoord.synthesis.footlock import _targets
+
+    T = 60
+    x = np.linspace(0.0, 6.0, T)  # the point slides 0.1 per frame
+    points = np.stack([x, np.zeros(T), np.zeros(T)], axis=1)
+    planted = np.zeros(T, bool)
+    planted[10:20] = planted[26:36] = True
+    tgt, ease, label, _ = _targets(points, planted, up=1, nb=12, cyclic=False)
+    assert (label[10:36] >= 0).all() and ease[20:26].min() > 0.5
+    np.testing.assert_allclose(tgt[9:21, 0], points[10:20, 0].mean())  # held at the locks
+    np.testing.assert_allclose(tgt[25:37, 0], points[26:36, 0].mean())
+    # from one lock (1.47) to the next (3.10) over 5 frames; the jump was 1.15
+    assert np.abs(np.diff(tgt[:, 0])).max() < 0.6

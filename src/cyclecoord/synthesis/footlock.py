@@ -220,10 +220,11 @@ def _targets(
     keeps its captured velocity: its path is shifted by ``w`` times the offset between
     the lock and the held frame beside it, so it leaves and reaches the lock at the speed
     it was captured with (easing the position itself would leave slow, low frames that a
-    fresh contact search calls skating).  A cyclic motion that travels moves by
-    ``loop_shift`` from one loop to the next: a contact that runs across the seam reads
-    the frames of the neighbouring loop there (its own frames shifted by it), not the
-    far end of this one.
+    fresh contact search calls skating).  Between two contacts whose eases meet, the
+    offset passes smoothly from the first lock's to the next's.  A cyclic motion that
+    travels moves by ``loop_shift`` from one loop to the next: a contact that runs across
+    the seam reads the frames of the neighbouring loop there (its own frames shifted by
+    it), not the far end of this one.
     """
     T = planted.size
     horiz = [k for k in range(3) if k != up]
@@ -236,25 +237,43 @@ def _targets(
             turn_only = (np.zeros(3), np.zeros(3), loop_shift[2], loop_shift[3])
             car = _next_loop(car, np.repeat([-1, 0, 1], T), turn_only)
     target = pts.copy()
-    side = np.zeros(pts.shape[0], dtype=int)
-    for k in np.unique(label[mid][label[mid] >= 0]):
-        a, b = runs[k]
-        lock = pts[a:b][:, horiz].mean(axis=0)
+    n_ext = pts.shape[0]
+    side = np.zeros(n_ext, dtype=int)
+    locks = np.zeros((len(runs), len(horiz)))
+    for k, (a, b) in enumerate(runs):
+        locks[k] = pts[a:b][:, horiz].mean(axis=0)
         if carry is not None:
             flat = np.isfinite(car[a:b, 0])
             if flat.any():
-                lock = (pts[a:b][flat] + car[a:b][flat])[:, horiz].mean(axis=0)
+                locks[k] = (pts[a:b][flat] + car[a:b][flat])[:, horiz].mean(axis=0)
+    # offset of each frame's path from its lock: the lock minus the held frame beside it
+    off = np.zeros((n_ext, len(horiz)))
+    held = np.zeros(n_ext, bool)
+    for k in np.unique(label[label >= 0]):
+        a, b = runs[k]
         rows = np.flatnonzero(label == k)
-        n_ext = pts.shape[0]
         before, after = rows < a - 1, rows > b
-        off = np.zeros((rows.size, len(horiz)))
-        off[before] = lock - pts[max(a - 1, 0), horiz]
-        off[after] = lock - pts[min(b, n_ext - 1), horiz]
-        eased = pts[rows][:, horiz] + w[rows, None] * off
-        eased[~(before | after)] = lock
+        off[rows[before]] = locks[k] - pts[max(a - 1, 0), horiz]
+        off[rows[after]] = locks[k] - pts[min(b, n_ext - 1), horiz]
+        held[rows[~(before | after)]] = True
         side[rows[rows < a]] = -1
         side[rows[rows >= b]] = 1
-        target[rows[:, None], horiz] = eased
+    # two contacts so close that the ease out of one runs into the ease into the next (no
+    # free frame between): the offset passes smoothly from the first lock's to the next's
+    # over the frames between their held frames, instead of jumping where the nearer run
+    # changes (at an ease weight near 1 that jump is a pop of the leg)
+    for k in range(len(runs) - 1):
+        b1, a2 = runs[k][1], runs[k + 1][0]
+        gap = np.arange(b1 + 1, a2 - 1)
+        if gap.size and (label[gap] >= 0).all():
+            u = _smoothstep((gap - b1) / (a2 - 1 - b1))[:, None]
+            off[gap] = (1 - u) * (locks[k] - pts[b1, horiz]) + u * (
+                locks[k + 1] - pts[a2 - 1, horiz]
+            )
+    eased = pts[:, horiz] + w[:, None] * off
+    eased[held] = locks[label[held]]
+    rows = np.flatnonzero(label >= 0)
+    target[rows[:, None], horiz] = eased[rows]
     return target[mid], np.where(label >= 0, w, 0.0)[mid], label[mid], side[mid]
 
 
