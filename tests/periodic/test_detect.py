@@ -57,6 +57,8 @@ def test_motion_cycles_follow_the_detected_classes(chain):
         assert c.cycle.n_frames == round(c.period_frames)
         assert c.period_frames == pytest.approx(periods[kind], rel=0.25)
         assert c.loop_closure <= 1.5
+        # no pop: the largest step is measured (positive) and under the warning's threshold
+        assert 0 < c.largest_step < 2.0
         assert c.cycle.channels == cap.motion.channels and c.cycle.fps == cap.motion.fps
         # the motion's own frames are nearer its cycle than any other motion's cycle
         a, b, _ = cap.boundaries[match[c.motion]]
@@ -128,7 +130,9 @@ def test_cli_detect(tmp_path, capsys):
         written = skating_report(cc.load(e["path"]))
         assert e["foot_skating"]["skating_frames"] == written["skating_frames"]
         assert e["frames"] == cc.load(e["path"]).n_frames
+        assert 0 < e["largest_step"] < 2.0  # measured, and no pop: no warning printed
     assert stdout.count("foot skating: ") == 3
+    assert "jumps" not in stdout
     src = tmp_path / "still.npz"
     cc.save(cc.datasets.make_static_capture(n_frames=600, random_state=1).motion, src)
     capsys.readouterr()

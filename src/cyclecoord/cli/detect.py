@@ -176,6 +176,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
         print(f"warning: {w}")
     extracted = []
     if args.extract and code == EXIT_OK:
+        from ..periodic.pipeline import MAX_POP
         from ..quality.contacts import skating_line, skating_report
 
         folder = Path(args.extract)
@@ -209,6 +210,12 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 f"{m.start_frame + mc.start}:{m.start_frame + mc.stop} ({how}), loop closure "
                 f"{mc.loop_closure:.2f} -> {out}"
             )
+            if mc.largest_step > MAX_POP:
+                print(
+                    f"  warning: the cycle jumps {mc.largest_step:.1f}x the capture's "
+                    "99th-percentile step in one frame (its repetitions disagree there); look "
+                    "at it, and try --bandwidth 2"
+                )
             skating = skating_report(mc.cycle)
             print("  " + skating_line(skating))
             extracted.append(
@@ -218,6 +225,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
                     "frames": int(mc.cycle.n_frames),
                     "source_frames": [m.start_frame + mc.start, m.start_frame + mc.stop],
                     "loop_closure": float(mc.loop_closure),
+                    "largest_step": float(mc.largest_step),
                     "foot_skating": skating,
                 }
             )
