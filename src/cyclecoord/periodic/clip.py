@@ -345,12 +345,12 @@ def capture_cycle(
     poses = span[local]
     # each repetition gets one vote per cycle sample, and runs fade in and out: no pops
     weights = edge_taper(np.isfinite(phase), EDGE_TAPER * float(period)) * hold_weights(phase)
-    taper = weights[local]
+    votes = weights[local]
     selection = None
     if bandwidth == "auto":
         selection = select_bandwidth(ph, poses, float(period), k=min(k, rows.size))
         width = float(selection.bandwidth)
-    frames = phase_average(ph, poses, P, width / float(period), weights=taper)
+    frames = phase_average(ph, poses, P, width / float(period), weights=votes)
     if amplitude == "typical":
         frames[:, joints] = typical_amplitude(frames[:, joints], phase, span[:, joints])
     layout = root_layout(motion) if prepared.root_columns.size else None
@@ -358,7 +358,7 @@ def capture_cycle(
     if layout:
         feats = phase_average(
             ph, decompose_root(motion.frames[lo:hi], layout)[local], P, width / float(period),
-            weights=taper,
+            weights=votes,
         )
     shift = 0
     if cycle_start == "slowest":

@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..motion import Motion
 from ..skeleton import rotation_matrices
-from .metrics import distance_to_cycle, loop_closure
+from .metrics import distance_to_cycle, largest_steps, loop_closure
 from .reference import joint_angles, joint_columns, used_mask
 
 __all__ = [
@@ -194,17 +194,8 @@ def largest_step(
     (a partial repetition starts or stops), or a seam left open.  Dimensionless; a
     diagnostic, not one of the issue's targets (a mean jerk does not see one bad step).
     """
-    x = np.asarray(angles, dtype=float)
-    cyc = np.linalg.norm(np.roll(x, -1, axis=0) - x, axis=1)
-    t = np.asarray(take_angles, dtype=float)
-    step = np.linalg.norm(np.diff(t, axis=0), axis=1)
-    if mask is not None:
-        m = np.asarray(mask, dtype=bool)
-        step = step[m[1:] & m[:-1]]
-    if cyc.size == 0 or step.size == 0:
-        return float("nan")
-    ref = float(np.percentile(step, 99))
-    return float(cyc.max() / ref) if ref > 0 else float("nan")
+    big, ref = largest_steps(angles, take_angles, mask)
+    return big / ref if ref > 0 else float("nan")
 
 
 def coverage(

@@ -44,6 +44,7 @@ __all__ = [
     "jerk_summary",
     "frame_steps",
     "loop_closure",
+    "largest_steps",
     "distance_to_cycle",
     "circular_distance",
     "PhaseAgreement",
@@ -279,6 +280,39 @@ def loop_closure(cycle: np.ndarray) -> float:
     if typical == 0.0:
         return 1.0 if seam == 0.0 else float("inf")
     return seam / typical
+
+
+def largest_steps(
+    cycle: np.ndarray, frames: np.ndarray, mask: np.ndarray | None = None
+) -> tuple[float, float]:
+    """A cycle's largest frame step and the 99th-percentile step of the frames it loops.
+
+    Parameters
+    ----------
+    cycle : array_like, shape (P, D)
+        One cycle; its steps are taken around the loop (the seam included).
+    frames : array_like, shape (T, D)
+        The capture, same channels.
+    mask : array_like of bool, shape (T,), optional
+        Frames taking part: only steps between two consecutive masked frames count.
+
+    Returns
+    -------
+    (float, float)
+        ``(largest cycle step, capture's 99th-percentile step)``, in the channels' units;
+        NaN where there is no step.  Their ratio over about 2 is a pop: a jump the
+        capture hardly ever makes.
+    """
+    x = np.asarray(cycle, dtype=float)
+    cyc = np.linalg.norm(np.roll(x, -1, axis=0) - x, axis=1)
+    step = frame_steps(frames)
+    if mask is not None:
+        m = np.asarray(mask, dtype=bool)
+        step = step[m[1:] & m[:-1]]
+    return (
+        float(cyc.max()) if cyc.size else float("nan"),
+        float(np.percentile(step, 99)) if step.size else float("nan"),
+    )
 
 
 def distance_to_cycle(frames: np.ndarray, cycle: np.ndarray) -> np.ndarray:

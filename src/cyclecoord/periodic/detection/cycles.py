@@ -57,19 +57,14 @@ class MotionCycle:
     largest_step: float = float("nan")
 
 
-def _largest_step(cycle: np.ndarray, poses: np.ndarray, rows: np.ndarray) -> float:
+def _pop(cycle: np.ndarray, poses: np.ndarray, rows: np.ndarray) -> float:
     """The cycle's largest step over the capture's 99th-percentile step on ``rows``."""
-    from ..windings import stretches
+    from ...quality.metrics import largest_steps
 
     mask = np.zeros(poses.shape[0], dtype=bool)
     mask[rows] = True
-    steps = [np.linalg.norm(np.diff(poses[a:b], axis=0), axis=1) for a, b in stretches(mask)]
-    step = np.concatenate(steps) if steps else np.zeros(0)
-    if step.size == 0 or cycle.shape[0] < 2:
-        return float("nan")
-    ref = float(np.percentile(step, 99))
-    cyc = np.linalg.norm(np.roll(cycle, -1, axis=0) - cycle, axis=1)
-    return float(cyc.max() / ref) if ref > 0 else float("nan")
+    big, ref = largest_steps(cycle, poses, mask)
+    return big / ref if ref > 0 else float("nan")
 
 
 def motion_cycles(
@@ -208,6 +203,6 @@ def motion_cycles(
         out.append(MotionCycle(
             motion=mid, start=a, stop=b, phase_from=source, n_frames_used=int(rows.size),
             period_frames=period, cycle=clip, loop_closure=float(loop_closure(typ.frames)),
-            largest_step=_largest_step(typ.frames, prepared.poses, rows),
+            largest_step=_pop(typ.frames, prepared.poses, rows),
         ))
     return out
