@@ -160,6 +160,15 @@ def add_selection_options(
         "--normalize", action="store_true", help="scale each channel by its standard deviation"
     )
     g.add_argument(
+        "--rotations",
+        choices=("auto", "rotvec", "euler"),
+        default="auto",
+        help="how joint rotations enter the analysis: rotation vectors about each joint's mean "
+        "(rotvec: Euler wraps and flips change nothing), the Euler channels as written (euler: "
+        "the paper's space), or rotation vectors only for joints whose Euler channels wrap, "
+        "flip or near gimbal lock (auto, default: CMU reads as in the paper)",
+    )
+    g.add_argument(
         "--temporal",
         action="store_true",
         help="time-aware metric: consecutive frames at distance 0",

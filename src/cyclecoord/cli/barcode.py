@@ -32,7 +32,8 @@ def cmd_barcode(args: argparse.Namespace) -> int:
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
     prep = Preprocessor(
-        difference_root=not args.no_root_diff, normalize=args.normalize, pca=args.pca
+        difference_root=not args.no_root_diff, normalize=args.normalize, pca=args.pca,
+        rotations=args.rotations,
     )
     pts = prep.fit_transform(motion).points
     from ..periodic.coordinates import CircularCoordinates

@@ -137,6 +137,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
             frames=args.frames,
             pca=args.pca,
             normalize=args.normalize,
+            rotations=args.rotations,
             temporal=args.temporal,
             difference_root=not args.no_root_diff,
             prime=args.prime,

@@ -163,6 +163,7 @@ def cmd_extract(args: argparse.Namespace) -> int:
             frames=args.frames,
             pca=args.pca,
             normalize=args.normalize,
+            rotations=args.rotations,
             temporal=args.temporal,
             delay=args.delay,
             difference_root=not args.no_root_diff,

@@ -127,7 +127,8 @@ def loop_cycle(
                 frames=np.roll(typical.frames, -shift, axis=0),
                 phases=np.roll(typical.phases, -shift),
             )
-    cyc = np.array(typical.frames, dtype=float)
+    near = motion.frames[int(rows[0]) if rows is not None and len(rows) else 0]
+    cyc = preprocessor.channel_values(typical.frames, near=near)
     if root.size:
         last = len(prepared.poses) - 1  # the last row repeats the one before (see difference_root)
         used = np.arange(last) if rows is None else np.asarray(rows, dtype=int)
@@ -370,7 +371,7 @@ def capture_cycle(
         shift = slowest_frame(joints)
     frames = np.roll(frames, -shift, axis=0)
     phases = np.mod((np.arange(P) + shift) / P, 1.0)
-    cyc = frames.copy()
+    cyc = preprocessor.channel_values(frames, near=motion.frames[rows[0]])
     heading_change = float("nan")
     if feats is not None:
         feats = np.roll(feats, -shift, axis=0)

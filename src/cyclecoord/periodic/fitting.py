@@ -145,7 +145,8 @@ class TakeFit:
         p = params
         lag = int(round(p["delay"] * motion.fps)) if p["delay"] else None
         self.prep = Preprocessor(difference_root=p["difference_root"], normalize=p["normalize"],
-                                 pca=p["pca"], root=p["root"], delay=lag)
+                                 pca=p["pca"], root=p["root"], delay=lag,
+                                 rotations=p.get("rotations", "auto"))
         self.prepared = self.prep.fit_transform(motion)
         self.joints = joint_columns(motion, self.prepared)
         T, steady = self.T, p["steady"]

@@ -19,11 +19,12 @@ from ..errors import ParameterError, ParseError
 from ..io import atomic_write
 from ..motion import Motion
 from .preprocess import Preprocessor
+from .rotations import RotationMap
 
 __all__ = ["PhaseModel"]
 
 _FORMAT = "cyclecoord-phase-model"
-_VERSION = 1
+_VERSION = 2  # 2: the joint-rotation map (rotations='rotvec'); 1 still reads
 
 
 @dataclass
@@ -104,6 +105,9 @@ class PhaseModel:
                 p.components_ if p.components_ is not None else np.zeros((0, len(p.mean_)))
             ),
         )
+        rmap = getattr(p, "rotation_map_", None)
+        if rmap is not None:
+            arrays.update({f"rot_{k}": v for k, v in rmap.to_arrays().items()})
         header = {
             "format": _FORMAT,
             "version": _VERSION,
@@ -114,6 +118,7 @@ class PhaseModel:
             "normalize": bool(p.normalize),
             "pca": p.pca,
             "root": getattr(p, "root_mode_", "euler"),
+            "rotations": "rotvec" if rmap is not None else "euler",
             "delay": None if p.delay is None else np.atleast_1d(p.delay).astype(int).tolist(),
             "n_channels": int(p.n_channels_),
         }
@@ -137,7 +142,7 @@ class PhaseModel:
             raise ParseError("not a cyclecoord model file (no header)", path) from None
         if header.get("format") != _FORMAT:
             raise ParseError(f"not a cyclecoord model file (format {header.get('format')!r})", path)
-        if header.get("version") != _VERSION:
+        if header.get("version") not in (1, _VERSION):
             raise ParseError(f"model file version {header.get('version')} is not supported", path)
         pre = Preprocessor(
             difference_root=header["difference_root"],
@@ -145,6 +150,7 @@ class PhaseModel:
             pca=header["pca"],
             delay=header.get("delay"),
             root=header.get("root", "euler"),
+            rotations="rotvec" if header.get("rotations") == "rotvec" else "euler",
         )
         try:
             pre.root_columns_ = arrays["pre_root_columns"].astype(int)
@@ -156,10 +162,16 @@ class PhaseModel:
             pre.components_ = comp if comp.size else None
             pre.explained_variance_ratio_ = None
             pre.n_channels_ = int(header["n_channels"])
+            pre.rotation_map_ = None
+            if pre.rotations == "rotvec":
+                pre.rotation_map_ = RotationMap.from_arrays(
+                    {k[4:]: v for k, v in arrays.items() if k.startswith("rot_")},
+                    pre.n_channels_,
+                )
             est = CircularCoordinates.from_arrays(
                 {k[3:]: v for k, v in arrays.items() if k.startswith("cc_")}
             )
-        except (KeyError, ParameterError) as exc:
+        except (KeyError, ValueError, ParameterError) as exc:
             raise ParseError(f"incomplete model file ({exc})", path) from None
         return cls(
             preprocessor=pre,

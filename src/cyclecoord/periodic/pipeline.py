@@ -73,6 +73,7 @@ def extract(
     delay: float | str | None = "auto",
     difference_root: bool = True,
     root: str = "body",
+    rotations: str = "auto",
     prime: int = DEFAULT_PRIME,
     max_scale: float | None = None,
     scale: float | None = None,
@@ -130,6 +131,12 @@ def extract(
     root : {"body", "euler"}, default "body"
         Root changes as rotation vectors and steps in the root's own frame (gimbal-free,
         heading-invariant; needs the skeleton) or as Euler-channel differences (paper).
+    rotations : {"auto", "rotvec", "euler"}, default "auto"
+        Joint rotations as rotation vectors about each joint's mean (``"rotvec"``: Euler
+        wraps and flips change nothing), the Euler channels as written (``"euler"``: the
+        paper's space), or rotation vectors for just the joints whose Euler channels wrap,
+        flip or near gimbal lock (``"auto"``; a CMU capture reads exactly as in the paper).
+        See :class:`~cyclecoord.periodic.preprocess.Preprocessor`.
     prime : int, default 47
         Coefficient field Z/p, a prime greater than 11.
     max_scale : float, optional
@@ -200,7 +207,8 @@ def extract(
     if preprocessor is not None or estimator is not None:
         chosen = configured_keywords(motion, preprocessor, estimator, dict(
             difference_root=difference_root, normalize=normalize, pca=pca, root=root, delay=delay,
-            max_scale=max_scale, scale=scale, class_index=class_index, prime=prime,
+            rotations=rotations, max_scale=max_scale, scale=scale, class_index=class_index,
+            prime=prime,
             scale_fraction=scale_fraction, temporal=temporal, landmarks=landmarks,
             memory_limit=memory_limit))
         options = {k: v for k, v in locals().items() if k not in (
@@ -247,6 +255,7 @@ def extract(
         normalize=normalize,
         temporal=temporal,
         difference_root=difference_root,
+        rotations=rotations,
         steady=steady,
         pca=pca,
         class_index=class_index,
@@ -257,7 +266,8 @@ def extract(
     params = dict(
         frames=None if frames is None else list(frames), pca=pca, normalize=normalize,
         temporal=temporal, delay=delay, difference_root=difference_root, root=root, prime=prime,
-        max_scale=max_scale, scale=scale, class_index=class_index, scale_fraction=scale_fraction,
+        rotations=rotations, max_scale=max_scale, scale=scale, class_index=class_index,
+        scale_fraction=scale_fraction,
         n_samples=n_samples, n_neighbors=n_neighbors, bandwidth=bandwidth, weighting=weighting,
         sampling=sampling, n_components=n_components, cycle_start=cycle_start,
         landmarks=landmarks, memory_limit=memory_limit, random_state=random_state, steady=steady,
@@ -293,6 +303,7 @@ EXTRACT_CONSTRAINTS = {
     "normalize": ["boolean"],
     "temporal": ["boolean"],
     "difference_root": ["boolean"],
+    "rotations": [Options("auto", "rotvec", "euler")],
     "steady": ["boolean"],
     "pca": [Interval(numbers.Integral, 1, None), None],
     "class_index": [Interval(numbers.Integral, 0, None)],

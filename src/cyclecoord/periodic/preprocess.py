@@ -168,6 +168,16 @@ class Preprocessor:
         channel weighs the same in the distance (constant channels are left unscaled).
     pca : int or None, default None
         Project onto the first ``pca`` principal components.
+    rotations : {"auto", "rotvec", "euler"}, default "auto"
+        How joint rotations enter the point cloud (:mod:`cyclecoord.periodic.rotations`).
+        ``"rotvec"``: each joint's rotation as a rotation vector (degrees) about its mean
+        rotation over the fitted capture, hinge angles kept on one branch, so Euler wraps
+        and flips change nothing.  ``"auto"``: the same for every joint whose Euler
+        channels wrap, flip or near gimbal lock anywhere in the capture, the channels as
+        written for the others (where they measure the rotation as faithfully), hinges on
+        one branch: a CMU capture reads exactly as in the paper, a BVH whose hips cross
+        +-180 degrees as rotations.  ``"euler"``: the Euler channels as written, the
+        paper's space (§3).
     delay : int, sequence of int, or None, default None
         Delay embedding: each point becomes ``[p(t), p(t - d1), p(t - d2), ...]`` for the
         given delays in frames (frames before the first repeat it).  A motion that goes
@@ -183,6 +193,8 @@ class Preprocessor:
         Which of them are rotations (differenced as angles, wrapped into [-180, 180)).
     mean_ : ndarray, shape (D,)
         Channel means of the prepared poses (used by PCA).
+    rotation_map_ : RotationMap or None
+        The fitted joint-rotation map (None when no joint needs one or ``rotations="euler"``).
     scale_ : ndarray, shape (D,)
         Per-channel divisors (ones unless ``normalize``).
     components_ : ndarray, shape (K, D) or None
@@ -197,8 +209,10 @@ class Preprocessor:
         pca: int | None = None,
         delay: int | None = None,
         root: str = "body",
+        rotations: str = "auto",
     ) -> None:
         self.root = root
+        self.rotations = rotations
         self.difference_root = difference_root
         self.normalize = normalize
         self.pca = pca
@@ -213,8 +227,12 @@ class Preprocessor:
                 f"frame {motion.start_frame + bad[0]} channel "
                 f"{motion.channels[bad[1]]} is not a finite number"
             )
+        if self.rotation_map_ is not None:
+            joints = self.rotation_map_.to_vectors(frames)
+        else:
+            joints = np.array(frames, dtype=float)
         if not self.difference_root:
-            return np.array(frames, dtype=float)
+            return joints
         if self.root_mode_ == "body":
             layout = _root_layout(motion, self.root_columns_)
             if layout is None:
@@ -222,10 +240,34 @@ class Preprocessor:
                     "body-frame root differencing needs the capture's skeleton with a 6-dof root; "
                     "use root='euler'"
                 )
-            out = np.array(frames, dtype=float)
+            out = joints
             out[:, self.root_columns_] = body_frame_differences(frames, self.root_columns_, *layout)
             return out
-        return difference_root(frames, self.root_columns_, self.root_rotation_mask_)
+        out = difference_root(frames, self.root_columns_, self.root_rotation_mask_)
+        rest = np.setdiff1d(np.arange(frames.shape[1]), self.root_columns_)
+        out[:, rest] = joints[:, rest]
+        return out
+
+    def channel_values(self, poses: np.ndarray, near: np.ndarray | None = None) -> np.ndarray:
+        """Joint columns of prepared poses back to the capture's channel values.
+
+        The inverse of the joint-rotation map (Euler angles continuous over rows, the first
+        row nearest ``near``); root columns are copied unchanged (see
+        :meth:`integrate_root` for them).
+
+        Parameters
+        ----------
+        poses : ndarray, shape (P, D)
+            Rows in the prepared space (before scaling and PCA).
+        near : ndarray, shape (D,), optional
+            Channel values (e.g. a captured frame) the first row's angles lie closest to.
+        """
+        if not hasattr(self, "root_columns_"):
+            raise ParameterError("this Preprocessor is not fitted yet; call fit() first")
+        p = np.array(poses, dtype=float)
+        if self.rotation_map_ is None:
+            return p
+        return self.rotation_map_.to_channels(p, near=near)
 
     def fit(self, motion: Motion) -> "Preprocessor":
         """Learn root columns, scaling and principal axes from ``motion``."""
@@ -248,6 +290,18 @@ class Preprocessor:
         self.root_mode_ = (
             "body" if (self.root == "body" and _root_layout(motion, cols) is not None) else "euler"
         )
+        if self.rotations not in ("auto", "rotvec", "euler"):
+            raise ParameterError(
+                f"rotations must be 'auto', 'rotvec' or 'euler', got {self.rotations!r}"
+            )
+        self.rotation_map_ = None
+        if self.rotations != "euler":
+            from .rotations import fit_rotation_map
+
+            bad = ~np.isfinite(motion.frames)
+            if not bad.any():
+                rmap = fit_rotation_map(motion, exclude=cols, mode=self.rotations)
+                self.rotation_map_ = rmap if rmap.columns.size else None
 
     def _fit_poses(self, poses: np.ndarray, motion: Motion) -> None:
         self.mean_ = poses.mean(axis=0)

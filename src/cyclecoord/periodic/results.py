@@ -293,7 +293,7 @@ def _landmark_report(est: CircularCoordinates | None) -> dict | None:
 
 #: extract's defaults for the settings a Preprocessor or CircularCoordinates can carry.
 EXTRACT_CONFIGURED_DEFAULTS = dict(
-    difference_root=True, normalize=False, pca=None, root="body", delay="auto",
+    difference_root=True, normalize=False, pca=None, root="body", delay="auto", rotations="auto",
     max_scale=None, scale=None, class_index=0, prime=DEFAULT_PRIME, scale_fraction=0.9,
     temporal=False, landmarks="auto", memory_limit=None,
 )
@@ -320,7 +320,8 @@ def configured_keywords(
         fps = getattr(motion, "fps", None) or 1.0
         chosen.update(difference_root=preprocessor.difference_root,
                       normalize=preprocessor.normalize, pca=preprocessor.pca,
-                      root=preprocessor.root, delay=None if not lag else float(lag) / fps)
+                      root=preprocessor.root, delay=None if not lag else float(lag) / fps,
+                      rotations=preprocessor.rotations)
     if estimator is not None:
         if not isinstance(estimator, CircularCoordinates):
             raise ParameterError(

@@ -141,7 +141,8 @@ def motion_cycles(
     if timing not in TIMINGS:
         raise ParameterError(f"timing must be one of {TIMINGS}, got {timing!r}")
     motion = result.motion
-    prep = Preprocessor(difference_root=result.parameters.get("difference_root", True))
+    prep = Preprocessor(difference_root=result.parameters.get("difference_root", True),
+                        rotations=result.parameters.get("rotations", "auto"))
     prepared = prep.fit_transform(motion)
     out: list[MotionCycle] = []
     for mid in range(result.n_motions):

@@ -41,6 +41,7 @@ def detect(
     normalize: bool = False,
     temporal: bool = False,
     difference_root: bool = True,
+    rotations: str = "auto",
     prime: int = DEFAULT_PRIME,
     max_scale: float | None = None,
     delay: float | tuple | None = 0.25,
@@ -73,8 +74,8 @@ def detect(
     motion : Motion
     frames : (start, stop), optional
         0-based half-open frame range to analyse.
-    pca, normalize, temporal, difference_root, prime, max_scale, landmarks, memory_limit
-        As for :func:`cyclecoord.extract`.
+    pca, normalize, temporal, difference_root, rotations, prime, max_scale, landmarks
+        As for :func:`cyclecoord.extract`; so is ``memory_limit``.
     delay : float, sequence of float, or None, default 0.25
         Delay embedding in seconds (each pose joined by the poses this long before), so
         that out-and-back movements (squats, jumping jacks, knee raises) form loops.
@@ -158,12 +159,14 @@ def detect(
             window_points=window_points, window_cycles=window_cycles,
             window_steadiness=window_steadiness, similarity=similarity, normalize=normalize,
             temporal=temporal, difference_root=difference_root, progress=progress,
+            rotations=rotations,
         ),
     )
     params = dict(
         frames=None if frames is None else list(frames), pca=pca, normalize=normalize,
         temporal=temporal, difference_root=difference_root, prime=prime, max_scale=max_scale,
-        landmarks=landmarks, delay=delay, n_classes=n_classes, max_classes=max_classes,
+        rotations=rotations, landmarks=landmarks, delay=delay, n_classes=n_classes,
+        max_classes=max_classes,
         min_persistence=min_persistence, scale_fraction=scale_fraction, window=window,
         max_period=max_period, min_consistency=min_consistency, min_cycles=min_cycles,
         merge_overlap=merge_overlap, method=method, window_lengths=list(window_lengths),
@@ -185,7 +188,8 @@ def detect(
     )
     lag = lag or None
     prepared = Preprocessor(
-        difference_root=difference_root, normalize=normalize, pca=pca, delay=lag
+        difference_root=difference_root, normalize=normalize, pca=pca, delay=lag,
+        rotations=rotations,
     ).fit_transform(motion)
     timings["prepare"] = time.perf_counter() - t0
 
@@ -264,7 +268,8 @@ def detect(
 
 #: detect's defaults for the settings a Preprocessor or CircularCoordinates can carry.
 _DETECT_CONFIGURED = dict(
-    difference_root=True, normalize=False, pca=None, delay=0.25, max_scale=None,
+    difference_root=True, normalize=False, pca=None, delay=0.25, rotations="auto",
+    max_scale=None,
     prime=DEFAULT_PRIME, scale_fraction=0.9, temporal=False, landmarks="auto", memory_limit=None,
 )
 
@@ -301,6 +306,7 @@ DETECT_CONSTRAINTS = {
     "normalize": ["boolean"],
     "temporal": ["boolean"],
     "difference_root": ["boolean"],
+    "rotations": [Options("auto", "rotvec", "euler")],
     "progress": ["boolean"],
 }
 
