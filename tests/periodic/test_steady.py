@@ -1,6 +1,7 @@
 """Steady frames of a take: pace, heading and the speed ramps out of standing (periodic.steady)."""
 
 import numpy as np
+import pytest
 
 from cyclecoord.periodic.steady import period_speed, steady_mask
 from cyclecoord.periodic.windings import stretches
@@ -73,3 +74,61 @@ def test_recurrence_of_some_columns_reads_them_block_by_block():
     np.testing.assert_array_equal(
         recurrence(x, 40.0, columns=cols, chunk=100), recurrence(x[:, cols], 40.0, chunk=100)
     )
+
+
+# ------------------------------------------------------------------ curved paths (issue 23)
+def curved(m, degrees_per_frame, start=0):
+    """The capture walked on a circle: from frame ``start`` on, the root's heading turns at
+    a constant rate and its ground steps turn with it."""
+    from scipy.spatial.transform import Rotation
+
+    from cyclecoord.conventions import continuous_euler
+    from cyclecoord.periodic.root import root_layout, root_rotations
+
+    lay = root_layout(m)
+    f = m.frames.copy()
+    R = root_rotations(f, lay)  # world rotations (T, 3, 3)
+    theta = np.radians(degrees_per_frame) * np.maximum(np.arange(m.n_frames) - start, 0)
+    turn = Rotation.from_rotvec(np.outer(theta, [0.0, 1.0, 0.0])).as_matrix()
+    p = f[:, [lay.column(t) for t in ("tx", "ty", "tz")]]
+    step = np.diff(p, axis=0)
+    new_step = np.einsum("tij,tj->ti", turn[:-1], step)
+    newp = np.vstack([p[:1], p[:1] + np.cumsum(new_step, axis=0)])
+    G = np.einsum("tij,tjk->tik", turn, R)
+    local = np.einsum("ji,tjk,kl->til", lay.axis, G, lay.axis)
+    ang = continuous_euler(local[:, None], lay.order)[:, 0]
+    for k, a in enumerate(lay.order.lower()):
+        f[:, lay.column("r" + a)] = ang[:, k]
+    for k, t in enumerate(("tx", "ty", "tz")):
+        f[:, lay.column(t)] = newp[:, k]
+    return m.with_frames(f)
+
+
+def test_a_walk_on_a_circle_is_steady():
+    """45 degrees of turn per cycle (an 8-cycle circle) is a walk, not a disturbance (the
+    old rule, at most 30 degrees of turn over a period, kept no frame of it)."""
+    import cyclecoord as cc
+    from cyclecoord.datasets import make_periodic_capture
+
+    m = make_periodic_capture(n_frames=720, period=120.0, speed_variation=0.05,
+                              random_state=1).motion
+    straight = cc.extract(m)
+    circle = cc.extract(curved(m, 45.0 / 120.0))
+    assert circle.period_frames == pytest.approx(straight.period_frames, rel=0.02)
+    used = sum(b - a for a, b in circle.used_frames)
+    assert used >= 0.8 * sum(b - a for a, b in straight.used_frames)
+    assert circle.heading_per_cycle == pytest.approx(45.0, abs=3.0)
+
+
+def test_steady_turning_rejects_the_start_of_a_turn_and_a_u_turn():
+    from cyclecoord.periodic.steady import steady_turning
+
+    P = 100
+    t = np.arange(1000)
+    circle = 0.3 * t  # 30 degrees a period, all along
+    assert steady_turning(circle, P).all()
+    corner = np.interp(t, [0, 450, 550, 999], [0, 0, 90, 90])  # a 90-degree corner in a period
+    ok = steady_turning(corner, P)
+    assert not ok[480:520].any() and ok[:300].all() and ok[700:].all()
+    u_turn = np.interp(t, [0, 450, 550, 999], [0, 0, 180, 180])
+    assert not steady_turning(u_turn, P)[450:550].any()

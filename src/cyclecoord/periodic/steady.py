@@ -12,8 +12,9 @@ only.  This module finds it from three per-frame signals:
   period before): its distance to the nearest pose 0.7-1.45 periods away, over the
   take's median of that distance;
 * **at the take's pace and heading** (:func:`steady_mask`): the circular coordinate
-  advances between 1/1.6 and 1.6 turns per period over a two-period window, and the heading turns
-  less than ``max_turn`` degrees over it.
+  advances between 1/1.6 and 1.6 turns per period over a two-period window, and the
+  heading turns at a steady rate (:func:`steady_turning`: a circle or a figure-8 is a
+  walk; the start and end of a turn and a U-turn are not).
 
 Frames passing all three, in runs of at least one period (gaps shorter than a quarter
 period inside a run are bridged), are the steady frames the cycle is built from.
@@ -30,6 +31,7 @@ __all__ = [
     "moving_mask",
     "recurrence",
     "steady_mask",
+    "steady_turning",
     "period_speed",
     "clean_runs",
     "centred_window",
@@ -198,6 +200,39 @@ def centred_window(n: int, half: int) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
+def steady_turning(
+    heading: np.ndarray, period: float, max_turn: float = 30.0, max_curve: float = 90.0
+) -> np.ndarray:
+    """Frames whose heading turns at a steady rate (see :func:`steady_mask`).
+
+    Parameters
+    ----------
+    heading : ndarray, shape (T,)
+        Continuous heading, degrees.
+    period : float
+        Frames per cycle.
+    max_turn : float
+        Largest change, in degrees per period, between a frame's turn over the period
+        around it and the turn over the periods centred one period before and after.
+    max_curve : float
+        Largest turn over the period around a frame, degrees.
+
+    Returns
+    -------
+    ndarray of bool, shape (T,)
+    """
+    h = np.asarray(heading, dtype=float)
+    n = h.size
+    lo, hi = centred_window(n, max(1, int(round(period / 2))))
+    rate = (h[hi] - h[lo]) / np.maximum(hi - lo, 1) * period  # degrees per period
+    shift = max(1, int(round(period)))
+    idx = np.arange(n)
+    before = rate[np.clip(idx - shift, 0, n - 1)]
+    after = rate[np.clip(idx + shift, 0, n - 1)]
+    change = np.maximum(np.abs(rate - before), np.abs(rate - after))
+    return (change <= max_turn) & (np.abs(rate) <= max_curve)
+
+
 def steady_mask(
     unwrapped: np.ndarray,
     candidates: np.ndarray,
@@ -209,6 +244,7 @@ def steady_mask(
     pace_window: float = 2.0,
     max_recurrence: float = 2.0,
     max_turn: float = 30.0,
+    max_curve: float = 90.0,
     speed: np.ndarray | None = None,
     max_speed_ratio: float = 1.3,
 ) -> np.ndarray:
@@ -226,8 +262,14 @@ def steady_mask(
         From :func:`recurrence`; a frame whose distance is over ``max_recurrence`` times
         the median over candidate frames is not steady.
     heading : ndarray, shape (T,), optional
-        Heading in degrees (continuous); a frame whose period-long window turns by more
-        than ``max_turn`` degrees is not steady.
+        Heading in degrees (continuous).  Turning at a steady rate is steady (a walk on a
+        circle or a figure-8 repeats itself in the body's own frame, where the root's
+        changes are measured): a frame is not steady where its period-long window turns
+        more than ``max_turn`` degrees more or less than the windows one period before
+        and after it (the start or end of a turn), or more than ``max_curve`` degrees in
+        all (a U-turn, a turn on the spot).
+    max_turn, max_curve : float
+        Degrees per period (see ``heading``).
     max_pace : float
         Turns per period over a period-long window must lie between ``1 / max_pace``
         and ``max_pace`` (starting, stopping and standing turn far slower).
@@ -262,9 +304,7 @@ def steady_mask(
             good_pace |= (pace >= 1.0 / max_pace) & (pace <= max_pace)
         good = good_pace
         if h is not None:
-            lo, hi = centred_window(b - a, max(1, int(round(period / 2))))
-            turn = np.abs(h[hi] - h[lo]) / np.maximum(hi - lo, 1) * period
-            good &= turn <= max_turn
+            good &= steady_turning(h, period, max_turn, max_curve)
         ok[a:b] &= good
     if speed is not None:
         v = np.asarray(speed, dtype=float)
