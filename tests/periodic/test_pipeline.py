@@ -85,7 +85,9 @@ def test_report_has_the_documented_fields():
     assert rep["barcode"]["h0"][-1][1] is None  # the infinite H0 bar
     d = rep["distance_to_cycle"]
     assert 0 < d["largest_cycle_step"] <= 2.0 * d["p99_frame_step"]  # no pop, no warning
-    assert not any("jumps" in w for w in res.warnings)
+    assert not any("pops" in w for w in res.warnings)
+    pq = rep["pose_quality"]  # the same figures on joint positions
+    assert pq["pop"] <= 2.0 and pq["seam"] <= 1.5 and pq["nearest_max"] <= 1.0
 
 
 def test_a_pop_in_the_cycle_is_a_warning(monkeypatch):
@@ -94,9 +96,9 @@ def test_a_pop_in_the_cycle_is_a_warning(monkeypatch):
     import cyclecoord.periodic.pipeline as pipeline
 
     m = cc.datasets.example_capture().motion
-    d = cc.extract(m).distance
-    monkeypatch.setattr(pipeline, "MAX_POP", 0.5 * d["largest_cycle_step"] / d["p99_frame_step"])
-    (note,) = [w for w in cc.extract(m).warnings if "jumps" in w]
+    pop = cc.extract(m).pose_quality.pop
+    monkeypatch.setattr(pipeline, "MAX_POP", 0.5 * pop)
+    (note,) = [w for w in cc.extract(m).warnings if "pops" in w]
     assert "99th-percentile step" in note and "--bandwidth 2" in note
 
 

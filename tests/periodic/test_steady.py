@@ -129,6 +129,6 @@ def test_steady_turning_rejects_the_start_of_a_turn_and_a_u_turn():
     assert steady_turning(circle, P).all()
     corner = np.interp(t, [0, 450, 550, 999], [0, 0, 90, 90])  # a 90-degree corner in a period
     ok = steady_turning(corner, P)
-    assert not ok[480:520].any() and ok[:300].all() and ok[700:].all()
+    assert not ok[420:580].any() and ok[:350].all() and ok[650:].all()
     u_turn = np.interp(t, [0, 450, 550, 999], [0, 0, 180, 180])
     assert not steady_turning(u_turn, P)[450:550].any()

@@ -254,11 +254,26 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
         if res.jerk.get("original", 0) > 0
         else float("nan")
     )
-    seam = "seamless" if res.loop_closure <= 1.5 else "a visible seam"
+    pq = res.pose_quality
+    if pq is not None:
+        # the words come from joint positions (the same whatever file the cycle is read from)
+        closure, ratio = pq.seam, pq.jerk_ratio
+        if pq.pops:
+            seam = f"pops ({pq.pop:.1f}x the capture's largest steps)"
+        elif pq.seam > 1.5:
+            seam = "a visible seam"
+        else:
+            seam = "seamless"
+        if pq.strays:
+            seam += f", poses {pq.nearest_max:.1f}x the capture's spread from any captured pose"
+    else:
+        closure = res.loop_closure
+        seam = "seamless" if closure <= 1.5 else "a visible seam"
+    pops = pq is not None and (pq.pops or pq.strays)
     smooth = (
         "as smooth as the capture or smoother"
-        if ratio <= 1.0
-        else f"{ratio:.1f}x the capture's jerk"
+        if ratio <= 1.0 and not pops
+        else f"{ratio:.2g}x the capture's jerk"
     )
     width = ""
     if res.parameters.get("bandwidth") is not None:
@@ -266,7 +281,7 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
         width = f"; kernel width {res.typical.bandwidth:.3g} frames{chosen}"
     lines.append(
         f"cycle: {res.cycle.n_frames} frames ({res.cycle.n_frames / fps:.3f} s), {seam} "
-        f"(last-to-first step {res.loop_closure:.2f} median steps), {smooth} (jerk ratio "
+        f"(last-to-first step {closure:.2f} median steps), {smooth} (jerk ratio "
         f"{ratio:.2f}){width}"
     )
     if np.isfinite(res.heading_per_cycle):

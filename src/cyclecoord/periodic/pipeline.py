@@ -26,6 +26,7 @@ from ..errors import NoPeriodicMotionError, ParameterError
 from ..quality.metrics import distance_to_cycle, frame_steps, jerk_summary, loop_closure
 from ..motion import Motion
 from .preprocess import Preprocessor
+from ..quality.pose_space import MAX_POP as POSE_MAX_POP, pose_quality
 from .clip import capture_cycle, loop_cycle
 from .windings import Windings, complete_windings, retime, stretches
 
@@ -36,8 +37,9 @@ __all__ = [
 
 #: Delay embedding (seconds) tried when a take's poses alone show no periodic motion.
 AUTO_DELAY = 0.25
-#: A cycle step over this many times the capture's 99th-percentile frame step is a warning.
-MAX_POP = 2.0
+#: A cycle step over this many times the capture's 99th-percentile frame step is a warning
+#: (one threshold with the console's words: quality.pose_space.MAX_POP).
+MAX_POP = POSE_MAX_POP
 
 # the result types live in .results; re-exported here, where they have always been imported
 from .results import MIN_TURNS, TIMINGS, TRAVELS, CycleOptions, ExtractionResult  # noqa: E402
@@ -355,12 +357,20 @@ def _finish(
     timings["cycle"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     jerk, closure, distance = _cycle_figures(prepared, typ, runs, rows, motion.fps)
-    pop = distance["largest_cycle_step"] / distance["p99_frame_step"]
+    poses = pose_quality(cycle_motion, motion, runs, period)
+    pop = poses.pop if poses is not None else (
+        distance["largest_cycle_step"] / distance["p99_frame_step"])
     if np.isfinite(pop) and pop > MAX_POP:
         notes.append(
-            f"the cycle jumps {distance['largest_cycle_step']:.3g} in one frame, {pop:.1f}x the "
-            "capture's 99th-percentile step (its repetitions disagree there); look at the "
-            "channels figure, and try --bandwidth 2 or --frames on a steadier stretch"
+            f"the cycle pops: its largest frame step is {pop:.1f}x the capture's "
+            "99th-percentile step (its repetitions disagree there); look at the channels "
+            "figure, and try --bandwidth 2 or --frames on a steadier stretch"
+        )
+    if poses is not None and poses.strays:
+        notes.append(
+            f"some cycle poses are {poses.nearest_max:.1f}x the capture's own spread from the "
+            "nearest captured pose (a pose the actor never held); try --rotations rotvec, "
+            "--frames on a steadier stretch or --bandwidth 2"
         )
     timings["metrics"] = time.perf_counter() - t0
     timings["total"] = sum(v for k, v in timings.items())
@@ -389,6 +399,7 @@ def _finish(
         phase=phase,
         windings=wind,
         heading_per_cycle=heading_change,
+        pose_quality=poses,
     )
 
 

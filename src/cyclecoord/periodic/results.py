@@ -169,6 +169,10 @@ class ExtractionResult:
         The complete windings: lengths, spread, anchors.
     heading_per_cycle : float
         Heading change of one cycle in degrees (as captured, before ``travel``).
+    pose_quality : PoseQuality or None
+        Seam, pop, nearest-pose distance and jerk measured on joint positions in the root's
+        frame (:mod:`cyclecoord.quality.pose_space`): the same whatever file the cycle is
+        read from.  None without a skeleton.
     """
 
     motion: Motion
@@ -195,6 +199,7 @@ class ExtractionResult:
     phase: np.ndarray | None = None
     windings: Windings | None = None
     heading_per_cycle: float = float("nan")
+    pose_quality: Any = None
 
     @property
     def used_frames(self) -> list[tuple[int, int]]:
@@ -245,6 +250,7 @@ class ExtractionResult:
             else None,
             "foot_skating": _cycle_skating(self.cycle),
             "distance_to_cycle": self.distance,
+            "pose_quality": None if self.pose_quality is None else self.pose_quality.to_dict(),
             "landmarks": _landmark_report(self.estimator),
             "cocycle_check": {
                 "triangles": int(self.estimator.cocycle_check_.n_triangles)

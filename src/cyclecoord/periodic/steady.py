@@ -14,7 +14,7 @@ only.  This module finds it from three per-frame signals:
 * **at the take's pace and heading** (:func:`steady_mask`): the circular coordinate
   advances between 1/1.6 and 1.6 turns per period over a two-period window, and the
   heading turns at a steady rate (:func:`steady_turning`: a circle or a figure-8 is a
-  walk; the start and end of a turn and a U-turn are not).
+  walk; a corner, its start and end, and a U-turn are not).
 
 Frames passing all three, in runs of at least one period (gaps shorter than a quarter
 period inside a run are bridged), are the steady frames the cycle is built from.
@@ -201,7 +201,7 @@ def centred_window(n: int, half: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def steady_turning(
-    heading: np.ndarray, period: float, max_turn: float = 30.0, max_curve: float = 90.0
+    heading: np.ndarray, period: float, max_turn: float = 30.0, max_curve: float = 60.0
 ) -> np.ndarray:
     """Frames whose heading turns at a steady rate (see :func:`steady_mask`).
 
@@ -213,7 +213,8 @@ def steady_turning(
         Frames per cycle.
     max_turn : float
         Largest change, in degrees per period, between a frame's turn over the period
-        around it and the turn over the periods centred one period before and after.
+        around it and the turns over the periods centred half a period before and after
+        (a frame whose window reaches into a turn's start or end).
     max_curve : float
         Largest turn over the period around a frame, degrees.
 
@@ -225,7 +226,7 @@ def steady_turning(
     n = h.size
     lo, hi = centred_window(n, max(1, int(round(period / 2))))
     rate = (h[hi] - h[lo]) / np.maximum(hi - lo, 1) * period  # degrees per period
-    shift = max(1, int(round(period)))
+    shift = max(1, int(round(period / 2)))
     idx = np.arange(n)
     before = rate[np.clip(idx - shift, 0, n - 1)]
     after = rate[np.clip(idx + shift, 0, n - 1)]
@@ -244,7 +245,7 @@ def steady_mask(
     pace_window: float = 2.0,
     max_recurrence: float = 2.0,
     max_turn: float = 30.0,
-    max_curve: float = 90.0,
+    max_curve: float = 60.0,
     speed: np.ndarray | None = None,
     max_speed_ratio: float = 1.3,
 ) -> np.ndarray:
@@ -265,9 +266,10 @@ def steady_mask(
         Heading in degrees (continuous).  Turning at a steady rate is steady (a walk on a
         circle or a figure-8 repeats itself in the body's own frame, where the root's
         changes are measured): a frame is not steady where its period-long window turns
-        more than ``max_turn`` degrees more or less than the windows one period before
+        more than ``max_turn`` degrees more or less than the windows half a period before
         and after it (the start or end of a turn), or more than ``max_curve`` degrees in
-        all (a U-turn, a turn on the spot).
+        all (a corner, a U-turn, a turn on the spot; 60 degrees a period is a circle of
+        six cycles).
     max_turn, max_curve : float
         Degrees per period (see ``heading``).
     max_pace : float

@@ -1,0 +1,211 @@
+"""A cycle's quality measured on joint positions, where the rotation channels do not matter.
+
+Loop closure, jerk and step figures computed on channels depend on how a file writes its
+rotations: a cycle read back from BVH (three Euler channels a joint) measures otherwise
+than from AMC, and an Euler wrap reads as a 360-degree jump.  Here every figure is taken
+from **joint positions by forward kinematics, in the root's frame**: each joint's (and end
+site's) position minus the root's, turned by the inverse of the root's rotation, plus the
+root's height.  Two files holding the same motion give the same numbers, and a pose step
+is what a viewer sees: how far the body's points move.
+
+* the **pose step** between two frames is the root-mean-square displacement of those
+  points (skeleton length units);
+* **seam**: the last-to-first step over the cycle's median step;
+* **pop**: the cycle's largest step (seam included) over the capture's 99th-percentile
+  step on the frames the cycle was made from;
+* **nearest-pose distance**: each cycle pose's distance to the nearest captured pose,
+  over the capture's own **spread**, the 90th percentile over captured poses of the
+  distance to the nearest pose of another repetition (at least half a period away).
+  Under 1, a cycle pose is as close to something the actor did as nine in ten captured
+  poses are to another repetition;
+* **jerk**: the mean norm of the points' third derivative (length units / s³), cycle over
+  capture (a ratio: no unit to picture).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..motion import Motion
+
+__all__ = ["PoseQuality", "root_frame_points", "pose_quality", "MAX_POP", "MAX_SEAM"]
+
+#: A cycle step over this many times the capture's 99th-percentile step is a pop.
+MAX_POP = 2.0
+#: A seam over this many median steps shows.
+MAX_SEAM = 1.5
+#: Captured frames compared against (a long take is sampled evenly down to this).
+MAX_REFERENCE_FRAMES = 20_000
+
+
+def root_frame_points(motion: Motion) -> np.ndarray:
+    """Joint and end-site positions in the root's frame, plus the root's height.
+
+    Parameters
+    ----------
+    motion : Motion
+        With a skeleton.
+
+    Returns
+    -------
+    ndarray, shape (T, 3 * (J + E) + 1)
+        Per frame: every point's position minus the root's, in the root's rotated frame
+        (skeleton length units), then the root's up (y) coordinate.
+    """
+    from ..periodic.root import root_layout, root_rotations
+
+    pos = np.asarray(motion.positions().positions, dtype=float)  # (T, N, 3)
+    layout = root_layout(motion)
+    R = root_rotations(motion.frames, layout) if layout is not None else None
+    root = pos[:, :1, :]
+    rel = pos - root
+    if R is not None:
+        rel = np.einsum("tji,tnj->tni", R, rel)
+    T = pos.shape[0]
+    return np.concatenate([rel.reshape(T, -1), root[:, 0, 1:2]], axis=1)
+
+
+def _steps(x: np.ndarray, cyclic: bool = False) -> np.ndarray:
+    n = x.shape[1] // 3 or 1
+    d = np.diff(x, axis=0, append=x[:1]) if cyclic else np.diff(x, axis=0)
+    return np.linalg.norm(d, axis=1) / np.sqrt(n)
+
+
+def _jerk(x: np.ndarray, fps: float, cyclic: bool) -> float:
+    if len(x) < 5:
+        return float("nan")
+    if cyclic:
+        x = np.concatenate([x[-3:], x, x[:3]])
+    j = np.diff(x, n=3, axis=0) * fps**3
+    n = x.shape[1] // 3 or 1
+    return float(np.mean(np.linalg.norm(j, axis=1) / np.sqrt(n)))
+
+
+@dataclass(frozen=True)
+class PoseQuality:
+    """A cycle's figures on joint positions (see the module notes).
+
+    Attributes
+    ----------
+    seam : float
+        Last-to-first step over the cycle's median step (no unit).
+    pop : float
+        Largest cycle step, seam included, over the capture's 99th-percentile step.
+    largest_step, p99_capture_step, median_cycle_step : float
+        The steps behind them (skeleton length units, RMS over the body's points).
+    nearest_max, nearest_median : float
+        Largest and median distance from a cycle pose to its nearest captured pose,
+        over the capture's spread (no unit).
+    spread : float
+        The capture's spread (length units).
+    jerk_ratio : float
+        The cycle's jerk over the capture's.
+    """
+
+    seam: float
+    pop: float
+    largest_step: float
+    p99_capture_step: float
+    median_cycle_step: float
+    nearest_max: float
+    nearest_median: float
+    spread: float
+    jerk_ratio: float
+
+    @property
+    def pops(self) -> bool:
+        return bool(np.isfinite(self.pop) and self.pop > MAX_POP)
+
+    @property
+    def seamless(self) -> bool:
+        return bool(self.seam <= MAX_SEAM and not self.pops)
+
+    @property
+    def strays(self) -> bool:
+        """Some cycle pose is farther from every captured pose than the capture's spread."""
+        return bool(np.isfinite(self.nearest_max) and self.nearest_max > 1.0)
+
+    def to_dict(self) -> dict:
+        return {k: (None if not np.isfinite(v) else float(v)) for k, v in asdict(self).items()}
+
+
+def _runs_points(capture: Motion, runs: list[tuple[int, int]]) -> list[np.ndarray]:
+    total = sum(b - a for a, b in runs)
+    every = max(1, int(np.ceil(total / MAX_REFERENCE_FRAMES)))
+    out = []
+    for a, b in runs:
+        if b - a >= 2:
+            # whole runs, sampled evenly on long takes (steps then span ``every`` frames)
+            out.append(root_frame_points(capture.window((a, b)))[::every])
+    return out
+
+
+def pose_quality(
+    cycle: Motion, capture: Motion, runs: list[tuple[int, int]], period: float
+) -> PoseQuality | None:
+    """Measure ``cycle`` against the frames of ``capture`` it was made from.
+
+    Parameters
+    ----------
+    cycle : Motion
+        The loop, one period of frames.
+    capture : Motion
+        The capture (same skeleton).
+    runs : list of (start, stop)
+        The capture's frames the cycle was made from (half-open, 0-based).
+    period : float
+        Frames per cycle in the capture (the spread compares poses at least half a period
+        apart).
+
+    Returns
+    -------
+    PoseQuality or None
+        None without a skeleton or with too few frames.
+    """
+    if cycle.skeleton is None or capture.skeleton is None or cycle.n_frames < 3:
+        return None
+    parts = _runs_points(capture, runs)
+    if not parts:
+        return None
+    every = max(1, int(np.ceil(sum(b - a for a, b in runs) / MAX_REFERENCE_FRAMES)))
+    cyc = root_frame_points(cycle)
+    csteps = _steps(cyc, cyclic=True)
+    seam = float(csteps[-1] / np.median(csteps)) if np.median(csteps) > 0 else float("nan")
+    cap_steps = np.concatenate([_steps(p) for p in parts if len(p) > 1]) if every == 1 else \
+        _steps(root_frame_points(capture.window(max(runs, key=lambda r: r[1] - r[0]))))
+    p99 = float(np.percentile(cap_steps, 99)) if cap_steps.size else float("nan")
+    pop = float(csteps.max() / p99) if p99 > 0 else float("nan")
+    pts = np.concatenate(parts)
+    frame_of = np.concatenate([
+        np.arange(a, b)[::every][: len(p)] for (a, b), p in zip(
+            [r for r in runs if r[1] - r[0] >= 2], parts)
+    ])
+    tree = cKDTree(pts)
+    near, _ = tree.query(cyc)
+    # spread: each captured pose's nearest pose in another repetition
+    half = max(1.0, 0.5 * float(period))
+    k = int(min(len(pts), max(8, 4 * np.ceil(period / every))))
+    d, idx = tree.query(pts, k=k)
+    far = np.abs(frame_of[idx] - frame_of[:, None]) >= half
+    d = np.where(far, d, np.inf)
+    best = d.min(axis=1)
+    best = best[np.isfinite(best)]
+    spread = float(np.percentile(best, 90)) if best.size else float("nan")
+    jc = _jerk(cyc, cycle.fps, cyclic=True)
+    jo = np.average([_jerk(p, capture.fps / every, False) for p in parts if len(p) >= 5],
+                    weights=[len(p) for p in parts if len(p) >= 5]) \
+        if any(len(p) >= 5 for p in parts) else float("nan")
+    return PoseQuality(
+        seam=seam,
+        pop=pop,
+        largest_step=float(csteps.max()),
+        p99_capture_step=p99,
+        median_cycle_step=float(np.median(csteps)),
+        nearest_max=float(near.max() / spread) if spread > 0 else float("nan"),
+        nearest_median=float(np.median(near) / spread) if spread > 0 else float("nan"),
+        spread=spread,
+        jerk_ratio=float(jc / jo) if jo and np.isfinite(jo) and jo > 0 else float("nan"),
+    )

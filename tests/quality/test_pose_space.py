@@ -1,0 +1,44 @@
+"""Cycle quality on joint positions: the same from every file, pops and strays called."""
+
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.quality.pose_space import pose_quality
+
+
+@pytest.fixture(scope="module")
+def extracted():
+    return cc.extract(cc.datasets.example_capture().motion)
+
+
+@pytest.mark.parametrize("suffix", [".bvh", ".npz", ".amc", ".glb"])
+def test_same_figures_from_every_file(extracted, tmp_path, suffix):
+    res = extracted
+    path = tmp_path / f"cycle{suffix}"
+    cc.save(res.cycle, path)
+    back = cc.load(path)
+    a = pose_quality(res.cycle, res.motion, res.used_frames, res.period_frames)
+    b = pose_quality(back, res.motion, res.used_frames, res.period_frames)
+    for k in ("seam", "pop", "nearest_max", "jerk_ratio"):
+        assert getattr(b, k) == pytest.approx(getattr(a, k), rel=0.02), k
+
+
+def test_a_pop_and_a_stray_pose_are_called(extracted):
+    res = extracted
+    good = pose_quality(res.cycle, res.motion, res.used_frames, res.period_frames)
+    assert not good.pops and good.seamless and not good.strays
+    f = res.cycle.frames.copy()
+    knee = res.cycle.channel_index("ltibia", "rx")
+    f[40:45, knee] += 60.0  # the knee snaps 60 degrees for five frames
+    bad = pose_quality(res.cycle.with_frames(f), res.motion, res.used_frames, res.period_frames)
+    assert bad.pops and not bad.seamless and bad.strays
+    assert bad.pop > 2.0 and bad.nearest_max > 1.0
+
+
+def test_capture_copy_is_at_distance_zero(extracted):
+    res = extracted
+    a, b = res.used_frames[0]
+    P = int(round(res.period_frames))
+    copy = res.motion.window((a, a + P))
+    q = pose_quality(copy, res.motion, res.used_frames, res.period_frames)
+    assert q.nearest_max == pytest.approx(0.0, abs=1e-9)
