@@ -898,6 +898,15 @@ def fk_check(motion, rig: Rig, own_points: np.ndarray) -> float | None:
     return worst
 
 
+def _reason(exc: Exception, motion) -> str:
+    """The error's first line without the file name it starts with."""
+    text = str(exc).splitlines()[0]
+    for prefix in (f"{motion.source}: ", f"{Path(str(motion.source)).name}: "):
+        if motion.source and text.startswith(prefix):
+            return text[len(prefix):]
+    return text
+
+
 def run_case(case: Case) -> dict[str, Any]:
     """Everything for one file."""
     row: dict[str, Any] = {"file": case.name, "kind": case.kind}
@@ -920,9 +929,9 @@ def run_case(case: Case) -> dict[str, Any]:
             result = cc.extract(motion)
         row["status"] = "ok"
     except NoPeriodicMotionError as exc:
-        row["status"], row["reason"] = "refused", str(exc).splitlines()[0]
+        row["status"], row["reason"] = "refused", _reason(exc, motion)
     except cc.CycleCoordError as exc:
-        row["status"], row["reason"] = "error", f"{type(exc).__name__}: {exc}".splitlines()[0]
+        row["status"], row["reason"] = "error", f"{type(exc).__name__}: {_reason(exc, motion)}"
     row["cpu_s"] = time.process_time() - c0
     row["wall_s"] = time.perf_counter() - w0
     ref = row["strike_period"] if np.isfinite(row["strike_period"]) else row["ac_period"]
