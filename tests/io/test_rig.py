@@ -1,14 +1,9 @@
 """Rig conventions: found on real and synthetic rigs, normalised for the analysis and restored."""
 
-import warnings
-from pathlib import Path
-
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-import cyclecoord as cc
-from cyclecoord.conventions import to_bvh_convention
 from cyclecoord.errors import ParameterError
 from cyclecoord.motion import Motion
 from cyclecoord.rig import (
@@ -21,100 +16,17 @@ from cyclecoord.rig import (
     parse_units,
     rig_summary,
 )
-from cyclecoord.skeleton import Joint, Skeleton
-
-BVH = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "bvh"
-BANDAI = sorted((BVH / "bandai").glob("*.bvh")) if (BVH / "bandai").is_dir() else []
-XSENS = BVH / "xsens" / "S02-Trial-Walk-1.bvh"
-
-
-def _shared(path: Path) -> Motion:
-    if not path.is_file():
-        pytest.skip(f"shared capture not found at {path} (../shared/data beside the checkout)")
-    return cc.load(path)
-
-
-def _bandai(k: int = 0) -> Motion:
-    if not BANDAI:
-        pytest.skip(f"shared Bandai captures not found under {BVH / 'bandai'}")
-    return cc.load(BANDAI[k])
-
-
-# ----------------------------------------------------------- synthetic rigs, built here
-def _walk() -> Motion:
-    """The synthetic walk on a BVH skeleton (root tx ty tz rz rx ry, joints ZXY), 160 frames."""
-    return to_bvh_convention(cc.datasets.example_capture().motion[:160], "ZXY")
-
-
-def _in_units(m: Motion, mpu: float) -> Motion:
-    """The walk with its lengths in a unit of ``mpu`` metres, a BVH without a length unit."""
-    k = CMU_UNIT / mpu
-    joints = tuple(
-        Joint(
-            j.name,
-            j.parent,
-            j.offset * k,
-            j.dofs,
-            j.rotation_order,
-            end_site=None if j.end_site is None else j.end_site * k,
-        )
-        for j in m.skeleton.joints
-    )
-    frames = np.array(m.frames)
-    for i, (_, d) in enumerate(m.channels):
-        if d.startswith("t"):
-            frames[:, i] *= k
-    skel = Skeleton(joints, name="scaled", source_format="bvh")
-    return Motion(frames, m.channels, fps=m.fps, skeleton=skel, source="scaled")
-
-
-def _turn_root(m: Motion, rot: np.ndarray) -> Motion:
-    """The root's transform premultiplied by ``rot``, Euler angles (ZXY) recomputed by SciPy."""
-    root = m.skeleton.joints[0].name
-    t = [m.channel_index(root, d) for d in ("tx", "ty", "tz")]
-    r = [m.channel_index(root, d) for d in ("rz", "rx", "ry")]
-    frames = np.array(m.frames)
-    turned = Rotation.from_matrix(rot) * Rotation.from_euler("ZXY", frames[:, r], degrees=True)
-    frames[:, r] = np.unwrap(turned.as_euler("ZXY", degrees=True), period=360, axis=0)
-    frames[:, t] = frames[:, t] @ rot.T
-    return m.with_frames(frames)
-
-
-def _static_root(m: Motion, rot: np.ndarray, shift, positions_everywhere: bool) -> Motion:
-    """A static ``joint_Root`` (constant rotation ``rot`` and translation ``shift``) above the
-    motion's root; with ``positions_everywhere`` every joint gets 6 channels, the positions of
-    the joints below the old root constant and equal to their offsets (the Bandai layout)."""
-    skel = m.skeleton
-    order = "ZXY"
-    six = ("tx", "ty", "tz", "rz", "rx", "ry")
-    joints = [Joint("joint_Root", -1, [0, 0, 0], six, order)]
-    for i, j in enumerate(skel.joints):
-        dofs = six if (positions_everywhere or i == 0) else j.dofs
-        joints.append(Joint(j.name, j.parent + 1, j.offset, dofs, j.rotation_order,
-                            end_site=j.end_site))
-    new = Skeleton(tuple(joints), name="static", source_format="bvh", length_unit=1.0)
-    T = m.n_frames
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)  # gimbal lock: the angles still hold
-        angles = Rotation.from_matrix(rot).as_euler(order, degrees=True)
-    cols = {("joint_Root", "tx"): shift[0], ("joint_Root", "ty"): shift[1],
-            ("joint_Root", "tz"): shift[2]}
-    cols.update({("joint_Root", "r" + a.lower()): v for a, v in zip(order, angles)})
-    columns = []
-    for c in new.channels:
-        if c in cols:
-            columns.append(np.full(T, cols[c]))
-        elif c in m.channels:
-            columns.append(m.frames[:, m.channel_index(*c)])
-        else:  # a constant position channel equal to the offset
-            columns.append(np.full(T, new[c[0]].offset["xyz".index(c[1][1])]))
-    return Motion(np.column_stack(columns), new.channels, fps=30.0, skeleton=new, source="static")
-
-
-def _z_up() -> Motion:
-    """The walk (centimetres) on a Z-up rig: the root turned +90 degrees about x."""
-    return _turn_root(_in_units(_walk(), 0.01), Z_TO_Y.T)
-
+from _rigs import (  # tests/ is on the path (rootdir conftest)
+    BVH,
+    XSENS,
+    bandai,
+    in_units,
+    shared,
+    static_root,
+    turn_root,
+    walk,
+    z_up,
+)
 
 def _check_round_trip(m: Motion) -> None:
     analysis, adapter = normalize_rig(m)
@@ -129,7 +41,7 @@ def _check_round_trip(m: Motion) -> None:
 # ------------------------------------------------------------------------ finding
 @pytest.mark.parametrize("k", range(5))
 def test_bandai_rig_found(k):
-    m = _bandai(k)
+    m = bandai(k)
     info = describe_rig(m)
     assert info.style == "Bandai-style" and info.static_root
     assert info.root == "joint_Root" and info.travelling_joint == "Hips"
@@ -147,7 +59,7 @@ def test_bandai_rig_found(k):
 
 
 def test_xsens_rig_found():
-    m = _shared(XSENS)
+    m = shared(XSENS)
     info = describe_rig(m)
     assert not info.static_root and info.travelling_joint == "Hips"
     assert info.channel_counts[0] == 6 and set(info.channel_counts[1:]) == {3}
@@ -174,20 +86,20 @@ def test_cmu_rig_found(walk_69_01):
 
 @pytest.mark.parametrize("unit", ["m", "cm", "mm", "in"])
 def test_units_from_height(unit):
-    m = _in_units(_walk(), UNITS[unit])
+    m = in_units(walk(), UNITS[unit])
     info = describe_rig(m)
     assert info.units == unit and info.units_source == "measured"
-    assert info.height_m == pytest.approx(describe_rig(_walk()).height_m, rel=1e-9)
+    assert info.height_m == pytest.approx(describe_rig(walk()).height_m, rel=1e-9)
     assert metres_per_unit(m) == UNITS[unit]
 
 
 def test_cmu_unit_guessed_on_a_bvh_without_length_unit():
-    info = describe_rig(_in_units(_walk(), CMU_UNIT))
+    info = describe_rig(in_units(walk(), CMU_UNIT))
     assert info.units == "cmu" and info.metres_per_unit == pytest.approx(CMU_UNIT)
 
 
 def test_units_given():
-    m = _in_units(_walk(), 0.01)
+    m = in_units(walk(), 0.01)
     info = describe_rig(m, "in")
     assert (info.units, info.units_source, info.metres_per_unit) == ("in", "given", 0.0254)
     assert "in as given" in info.summary()
@@ -200,7 +112,7 @@ def test_units_given():
 
 
 def test_z_up_found():
-    info = describe_rig(_z_up())
+    info = describe_rig(z_up())
     assert info.up_axis == "Z" and info.units == "cm"
 
 
@@ -213,7 +125,7 @@ def test_no_skeleton():
 
 # ---------------------------------------------------------------- normalising
 def test_bandai_analysis_motion():
-    m = _bandai(0)
+    m = bandai(0)
     analysis, adapter = normalize_rig(m)
     skel = analysis.skeleton
     assert skel.names[0] == "Hips" and "joint_Root" not in skel.names
@@ -233,7 +145,7 @@ def test_bandai_analysis_motion():
 
 
 def test_xsens_reference_frame_dropped():
-    m = _shared(XSENS)
+    m = shared(XSENS)
     analysis, adapter = normalize_rig(m)
     assert adapter.dropped_frames == 1 and analysis.n_frames == m.n_frames - 1
     assert analysis.start_frame == m.start_frame + 1
@@ -248,7 +160,7 @@ def test_cmu_unchanged(walk_69_01):
 
 
 def test_z_up_turned_y_up_and_continuous():
-    m = _z_up()
+    m = z_up()
     analysis, adapter = normalize_rig(m)
     assert adapter.changes() == ["turned Z-up to Y-up"]
     want = m.positions().positions @ Z_TO_Y.T
@@ -261,10 +173,10 @@ def test_z_up_turned_y_up_and_continuous():
 
 def test_root_turning_round_stays_continuous():
     """A root turning twice round on a Z-up rig: its Euler channels never jump."""
-    m = _in_units(_walk(), 0.01)
+    m = in_units(walk(), 0.01)
     frames = np.array(m.frames)
     frames[:, m.channel_index("root", "ry")] = np.linspace(0, 720, m.n_frames)
-    m = _turn_root(m.with_frames(frames), Z_TO_Y.T)
+    m = turn_root(m.with_frames(frames), Z_TO_Y.T)
     analysis, adapter = normalize_rig(m)
     root = [analysis.channel_index("root", d) for d in ("rz", "rx", "ry")]
     assert np.abs(np.diff(analysis.frames[:, root], axis=0)).max() < 10.0
@@ -275,41 +187,41 @@ def test_root_turning_round_stays_continuous():
 
 def test_static_root_with_rotation_folded():
     """A static root turned +90 about x (a Z-up world) and shifted: folded, then turned Y-up."""
-    walk = _in_units(_walk(), 0.01)
-    m = _static_root(walk, Z_TO_Y.T, (12.0, -3.0, 4.0), positions_everywhere=True)
+    w = in_units(walk(), 0.01)
+    m = static_root(w, Z_TO_Y.T, (12.0, -3.0, 4.0), positions_everywhere=True)
     info = describe_rig(m)
     assert info.static_root and info.travelling_joint == "root" and info.up_axis == "Z"
     assert info.style == "Bandai-style"
     analysis, adapter = normalize_rig(m)
-    assert analysis.skeleton.names == walk.skeleton.names
-    assert set(analysis.channels) == set(walk.channels)
+    assert analysis.skeleton.names == w.skeleton.names
+    assert set(analysis.channels) == set(w.channels)
     # analysis world = Z_TO_Y (t0 + R0 p) with R0 = Z_TO_Y.T: the walk shifted
     shift = Z_TO_Y @ np.array([12.0, -3.0, 4.0])
-    want = walk.positions().positions + shift
+    want = w.positions().positions + shift
     assert np.abs(analysis.positions().positions - want).max() < 1e-9 * info.height
 
 
 @pytest.mark.parametrize(
     "build",
     [
-        pytest.param(lambda: _bandai(0), id="bandai-walk"),
-        pytest.param(lambda: _bandai(3), id="bandai-turn"),
-        pytest.param(lambda: _shared(XSENS), id="xsens"),
-        pytest.param(lambda: _shared(BVH.parent / "cmu" / "69" / "69_01.amc"), id="cmu-69_01"),
-        pytest.param(_z_up, id="synthetic-z-up"),
+        pytest.param(lambda: bandai(0), id="bandai-walk"),
+        pytest.param(lambda: bandai(3), id="bandai-turn"),
+        pytest.param(lambda: shared(XSENS), id="xsens"),
+        pytest.param(lambda: shared(BVH.parent / "cmu" / "69" / "69_01.amc"), id="cmu-69_01"),
+        pytest.param(z_up, id="synthetic-z-up"),
         pytest.param(
-            lambda: _static_root(_in_units(_walk(), 0.01), np.eye(3), (0, 0, 0), True),
+            lambda: static_root(in_units(walk(), 0.01), np.eye(3), (0, 0, 0), True),
             id="synthetic-static-root",
         ),
         pytest.param(
-            lambda: _static_root(
-                _in_units(_walk(), 0.001), Z_TO_Y.T, (120.0, -30.0, 40.0), True
+            lambda: static_root(
+                in_units(walk(), 0.001), Z_TO_Y.T, (120.0, -30.0, 40.0), True
             ),
             id="synthetic-static-root-turned",
         ),
         pytest.param(
-            lambda: _static_root(
-                _z_up(), Rotation.from_euler("ZXY", [30, 10, -20], degrees=True).as_matrix(),
+            lambda: static_root(
+                z_up(), Rotation.from_euler("ZXY", [30, 10, -20], degrees=True).as_matrix(),
                 (5.0, 1.0, 2.0), False,
             ),
             id="synthetic-static-root-tilted-z-up",
@@ -321,7 +233,7 @@ def test_restore_gives_back_the_capture(build):
 
 
 def test_restore_a_clip_of_the_analysis_motion():
-    m = _static_root(_in_units(_walk(), 0.001), Z_TO_Y.T, (120.0, -30.0, 40.0), True)
+    m = static_root(in_units(walk(), 0.001), Z_TO_Y.T, (120.0, -30.0, 40.0), True)
     analysis, adapter = normalize_rig(m)
     back = adapter.restore(analysis[20:70])
     assert back.n_frames == 50 and back.start_frame == 20
@@ -332,7 +244,7 @@ def test_restore_a_clip_of_the_analysis_motion():
 
 
 def test_restore_refuses_other_channels():
-    m = _bandai(0)
+    m = bandai(0)
     _, adapter = normalize_rig(m)
     with pytest.raises(ParameterError, match="analysis rig"):
         adapter.restore(m)
