@@ -220,7 +220,7 @@ class RigInfo:
             f"{self.fps:g} fps",
         ]
         if self.reference_frame:
-            parts.append(f"frame {self.start_frame} a reference pose (left out of the analysis)")
+            parts.append(f"frame {self.start_frame} a reference pose (discontinuous with the next)")
         return f"{self.style} rig: " + ", ".join(parts)
 
     def to_dict(self) -> dict:
