@@ -121,6 +121,54 @@ def byte_size(text: str) -> float:
     return v
 
 
+def units(text: str) -> str | float:
+    """Parse ``--units``: ``auto``, ``m``, ``cm``, ``mm``, ``in`` or metres per unit."""
+    from ..rig import parse_units
+
+    try:
+        value = parse_units(text)
+    except ParameterError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return "auto" if value is None else (text.strip().lower() if text.strip().isalpha() else value)
+
+
+def add_units_option(g: argparse._ActionsContainer) -> None:
+    """``--units``: the capture's length unit, for every command that reads captures."""
+    g.add_argument(
+        "--units",
+        type=units,
+        default="auto",
+        metavar="auto|m|cm|mm|in|M",
+        help="length unit of the capture: auto (default: an ASF's own :units length, "
+        "otherwise guessed from the body's height), m, cm, mm, in, or M metres per unit; "
+        "reported on the first line and used to write glTF and USD in metres",
+    )
+
+
+def export_units(args: argparse.Namespace, path: str | None) -> dict:
+    """Keyword arguments of :func:`cyclecoord.io.save` that carry ``--units`` to a glTF or
+    USD output (none for ``auto``, where the writer measures the unit itself)."""
+    from ..rig import parse_units
+
+    mpu = parse_units(getattr(args, "units", "auto"))
+    if mpu is None or not path:
+        return {}
+    suffix = Path(path).suffix.lower()
+    if suffix in (".glb", ".gltf"):
+        return {"scale": mpu}
+    if suffix in (".usda", ".usdc", ".usd"):
+        return {"meters_per_unit": mpu}
+    return {}
+
+
+def rig_line(motion, args: argparse.Namespace | None = None) -> str:
+    """The console's first line: the rig found (:func:`cyclecoord.rig.rig_summary`), with
+    ``--units`` when the command has it."""
+    from ..rig import rig_summary
+
+    return rig_summary(motion, getattr(args, "units", "auto") if args is not None else "auto")
+
+
 def add_selection_options(
     p: argparse.ArgumentParser,
     title: str = "what to analyse and how",

@@ -5,14 +5,22 @@ from __future__ import annotations
 import argparse
 
 from ..io import input_files, refuse_clobber
-from ._options import EXIT_OK, check_output, frame_range, positive_float
+from ._options import (
+    EXIT_OK,
+    add_units_option,
+    check_output,
+    export_units,
+    frame_range,
+    positive_float,
+    rig_line,
+)
 from .report import load_input
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     c = subparsers.add_parser(
         "convert",
-        help="convert between ASF/AMC, BVH, NPZ and CSV",
+        help="convert between ASF/AMC, BVH, NPZ, CSV, glTF and USD",
         description="Convert a capture between formats, chosen by the file suffixes.",
     )
     c.add_argument("input", metavar="INPUT")
@@ -22,13 +30,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         required=True,
         metavar="OUT",
         help="output file; its suffix chooses the format (.amc with its .asf beside it, "
-        ".bvh, .npz, .csv); never one of the inputs",
+        ".bvh, .npz, .csv, .glb/.gltf and .usda/.usdc/.usd in metres); never one of the inputs",
     )
     c.add_argument("--skeleton", metavar="ASF", help="ASF skeleton for an AMC input")
     c.add_argument(
         "--fps", type=positive_float, metavar="F", help="frame rate to record in the output"
     )
     c.add_argument("--frames", type=frame_range, metavar="A:B", help="only these frames")
+    add_units_option(c)
     c.set_defaults(func=cmd_convert)
     return c
 
@@ -40,7 +49,8 @@ def cmd_convert(args: argparse.Namespace) -> int:
     refuse_clobber(input_files(args.input, args.skeleton), [("-o", args.output)])
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
-    save(motion, args.output)
+    print(rig_line(motion, args))
+    save(motion, args.output, **export_units(args, args.output))
     print(
         f"{args.input} -> {args.output}: {motion.n_frames} frames, {motion.n_channels} channels, "
         f"{motion.fps:g} fps"

@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from ._options import add_units_option, export_units, rig_line
+
 
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
@@ -31,6 +33,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("--frames", metavar="A:B", help="0-based half-open frame range")
     p.add_argument("--skeleton", metavar="ASF", help="skeleton for an .amc INPUT")
     p.add_argument("--fps", type=float, metavar="HZ", help="frame rate of INPUT")
+    add_units_option(p)
     p.add_argument(
         "--height",
         type=float,
@@ -79,6 +82,7 @@ def run(args: argparse.Namespace) -> int:
         if out and Path(out).exists() and Path(out).resolve() == Path(args.input).resolve():
             raise ParameterError(f"{out} is the input; choose another output name")
     motion = load_input(args.input, args.skeleton, args.fps).window(frame_window(args.frames))
+    print(rig_line(motion, args))
     options = {"height": args.height, "speed": args.speed}
     contacts = foot_contacts(motion, **options)
     skating = foot_skating(motion, contacts, skate_speed=args.skate_speed)
@@ -123,7 +127,7 @@ def run(args: argparse.Namespace) -> int:
         }
         result = locked.motion
     if args.output:
-        save(result, args.output)
+        save(result, args.output, **export_units(args, args.output))
         print(f"wrote {args.output}")
     if args.report:
         write_json(args.report, json.loads(json.dumps(payload, default=float)))

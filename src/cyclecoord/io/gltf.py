@@ -13,11 +13,14 @@ built here:
   skinned rigidly to it) so viewers that show only meshes show the figure;
 * every accessor with ``min``/``max``, every buffer view 4-byte aligned.
 
-glTF lengths are metres: an ASF skeleton (CMU: ``:units length 0.45``, 1/0.45 inch a
-unit) is scaled by ``0.0254 / length_unit``; other skeletons by 1 unless ``scale`` is
-given.  The scale, the frame rate and the original skeleton (axes, degrees of freedom,
-rotation orders, limits) are kept in the file's ``extras`` so :func:`read_gltf` gives back
-the motion's own channels.  A glTF from elsewhere is read with three rotation degrees of
+glTF lengths are metres and its up axis is y: an ASF skeleton (CMU: ``:units length 0.45``,
+1/0.45 inch a unit) is scaled by ``0.0254 / length_unit``; other skeletons by the metres
+per unit :func:`cyclecoord.rig.describe_rig` finds from the body's height (a centimetre,
+millimetre or inch BVH comes out at its real size) unless ``scale`` is given; a Z-up rig
+has its root turned by :data:`cyclecoord.rig.Z_TO_Y`.  The scale, that rotation, the frame
+rate and the original skeleton (axes, degrees of freedom, rotation orders, limits) are
+kept in the file's ``extras`` so :func:`read_gltf` gives back the motion's own channels.
+A glTF from elsewhere is read with three rotation degrees of
 freedom per joint (``rx ry rz``, order ``ZYX``) and translations on animated nodes.
 """
 
@@ -42,7 +45,9 @@ _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
 
 
 def default_scale(skeleton: Skeleton) -> float:
-    """Metres per skeleton length unit: ``0.0254 / length_unit`` for ASF, else 1."""
+    """Metres per skeleton length unit from the skeleton alone: ``0.0254 / length_unit`` for
+    ASF, else 1.  Exports measure the unit of other skeletons instead
+    (:func:`cyclecoord.rig.metres_per_unit`)."""
     if skeleton.source_format == "asf" and skeleton.length_unit > 0:
         return 0.0254 / skeleton.length_unit
     return 1.0
@@ -203,8 +208,8 @@ def _stick_mesh(rest: np.ndarray, bones: list[tuple[int, int]], radius: float):
 
 
 # ------------------------------------------------------------------------------ write
-def _build(motion: Motion, scale: float, mesh: bool):
-    """The pygltflib document and its binary buffer."""
+def _build(motion: Motion, scale: float, mesh: bool, up: np.ndarray):
+    """The pygltflib document and its binary buffer; ``up`` (3, 3) turns the root."""
     import pygltflib as g
 
     from .._kinematics import local_transforms
@@ -212,6 +217,10 @@ def _build(motion: Motion, scale: float, mesh: bool):
 
     skel = motion.skeleton
     trans, rots = local_transforms(motion)
+    turned = not np.array_equal(up, np.eye(3))
+    if turned:  # the root's transform premultiplied: the file is y-up
+        trans[:, 0] = trans[:, 0] @ up.T
+        rots[:, 0] = np.einsum("ab,tbc->tac", up, rots[:, 0])
     T, n = trans.shape[:2]
     gltf = g.GLTF2(asset=g.Asset(version="2.0", generator="cyclecoord"))
     blob = _Blob(gltf)
@@ -268,6 +277,10 @@ def _build(motion: Motion, scale: float, mesh: bool):
     rest = forward_kinematics(rest_motion).positions[0] * scale  # joints then end sites
     ibm = np.tile(np.eye(4), (n_nodes, 1, 1))
     ibm[:, :3, 3] = -rest
+    if turned:  # bind pose turned with the root: inverse of T(up @ rest) @ up
+        ibm[:, :3, :3] = up.T
+        rest = rest @ up.T
+        gltf.nodes[0].rotation = Rotation.from_matrix(up).as_quat().tolist()
     ibm_acc = blob.add(ibm.transpose(0, 2, 1).reshape(n_nodes, 16).astype(np.float32), "MAT4")
     gltf.skins.append(
         g.Skin(
@@ -310,6 +323,7 @@ def _build(motion: Motion, scale: float, mesh: bool):
             "fps": motion.fps,
             "frames": T,
             "scale": scale,
+            **({"up_rotation": up.tolist()} if turned else {}),
             "start_frame": motion.start_frame,
             "source": motion.source,
             "channels": [list(c) for c in motion.channels],
@@ -338,7 +352,8 @@ def write_gltf(
         ``.glb`` (one binary file) or ``.gltf`` (JSON, with its buffer in a ``.bin`` of
         the same stem beside it).  Written atomically: on any error nothing is left.
     scale : float, optional
-        Metres per skeleton length unit; default :func:`default_scale`.
+        Metres per skeleton length unit; default ``0.0254 / length_unit`` for ASF, else
+        measured (:func:`cyclecoord.rig.metres_per_unit`).
     mesh : bool, default True
         Add a skinned stick mesh (one prism per bone).
 
@@ -353,11 +368,15 @@ def write_gltf(
         raise ParameterError(
             f"{p}: glTF files end in .glb or .gltf, got {p.suffix or '(no suffix)'!r}"
         )
-    skel = check_exportable(motion, "glTF")
-    s = default_scale(skel) if scale is None else float(scale)
-    if not (np.isfinite(s) and s > 0):
+    from ..rig import Z_TO_Y, describe_rig
+
+    check_exportable(motion, "glTF")
+    if scale is not None and not (np.isfinite(float(scale)) and float(scale) > 0):
         raise ParameterError(f"scale must be a positive number of metres per unit, got {scale!r}")
-    gltf, data = _build(motion, s, mesh)
+    info = describe_rig(motion, "auto" if scale is None else float(scale))
+    s = info.metres_per_unit
+    up = Z_TO_Y if info.up_axis == "Z" else np.eye(3)
+    gltf, data = _build(motion, s, mesh, up)
     if suffix == ".glb":
         gltf.set_binary_blob(data)
         with atomic_path(p, suffix=".glb") as tmp:
@@ -595,7 +614,12 @@ def read_gltf(path: str | os.PathLike[str]) -> Motion:
             raise ParseError(f"joints {missing[:3]} of the stored skeleton have no node", str(p))
         cols = [by_name[j.name] for j in skel.joints]
         scale = float(extras.get("scale", 1.0))
-        frames = channels_from_local(skel, trans[:, cols] / scale, rots[:, cols])
+        trans, rots = trans[:, cols] / scale, rots[:, cols]
+        if "up_rotation" in extras:  # undo the turn that made the file y-up
+            up = np.asarray(extras["up_rotation"], dtype=float)
+            trans[:, 0] = trans[:, 0] @ up
+            rots[:, 0] = np.einsum("ba,tbc->tac", up, rots[:, 0])
+        frames = channels_from_local(skel, trans, rots)
         motion = Motion(
             frames,
             skel.channels,

@@ -10,10 +10,11 @@ joint per joint of ours and per end site, ``restTransforms`` = the rest offsets,
 ``bindTransforms`` = the rest pose in world space) and ``/Motion/Skeleton/Animation`` (a
 ``SkelAnimation`` with translations, rotations and scales of every joint at every frame,
 one time code per frame).  Lengths stay in the skeleton's units with ``metersPerUnit``
-saying what they are (``0.0254 / length_unit`` for an ASF skeleton), ``upAxis`` is Y and
-``timeCodesPerSecond`` the motion's frame rate.  The original skeleton and channels are kept
-in the skeleton prim's ``customData`` so :func:`read_usd` returns the motion's own
-channels.
+saying what they are (``0.0254 / length_unit`` for an ASF skeleton, otherwise what
+:func:`cyclecoord.rig.describe_rig` measures from the body's height), ``upAxis`` is the
+rig's (Y, or Z for a Z-up rig) and ``timeCodesPerSecond`` the motion's frame rate.  The
+original skeleton and channels are kept in the skeleton prim's ``customData`` so
+:func:`read_usd` returns the motion's own channels.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from ..errors import ParameterError, ParseError
 from ..motion import Motion
 from ..skeleton import Joint, Skeleton
 from ._atomic import atomic_path
-from .gltf import check_exportable, default_scale, skeleton_from_dict, skeleton_to_dict
+from .gltf import check_exportable, skeleton_from_dict, skeleton_to_dict
 
 __all__ = ["USD_SUFFIXES", "read_usd", "usd_joint_positions", "write_usd", "require_usd"]
 
@@ -98,7 +99,9 @@ def write_usd(
     path : path-like
         ``.usda`` (text), ``.usdc`` or ``.usd`` (binary crate).  Written atomically.
     meters_per_unit : float, optional
-        Stage ``metersPerUnit``; default ``0.0254 / length_unit`` for ASF skeletons, else 1.
+        Stage ``metersPerUnit``; default ``0.0254 / length_unit`` for ASF skeletons, else
+        measured (:func:`cyclecoord.rig.metres_per_unit`).  The stage's ``upAxis`` is the
+        rig's up axis (:func:`cyclecoord.rig.describe_rig`).
 
     Raises
     ------
@@ -114,10 +117,15 @@ def write_usd(
         raise ParameterError(
             f"{p}: USD files end in {', '.join(USD_SUFFIXES)}, got {p.suffix or '(no suffix)'!r}"
         )
+    from ..rig import describe_rig
+
     skel = check_exportable(motion, "USD")
-    mpu = default_scale(skel) if meters_per_unit is None else float(meters_per_unit)
-    if not (np.isfinite(mpu) and mpu > 0):
+    if meters_per_unit is not None and not (
+        np.isfinite(float(meters_per_unit)) and float(meters_per_unit) > 0
+    ):
         raise ParameterError(f"meters_per_unit must be a positive number, got {meters_per_unit!r}")
+    info = describe_rig(motion, "auto" if meters_per_unit is None else float(meters_per_unit))
+    mpu = info.metres_per_unit
     Gf, _Sdf, Tf, Usd, UsdGeom, UsdSkel, Vt = require_usd()
 
     trans, rots = local_transforms(motion)
@@ -133,7 +141,7 @@ def write_usd(
     bind_p, bind_r = global_transforms(rest_t[None], rest_r[None], np.asarray(parents))
 
     stage = Usd.Stage.CreateInMemory()
-    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z if info.up_axis == "Z" else UsdGeom.Tokens.y)
     UsdGeom.SetStageMetersPerUnit(stage, mpu)
     stage.SetTimeCodesPerSecond(motion.fps)
     stage.SetFramesPerSecond(motion.fps)

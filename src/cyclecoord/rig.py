@@ -1,0 +1,845 @@
+"""Rig conventions of a capture, found, reported and undone for the analysis.
+
+This module has one job: to say how a capture's rig is laid out and to hand the analysis a
+motion in one convention, then write results back in the user's own rig.
+:func:`describe_rig` finds the joint that travels (the root, or a static root whose
+channels never change with one child that carries the travel, as in the Bandai Namco
+rig), the joints whose position channels are constant offsets, the length unit (from the
+body's height by forward kinematics: metres, centimetres, millimetres, inches, CMU's
+ASF unit of 1/0.45 inch, or the ASF ``:units length``), the up axis (Y or Z, the axis the
+body extends along), the frame rate and a reference pose in the first frame that is
+discontinuous with the rest (Xsens MVN exports); :meth:`RigInfo.summary` says it in one
+line.  :func:`normalize_rig` gives the motion the analysis should see (static root folded
+into its child, constant position channels made offsets, Y up, reference frame dropped)
+and a :class:`RigAdapter` whose :meth:`~RigAdapter.restore` writes any motion on the
+analysis skeleton (a cycle, a blend) back with the original skeleton and channels.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Union
+
+import numpy as np
+
+from ._kinematics import local_transforms
+from .conventions import continuous_euler
+from .errors import ParameterError
+from .motion import Motion
+from .skeleton import AXIS_INDEX, Joint, Skeleton, forward_kinematics
+
+__all__ = [
+    "UNITS",
+    "RigAdapter",
+    "RigInfo",
+    "describe_rig",
+    "metres_per_unit",
+    "normalize_rig",
+    "parse_units",
+    "rig_summary",
+]
+
+#: Metres per unit of the length units ``--units`` names.
+UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}
+#: One CMU ASF unit (``:units length 0.45``: 1/0.45 inch) in metres; a candidate when
+#: guessing the unit of a BVH written from CMU data.
+CMU_UNIT = 0.0254 / 0.45
+_CANDIDATES = {**UNITS, "cmu": CMU_UNIT}
+#: A human's height in metres; guessed units put the measured height closest to it (in
+#: ratio), so heights of about 1.1-2.5 m are read right.
+_HUMAN_HEIGHT = 1.7
+#: Rotation taking a Z-up world to a Y-up one (-90 degrees about x: z -> y, y -> -z).
+Z_TO_Y = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+
+Units = Union[str, float, None]
+
+
+def parse_units(units: Units) -> float | None:
+    """Metres per unit for a units option, ``None`` for ``"auto"``.
+
+    Parameters
+    ----------
+    units : {"auto", "m", "cm", "mm", "in"} or float or None
+        A unit name, a positive number of metres per unit (also as text, e.g.
+        ``"0.0254"``), or ``"auto"``/``None`` to measure it.
+
+    Returns
+    -------
+    float or None
+
+    Raises
+    ------
+    ParameterError
+        For an unknown name or a number that is not positive and finite.
+    """
+    if units is None:
+        return None
+    if isinstance(units, str):
+        key = units.strip().lower()
+        if key == "auto":
+            return None
+        if key in UNITS:
+            return UNITS[key]
+        try:
+            value = float(key)
+        except ValueError:
+            raise ParameterError(
+                f"units must be auto, {', '.join(UNITS)} or a number of metres per unit, "
+                f"got {units!r}"
+            ) from None
+    else:
+        value = float(units)
+    if not (np.isfinite(value) and value > 0):
+        raise ParameterError(f"metres per unit must be a positive number, got {units!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class RigInfo:
+    """What :func:`describe_rig` found about a capture's rig.
+
+    Attributes
+    ----------
+    style : str
+        ``"Bandai-style"`` (static root, positions on every joint) or the source format
+        (``"BVH"``, ``"ASF"``, ``"glTF"``, ...).
+    source_format : str
+        The skeleton's ``source_format``.
+    n_joints : int
+        Joints of the skeleton as written (a static root included).
+    root : str
+        The skeleton's root joint.
+    travelling_joint : str
+        The joint that carries the travel: the root, or the child of a static root.
+    static_root : bool
+        The root's channels are constant and it has one child (which travels).
+    channel_counts : tuple of int, shape (n_joints,)
+        Channels per joint, skeleton order.
+    constant_position_joints : tuple of str
+        Joints other than the travelling one whose position channels are all constant
+        (they are offsets written as channels).
+    units : str
+        ``"m"``, ``"cm"``, ``"mm"``, ``"in"``, ``"cmu"`` (1/0.45 inch), ``"asf"`` (the
+        ASF ``:units length``) or ``"custom"`` (a number given).
+    units_source : str
+        ``"measured"`` (guessed from the height), ``"skeleton"`` (the ASF length unit) or
+        ``"given"``.
+    metres_per_unit : float
+        Metres per skeleton length unit.
+    height : float
+        The body's extent along the up axis (lowest to highest joint or end site), median
+        over frames, in skeleton length units.
+    up_axis : str
+        ``"Y"`` or ``"Z"``.
+    extents : tuple of float, shape (3,)
+        Median extent of the body along x, y and z, skeleton length units.
+    fps : float
+        Frames per second.
+    n_frames : int
+        Frames of the capture.
+    reference_frame : bool
+        The first frame is a reference pose, discontinuous with the second.
+    first_step_ratio : float
+        Largest joint move from the first frame to the second over the largest move
+        between later frames (among the next 200); ``nan`` for fewer than 10 frames.
+    start_frame : int
+        The motion's ``start_frame`` (the first frame's number in the capture).
+    """
+
+    style: str
+    source_format: str
+    n_joints: int
+    root: str
+    travelling_joint: str
+    static_root: bool
+    channel_counts: tuple[int, ...]
+    constant_position_joints: tuple[str, ...]
+    units: str
+    units_source: str
+    metres_per_unit: float
+    height: float
+    up_axis: str
+    extents: tuple[float, float, float]
+    fps: float
+    n_frames: int
+    reference_frame: bool
+    first_step_ratio: float
+    start_frame: int = 0
+
+    @property
+    def height_m(self) -> float:
+        """The measured height in metres."""
+        return self.height * self.metres_per_unit
+
+    @property
+    def position_channels_everywhere(self) -> bool:
+        """Every joint has 6 channels (positions and rotations)."""
+        return bool(self.channel_counts) and all(c == 6 for c in self.channel_counts)
+
+    def _units_text(self) -> str:
+        if self.units == "custom":
+            text = f"{self.metres_per_unit:.4g} m per unit"
+        elif self.units == "asf":
+            lu = 0.0254 / self.metres_per_unit
+            lead = "ASF units" if self.source_format == "asf" else "units"
+            text = f"{lead} of " + ("1 in" if abs(lu - 1) < 1e-9 else f"1/{lu:g} in")
+        elif self.units == "cmu":
+            text = "CMU units of 1/0.45 in"
+        else:
+            text = self.units
+        if self.units_source == "given":
+            text += " as given"
+        return f"{text} ({self.height_m:.2f} m tall)"
+
+    def _channels_text(self) -> str:
+        counts = self.channel_counts
+        n = self.n_joints
+        if counts and len(set(counts)) == 1:
+            text = f"{n} joints with {counts[0]} channels"
+            if self.constant_position_joints and counts[0] == 6:
+                below = f" below {self.travelling_joint}" if self.static_root else ""
+                text += f" (positions constant{below})"
+            return text
+        if len(counts) > 1 and len(set(counts[1:])) == 1:
+            return f"{n} joints ({counts[0]} channels on the root, {counts[1]} on the others)"
+        return f"{n} joints"
+
+    def summary(self) -> str:
+        """One line saying what was found, e.g. ``"Bandai-style rig: static root
+        joint_Root, Hips travels, 22 joints with 6 channels (positions constant below
+        Hips), cm (1.33 m tall), Y-up, 30 fps"``."""
+        if self.static_root:
+            travel = f"static root {self.root}, {self.travelling_joint} travels"
+        else:
+            travel = f"{self.travelling_joint} travels"
+        parts = [
+            travel,
+            self._channels_text(),
+            self._units_text(),
+            f"{self.up_axis}-up",
+            f"{self.fps:g} fps",
+        ]
+        if self.reference_frame:
+            parts.append(f"frame {self.start_frame} a reference pose (discontinuous with the next)")
+        return f"{self.style} rig: " + ", ".join(parts)
+
+    def to_dict(self) -> dict:
+        """A JSON-ready description (plain lists, floats and strings)."""
+        return {
+            "summary": self.summary(),
+            "style": self.style,
+            "source_format": self.source_format,
+            "joints": self.n_joints,
+            "root": self.root,
+            "travelling_joint": self.travelling_joint,
+            "static_root": self.static_root,
+            "channels_per_joint": list(self.channel_counts),
+            "position_channels_everywhere": self.position_channels_everywhere,
+            "constant_position_joints": list(self.constant_position_joints),
+            "units": self.units,
+            "units_source": self.units_source,
+            "metres_per_unit": float(self.metres_per_unit),
+            "height": float(self.height),
+            "height_m": float(self.height_m),
+            "up_axis": self.up_axis,
+            "extents": [float(e) for e in self.extents],
+            "fps": float(self.fps),
+            "frames": int(self.n_frames),
+            "reference_frame": bool(self.reference_frame),
+            "first_step_ratio": None
+            if not np.isfinite(self.first_step_ratio)
+            else float(self.first_step_ratio),
+        }
+
+
+# ------------------------------------------------------------------------ finding
+def _skeleton_of(motion: Motion) -> Skeleton:
+    if not isinstance(motion, Motion):
+        raise ParameterError(f"expected a Motion, got {type(motion).__name__}")
+    if motion.skeleton is None:
+        raise ParameterError(
+            "rig conventions need a skeleton; this motion has none (load it from ASF/AMC, "
+            "BVH, glTF, USD or an .npz with a skeleton)"
+        )
+    if motion.n_frames < 1:
+        raise ParameterError("rig conventions need at least one frame")
+    return motion.skeleton
+
+
+def _length_tolerance(skel: Skeleton) -> float:
+    """Largest spread of a length channel that still counts as constant."""
+    return 1e-8 * max(skel.total_length(), 1e-12)
+
+
+#: Largest spread (degrees) of an angle channel that still counts as constant.
+_ANGLE_TOLERANCE = 1e-8
+
+
+def _constant(motion: Motion, channels: list[tuple[str, str]]) -> bool:
+    """Whether every listed channel the motion has keeps one value over all frames."""
+    tol_len = _length_tolerance(motion.skeleton)
+    col = {c: i for i, c in enumerate(motion.channels)}
+    for c in channels:
+        k = col.get(c)
+        if k is None:
+            continue
+        tol = tol_len if c[1].startswith("t") else _ANGLE_TOLERANCE
+        if np.ptp(motion.frames[:, k]) > tol:
+            return False
+    return True
+
+
+def _joint_channels(motion: Motion, joint: Joint, kind: str = "") -> list[tuple[str, str]]:
+    return [(joint.name, d) for d in joint.dofs if d.startswith(kind)]
+
+
+def _static_root(motion: Motion) -> bool:
+    """Root with constant channels, no end site and exactly one child joint."""
+    skel = motion.skeleton
+    root = skel.joints[0]
+    if len(skel.joints) < 2 or root.end_site is not None or len(skel.children(0)) != 1:
+        return False
+    return _constant(motion, _joint_channels(motion, root))
+
+
+def _constant_position_joints(motion: Motion, first: int) -> tuple[str, ...]:
+    """Joints after index ``first`` with position channels that are all constant."""
+    out = []
+    for j in motion.skeleton.joints[first + 1 :]:
+        chans = _joint_channels(motion, j, "t")
+        if chans and _constant(motion, chans):
+            out.append(j.name)
+    return tuple(out)
+
+
+def _sample(n: int, most: int) -> np.ndarray:
+    return np.unique(np.linspace(0, n - 1, min(n, most)).round().astype(int))
+
+
+def _body_points(motion: Motion, frames: np.ndarray, skip_root: bool) -> np.ndarray:
+    """World positions ``(K, P, 3)`` of joints and end sites at ``frames``."""
+    pos = forward_kinematics(motion[frames]).positions
+    return pos[:, 1:] if skip_root else pos
+
+
+def _first_step_ratio(motion: Motion, skip_root: bool) -> tuple[float, float]:
+    """Largest point move frame 0 -> 1, and its ratio to the largest later move (200 frames)."""
+    T = motion.n_frames
+    if T < 10:
+        return float("nan"), float("nan")
+    pos = _body_points(motion, np.arange(min(T, 202)), skip_root)
+    steps = np.linalg.norm(np.diff(pos, axis=0), axis=2).max(axis=1)
+    later = float(steps[1:].max())
+    ratio = float("inf") if later <= 0 else float(steps[0] / later)
+    return float(steps[0]), ratio
+
+
+def _guess_units(height: float) -> tuple[str, float]:
+    """The candidate unit putting ``height`` nearest a human's height (in ratio)."""
+    if not (np.isfinite(height) and height > 0):
+        return "m", 1.0
+    name = min(_CANDIDATES, key=lambda u: abs(np.log(height * _CANDIDATES[u] / _HUMAN_HEIGHT)))
+    return name, _CANDIDATES[name]
+
+
+def describe_rig(motion: Motion, units: Units = "auto") -> RigInfo:
+    """Find a capture's rig conventions: travelling joint, channels, units, up axis, rate.
+
+    Parameters
+    ----------
+    motion : Motion
+        A capture with a skeleton, frames ``(T, D)``.
+    units : {"auto", "m", "cm", "mm", "in"} or float, default "auto"
+        Length unit of the skeleton, or a number of metres per unit.  ``"auto"`` uses the
+        ASF ``:units length`` when the skeleton has one (ASF: ``0.0254 / length_unit``
+        metres per unit, CMU 0.0564), otherwise guesses from the body's height: the unit
+        among m, cm, mm, in and CMU's 1/0.45 in that makes it closest to 1.7 m.
+
+    Returns
+    -------
+    RigInfo
+
+    Notes
+    -----
+    The height is the median over (up to 400 evenly spread) frames of the body's extent
+    along the up axis, lowest to highest joint or end site, a static root left out: a
+    standing or walking pose.  It is where the skeleton's points reach: a rig whose head
+    ends at the skull's base (Bandai: the ``Head`` end site has zero offset) measures some
+    20 cm shorter than the performer.  The up axis is whichever of y and z that median
+    extent is larger along.  The first frame is a reference pose when its largest joint
+    move to the second frame exceeds 5 times the largest move between the next 200 frames
+    and 2 % of the height.  Only ratios of lengths are used, so the findings do not
+    depend on the unit.
+    """
+    skel = _skeleton_of(motion)
+    static = _static_root(motion)
+    travel_index = 1 if static else 0
+    T = motion.n_frames
+    pos = _body_points(motion, _sample(T, 400), static)
+    extents = np.median(np.ptp(pos, axis=1), axis=0)
+    up = "Z" if extents[2] > extents[1] else "Y"
+    height = float(extents[AXIS_INDEX[up.lower()]])
+    step0, ratio = _first_step_ratio(motion, static)
+    reference = bool(np.isfinite(ratio) and ratio > 5.0 and step0 > 0.02 * height)
+    if reference:  # measure the body without the reference pose
+        pos = _body_points(motion, 1 + _sample(T - 1, 400), static)
+        extents = np.median(np.ptp(pos, axis=1), axis=0)
+        up = "Z" if extents[2] > extents[1] else "Y"
+        height = float(extents[AXIS_INDEX[up.lower()]])
+
+    given = parse_units(units)
+    if given is not None:
+        named = [u for u, v in UNITS.items() if v == given]
+        unit, source, mpu = (named[0] if named else "custom"), "given", given
+    elif skel.source_format == "asf" or (skel.length_unit != 1.0 and skel.length_unit > 0):
+        unit, source, mpu = "asf", "skeleton", 0.0254 / skel.length_unit
+    else:
+        unit, mpu = _guess_units(height)
+        source = "measured"
+
+    constant = _constant_position_joints(motion, travel_index)
+    counts = tuple(len(j.dofs) for j in skel.joints)
+    label = {"asf": "ASF", "bvh": "BVH", "gltf": "glTF", "usd": "USD", "synthetic": "synthetic"}
+    everywhere = all(c == 6 for c in counts)
+    if static and everywhere and len(constant) == len(skel.joints) - 2:
+        style = "Bandai-style"
+    else:
+        style = label.get(skel.source_format, skel.source_format or "unnamed")
+    return RigInfo(
+        style=style,
+        source_format=skel.source_format,
+        n_joints=len(skel.joints),
+        root=skel.joints[0].name,
+        travelling_joint=skel.joints[travel_index].name,
+        static_root=static,
+        channel_counts=counts,
+        constant_position_joints=constant,
+        units=unit,
+        units_source=source,
+        metres_per_unit=float(mpu),
+        height=height,
+        up_axis=up,
+        extents=(float(extents[0]), float(extents[1]), float(extents[2])),
+        fps=float(motion.fps),
+        n_frames=T,
+        reference_frame=reference,
+        first_step_ratio=ratio,
+        start_frame=int(motion.start_frame),
+    )
+
+
+def metres_per_unit(motion: Motion, units: Units = "auto") -> float:
+    """Metres per skeleton length unit (see :func:`describe_rig`), what glTF and USD
+    exports scale by.
+
+    ``units`` given (a name or a number) is returned without looking at the motion; an ASF
+    skeleton gives ``0.0254 / length_unit`` as before; otherwise the unit is measured.
+    """
+    given = parse_units(units)
+    if given is not None:
+        return given
+    skel = _skeleton_of(motion)
+    if skel.source_format == "asf" or (skel.length_unit != 1.0 and skel.length_unit > 0):
+        return 0.0254 / skel.length_unit
+    return describe_rig(motion).metres_per_unit
+
+
+def rig_summary(motion: Motion, units: Units = "auto") -> str:
+    """The console's first line: what :func:`describe_rig` found, in one sentence.
+
+    A motion without a skeleton gets a line saying so (channels and rate only).
+    """
+    if not isinstance(motion, Motion):
+        raise ParameterError(f"expected a Motion, got {type(motion).__name__}")
+    if motion.skeleton is None or motion.n_frames < 1:
+        return (
+            f"no skeleton: {motion.n_channels} channels, {motion.fps:g} fps "
+            "(rig, units and up axis unknown)"
+        )
+    return describe_rig(motion, units).summary()
+
+
+# ------------------------------------------------------------------ normalising
+def _full_order(joint: Joint) -> str:
+    """The joint's Euler order completed to three axes (``"ZXY"`` for none)."""
+    order = joint.rotation_order
+    if len(order) == 3:
+        return order
+    if not order:
+        return "ZXY"
+    return order + "".join(a for a in "XYZ" if a not in order)
+
+
+def _euler_columns(
+    joint: Joint, order: str, rotations: np.ndarray, near: np.ndarray | None
+) -> dict[str, np.ndarray]:
+    """Rotation channel values ``{dof: (T,)}`` in ``order`` of local rotations ``(T, 3, 3)``,
+    continuous over frames, first frame nearest ``near`` (degrees, in ``order``)."""
+    rel = joint.axis.T @ rotations @ joint.axis
+    angles = continuous_euler(rel[:, None], order, near=None if near is None else near[None])
+    return {"r" + a.lower(): angles[:, 0, k] for k, a in enumerate(order)}
+
+
+def _channel_values(motion: Motion, joint: Joint, order: str) -> np.ndarray | None:
+    """The motion's first-frame angles of ``joint`` in ``order`` (None if it lacks any)."""
+    col = {c: i for i, c in enumerate(motion.channels)}
+    ks = [col.get((joint.name, "r" + a.lower())) for a in order]
+    if any(k is None for k in ks):
+        return None
+    return np.array([motion.frames[0, k] for k in ks])
+
+
+@dataclass(frozen=True, eq=False)
+class RigAdapter:
+    """How a capture's rig maps to the analysis rig, and back (:meth:`restore`).
+
+    Attributes
+    ----------
+    info : RigInfo
+        What was found on the capture.
+    original : Skeleton
+        The capture's skeleton.
+    original_channels : tuple of (str, str)
+        The capture's channels, in its order.
+    analysis : Skeleton
+        The skeleton of the analysis motion.
+    analysis_channels : tuple of (str, str)
+        The analysis motion's channels.
+    folded_root : bool
+        The static root was folded into its child (which is the analysis root).
+    root_rotation : ndarray, shape (3, 3)
+        The static root's constant local rotation ``R0`` (identity when not folded).
+    root_translation : ndarray, shape (3,)
+        Its constant local translation ``t0``, skeleton length units.
+    root_values : dict
+        ``{(joint, dof): value}`` of the static root's constant channels.
+    position_values : dict
+        ``{(joint, dof): value}`` of the dropped constant position channels (degrees /
+        length units); each is the joint's offset component on the analysis skeleton.
+    up_rotation : ndarray, shape (3, 3)
+        Rotation premultiplied to the analysis root (``Z_TO_Y`` for a Z-up rig, else the
+        identity).
+    dropped_frames : int
+        Frames dropped from the start (1 for a reference pose, else 0).
+    root_near : ndarray of shape (3,) or None
+        The original travelling joint's first-frame angles, so restored Euler channels
+        start on the capture's own branch.
+    """
+
+    info: RigInfo
+    original: Skeleton
+    original_channels: tuple[tuple[str, str], ...]
+    analysis: Skeleton
+    analysis_channels: tuple[tuple[str, str], ...]
+    folded_root: bool = False
+    root_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    root_translation: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    root_values: dict = field(default_factory=dict)
+    position_values: dict = field(default_factory=dict)
+    up_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    dropped_frames: int = 0
+    root_near: np.ndarray | None = None
+
+    @property
+    def rotates_root(self) -> bool:
+        """The analysis root's transform differs from the travelling joint's (a rotation)."""
+        return not (
+            np.array_equal(self.root_rotation, np.eye(3))
+            and np.array_equal(self.up_rotation, np.eye(3))
+        )
+
+    @property
+    def identity(self) -> bool:
+        """Nothing was changed: the analysis motion is the capture itself."""
+        return not (
+            self.folded_root or self.position_values or self.rotates_root or self.dropped_frames
+        )
+
+    def changes(self) -> list[str]:
+        """What :func:`normalize_rig` did, one short phrase per step."""
+        out = []
+        if self.dropped_frames:
+            out.append("reference first frame dropped")
+        if self.folded_root:
+            out.append(f"static root {self.original.joints[0].name} folded into "
+                       f"{self.analysis.joints[0].name}")
+        if self.position_values:
+            joints = sorted({j for j, _ in self.position_values})
+            out.append(f"constant position channels of {len(joints)} joints made offsets")
+        if not np.array_equal(self.up_rotation, np.eye(3)):
+            out.append("turned Z-up to Y-up")
+        return out
+
+    def restore(self, motion: Motion) -> Motion:
+        """A motion on the analysis skeleton written back in the capture's own rig.
+
+        Parameters
+        ----------
+        motion : Motion
+            Frames ``(T, D')`` with the analysis channels (any order): the analysis motion,
+            or a cycle, blend or clip computed on it.
+
+        Returns
+        -------
+        Motion
+            Frames ``(T, D)`` with :attr:`original_channels` in their order and the
+            original skeleton: the static root re-added with its constant channels, the
+            position channels re-added with their constant values, the up axis turned
+            back; Euler channels continuous over frames.  A dropped reference frame is
+            not put back.  Rate, source, start frame and metadata are ``motion``'s.
+
+        Raises
+        ------
+        ParameterError
+            When ``motion`` does not have the analysis channels.
+        """
+        if not isinstance(motion, Motion):
+            raise ParameterError(f"restore takes a Motion, got {type(motion).__name__}")
+        have, want = set(motion.channels), set(self.analysis_channels)
+        if have != want:
+            missing = sorted(want - have)[:4]
+            extra = sorted(have - want)[:4]
+            raise ParameterError(
+                "restore needs a motion with the analysis rig's channels "
+                f"(missing {missing}, extra {extra})"
+            )
+        if self.identity:
+            out = motion if motion.channels == self.original_channels else motion.select(
+                self.original_channels
+            )
+            return out if out.skeleton is self.original else replace(out, skeleton=self.original)
+        m = replace(motion, skeleton=self.analysis)
+        T = m.n_frames
+        col = {c: i for i, c in enumerate(m.channels)}
+        values: dict[tuple[str, str], np.ndarray] = {}
+        # every column that passes through unchanged
+        for c, k in col.items():
+            values[c] = m.frames[:, k]
+        new_root = self.analysis.joints[0]
+        old_k = 1 if self.folded_root else 0
+        old = self.original.joints[old_k]
+        if self.rotates_root or self.folded_root:
+            for d in new_root.dofs:
+                values.pop((new_root.name, d), None)
+            if self.rotates_root:
+                trans, rots = local_transforms(m)
+                R = np.einsum("ba,tbc->tac", self.up_rotation, rots[:, 0])  # Q.T @ R
+                p = trans[:, 0] @ self.up_rotation  # Q.T @ p
+                R = np.einsum("ba,tbc->tac", self.root_rotation, R)  # R0.T @ R
+                p = (p - self.root_translation) @ self.root_rotation  # R0.T (p - t0)
+                order = _full_order(old)
+                angles = _euler_columns(old, order, R, self.root_near)
+                for d in old.dofs:
+                    if d.startswith("t"):
+                        values[(old.name, d)] = p[:, AXIS_INDEX[d[1]]]
+                    else:
+                        values[(old.name, d)] = angles[d]
+            else:  # folded with identity rotation: channels copied, translation shifted
+                for d in old.dofs:
+                    k = col.get((new_root.name, d))
+                    if k is None:
+                        continue
+                    v = m.frames[:, k]
+                    if d.startswith("t"):
+                        v = v - self.root_translation[AXIS_INDEX[d[1]]]
+                    values[(old.name, d)] = v
+        for c, v in list(self.root_values.items()) + list(self.position_values.items()):
+            values[c] = np.full(T, v)
+        frames = np.column_stack(
+            [
+                values[c] if c in values else np.zeros(T)
+                for c in self.original_channels
+            ]
+        ) if self.original_channels else np.zeros((T, 0))
+        return replace(
+            m,
+            frames=frames,
+            channels=self.original_channels,
+            skeleton=self.original,
+        )
+
+
+def normalize_rig(motion: Motion, info: RigInfo | None = None) -> tuple[Motion, RigAdapter]:
+    """The motion the analysis should see, and the adapter that writes results back.
+
+    Steps, each only where :func:`describe_rig` found it:
+
+    1. a reference first frame is dropped (``start_frame`` advances);
+    2. a static root is folded into its only child, which becomes the root: its
+       transform becomes ``R0 @ R_child`` and ``t0 + R0 @ p_child`` (``R0``, ``t0`` the
+       root's constant rotation and translation), written as the child's channels
+       ``tx ty tz`` and three Euler angles in the child's order;
+    3. constant position channels of the other joints are dropped, their values becoming
+       the joints' offsets;
+    4. a Z-up rig is turned Y-up by premultiplying the root's transform by
+       :data:`Z_TO_Y`.
+
+    Lengths keep the capture's unit.  Euler angles of a changed root are continuous over
+    frames (:func:`cyclecoord.conventions.continuous_euler`) and start on the branch of
+    the capture's own first frame; where the root's rotation is unchanged its channels
+    are copied.  Forward kinematics of the result equals the capture's (reference frame
+    aside).
+
+    Parameters
+    ----------
+    motion : Motion
+        A capture with a skeleton, frames ``(T, D)``.
+    info : RigInfo, optional
+        :func:`describe_rig` of ``motion`` when already computed.
+
+    Returns
+    -------
+    analysis : Motion
+        Frames ``(T', D')``, ``T' = T - 1`` when a reference frame was dropped; ``motion``
+        itself when nothing needed changing.
+    adapter : RigAdapter
+        Its :meth:`~RigAdapter.restore` gives a motion on the analysis skeleton back in
+        the capture's skeleton and channels.
+    """
+    skel = _skeleton_of(motion)
+    if info is None:
+        info = describe_rig(motion)
+    channels = tuple(motion.channels)
+    m = motion[1:] if info.reference_frame and motion.n_frames > 1 else motion
+    dropped = motion.n_frames - m.n_frames
+    fold = info.static_root
+    up = Z_TO_Y if info.up_axis == "Z" else np.eye(3)
+    col = {c: i for i, c in enumerate(m.channels)}
+    T = m.n_frames
+    first = 1 if fold else 0
+    constant = set(info.constant_position_joints)
+
+    root_values: dict = {}
+    R0, t0 = np.eye(3), np.zeros(3)
+    if fold:
+        root = skel.joints[0]
+        root_values = {
+            (root.name, d): float(m.frames[0, col[(root.name, d)]])
+            for d in root.dofs
+            if (root.name, d) in col
+        }
+        trans0, rots0 = local_transforms(m[:1])
+        R0, t0 = rots0[0, 0], trans0[0, 0]
+        if np.allclose(R0, np.eye(3), rtol=0, atol=1e-15):
+            R0 = np.eye(3)
+
+    joints: list[Joint] = []
+    position_values: dict = {}
+    columns: dict[tuple[str, str], np.ndarray] = {}
+    for i, j in enumerate(skel.joints[first:], start=first):
+        parent = -1 if i == first else j.parent - first
+        offset = j.offset.copy()
+        dofs = list(j.dofs)
+        if i > first and j.name in constant:
+            for d in j.dofs:
+                if d.startswith("t"):
+                    k = col.get((j.name, d))
+                    if k is not None:
+                        value = float(np.mean(m.frames[:, k]))
+                        position_values[(j.name, d)] = value
+                        offset[AXIS_INDEX[d[1]]] = value
+                    dofs.remove(d)
+        joints.append(
+            Joint(
+                name=j.name,
+                parent=parent,
+                offset=offset,
+                dofs=tuple(dofs),
+                rotation_order=j.rotation_order,
+                axis=j.axis.copy(),
+                end_site=None if j.end_site is None else j.end_site.copy(),
+                limits=dict(j.limits),
+            )
+        )
+        for d in dofs:
+            k = col.get((j.name, d))
+            if k is not None:
+                columns[(j.name, d)] = m.frames[:, k]
+
+    new_root = skel.joints[first]
+    rotates = not (np.array_equal(R0, np.eye(3)) and np.array_equal(up, np.eye(3)))
+    near = None
+    if rotates or fold:
+        t_dofs = [d for d in new_root.dofs if d.startswith("t")]
+        if len(t_dofs) < 3:
+            t_dofs = ["tx", "ty", "tz"]
+        order = _full_order(new_root) if rotates else new_root.rotation_order
+        r_dofs = ["r" + a.lower() for a in order]
+        if [d for d in new_root.dofs if d.startswith("r")] == r_dofs and len(
+            [d for d in new_root.dofs if d.startswith("t")]
+        ) == 3:
+            dofs = tuple(new_root.dofs)
+        else:
+            dofs = tuple(t_dofs + r_dofs)
+        trans, rots = local_transforms(m)
+        if fold:
+            R = np.einsum("ab,tbc->tac", R0, rots[:, 1])
+            p = t0 + np.einsum("ab,tb->ta", R0, trans[:, 1])
+        else:
+            R, p = rots[:, 0], trans[:, 0]
+        for d in [d for d in new_root.dofs]:
+            columns.pop((new_root.name, d), None)
+        if rotates:
+            R = np.einsum("ab,tbc->tac", up, R)
+            p = p @ up.T
+            near = _channel_values(m, new_root, order)
+            angles = _euler_columns(new_root, order, R, near)
+        else:  # only folded, R0 = I: rotation channels copied
+            angles = {
+                d: m.frames[:, col[(new_root.name, d)]]
+                for d in r_dofs
+                if (new_root.name, d) in col
+            }
+        for d in dofs:
+            columns[(new_root.name, d)] = (
+                p[:, AXIS_INDEX[d[1]]] if d.startswith("t") else angles.get(d, np.zeros(T))
+            )
+        joints[0] = replace_joint(joints[0], dofs=dofs, rotation_order=order)
+
+    analysis_skel = Skeleton(
+        joints=tuple(joints),
+        name=skel.name,
+        length_unit=skel.length_unit,
+        source_format=skel.source_format,
+    )
+    kept = [c for c in analysis_skel.channels if c in columns]
+    extra = [c for c in m.channels if c[0] not in analysis_skel.names and c[0] not in skel.names]
+    analysis_channels = tuple(kept + extra)
+    adapter = RigAdapter(
+        info=info,
+        original=skel,
+        original_channels=channels,
+        analysis=analysis_skel,
+        analysis_channels=analysis_channels,
+        folded_root=fold,
+        root_rotation=R0,
+        root_translation=t0,
+        root_values=root_values,
+        position_values=position_values,
+        up_rotation=np.array(up, dtype=float),
+        dropped_frames=dropped,
+        root_near=_channel_values(m, new_root, _full_order(new_root)) if rotates else None,
+    )
+    if adapter.identity:
+        return motion, replace(adapter, analysis=skel, analysis_channels=channels)
+    frames = np.column_stack(
+        [columns[c] for c in kept] + [m.frames[:, col[c]] for c in extra]
+    ) if analysis_channels else np.zeros((T, 0))
+    out = replace(m, frames=frames, channels=analysis_channels, skeleton=analysis_skel)
+    return out, adapter
+
+
+def replace_joint(joint: Joint, **changes) -> Joint:
+    """A copy of ``joint`` with some fields changed (re-validated)."""
+    fields = {
+        "name": joint.name,
+        "parent": joint.parent,
+        "offset": joint.offset.copy(),
+        "dofs": joint.dofs,
+        "rotation_order": joint.rotation_order,
+        "axis": joint.axis.copy(),
+        "end_site": None if joint.end_site is None else joint.end_site.copy(),
+        "limits": dict(joint.limits),
+    }
+    fields.update(changes)
+    return Joint(**fields)
