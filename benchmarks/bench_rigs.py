@@ -529,8 +529,10 @@ def root_frame(points: np.ndarray, body: Body) -> np.ndarray:
 
 def pose_vectors(points: np.ndarray, body: Body) -> np.ndarray:
     """Root-frame poses flattened to ``(T, 3P)``, scaled so the Euclidean distance of two
-    rows is the RMS point distance."""
-    x = root_frame(points, body)
+    rows is the RMS point distance.  Points before the body root (a static root above a
+    travelling hips: its ancestors, which come first in file order) are left out: relative
+    to the hips they travel with the walk."""
+    x = root_frame(points, body)[:, body.root_point:]
     return x.reshape(len(x), -1) / math.sqrt(x.shape[1])
 
 

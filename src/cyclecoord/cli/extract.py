@@ -227,10 +227,14 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
     fps = m.fps
     used = res.used_frames
     n_used = sum(b - a for a, b in used)
-    lines = [
+    lines = []
+    if getattr(res, "rig", None) is not None:
+        changes = f" (analysed with {'; '.join(res.rig_changes)})" if res.rig_changes else ""
+        lines.append(f"rig: {res.rig.summary()}{changes}")
+    lines.append(
         f"{m.source or name}: {m.n_frames} frames at {fps:g} fps"
         + (f" (frames {m.start_frame}:{m.start_frame + m.n_frames})" if m.start_frame else "")
-    ]
+    )
     if n_used < m.n_frames:
         lines.append(
             f"steady motion in frames {_frames_text(used, m.start_frame)} ({n_used} of "

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numbers
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -76,6 +77,7 @@ def extract(
     difference_root: bool = True,
     root: str = "body",
     rotations: str = "auto",
+    rig: bool = True,
     prime: int = DEFAULT_PRIME,
     max_scale: float | None = None,
     scale: float | None = None,
@@ -139,6 +141,12 @@ def extract(
         paper's space), or rotation vectors for just the joints whose Euler channels wrap,
         flip or near gimbal lock (``"auto"``; a CMU capture reads exactly as in the paper).
         See :class:`~cyclecoord.periodic.preprocess.Preprocessor`.
+    rig : bool, default True
+        Read the rig's conventions first (:func:`cyclecoord.rig.normalize_rig`): a static
+        root whose child travels is folded into it, constant position channels become
+        offsets, a Z-up rig is turned Y-up and a reference first frame is dropped; the
+        analysis runs on that motion (``result.motion``) and the cycle is written back in
+        the capture's own rig.  False analyses the channels as they are.
     prime : int, default 47
         Coefficient field Z/p, a prime greater than 11.
     max_scale : float, optional
@@ -268,8 +276,8 @@ def extract(
     params = dict(
         frames=None if frames is None else list(frames), pca=pca, normalize=normalize,
         temporal=temporal, delay=delay, difference_root=difference_root, root=root, prime=prime,
-        rotations=rotations, max_scale=max_scale, scale=scale, class_index=class_index,
-        scale_fraction=scale_fraction,
+        rotations=rotations, rig=rig, max_scale=max_scale, scale=scale,
+        class_index=class_index, scale_fraction=scale_fraction,
         n_samples=n_samples, n_neighbors=n_neighbors, bandwidth=bandwidth, weighting=weighting,
         sampling=sampling, n_components=n_components, cycle_start=cycle_start,
         landmarks=landmarks, memory_limit=memory_limit, random_state=random_state, steady=steady,
@@ -281,14 +289,27 @@ def extract(
             f"{motion.source or 'capture'}: {motion.n_frames} frames are too few to find a cycle "
             f"(need at least {max(10, 2 * n_neighbors)})"
         )
+    adapter = info = None
+    if motion.skeleton is not None:
+        from ..rig import describe_rig, normalize_rig
+
+        info = describe_rig(motion)
+        if rig:
+            motion, adapter = normalize_rig(motion, info)
+            if adapter.identity:
+                adapter = None
     run = TakeFit(motion, params, require_clear)
     fit, used = run.fit_steady()
-    return _finish(
+    res = _finish(
         motion, run.prepared, run.prep, fit, used, run.notes, run.timings, params, run.fail,
         n_components=n_components, n_samples=n_samples, n_neighbors=n_neighbors,
         weighting=weighting, sampling=sampling, bandwidth=bandwidth, random_state=random_state,
         cycle_start=cycle_start, timing=timing, travel=travel, min_turns=min_turns,
     )
+    if adapter is not None:
+        # the cycle in the capture's own rig (static root, position channels, up axis)
+        res = replace(res, cycle=adapter.restore(res.cycle), rig_changes=adapter.changes())
+    return replace(res, rig=info)
 
 
 #: What :func:`extract`'s options may be (:mod:`cyclecoord._validation`); the scale and

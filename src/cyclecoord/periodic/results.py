@@ -173,6 +173,13 @@ class ExtractionResult:
         Seam, pop, nearest-pose distance and jerk measured on joint positions in the root's
         frame (:mod:`cyclecoord.quality.pose_space`): the same whatever file the cycle is
         read from.  None without a skeleton.
+    rig : RigInfo or None
+        What :func:`cyclecoord.rig.describe_rig` found on the capture (None without a
+        skeleton).
+    rig_changes : list of str
+        What :func:`cyclecoord.rig.normalize_rig` changed before the analysis (empty when
+        the capture was analysed as it is); ``motion`` is the analysed motion and
+        ``cycle`` is written back in the capture's own rig.
     """
 
     motion: Motion
@@ -200,6 +207,13 @@ class ExtractionResult:
     windings: Windings | None = None
     heading_per_cycle: float = float("nan")
     pose_quality: Any = None
+    rig: Any = None
+    rig_changes: list = field(default_factory=list)
+
+    def _rig_dict(self) -> dict | None:
+        if self.rig is None:
+            return None
+        return {**self.rig.to_dict(), "changes": list(self.rig_changes)}
 
     @property
     def used_frames(self) -> list[tuple[int, int]]:
@@ -251,6 +265,7 @@ class ExtractionResult:
             "foot_skating": _cycle_skating(self.cycle),
             "distance_to_cycle": self.distance,
             "pose_quality": None if self.pose_quality is None else self.pose_quality.to_dict(),
+            "rig": self._rig_dict(),
             "landmarks": _landmark_report(self.estimator),
             "cocycle_check": {
                 "triangles": int(self.estimator.cocycle_check_.n_triangles)

@@ -4,7 +4,8 @@ Loop closure, jerk and step figures computed on channels depend on how a file wr
 rotations: a cycle read back from BVH (three Euler channels a joint) measures otherwise
 than from AMC, and an Euler wrap reads as a 360-degree jump.  Here every figure is taken
 from **joint positions by forward kinematics, in the root's frame**: each joint's (and end
-site's) position minus the root's, turned by the inverse of the root's rotation, plus the
+site's) position minus the travelling root's, turned by the inverse of the root's heading
+(the twist of its rotation about the vertical, so the body's lean is kept), plus the
 root's height.  Two files holding the same motion give the same numbers, and a pose step
 is what a viewer sees: how far the body's points move.
 
@@ -28,6 +29,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
 
@@ -52,18 +54,26 @@ def root_frame_points(motion: Motion) -> np.ndarray:
     Returns
     -------
     ndarray, shape (T, 3 * (J + E) + 1)
-        Per frame: every point's position minus the root's, in the root's rotated frame
-        (skeleton length units), then the root's up (y) coordinate.
+        Per frame: every point's position minus the travelling root's, turned by the
+        inverse of the root's heading (skeleton length units), then the root's up (y)
+        coordinate.
     """
     from ..periodic.root import root_layout, root_rotations
+    from ..rig import normalize_rig
 
+    if motion.skeleton is not None:
+        motion, _ = normalize_rig(motion)  # the travelling joint is the root
     pos = np.asarray(motion.positions().positions, dtype=float)  # (T, N, 3)
     layout = root_layout(motion)
-    R = root_rotations(motion.frames, layout) if layout is not None else None
     root = pos[:, :1, :]
     rel = pos - root
-    if R is not None:
-        rel = np.einsum("tji,tnj->tni", R, rel)
+    if layout is not None:
+        # heading only (the twist of the root's rotation about the vertical): the body's
+        # lean stays in the points, so a cycle whose hips tilt back at the seam shows it
+        q = Rotation.from_matrix(root_rotations(motion.frames, layout)).as_quat()
+        yaw = 2.0 * np.arctan2(q[:, 1], q[:, 3])
+        Y = Rotation.from_rotvec(np.outer(yaw, [0.0, 1.0, 0.0])).as_matrix()
+        rel = np.einsum("tji,tnj->tni", Y, rel)
     T = pos.shape[0]
     return np.concatenate([rel.reshape(T, -1), root[:, 0, 1:2]], axis=1)
 
