@@ -132,3 +132,21 @@ def test_the_shared_check(tmp_path):
         refuse_clobber([a], [("-o", a)])
     with pytest.raises(ParameterError, match="would write a.bvh over the input"):
         refuse_clobber([a], [], [("--extract", tmp_path, r"a\.bvh")])
+
+
+def test_a_folder_output_holding_a_link_to_an_input(tmp_path):
+    """A file the folder output would write that is an input by another name: a hard or a
+    symbolic link (the input itself lies elsewhere)."""
+    a = tmp_path / "a.bvh"
+    a.write_text("x")
+    figs = tmp_path / "figs"
+    figs.mkdir()
+    os.link(a, figs / "pca.png")
+    with pytest.raises(ParameterError, match=r"--plot would write pca.png over the input .*a\.bvh"):
+        refuse_clobber([a], [], [("--plot", figs, r".*\.png")])
+    (figs / "pca.png").unlink()
+    os.symlink(a, figs / "pca.png")
+    with pytest.raises(ParameterError, match="would write pca.png over the input"):
+        refuse_clobber([a], [], [("--plot", figs, r".*\.png")])
+    refuse_clobber([a], [], [("--plot", figs, r".*\.svg")])  # not a name it writes
+    refuse_clobber([a], [], [("--plot", tmp_path / "missing", r".*\.png")])
