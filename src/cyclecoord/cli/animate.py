@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from ._outputs import declare
+
 __all__ = ["add_parser", "run"]
 
 
@@ -26,6 +28,19 @@ def add_parser(subparsers) -> None:
     )
     p.add_argument("--no-check", action="store_true", help="skip the plausibility checks")
     p.set_defaults(func=run)
+    declare(p, inputs=_script_files, files=("-o", "--report"), derived=_skeleton_output)
+
+
+def _script_files(args: argparse.Namespace) -> list[Path]:
+    from ..synthesis.latent.script import script_files
+
+    return script_files(args.script)
+
+
+def _skeleton_output(args: argparse.Namespace) -> list[tuple[str, Path]]:
+    """``-o OUT.amc`` also writes ``OUT.asf``."""
+    out = Path(args.output)
+    return [("-o", out.with_suffix(".asf"))] if out.suffix.lower() == ".amc" else []
 
 
 def run(args: argparse.Namespace) -> int:
@@ -38,10 +53,6 @@ def run(args: argparse.Namespace) -> int:
 
     out = Path(args.output)
     script = Path(args.script)
-    if out.resolve() == script.resolve() or (
-        args.report and Path(args.report).resolve() == script.resolve()
-    ):
-        raise ParameterError(f"an output would overwrite the script {script}")
     for target in [out] + ([Path(args.report)] if args.report else []):
         if not (target.parent if str(target.parent) else Path(".")).is_dir():
             raise ParameterError(f"{target}: folder {target.parent} does not exist")

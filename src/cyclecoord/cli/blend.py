@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io import input_files, refuse_clobber
+from ..io import input_files
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
@@ -15,6 +15,7 @@ from ._options import (
     positive_float,
     positive_int,
 )
+from ._outputs import declare
 from .report import clean, load_input, write_json
 
 
@@ -39,6 +40,7 @@ def add_parser(subparsers) -> None:
     )
     add_input_options(bl)
     bl.set_defaults(func=cmd_blend)
+    declare(bl, inputs=_inputs, files=("-o", "--report"))
 
     tr = subparsers.add_parser(
         "transition",
@@ -66,6 +68,12 @@ def add_parser(subparsers) -> None:
     )
     add_input_options(tr)
     tr.set_defaults(func=cmd_transition)
+    declare(tr, inputs=_inputs, files=("-o", "--report"))
+
+
+def _inputs(args: argparse.Namespace) -> list:
+    """Every file blend and transition read: each input and an AMC's ``.asf``."""
+    return [f for src in args.inputs for f in input_files(src)]
 
 
 def add_input_options(q: argparse.ArgumentParser) -> None:
@@ -218,13 +226,9 @@ def _load_cycles(args: argparse.Namespace) -> list:
 
 
 def _check_outputs(args: argparse.Namespace) -> None:
-    """Fail fast on outputs we could not write or that would overwrite an input."""
+    """Fail fast on outputs we could not write (main has refused those naming an input)."""
     check_output(args.output)
     check_output(args.report, "report")
-    refuse_clobber(
-        [f for src in args.inputs for f in input_files(src)],
-        [("-o", args.output), ("--report", args.report)],
-    )
 
 
 def finish(

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from ..io import input_files, refuse_clobber
 from ._options import EXIT_OK, check_output, frame_range, positive_float
+from ._outputs import capture_inputs, declare
 from .report import load_input
 
 
@@ -30,6 +30,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     c.add_argument("--frames", type=frame_range, metavar="A:B", help="only these frames")
     c.set_defaults(func=cmd_convert)
+    declare(c, inputs=capture_inputs(), files=("-o",))
     return c
 
 
@@ -37,7 +38,6 @@ def cmd_convert(args: argparse.Namespace) -> int:
     from ..io import save
 
     check_output(args.output)
-    refuse_clobber(input_files(args.input, args.skeleton), [("-o", args.output)])
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
     save(motion, args.output)

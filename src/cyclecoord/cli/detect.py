@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io import input_files, refuse_clobber
+from ..io import input_files
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
@@ -17,6 +17,7 @@ from ._options import (
     named,
     positive_int,
 )
+from ._outputs import declare
 from .report import clean, load_input, summary_barcode, write_json
 
 
@@ -109,6 +110,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "(coordinates.png) and the windows coloured by motion (windows.png)",
     )
     d.set_defaults(func=cmd_detect)
+    declare(
+        d,
+        inputs=lambda a: input_files(a.input, a.skeleton),
+        files=("--report",),
+        # the cycles, in any --extract-format (a .gltf's .bin beside it)
+        folders={"--extract": r"motion\d+_cycle\.[A-Za-z]+", "--plot": r".*\.png"},
+    )
     return d
 
 
@@ -124,11 +132,6 @@ def cmd_detect(args: argparse.Namespace) -> int:
         )
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
-    refuse_clobber(
-        input_files(args.input, args.skeleton),
-        [("--report", args.report)],
-        [("--extract", args.extract, r"motion\d+_cycle\.bvh"), ("--plot", args.plot, r".*\.png")],
-    )
     motion = load_input(args.input, args.skeleton, args.fps)
     code = EXIT_OK
     try:

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io import input_files, refuse_clobber
+from ..io import input_files
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
@@ -22,6 +22,7 @@ from ._options import (
     positive_float,
     positive_int,
 )
+from ._outputs import declare
 from .report import clean, load_input, partial_report, summary_barcode, write_json
 
 
@@ -134,6 +135,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="do not fit: give every frame of INPUT its phase from a saved model (with --report)",
     )
     e.set_defaults(func=cmd_extract)
+    declare(
+        e,
+        inputs=lambda a: input_files(a.input, a.skeleton) + input_files(a.apply),
+        files=("-o", "--report", "--save-model"),
+        folders={"--plot": r".*\.png"},
+    )
     return e
 
 
@@ -147,11 +154,6 @@ def cmd_extract(args: argparse.Namespace) -> int:
         check_output(args.save_model, "model")
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
-    refuse_clobber(
-        input_files(args.input, args.skeleton) + input_files(args.apply),
-        [("-o", args.output), ("--report", args.report), ("--save-model", args.save_model)],
-        [("--plot", args.plot, r".*\.png")],
-    )
     motion = load_input(args.input, args.skeleton, args.fps)
     if args.apply:
         return _apply_model(args, motion)

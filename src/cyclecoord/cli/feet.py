@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from ._outputs import capture_inputs, declare
+
 
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
@@ -61,6 +63,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("-o", "--output", metavar="OUT", help="write the (locked) motion")
     p.add_argument("--report", metavar="JSON", help="write contacts and skating figures")
     p.set_defaults(func=run)
+    declare(p, inputs=capture_inputs(), files=("-o", "--report"))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -75,9 +78,6 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("--lock writes the locked motion: give -o OUT")
     check_output(args.output)
     check_output(args.report, "report")
-    for out in (args.output, args.report):
-        if out and Path(out).exists() and Path(out).resolve() == Path(args.input).resolve():
-            raise ParameterError(f"{out} is the input; choose another output name")
     motion = load_input(args.input, args.skeleton, args.fps).window(frame_window(args.frames))
     options = {"height": args.height, "speed": args.speed}
     contacts = foot_contacts(motion, **options)

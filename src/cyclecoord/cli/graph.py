@@ -11,7 +11,9 @@ import argparse
 from pathlib import Path
 
 from ..errors import ParameterError
+from ..io import input_files
 from ._options import EXIT_OK, check_output, positive_float, positive_int
+from ._outputs import declare
 from .report import clean, load_input, write_json
 
 __all__ = ["add_parser", "run"]
@@ -104,7 +106,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument("--no-topo", action="store_true", help="crossval: skip the bottleneck distances")
     p.set_defaults(func=run)
+    declare(p, inputs=_files_read, files=("-o", "--report"), folders={"--plot": r".*\.png"})
     return p
+
+
+def _files_read(args: argparse.Namespace) -> list[Path]:
+    """Every file graph reads: the takes (an AMC's ``.asf`` with it), --start and --target."""
+    names = list(args.inputs) + [_take_spec(t)[0] for t in (args.start, args.target) if t]
+    return [f for name in names for f in input_files(name)]
 
 
 def _take_spec(text: str) -> tuple[str, int]:
@@ -137,13 +146,6 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.report, "report")
     if not crossval:
         check_output(args.output)
-        for out in (args.output, args.report):
-            if out and any(
-                Path(out).exists() and Path(out).resolve() == Path(s).resolve()
-                for s in inputs
-                if Path(s).exists()
-            ):
-                raise ParameterError(f"{out}: refusing to overwrite an input file")
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder")
     motions = [

@@ -6,8 +6,9 @@ import argparse
 from pathlib import Path
 
 from ..errors import ParameterError
-from ..io import input_files, refuse_clobber
+from ..io import input_files
 from ._options import EXIT_OK, frame_range, positive_float, positive_int
+from ._outputs import declare
 from .report import load_input
 
 
@@ -67,6 +68,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="keep the figure centred and move the floor (default: only when it travels far)",
     )
     r.set_defaults(func=cmd_render)
+    declare(
+        r,
+        inputs=lambda a: input_files(a.input, a.skeleton) + input_files(a.side_by_side),
+        files=("-o",),
+    )
     return r
 
 
@@ -82,10 +88,6 @@ def cmd_render(args: argparse.Namespace) -> int:
     folder = out.parent if str(out.parent) else Path(".")
     if not folder.is_dir():
         raise ParameterError(f"{args.output}: folder {folder} does not exist")
-    refuse_clobber(
-        input_files(args.input, args.skeleton) + input_files(args.side_by_side),
-        [("-o", args.output)],
-    )
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
     other = load_input(args.side_by_side, None, None) if args.side_by_side else None

@@ -5,6 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..io import input_files
+from ._outputs import declare
+
 
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
@@ -49,6 +52,11 @@ def add_parser(subparsers) -> None:
     )
     p.add_argument("--no-contacts", action="store_true", help="do not mark planted feet")
     p.set_defaults(func=run)
+    declare(
+        p,
+        inputs=lambda a: input_files(a.input, a.skeleton) + input_files(a.side_by_side),
+        files=("-o",),
+    )
 
 
 def frame_window(text: str | None):
@@ -77,9 +85,6 @@ def run(args: argparse.Namespace) -> int:
     folder = out.parent if str(out.parent) else Path(".")
     if not folder.is_dir():
         raise ParameterError(f"{out}: folder {folder} does not exist")
-    for src in (args.input, args.side_by_side):
-        if src and Path(src).exists() and Path(src).resolve() == out.resolve():
-            raise ParameterError(f"{out} is an input; choose another output name")
     items = []
     m = load_input(args.input, args.skeleton, args.fps).window(frame_window(args.frames))
     items.append(ViewerInput(m, Path(args.input).name, args.cycle))
