@@ -121,3 +121,67 @@ def test_ctrl_c_while_usd_core_loads_in_a_real_process(walk_bvh, tmp_path):
             continue  # the run had finished before the signal
         assert p.returncode in (130, -signal.SIGINT), stderr
         assert "postprocessing module" not in stderr
+
+
+@pytest.fixture(scope="module")
+def walk300(tmp_path_factory):
+    p = tmp_path_factory.mktemp("walk300") / "walk.bvh"
+    cc.save(cc.datasets.example_capture().motion[:300], p)
+    return p
+
+
+def _listing(folder):
+    return {p.relative_to(folder).as_posix(): p.read_bytes() if p.is_file() else None
+            for p in folder.rglob("*")}
+
+
+def test_extract_interrupted_after_the_cycle_changes_no_output(walk300, tmp_path, monkeypatch,
+                                                                capsys):
+    """The issue's run: `extract --plot DIR -o OUT.bvh` stopped by Ctrl-C after the cycle was
+    written, while drawing the figures: OUT.bvh, the report and the model stay as they
+    were, and neither the figure folder (barcode.png was drawn) nor a staging folder is
+    left."""
+    out, report, model = tmp_path / "OUT.bvh", tmp_path / "r.json", tmp_path / "m.npz"
+    for p in (out, report, model):
+        p.write_text(f"the existing {p.name}\n")
+    before = _listing(tmp_path)
+
+    def ctrl_c(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("cyclecoord.plot.figures.plot_pca", ctrl_c)  # after barcode.png
+    code = main(["extract", str(walk300), "-o", str(out), "--plot", str(tmp_path / "figs"),
+                 "--report", str(report), "--save-model", str(model)])
+    captured = capsys.readouterr()
+    assert code == 130 and "interrupted" in captured.err
+    assert "wrote" not in captured.out  # nothing was moved into place, nothing is claimed
+    assert _listing(tmp_path) == before
+
+
+def test_extract_writes_every_output_at_the_end(walk300, tmp_path, capsys):
+    out, figs = tmp_path / "OUT.bvh", tmp_path / "new" / "figs"
+    out.write_text("the existing OUT.bvh\n")
+    code = main(["extract", str(walk300), "-o", str(out), "--plot", str(figs)])
+    printed = capsys.readouterr().out
+    assert code == 0 and cc.load(out).n_frames > 10
+    assert sorted(p.name for p in figs.iterdir()) == sorted(
+        ["barcode.png", "pca.png", "density.png", "coordinate.png", "channels.png"])
+    assert f"wrote {out}" in printed and f"wrote {figs / 'pca.png'}" in printed
+    assert sorted(p.name for p in tmp_path.rglob("*")) == sorted(
+        ["OUT.bvh", "new", "figs", "barcode.png", "pca.png", "density.png", "coordinate.png",
+         "channels.png"])  # no staging folder left
+
+
+def test_feet_interrupted_before_the_report_keeps_the_motion(walk300, tmp_path, monkeypatch,
+                                                              capsys):
+    out, report = tmp_path / "locked.bvh", tmp_path / "feet.json"
+    out.write_text("the existing locked.bvh\n")
+    before = _listing(tmp_path)
+
+    def ctrl_c(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("cyclecoord.cli.report.write_json", ctrl_c)
+    code = main(["feet", str(walk300), "-o", str(out), "--report", str(report)])
+    assert code == 130, capsys.readouterr().err
+    assert _listing(tmp_path) == before

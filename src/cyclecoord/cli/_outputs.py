@@ -16,6 +16,10 @@ Each subcommand calls :func:`declare` on its parser with
 spelling, a symbolic link or a hard link, replaces an input, and nothing is computed first.
 ``tests/cli/test_clobber.py`` walks every parser and fails on an output option that is not
 declared.
+
+:class:`Outputs` is the command side of the rule that an interrupted run changes nothing:
+a :class:`cyclecoord.io.StagedOutputs` whose "wrote ..." lines are printed once the files
+are in place.
 """
 
 from __future__ import annotations
@@ -25,9 +29,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
-from ..io import input_files, refuse_clobber
+from ..io import StagedOutputs, input_files, refuse_clobber
 
-__all__ = ["OUTPUT_FLAGS", "Paths", "capture_inputs", "check_paths", "declare"]
+__all__ = ["OUTPUT_FLAGS", "Outputs", "Paths", "capture_inputs", "check_paths", "declare"]
 
 #: Option names that always write something; a command that has one must declare it.
 OUTPUT_FLAGS = ("-o", "--output", "--report", "--plot", "--save-model", "--extract")
@@ -114,3 +118,37 @@ def check_paths(args: argparse.Namespace) -> None:
     paths = getattr(args, "paths", None)
     if paths is not None:
         paths.check(args)
+
+
+class Outputs(StagedOutputs):
+    """The outputs of one command: staged, moved into place at the end, then announced.
+
+    :meth:`wrote` queues a ``wrote PATH`` line; the lines are printed after
+    :meth:`commit`, so a run interrupted before the end prints none and changes nothing.
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._lines: list[str] = []
+
+    def wrote(self, path: Any, detail: str = "") -> None:
+        """Print ``wrote PATH`` (and ``detail``) once the outputs are in place."""
+        self._lines.append(f"wrote {path}{detail}")
+
+    def save(self, motion: Any, path: Any, announce: bool = True, **kwargs: Any) -> None:
+        """Stage ``motion`` as ``path`` (see :meth:`StagedOutputs.save`) and, unless
+        ``announce`` is False, print ``wrote PATH`` at the end."""
+        super().save(motion, path, **kwargs)
+        if announce:
+            self.wrote(path)
+
+    def commit(self) -> list[Path]:
+        moved = super().commit()
+        for line in self._lines:
+            print(line)
+        self._lines.clear()
+        return moved
+
+    def discard(self) -> None:
+        super().discard()
+        self._lines.clear()

@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ._outputs import declare
+from ._outputs import Outputs, declare
 
 __all__ = ["add_parser", "run"]
 
@@ -44,9 +44,6 @@ def _skeleton_output(args: argparse.Namespace) -> list[tuple[str, Path]]:
 
 
 def run(args: argparse.Namespace) -> int:
-    import tempfile
-
-    from .. import save
     from ..errors import ParameterError
     from ..io import atomic_write
     from ..synthesis.latent.script import run_script
@@ -57,21 +54,13 @@ def run(args: argparse.Namespace) -> int:
         if not (target.parent if str(target.parent) else Path(".")).is_dir():
             raise ParameterError(f"{target}: folder {target.parent} does not exist")
     motion, report = run_script(script, check=not args.no_check, progress=True)
-    # write both outputs to temporary files first, so a failure leaves neither
-    with tempfile.TemporaryDirectory(dir=out.parent if str(out.parent) else ".") as tmp:
-        staged = Path(tmp) / ("motion" + out.suffix)
-        asf = None
-        if out.suffix.lower() == ".amc":
-            asf = Path(tmp) / "motion.asf"
-            save(motion, staged, asf_path=asf)
-        else:
-            save(motion, staged)
+    # every output moves into place at the end, so a failure or Ctrl-C leaves none
+    with Outputs() as staged:
+        skeleton = [asf for _option, asf in _skeleton_output(args)]
+        staged.save(motion, out, announce=False, **({"asf_path": skeleton[0]} if skeleton else {}))
         if args.report:
-            with atomic_write(args.report) as fh:
+            with atomic_write(staged.file(args.report)) as fh:
                 json.dump(report, fh, indent=2, default=float)
-        if asf is not None:
-            asf.replace(out.with_suffix(".asf"))
-        staged.replace(out)
     t = report["timing"]
     fps = t["frames_per_second"]
     cpu = t.get("frames_per_cpu_second")

@@ -15,7 +15,7 @@ from ._options import (
     positive_float,
     positive_int,
 )
-from ._outputs import declare
+from ._outputs import Outputs, declare
 from .report import clean, load_input, write_json
 
 
@@ -232,28 +232,41 @@ def _check_outputs(args: argparse.Namespace) -> None:
 
 
 def finish(
-    args: argparse.Namespace, motion, payload: dict, report, what: str, problem: str | None = None
+    args: argparse.Namespace,
+    motion,
+    payload: dict,
+    report,
+    what: str,
+    problem: str | None = None,
+    out: Outputs | None = None,
 ) -> int:
-    """Print the plausibility verdict, honour --strict, write the motion and the report."""
-    from ..io import save
+    """Print the plausibility verdict, honour --strict, write the motion and the report.
+
+    The outputs go through ``out`` (the command's staged outputs; a new one when None) and
+    move into place together; with --strict and a failed check the report (and what was
+    staged before it) is moved into place and the motion is not written.
+    """
     from ..errors import ImplausibleMotionError
 
+    if out is None:
+        with Outputs() as own:
+            return finish(args, motion, payload, report, what, problem, own)
     print(report.summary())
     payload["plausibility"] = report.to_dict()
     refused = args.strict and (not report.clean or problem is not None)
     payload["written"] = None if refused or not args.output else args.output
     if args.report:
-        write_json(args.report, clean(payload))
-        print(f"wrote {args.report}")
+        write_json(out.file(args.report), clean(payload))
+        out.wrote(args.report)
     if refused:
+        out.commit()  # the report says why the motion is not written
         why = problem if report.clean and problem else "fails the plausibility checks"
         raise ImplausibleMotionError(
             f"the {what} {why} and --strict is set; nothing written"
             + (f" (see {args.report})" if args.report else "")
         )
     if args.output:
-        save(motion, args.output)
-        print(f"wrote {args.output}")
+        out.save(motion, args.output)
     return EXIT_OK
 
 

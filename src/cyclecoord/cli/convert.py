@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ._options import EXIT_OK, check_output, frame_range, positive_float
-from ._outputs import capture_inputs, declare
+from ._outputs import Outputs, capture_inputs, declare
 from .report import load_input
 
 
@@ -35,12 +35,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def cmd_convert(args: argparse.Namespace) -> int:
-    from ..io import save
-
     check_output(args.output)
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
-    save(motion, args.output)
+    with Outputs() as out:  # an AMC and its .asf move into place together
+        out.save(motion, args.output, announce=False)  # the line below names it
     print(
         f"{args.input} -> {args.output}: {motion.n_frames} frames, {motion.n_channels} channels, "
         f"{motion.fps:g} fps"

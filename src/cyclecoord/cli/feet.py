@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ._outputs import capture_inputs, declare
+from ._outputs import Outputs, capture_inputs, declare
 
 
 def add_parser(subparsers) -> None:
@@ -68,7 +68,6 @@ def add_parser(subparsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
-    from ..io import save
     from ..quality.contacts import contact_runs, foot_contacts, foot_skating
     from ._options import check_output
     from .report import load_input, write_json
@@ -122,10 +121,10 @@ def run(args: argparse.Namespace) -> int:
             "max_lock_error": locked.max_error,
         }
         result = locked.motion
-    if args.output:
-        save(result, args.output)
-        print(f"wrote {args.output}")
-    if args.report:
-        write_json(args.report, json.loads(json.dumps(payload, default=float)))
-        print(f"wrote {args.report}")
+    with Outputs() as out:  # both move into place at the end, or neither does
+        if args.output:
+            out.save(result, args.output)
+        if args.report:
+            write_json(out.file(args.report), json.loads(json.dumps(payload, default=float)))
+            out.wrote(args.report)
     return 0

@@ -13,7 +13,7 @@ from pathlib import Path
 from ..errors import ParameterError
 from ..io import input_files
 from ._options import EXIT_OK, check_output, positive_float, positive_int
-from ._outputs import declare
+from ._outputs import Outputs, declare
 from .report import clean, load_input, write_json
 
 __all__ = ["add_parser", "run"]
@@ -151,12 +151,13 @@ def run(args: argparse.Namespace) -> int:
     motions = [
         load_input(p) for p in tqdm(inputs, desc="loading", unit="take", disable=len(inputs) < 4)
     ]
-    if crossval:
-        return _crossval(args, motions)
-    return _generate(args, inputs, motions)
+    with Outputs() as out:  # every output moves into place at the end, or none does
+        if crossval:
+            return _crossval(args, motions, out)
+        return _generate(args, inputs, motions, out)
 
 
-def _crossval(args: argparse.Namespace, motions: list) -> int:
+def _crossval(args: argparse.Namespace, motions: list, out: Outputs) -> int:
     from ..synthesis.graph import DEFAULT_METHODS, cross_validate
 
     methods = [m.strip() for m in (args.method or ",".join(DEFAULT_METHODS)).split(",")]
@@ -179,17 +180,17 @@ def _crossval(args: argparse.Namespace, motions: list) -> int:
         f"{outside} steps outside the hull"
     )
     if args.report:
-        write_json(args.report, clean(cv.to_report()))
-        print(f"wrote {args.report}")
+        write_json(out.file(args.report), clean(cv.to_report()))
+        out.wrote(args.report)
     if args.plot:
         from ..plot.graph import save_crossval_figures
 
-        for p in save_crossval_figures(cv, motions, args.plot):
-            print(f"wrote {p}")
+        for p in save_crossval_figures(cv, motions, out.folder(args.plot)):
+            out.wrote(Path(args.plot) / p.name)
     return EXIT_OK
 
 
-def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int:
+def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: Outputs) -> int:
     from ..quality.plausibility import check_plausibility
     from ..synthesis.graph import MotionGraphSynth
     from .blend import finish
@@ -259,7 +260,7 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int
     if args.plot:
         from ..plot.graph import save_graph_figures
 
-        for p in save_graph_figures(synth, gen, args.plot):
-            print(f"wrote {p}")
+        for p in save_graph_figures(synth, gen, out.folder(args.plot)):
+            out.wrote(Path(args.plot) / p.name)
     report = check_plausibility(gen.motion, motions)
-    return finish(args, gen.motion, payload, report, "generated motion")
+    return finish(args, gen.motion, payload, report, "generated motion", out=out)

@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ._outputs import declare
+from ._outputs import Outputs, declare
 
 __all__ = ["add_parser", "parse_take", "run"]
 
@@ -139,16 +139,11 @@ def run(args: argparse.Namespace) -> int:
         "fit_wall_s": time.perf_counter() - w0,
         "iterations": model.gp_.n_iter_,
     }
-    existed = out.exists()
-    model.save(out)
-    if args.report:
-        try:
-            with atomic_write(args.report) as fh:
+    with Outputs() as staged:  # the model and the report move into place together
+        model.save(staged.file(out))
+        if args.report:
+            with atomic_write(staged.file(args.report)) as fh:
                 json.dump(summary, fh, indent=2)
-        except BaseException:
-            if not existed:
-                out.unlink(missing_ok=True)  # no partial output
-            raise
     print(
         f"{out}: {summary['frames']} frames in {len(names)} segments, {summary['pca_components']} "
         "PCA "

@@ -8,7 +8,7 @@ from pathlib import Path
 from ..errors import ParameterError
 from ..io import input_files
 from ._options import EXIT_OK, frame_range, positive_float, positive_int
-from ._outputs import declare
+from ._outputs import Outputs, declare
 from .report import load_input
 
 
@@ -91,9 +91,11 @@ def cmd_render(args: argparse.Namespace) -> int:
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
     other = load_input(args.side_by_side, None, None) if args.side_by_side else None
-    path = render(motion, out, other=other, view=args.view, step=args.step, follow=args.follow)
+    with Outputs() as staged:
+        render(motion, staged.file(out), other=other, view=args.view, step=args.step,
+               follow=args.follow)
     what = f"{motion.n_frames} frames" + (
         f" beside {other.n_frames} frames of {args.side_by_side}" if other else ""
     )
-    print(f"wrote {path} ({what}, {args.view} view)")
+    print(f"wrote {out} ({what}, {args.view} view)")
     return EXIT_OK

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..io import input_files
-from ._outputs import declare
+from ._outputs import Outputs, declare
 
 
 def add_parser(subparsers) -> None:
@@ -97,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
         except ParameterError as exc:
             print(f"{it.label}: foot skating not measured ({exc})")
     fig = skeleton_figure(items, contacts=not args.no_contacts, max_fps=args.max_fps)
-    write_viewer(fig, out)
-    size = out.stat().st_size / 1e6
+    with Outputs() as staged:
+        size = write_viewer(fig, staged.file(out)).stat().st_size / 1e6
     print(f"wrote {out} ({size:.1f} MB, {len(fig.frames)} animation frames, self-contained)")
     return 0
