@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from ._outputs import Outputs, declare
+
 __all__ = ["add_parser", "run"]
 
 
@@ -26,41 +28,39 @@ def add_parser(subparsers) -> None:
     )
     p.add_argument("--no-check", action="store_true", help="skip the plausibility checks")
     p.set_defaults(func=run)
+    declare(p, inputs=_script_files, files=("-o", "--report"), derived=_skeleton_output)
+
+
+def _script_files(args: argparse.Namespace) -> list[Path]:
+    from ..synthesis.latent.script import script_files
+
+    return script_files(args.script)
+
+
+def _skeleton_output(args: argparse.Namespace) -> list[tuple[str, Path]]:
+    """``-o OUT.amc`` also writes ``OUT.asf``."""
+    out = Path(args.output)
+    return [("-o", out.with_suffix(".asf"))] if out.suffix.lower() == ".amc" else []
 
 
 def run(args: argparse.Namespace) -> int:
-    import tempfile
-
-    from .. import save
     from ..errors import ParameterError
     from ..io import atomic_write
     from ..synthesis.latent.script import run_script
 
     out = Path(args.output)
     script = Path(args.script)
-    if out.resolve() == script.resolve() or (
-        args.report and Path(args.report).resolve() == script.resolve()
-    ):
-        raise ParameterError(f"an output would overwrite the script {script}")
     for target in [out] + ([Path(args.report)] if args.report else []):
         if not (target.parent if str(target.parent) else Path(".")).is_dir():
             raise ParameterError(f"{target}: folder {target.parent} does not exist")
     motion, report = run_script(script, check=not args.no_check, progress=True)
-    # write both outputs to temporary files first, so a failure leaves neither
-    with tempfile.TemporaryDirectory(dir=out.parent if str(out.parent) else ".") as tmp:
-        staged = Path(tmp) / ("motion" + out.suffix)
-        asf = None
-        if out.suffix.lower() == ".amc":
-            asf = Path(tmp) / "motion.asf"
-            save(motion, staged, asf_path=asf)
-        else:
-            save(motion, staged)
+    # every output moves into place at the end, so a failure or Ctrl-C leaves none
+    with Outputs() as staged:
+        skeleton = [asf for _option, asf in _skeleton_output(args)]
+        staged.save(motion, out, announce=False, **({"asf_path": skeleton[0]} if skeleton else {}))
         if args.report:
-            with atomic_write(args.report) as fh:
+            with atomic_write(staged.file(args.report)) as fh:
                 json.dump(report, fh, indent=2, default=float)
-        if asf is not None:
-            asf.replace(out.with_suffix(".asf"))
-        staged.replace(out)
     t = report["timing"]
     fps = t["frames_per_second"]
     cpu = t.get("frames_per_cpu_second")

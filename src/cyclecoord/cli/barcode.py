@@ -6,6 +6,7 @@ import argparse
 import json
 
 from ._options import EXIT_OK, add_selection_options
+from ._outputs import capture_inputs, declare
 from .report import clean, load_input, summary_barcode
 
 
@@ -23,6 +24,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="print JSON ({'h0': [[b, d], ...], 'h1': ...}; d null = infinite)",
     )
     b.set_defaults(func=cmd_barcode)
+    declare(b, inputs=capture_inputs())  # prints; writes no file
     return b
 
 

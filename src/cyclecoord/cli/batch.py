@@ -6,6 +6,7 @@ import argparse
 
 from ..batch import CYCLE_FORMATS
 from ._options import EXIT_ERROR, EXIT_OK, add_cycle_options, add_selection_options, cycle_options
+from ._outputs import declare
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -67,6 +68,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (0)")
     add_cycle_options(ba.add_argument_group("the cycle (the same for every capture)"))
     ba.set_defaults(func=cmd_batch)
+    declare(
+        ba,
+        inputs=lambda a: (),
+        # the captures are found by the scan: run_batch checks every capture's report and
+        # cycle and the summary against every capture and its .asf (refuse_clobber)
+        elsewhere={"-o": "cyclecoord.batch.run_batch"},
+    )
     return ba
 
 

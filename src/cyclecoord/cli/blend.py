@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io import input_files, refuse_clobber
+from ..io import input_files
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
@@ -15,6 +15,7 @@ from ._options import (
     positive_float,
     positive_int,
 )
+from ._outputs import Outputs, declare
 from .report import clean, load_input, write_json
 
 
@@ -39,6 +40,7 @@ def add_parser(subparsers) -> None:
     )
     add_input_options(bl)
     bl.set_defaults(func=cmd_blend)
+    declare(bl, inputs=_inputs, files=("-o", "--report"))
 
     tr = subparsers.add_parser(
         "transition",
@@ -66,6 +68,12 @@ def add_parser(subparsers) -> None:
     )
     add_input_options(tr)
     tr.set_defaults(func=cmd_transition)
+    declare(tr, inputs=_inputs, files=("-o", "--report"))
+
+
+def _inputs(args: argparse.Namespace) -> list:
+    """Every file blend and transition read: each input and an AMC's ``.asf``."""
+    return [f for src in args.inputs for f in input_files(src)]
 
 
 def add_input_options(q: argparse.ArgumentParser) -> None:
@@ -218,38 +226,47 @@ def _load_cycles(args: argparse.Namespace) -> list:
 
 
 def _check_outputs(args: argparse.Namespace) -> None:
-    """Fail fast on outputs we could not write or that would overwrite an input."""
+    """Fail fast on outputs we could not write (main has refused those naming an input)."""
     check_output(args.output)
     check_output(args.report, "report")
-    refuse_clobber(
-        [f for src in args.inputs for f in input_files(src)],
-        [("-o", args.output), ("--report", args.report)],
-    )
 
 
 def finish(
-    args: argparse.Namespace, motion, payload: dict, report, what: str, problem: str | None = None
+    args: argparse.Namespace,
+    motion,
+    payload: dict,
+    report,
+    what: str,
+    problem: str | None = None,
+    out: Outputs | None = None,
 ) -> int:
-    """Print the plausibility verdict, honour --strict, write the motion and the report."""
-    from ..io import save
+    """Print the plausibility verdict, honour --strict, write the motion and the report.
+
+    The outputs go through ``out`` (the command's staged outputs; a new one when None) and
+    move into place together; with --strict and a failed check the report (and what was
+    staged before it) is moved into place and the motion is not written.
+    """
     from ..errors import ImplausibleMotionError
 
+    if out is None:
+        with Outputs() as own:
+            return finish(args, motion, payload, report, what, problem, own)
     print(report.summary())
     payload["plausibility"] = report.to_dict()
     refused = args.strict and (not report.clean or problem is not None)
     payload["written"] = None if refused or not args.output else args.output
     if args.report:
-        write_json(args.report, clean(payload))
-        print(f"wrote {args.report}")
+        write_json(out.file(args.report), clean(payload))
+        out.wrote(args.report)
     if refused:
+        out.commit()  # the report says why the motion is not written
         why = problem if report.clean and problem else "fails the plausibility checks"
         raise ImplausibleMotionError(
             f"the {what} {why} and --strict is set; nothing written"
             + (f" (see {args.report})" if args.report else "")
         )
     if args.output:
-        save(motion, args.output)
-        print(f"wrote {args.output}")
+        out.save(motion, args.output)
     return EXIT_OK
 
 

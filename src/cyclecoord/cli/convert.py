@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from ..io import input_files, refuse_clobber
 from ._options import (
     EXIT_OK,
     add_units_option,
@@ -14,6 +13,7 @@ from ._options import (
     positive_float,
     rig_line,
 )
+from ._outputs import Outputs, capture_inputs, declare
 from .report import load_input
 
 
@@ -39,18 +39,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     c.add_argument("--frames", type=frame_range, metavar="A:B", help="only these frames")
     add_units_option(c)
     c.set_defaults(func=cmd_convert)
+    declare(c, inputs=capture_inputs(), files=("-o",))
     return c
 
 
 def cmd_convert(args: argparse.Namespace) -> int:
-    from ..io import save
-
     check_output(args.output)
-    refuse_clobber(input_files(args.input, args.skeleton), [("-o", args.output)])
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
     print(rig_line(motion, args))
-    save(motion, args.output, **export_units(args, args.output))
+    with Outputs() as out:  # an AMC and its .asf move into place together
+        # the line below names it
+        out.save(motion, args.output, announce=False, **export_units(args, args.output))
     print(
         f"{args.input} -> {args.output}: {motion.n_frames} frames, {motion.n_channels} channels, "
         f"{motion.fps:g} fps"

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io import input_files, refuse_clobber
+from ..io import input_files
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
@@ -17,6 +17,7 @@ from ._options import (
     named,
     positive_int,
 )
+from ._outputs import Outputs, declare
 from .report import clean, load_input, summary_barcode, write_json
 
 
@@ -109,14 +110,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "(coordinates.png) and the windows coloured by motion (windows.png)",
     )
     d.set_defaults(func=cmd_detect)
+    declare(
+        d,
+        inputs=lambda a: input_files(a.input, a.skeleton),
+        files=("--report",),
+        # the cycles, in any --extract-format (a .gltf's .bin beside it)
+        folders={"--extract": r"motion\d+_cycle\.[A-Za-z]+", "--plot": r".*\.png"},
+    )
     return d
 
 
 def cmd_detect(args: argparse.Namespace) -> int:
     """``cyclecoord detect``: several periodic motions, their segments and per-frame labels."""
-    from ..io import save
-    from ..periodic.detection import detect, motion_cycles
-
     check_output(args.report, "report")
     if args.extract and Path(args.extract).exists() and not Path(args.extract).is_dir():
         raise ParameterError(
@@ -124,12 +129,14 @@ def cmd_detect(args: argparse.Namespace) -> int:
         )
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
-    refuse_clobber(
-        input_files(args.input, args.skeleton),
-        [("--report", args.report)],
-        [("--extract", args.extract, r"motion\d+_cycle\.bvh"), ("--plot", args.plot, r".*\.png")],
-    )
     motion = load_input(args.input, args.skeleton, args.fps)
+    with Outputs() as out:  # every output moves into place at the end, or none does
+        return _detect(args, motion, out)
+
+
+def _detect(args: argparse.Namespace, motion, out: Outputs) -> int:
+    from ..periodic.detection import detect, motion_cycles
+
     code = EXIT_OK
     try:
         res = detect(
@@ -181,7 +188,6 @@ def cmd_detect(args: argparse.Namespace) -> int:
         from ..quality.contacts import skating_line, skating_report
 
         folder = Path(args.extract)
-        folder.mkdir(parents=True, exist_ok=True)
         cycles = motion_cycles(
             res,
             bandwidth=args.bandwidth,
@@ -199,8 +205,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
                     "cycles, under the 1.5 a typical cycle needs (extract refuses such a take too)"
                 )
         for mc in cycles:
-            out = folder / f"motion{mc.motion}_cycle.{args.extract_format}"
-            save(mc.cycle, out)
+            path = folder / f"motion{mc.motion}_cycle.{args.extract_format}"
+            out.save(mc.cycle, path, announce=False)  # the line below names it
             how = (
                 f"phase from H1 {mc.phase_from}'s coordinate on {mc.n_frames_used} excited frames"
                 if mc.phase_from != "time"
@@ -209,7 +215,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
             print(
                 f"motion {mc.motion}: cycle of {mc.cycle.n_frames} frames from frames "
                 f"{m.start_frame + mc.start}:{m.start_frame + mc.stop} ({how}), loop closure "
-                f"{mc.loop_closure:.2f} -> {out}"
+                f"{mc.loop_closure:.2f} -> {path}"
             )
             if mc.largest_step > MAX_POP:
                 print(
@@ -222,7 +228,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
             extracted.append(
                 {
                     "motion": int(mc.motion),
-                    "path": str(out),
+                    "path": str(path),
                     "frames": int(mc.cycle.n_frames),
                     "source_frames": [m.start_frame + mc.start, m.start_frame + mc.stop],
                     "loop_closure": float(mc.loop_closure),
@@ -231,25 +237,24 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 }
             )
     if args.plot:
-        _save_plots(res, args.plot)
+        _save_plots(res, args.plot, out)
     if args.report:
         payload = res.to_report()
         if args.extract:
             # the cycles written by --extract, with their foot skating (as extract's report)
             payload["extracted"] = extracted
-        write_json(args.report, clean(payload))
-        print(f"wrote {args.report}")
+        write_json(out.file(args.report), clean(payload))
+        out.wrote(args.report)
     print("time: " + ", ".join(f"{k} {v:.3f}s" for k, v in res.timings.items()))
     return code
 
 
-def _save_plots(res, folder: str) -> None:
+def _save_plots(res, folder: str, out: Outputs) -> None:
     """``detect --plot DIR``: barcode, coordinates with segments shaded, windows by motion."""
     from ..plot.figures import plot_barcode, plot_coordinate, plot_windows
 
     m = res.motion
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
+    staged = out.folder(folder)
     import matplotlib
 
     matplotlib.use("Agg")
@@ -273,7 +278,7 @@ def _save_plots(res, folder: str) -> None:
     from ..io import atomic_write
 
     for name, fig in figs.items():
-        with atomic_write(folder / name, "wb") as fh:
+        with atomic_write(staged / name, "wb") as fh:
             fig.savefig(fh, format="png", dpi=100)
         plt.close(fig)
-        print(f"wrote {folder / name}")
+        out.wrote(Path(folder) / name)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import NoPeriodicMotionError, ParameterError
-from ..io import input_files, refuse_clobber
+from ..io import input_files
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
@@ -22,6 +22,7 @@ from ._options import (
     positive_float,
     positive_int,
 )
+from ._outputs import Outputs, declare
 from .report import clean, load_input, partial_report, summary_barcode, write_json
 
 
@@ -134,27 +135,32 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="do not fit: give every frame of INPUT its phase from a saved model (with --report)",
     )
     e.set_defaults(func=cmd_extract)
+    declare(
+        e,
+        inputs=lambda a: input_files(a.input, a.skeleton) + input_files(a.apply),
+        files=("-o", "--report", "--save-model"),
+        folders={"--plot": r".*\.png"},
+    )
     return e
 
 
 def cmd_extract(args: argparse.Namespace) -> int:
-    from ..io import save
-    from ..periodic.pipeline import extract
-
     check_output(args.output)
     check_output(args.report, "report")
     if args.save_model:
         check_output(args.save_model, "model")
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
-    refuse_clobber(
-        input_files(args.input, args.skeleton) + input_files(args.apply),
-        [("-o", args.output), ("--report", args.report), ("--save-model", args.save_model)],
-        [("--plot", args.plot, r".*\.png")],
-    )
     motion = load_input(args.input, args.skeleton, args.fps)
-    if args.apply:
-        return _apply_model(args, motion)
+    with Outputs() as out:  # every output moves into place at the end, or none does
+        if args.apply:
+            return _apply_model(args, motion, out)
+        return _extract(args, motion, out)
+
+
+def _extract(args: argparse.Namespace, motion, out: Outputs) -> int:
+    from ..periodic.pipeline import extract
+
     report_payload = None
     code = EXIT_OK
     try:
@@ -187,7 +193,7 @@ def cmd_extract(args: argparse.Namespace) -> int:
             print(summary_barcode(partial.barcode))
             report_payload = partial_report(exc)
             if args.plot:
-                _save_plots(partial, args.plot)
+                _save_plots(partial, args.plot, out)
         code = EXIT_NO_PERIODIC
     else:
         for line in describe_extraction(res, args.input, verbose=args.verbose):
@@ -198,21 +204,20 @@ def cmd_extract(args: argparse.Namespace) -> int:
             print(locked.summary() if locked is not None else
                   "feet: not locked: the cycle has no skeleton with recognisable feet")
         if args.output:
-            save(cycle, args.output)
-            print(f"wrote {args.output}")
+            out.save(cycle, args.output)
         if args.save_model:
-            res.model.save(args.save_model)
-            print(f"wrote {args.save_model}")
+            res.model.save(out.file(args.save_model))
+            out.wrote(args.save_model)
         if args.plot:
-            _save_plots(res, args.plot)
+            _save_plots(res, args.plot, out)
         report_payload = res.to_report()
         if locked is not None:
             report_payload["foot_lock"] = locked.to_dict()
         if args.verbose:
             print("time: " + ", ".join(f"{k} {v:.3f}s" for k, v in res.timings.items()))
     if args.report and report_payload is not None:
-        write_json(args.report, clean(report_payload))
-        print(f"wrote {args.report}")
+        write_json(out.file(args.report), clean(report_payload))
+        out.wrote(args.report)
     return code
 
 
@@ -366,7 +371,7 @@ def _feet_line(cycle) -> str | None:
     )
 
 
-def _apply_model(args: argparse.Namespace, motion) -> int:
+def _apply_model(args: argparse.Namespace, motion, out: Outputs) -> int:
     """``extract --apply MODEL``: phase of every frame from a saved model, no refit."""
     from ..periodic.phase_model import PhaseModel
 
@@ -389,14 +394,14 @@ def _apply_model(args: argparse.Namespace, motion) -> int:
             "period_frames": info["period_frames"],
             "model_period_frames": model.period_frames,
         }
-        write_json(args.report, clean(payload))
-        print(f"wrote {args.report}")
+        write_json(out.file(args.report), clean(payload))
+        out.wrote(args.report)
     return EXIT_OK
 
 
-def _save_plots(result, folder: str) -> None:
+def _save_plots(result, folder: str, out: Outputs) -> None:
     """``extract --plot DIR``: the standard figures (only the barcode when nothing was found)."""
     from ..plot.figures import save_figures
 
-    for path in save_figures(result, folder):
-        print(f"wrote {path}")
+    for path in save_figures(result, out.folder(folder)):
+        out.wrote(Path(folder) / path.name)

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from ._options import add_units_option, export_units, rig_line
+from ._outputs import Outputs, capture_inputs, declare
 
 
 def add_parser(subparsers) -> None:
@@ -64,11 +65,11 @@ def add_parser(subparsers) -> None:
     p.add_argument("-o", "--output", metavar="OUT", help="write the (locked) motion")
     p.add_argument("--report", metavar="JSON", help="write contacts and skating figures")
     p.set_defaults(func=run)
+    declare(p, inputs=capture_inputs(), files=("-o", "--report"))
 
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
-    from ..io import save
     from ..quality.contacts import contact_runs, foot_contacts, foot_skating
     from ._options import check_output
     from .report import load_input, write_json
@@ -78,9 +79,6 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("--lock writes the locked motion: give -o OUT")
     check_output(args.output)
     check_output(args.report, "report")
-    for out in (args.output, args.report):
-        if out and Path(out).exists() and Path(out).resolve() == Path(args.input).resolve():
-            raise ParameterError(f"{out} is the input; choose another output name")
     motion = load_input(args.input, args.skeleton, args.fps).window(frame_window(args.frames))
     print(rig_line(motion, args))
     options = {"height": args.height, "speed": args.speed}
@@ -126,10 +124,10 @@ def run(args: argparse.Namespace) -> int:
             "max_lock_error": locked.max_error,
         }
         result = locked.motion
-    if args.output:
-        save(result, args.output, **export_units(args, args.output))
-        print(f"wrote {args.output}")
-    if args.report:
-        write_json(args.report, json.loads(json.dumps(payload, default=float)))
-        print(f"wrote {args.report}")
+    with Outputs() as out:  # both move into place at the end, or neither does
+        if args.output:
+            out.save(result, args.output, **export_units(args, args.output))
+        if args.report:
+            write_json(out.file(args.report), json.loads(json.dumps(payload, default=float)))
+            out.wrote(args.report)
     return 0

@@ -11,7 +11,9 @@ import argparse
 from pathlib import Path
 
 from ..errors import ParameterError
+from ..io import input_files
 from ._options import EXIT_OK, check_output, positive_float, positive_int
+from ._outputs import Outputs, declare
 from .report import clean, load_input, write_json
 
 __all__ = ["add_parser", "run"]
@@ -104,7 +106,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument("--no-topo", action="store_true", help="crossval: skip the bottleneck distances")
     p.set_defaults(func=run)
+    declare(p, inputs=_files_read, files=("-o", "--report"), folders={"--plot": r".*\.png"})
     return p
+
+
+def _files_read(args: argparse.Namespace) -> list[Path]:
+    """Every file graph reads: the takes (an AMC's ``.asf`` with it), --start and --target."""
+    names = list(args.inputs) + [_take_spec(t)[0] for t in (args.start, args.target) if t]
+    return [f for name in names for f in input_files(name)]
 
 
 def _take_spec(text: str) -> tuple[str, int]:
@@ -137,24 +146,18 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.report, "report")
     if not crossval:
         check_output(args.output)
-        for out in (args.output, args.report):
-            if out and any(
-                Path(out).exists() and Path(out).resolve() == Path(s).resolve()
-                for s in inputs
-                if Path(s).exists()
-            ):
-                raise ParameterError(f"{out}: refusing to overwrite an input file")
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder")
     motions = [
         load_input(p) for p in tqdm(inputs, desc="loading", unit="take", disable=len(inputs) < 4)
     ]
-    if crossval:
-        return _crossval(args, motions)
-    return _generate(args, inputs, motions)
+    with Outputs() as out:  # every output moves into place at the end, or none does
+        if crossval:
+            return _crossval(args, motions, out)
+        return _generate(args, inputs, motions, out)
 
 
-def _crossval(args: argparse.Namespace, motions: list) -> int:
+def _crossval(args: argparse.Namespace, motions: list, out: Outputs) -> int:
     from ..synthesis.graph import DEFAULT_METHODS, cross_validate
 
     methods = [m.strip() for m in (args.method or ",".join(DEFAULT_METHODS)).split(",")]
@@ -177,17 +180,17 @@ def _crossval(args: argparse.Namespace, motions: list) -> int:
         f"{outside} steps outside the hull"
     )
     if args.report:
-        write_json(args.report, clean(cv.to_report()))
-        print(f"wrote {args.report}")
+        write_json(out.file(args.report), clean(cv.to_report()))
+        out.wrote(args.report)
     if args.plot:
         from ..plot.graph import save_crossval_figures
 
-        for p in save_crossval_figures(cv, motions, args.plot):
-            print(f"wrote {p}")
+        for p in save_crossval_figures(cv, motions, out.folder(args.plot)):
+            out.wrote(Path(args.plot) / p.name)
     return EXIT_OK
 
 
-def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int:
+def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: Outputs) -> int:
     from ..quality.plausibility import check_plausibility
     from ..synthesis.graph import MotionGraphSynth
     from .blend import finish
@@ -257,7 +260,7 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list) -> int
     if args.plot:
         from ..plot.graph import save_graph_figures
 
-        for p in save_graph_figures(synth, gen, args.plot):
-            print(f"wrote {p}")
+        for p in save_graph_figures(synth, gen, out.folder(args.plot)):
+            out.wrote(Path(args.plot) / p.name)
     report = check_plausibility(gen.motion, motions)
-    return finish(args, gen.motion, payload, report, "generated motion")
+    return finish(args, gen.motion, payload, report, "generated motion", out=out)

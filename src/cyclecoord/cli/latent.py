@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from ._outputs import Outputs, declare
+
 __all__ = ["add_parser", "parse_take", "run"]
 
 
@@ -65,7 +67,24 @@ def add_parser(subparsers) -> None:
     f.add_argument("--max-iter", type=int, default=200, help="optimiser iterations (default 200)")
     f.add_argument("--report", metavar="R.json", help="also write the model's summary as JSON")
     f.set_defaults(func=run)
+    declare(f, inputs=_take_files, files=("-o", "--report"))
     p.set_defaults(func=lambda args: _usage(p))
+    declare(p, inputs=lambda args: ())
+
+
+def _take_files(args: argparse.Namespace) -> list[Path]:
+    """Every file ``latent fit`` reads: each take and, for an AMC, its ``.asf``."""
+    from ..errors import ParameterError
+    from ..io import input_files
+
+    files: list[Path] = []
+    for text in args.takes:
+        try:
+            path = parse_take(text)[0]
+        except ParameterError:
+            continue  # run() reports it
+        files += input_files(path)
+    return files
 
 
 def _usage(parser) -> int:
@@ -92,11 +111,9 @@ def run(args: argparse.Namespace) -> int:
         folder = target.parent if str(target.parent) else Path(".")
         if not folder.is_dir():
             raise ParameterError(f"{target}: folder {folder} does not exist")
-    inputs = set()
     segments, names = [], []
     for i, text in enumerate(args.takes):
         path, a, b, name = parse_take(text)
-        inputs.add(Path(path).resolve())
         motion = load(path).window((a, b))
         seg = motion[:: args.step]
         if seg.n_frames < 3:
@@ -110,8 +127,6 @@ def run(args: argparse.Namespace) -> int:
             else ""
         )
         names.append(label)
-    if out.resolve() in inputs:
-        raise ParameterError(f"output {out} is one of the inputs")
     if len(set(names)) != len(names):
         raise ParameterError(f"segment names repeat: {names}; name them with =NAME")
     t0 = time.process_time()
@@ -124,16 +139,11 @@ def run(args: argparse.Namespace) -> int:
         "fit_wall_s": time.perf_counter() - w0,
         "iterations": model.gp_.n_iter_,
     }
-    existed = out.exists()
-    model.save(out)
-    if args.report:
-        try:
-            with atomic_write(args.report) as fh:
+    with Outputs() as staged:  # the model and the report move into place together
+        model.save(staged.file(out))
+        if args.report:
+            with atomic_write(staged.file(args.report)) as fh:
                 json.dump(summary, fh, indent=2)
-        except BaseException:
-            if not existed:
-                out.unlink(missing_ok=True)  # no partial output
-            raise
     print(
         f"{out}: {summary['frames']} frames in {len(names)} segments, {summary['pca_components']} "
         "PCA "

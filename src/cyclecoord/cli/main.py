@@ -14,6 +14,7 @@ from collections.abc import Sequence
 
 from ..errors import CycleCoordError
 from ._options import EXIT_ERROR, EXIT_NO_PERIODIC, EXIT_OK, EXIT_USAGE, named
+from ._outputs import check_paths
 
 __all__ = [
     "COMMAND_MODULES",
@@ -27,9 +28,11 @@ __all__ = [
 
 
 #: Subcommands that live in a module of their own under ``cyclecoord.cli``: each module has
-#: ``add_parser(subparsers)``, which adds its parser and sets ``func`` to the function that
-#: runs it (taking the parsed arguments, returning the exit code).  Modules must import
-#: their heavy dependencies inside that function so ``cyclecoord --help`` stays fast.
+#: ``add_parser(subparsers)``, which adds its parser, sets ``func`` to the function that
+#: runs it (taking the parsed arguments, returning the exit code) and declares what it
+#: reads and writes (:func:`cyclecoord.cli._outputs.declare`; :func:`main` refuses an output
+#: that names an input before running it).  Modules must import their heavy dependencies
+#: inside that function so ``cyclecoord --help`` stays fast.
 COMMAND_MODULES: tuple[str, ...] = (
     "extract",
     "barcode",
@@ -92,6 +95,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_USAGE
+    try:
+        check_paths(args)  # no output may name an input: refused before anything runs
+    except CycleCoordError as exc:  # names the output, its option and the input already
+        print(f"cyclecoord: error: {exc}", file=sys.stderr)
+        return EXIT_ERROR
     try:
         return int(args.func(args))
     except CycleCoordError as exc:

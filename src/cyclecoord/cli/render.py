@@ -6,8 +6,9 @@ import argparse
 from pathlib import Path
 
 from ..errors import ParameterError
-from ..io import input_files, refuse_clobber
+from ..io import input_files
 from ._options import EXIT_OK, frame_range, positive_float, positive_int
+from ._outputs import Outputs, declare
 from .report import load_input
 
 
@@ -67,6 +68,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="keep the figure centred and move the floor (default: only when it travels far)",
     )
     r.set_defaults(func=cmd_render)
+    declare(
+        r,
+        inputs=lambda a: input_files(a.input, a.skeleton) + input_files(a.side_by_side),
+        files=("-o",),
+    )
     return r
 
 
@@ -82,16 +88,14 @@ def cmd_render(args: argparse.Namespace) -> int:
     folder = out.parent if str(out.parent) else Path(".")
     if not folder.is_dir():
         raise ParameterError(f"{args.output}: folder {folder} does not exist")
-    refuse_clobber(
-        input_files(args.input, args.skeleton) + input_files(args.side_by_side),
-        [("-o", args.output)],
-    )
     motion = load_input(args.input, args.skeleton, args.fps)
     motion = motion.window(args.frames)
     other = load_input(args.side_by_side, None, None) if args.side_by_side else None
-    path = render(motion, out, other=other, view=args.view, step=args.step, follow=args.follow)
+    with Outputs() as staged:
+        render(motion, staged.file(out), other=other, view=args.view, step=args.step,
+               follow=args.follow)
     what = f"{motion.n_frames} frames" + (
         f" beside {other.n_frames} frames of {args.side_by_side}" if other else ""
     )
-    print(f"wrote {path} ({what}, {args.view} view)")
+    print(f"wrote {out} ({what}, {args.view} view)")
     return EXIT_OK

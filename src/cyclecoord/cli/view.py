@@ -5,6 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..io import input_files
+from ._outputs import Outputs, declare
+
 
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
@@ -49,6 +52,11 @@ def add_parser(subparsers) -> None:
     )
     p.add_argument("--no-contacts", action="store_true", help="do not mark planted feet")
     p.set_defaults(func=run)
+    declare(
+        p,
+        inputs=lambda a: input_files(a.input, a.skeleton) + input_files(a.side_by_side),
+        files=("-o",),
+    )
 
 
 def frame_window(text: str | None):
@@ -77,9 +85,6 @@ def run(args: argparse.Namespace) -> int:
     folder = out.parent if str(out.parent) else Path(".")
     if not folder.is_dir():
         raise ParameterError(f"{out}: folder {folder} does not exist")
-    for src in (args.input, args.side_by_side):
-        if src and Path(src).exists() and Path(src).resolve() == out.resolve():
-            raise ParameterError(f"{out} is an input; choose another output name")
     items = []
     m = load_input(args.input, args.skeleton, args.fps).window(frame_window(args.frames))
     items.append(ViewerInput(m, Path(args.input).name, args.cycle))
@@ -92,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
         except ParameterError as exc:
             print(f"{it.label}: foot skating not measured ({exc})")
     fig = skeleton_figure(items, contacts=not args.no_contacts, max_fps=args.max_fps)
-    write_viewer(fig, out)
-    size = out.stat().st_size / 1e6
+    with Outputs() as staged:
+        size = write_viewer(fig, staged.file(out)).stat().st_size / 1e6
     print(f"wrote {out} ({size:.1f} MB, {len(fig.frames)} animation frames, self-contained)")
     return 0

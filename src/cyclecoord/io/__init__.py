@@ -7,10 +7,12 @@ Supported formats: ``.amc`` (Acclaim motion, with its ``.asf`` skeleton), ``.bvh
 :mod:`~cyclecoord.io.usd`).  The per-format readers and writers are re-exported here; the
 ASF/AMC, glTF and USD ones are imported on first use.
 
-Two helpers every writer of the package uses live here too: :func:`atomic_write` /
+The helpers every writer of the package uses live here too: :func:`atomic_write` /
 :func:`atomic_path` (an output appears whole or not at all: it is written beside the
-target and renamed over it) and :func:`refuse_clobber` / :func:`input_files` /
-:func:`same_file` (no output is written over an input, however the paths are spelled).
+target and renamed over it), :class:`StagedOutputs` (every output of a run moved into
+place together at the end, so an interrupted run changes none) and :func:`refuse_clobber`
+/ :func:`input_files` / :func:`same_file` (no output is written over an input, however the
+paths are spelled).
 Import them from ``cyclecoord.io``; their modules ``_atomic`` and ``_paths`` are private.
 """
 
@@ -27,7 +29,7 @@ import numpy as np
 from ..errors import ParameterError, ParseError
 from ..motion import DEFAULT_FPS, Motion
 from ..skeleton import Skeleton
-from ._atomic import atomic_path, atomic_write
+from ._atomic import StagedOutputs, atomic_path, atomic_write
 from ._paths import input_files, refuse_clobber, same_file
 from .bvh import read_bvh, write_bvh
 from .tabular import read_csv, read_npz, write_csv, write_npz
@@ -54,6 +56,7 @@ __all__ = [
     "write_usd",
     "atomic_write",
     "atomic_path",
+    "StagedOutputs",
     "refuse_clobber",
     "input_files",
     "same_file",
@@ -247,6 +250,22 @@ def _check_kwargs(suffix: str, kwargs: dict, allowed: tuple[str, ...]) -> None:
         )
 
 
+def _amc_default_skeleton(motion: Motion, amc_path: Path) -> Path | None:
+    """Where :func:`save` writes the skeleton of an AMC at ``amc_path`` when no
+    ``asf_path`` is given: :func:`default_asf_path`, or None when an equal skeleton is
+    already there.  A different skeleton there is never overwritten (ParameterError)."""
+    asf = default_asf_path(amc_path)
+    if asf.exists() and _can_reuse_asf(asf, motion.skeleton):
+        return None
+    if asf.exists():
+        raise ParameterError(
+            f"{asf} already exists and holds a different skeleton; pass asf_path= "
+            "to choose where this motion's skeleton goes (the existing file may "
+            "belong to other AMC files and is not overwritten)"
+        )
+    return asf
+
+
 def save(motion: Motion, path: str | os.PathLike[str], **kwargs: Any) -> None:
     """Write a motion in the format given by the suffix of ``path``.
 
@@ -317,18 +336,12 @@ def save(motion: Motion, path: str | os.PathLike[str], **kwargs: Any) -> None:
                 raise ParameterError(f"asf_path {asf} is the AMC output itself")
             write_amc(motion, p, skeleton_path=asf)
             return
-        asf = default_asf_path(p)
-        if asf.exists() and _can_reuse_asf(asf, motion.skeleton):
+        asf = _amc_default_skeleton(motion, p)
+        if asf is None:
             # an equivalent skeleton is already there (e.g. the one the motion was
             # read with): leave it untouched and write only the AMC
             write_amc(motion, p)
             return
-        if asf.exists():
-            raise ParameterError(
-                f"{asf} already exists and holds a different skeleton; pass asf_path= "
-                "to choose where this motion's skeleton goes (the existing file may "
-                "belong to other AMC files and is not overwritten)"
-            )
         write_amc(motion, p, skeleton_path=asf)
     elif suffix == ".bvh":
         _check_kwargs(suffix, kwargs, ("rotation_order",))

@@ -2,9 +2,11 @@
 
 Paths are compared as the files they reach: relative paths, ``..``, symbolic links (of
 the file or of any folder above it) and hard links all count, so ``-o ./x/../walk.bvh``,
-``-o link.bvh`` (a link to the input) and the input itself are refused alike.  Every
-command and every output option goes through :func:`refuse_clobber` before anything is
-computed.
+``-o link.bvh`` (a link to the input) and the input itself are refused alike, and so is a
+folder output (``--plot DIR``) holding an input, or a link to one, under a name it writes.
+Every command and every output option goes through :func:`refuse_clobber` before anything
+is computed: the command line declares each command's inputs and outputs
+(:mod:`cyclecoord.cli._outputs`) and checks them before running it.
 """
 
 from __future__ import annotations
@@ -121,6 +123,22 @@ def refuse_clobber(
         for key, src in by_path.items():
             parent, name = os.path.split(key)
             if _real(parent) == where and names.fullmatch(name):
+                raise ParameterError(
+                    f"{folder}: {option} would write {name} over the input {src}; "
+                    "inputs are never modified, choose another folder"
+                )
+        # a file already there under such a name that is an input by another link
+        try:
+            present = [n for n in os.listdir(folder) if names.fullmatch(n)]
+        except OSError:  # no such folder (yet)
+            present = []
+        for name in present:
+            try:
+                st = os.stat(os.path.join(folder, name))
+            except OSError:
+                continue
+            src = by_inode.get((st.st_dev, st.st_ino))
+            if src is not None:
                 raise ParameterError(
                     f"{folder}: {option} would write {name} over the input {src}; "
                     "inputs are never modified, choose another folder"

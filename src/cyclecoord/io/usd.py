@@ -39,9 +39,17 @@ _KEY = "cyclecoord"
 
 def require_usd():
     """The usd-core modules (Gf, Sdf, Tf, Usd, UsdGeom, UsdSkel, Vt), or one clear
-    ParameterError saying how to install them."""
+    ParameterError saying how to install them.
+
+    Ctrl-C is held back while they load and raised once they have: usd-core catches a
+    ``KeyboardInterrupt`` raised while it post-processes its modules, prints it as a
+    warning and goes on (see :mod:`cyclecoord._signals`).
+    """
+    from .._signals import deferred_interrupt
+
     try:
-        from pxr import Gf, Sdf, Tf, Usd, UsdGeom, UsdSkel, Vt
+        with deferred_interrupt():
+            from pxr import Gf, Sdf, Tf, Usd, UsdGeom, UsdSkel, Vt
     except ImportError:
         raise ParameterError(
             "USD files need the optional usd-core package: pip install 'cyclecoord[usd]'"
@@ -233,12 +241,11 @@ def read_usd(path: str | os.PathLike[str]) -> Motion:
     another gives one joint per USD joint with ``rx ry rz`` rotations (order ``ZYX``),
     ``tx ty tz`` on root joints, lengths in the stage's units.
     """
-    from pxr import Usd
-
     from .._kinematics import channels_from_local
 
     p = Path(path)
-    _stage, prim, query, times, fps = _open(p)
+    _stage, prim, query, times, fps = _open(p)  # loads usd-core (require_usd)
+    from pxr import Usd
     local = np.array(
         [np.array(query.ComputeJointLocalTransforms(Usd.TimeCode(float(t)))) for t in times]
     )  # (T, J, 4, 4), row vectors

@@ -38,7 +38,7 @@ from .commands import Synthesizer
 from .model import LatentModel
 from .particle import ParticleParams
 
-__all__ = ["COMMANDS", "TOP_KEYS", "load_script", "run_script"]
+__all__ = ["COMMANDS", "TOP_KEYS", "load_script", "model_file", "run_script", "script_files"]
 
 TOP_KEYS = {
     "fps",
@@ -63,6 +63,38 @@ _REQUIRED = {"MOVE": {"to"}, "IDLE": {"duration"}, "TRANSITION": {"to"}, "PLAY":
 
 def _fail(path: Path, where: str, message: str) -> ParameterError:
     return ParameterError(f"{path}: {where}: {message}")
+
+
+def model_file(script: Path, entry: str) -> Path:
+    """The model file a script's ``models`` entry names (relative to the script's folder)."""
+    return (script.parent / entry) if not Path(entry).is_absolute() else Path(entry)
+
+
+def script_files(path: str | Path) -> list[Path]:
+    """Every file a run of the script reads: the script and the model files it names.
+
+    Only files that exist; a script that cannot be read or parsed gives itself alone
+    (:func:`load_script` reports what is wrong).  For the output rule of ``animate``: no
+    output may replace one of these.
+    """
+    p = Path(path)
+    if not p.is_file():
+        return []
+    files = [p]
+    try:
+        spec = json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return files
+    models = spec.get("models") if isinstance(spec, dict) else None
+    for entry in models.values() if isinstance(models, dict) else ():
+        if not isinstance(entry, str):
+            continue
+        try:
+            if model_file(p, entry).is_file():
+                files.append(model_file(p, entry))
+        except (OSError, ValueError):  # a name the OS refuses (NUL, too long)
+            pass
+    return files
 
 
 def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel]]:
@@ -99,7 +131,7 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
     for name, file in models_spec.items():
         if not isinstance(file, str):
             raise _fail(p, f"models.{name}", f"must be a path, got {file!r}")
-        mp = (p.parent / file) if not Path(file).is_absolute() else Path(file)
+        mp = model_file(p, file)
         if not mp.is_file():
             raise _fail(p, f"models.{name}", f"model file {mp} not found")
         try:

@@ -1,0 +1,187 @@
+"""Ctrl-C is never swallowed, whatever library is loading, and an interrupted run leaves
+every existing output as it was (issue 26, "Interrupted runs")."""
+
+import signal
+import sys
+import threading
+import time
+
+import pytest
+
+import cyclecoord as cc
+from cyclecoord._signals import deferred_interrupt
+from cyclecoord.cli import main
+
+
+@pytest.fixture
+def sigint_raises():
+    """Python's own SIGINT handler (a shell's background job starts with SIGINT ignored)."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+@pytest.fixture(scope="module")
+def walk_bvh(tmp_path_factory):
+    p = tmp_path_factory.mktemp("walk") / "walk.bvh"
+    cc.save(cc.datasets.example_capture().motion[:150], p)
+    return p
+
+
+def test_deferred_interrupt_raises_at_the_end_of_the_block(sigint_raises):
+    done = []
+    with pytest.raises(KeyboardInterrupt):
+        with deferred_interrupt():
+            signal.raise_signal(signal.SIGINT)
+            done.append("the block went on")
+    assert done == ["the block went on"]
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    with deferred_interrupt():  # no Ctrl-C: nothing raised
+        pass
+
+
+def test_deferred_interrupt_wins_over_the_blocks_own_error(sigint_raises):
+    with pytest.raises(KeyboardInterrupt) as info:
+        with deferred_interrupt():
+            signal.raise_signal(signal.SIGINT)
+            raise ImportError("the library failed to load")
+    assert isinstance(info.value.__context__, ImportError)
+
+
+def test_deferred_interrupt_outside_the_main_thread_does_nothing(sigint_raises):
+    seen = []
+
+    def body():
+        with deferred_interrupt():
+            seen.append(signal.getsignal(signal.SIGINT))
+
+    t = threading.Thread(target=body)
+    t.start()
+    t.join()
+    assert seen == [signal.default_int_handler]
+
+
+def _fake_usd_core(folder, swallow: bool):
+    """A ``pxr`` package whose import is hit by Ctrl-C and, like usd-core's C++
+    ``Tf_PyPostProcessModule``, catches the KeyboardInterrupt, prints a warning and goes on
+    (here: on to a failure to load, so a swallowed Ctrl-C shows as exit 1)."""
+    pkg = folder / "pxr"
+    pkg.mkdir()
+    body = (
+        "import signal, sys\n"
+        "try:\n"
+        "    signal.raise_signal(signal.SIGINT)\n"
+        "    sum(range(1000))\n"
+        "except KeyboardInterrupt:\n"
+        "    sys.stderr.write('Warning: Error occurred postprocessing module pxr.Vt._vt!\\n')\n"
+        "raise ImportError('fake usd-core: failed to load')\n"
+    ) if swallow else "raise KeyboardInterrupt\n"
+    (pkg / "__init__.py").write_text(body)
+
+
+@pytest.mark.parametrize("swallow", [True, False], ids=["usd-core-swallows", "import-raises"])
+def test_ctrl_c_while_usd_core_loads_exits_130(walk_bvh, tmp_path, monkeypatch, capsys,
+                                               sigint_raises, swallow):
+    _fake_usd_core(tmp_path, swallow)
+    for name in [m for m in sys.modules if m == "pxr" or m.startswith("pxr.")]:
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    out = tmp_path / "walk.usda"
+    code = main(["convert", str(walk_bvh), "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code == 130, err
+    assert "interrupted" in err and "usd-core package" not in err
+    assert not out.exists()
+
+
+def test_ctrl_c_while_usd_core_loads_in_a_real_process(walk_bvh, tmp_path):
+    """The issue's run: Ctrl-C at random times in the first half second of a .usda convert
+    (usd-core loading): every run that was still going exits 130, none with usd-core's
+    warning that it caught the interrupt."""
+    pytest.importorskip("pxr")
+    import os
+    import random
+    import subprocess
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    code = ("import sys, time\nfrom cyclecoord.cli import main\nprint('ready', flush=True)\n"
+            "rc = main(sys.argv[1:])\nprint('returned', time.time(), flush=True)\nsys.exit(rc)")
+    rng = random.Random(26)
+    for i in range(6):
+        out = tmp_path / f"o{i}.usda"
+        p = subprocess.Popen([sys.executable, "-c", code, "convert", str(walk_bvh), "-o", str(out)],
+                             env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        assert p.stdout.readline().strip() == "ready"
+        time.sleep(rng.uniform(0.0, 0.4))
+        sent = time.time()
+        p.send_signal(signal.SIGINT)
+        stdout, stderr = p.communicate(timeout=120)
+        returned = [float(ln.split()[1]) for ln in stdout.splitlines() if ln.startswith("returned")]
+        if returned and returned[0] < sent:
+            continue  # the run had finished before the signal
+        assert p.returncode in (130, -signal.SIGINT), stderr
+        assert "postprocessing module" not in stderr
+
+
+@pytest.fixture(scope="module")
+def walk300(tmp_path_factory):
+    p = tmp_path_factory.mktemp("walk300") / "walk.bvh"
+    cc.save(cc.datasets.example_capture().motion[:300], p)
+    return p
+
+
+def _listing(folder):
+    return {p.relative_to(folder).as_posix(): p.read_bytes() if p.is_file() else None
+            for p in folder.rglob("*")}
+
+
+def test_extract_interrupted_after_the_cycle_changes_no_output(walk300, tmp_path, monkeypatch,
+                                                                capsys):
+    """The issue's run: `extract --plot DIR -o OUT.bvh` stopped by Ctrl-C after the cycle was
+    written, while drawing the figures: OUT.bvh, the report and the model stay as they
+    were, and neither the figure folder (barcode.png was drawn) nor a staging folder is
+    left."""
+    out, report, model = tmp_path / "OUT.bvh", tmp_path / "r.json", tmp_path / "m.npz"
+    for p in (out, report, model):
+        p.write_text(f"the existing {p.name}\n")
+    before = _listing(tmp_path)
+
+    def ctrl_c(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("cyclecoord.plot.figures.plot_pca", ctrl_c)  # after barcode.png
+    code = main(["extract", str(walk300), "-o", str(out), "--plot", str(tmp_path / "figs"),
+                 "--report", str(report), "--save-model", str(model)])
+    captured = capsys.readouterr()
+    assert code == 130 and "interrupted" in captured.err
+    assert "wrote" not in captured.out  # nothing was moved into place, nothing is claimed
+    assert _listing(tmp_path) == before
+
+
+def test_extract_writes_every_output_at_the_end(walk300, tmp_path, capsys):
+    out, figs = tmp_path / "OUT.bvh", tmp_path / "new" / "figs"
+    out.write_text("the existing OUT.bvh\n")
+    code = main(["extract", str(walk300), "-o", str(out), "--plot", str(figs)])
+    printed = capsys.readouterr().out
+    assert code == 0 and cc.load(out).n_frames > 10
+    assert sorted(p.name for p in figs.iterdir()) == sorted(
+        ["barcode.png", "pca.png", "density.png", "coordinate.png", "channels.png"])
+    assert f"wrote {out}" in printed and f"wrote {figs / 'pca.png'}" in printed
+    assert sorted(p.name for p in tmp_path.rglob("*")) == sorted(
+        ["OUT.bvh", "new", "figs", "barcode.png", "pca.png", "density.png", "coordinate.png",
+         "channels.png"])  # no staging folder left
+
+
+def test_feet_interrupted_before_the_report_keeps_the_motion(walk300, tmp_path, monkeypatch,
+                                                              capsys):
+    out, report = tmp_path / "locked.bvh", tmp_path / "feet.json"
+    out.write_text("the existing locked.bvh\n")
+    before = _listing(tmp_path)
+
+    def ctrl_c(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("cyclecoord.cli.report.write_json", ctrl_c)
+    code = main(["feet", str(walk300), "-o", str(out), "--report", str(report)])
+    assert code == 130, capsys.readouterr().err
+    assert _listing(tmp_path) == before
