@@ -294,17 +294,26 @@ def _joint_channels(motion: Motion, joint: Joint, kind: str = "") -> list[tuple[
 
 
 def _static_root(motion: Motion) -> bool:
-    """Root with constant channels, no end site and exactly one child joint."""
+    """Root with constant channels over two frames or more, no end site and exactly one
+    child joint."""
     skel = motion.skeleton
     root = skel.joints[0]
-    if len(skel.joints) < 2 or root.end_site is not None or len(skel.children(0)) != 1:
+    if (
+        motion.n_frames < 2
+        or len(skel.joints) < 2
+        or root.end_site is not None
+        or len(skel.children(0)) != 1
+    ):
         return False
     return _constant(motion, _joint_channels(motion, root))
 
 
 def _constant_position_joints(motion: Motion, first: int) -> tuple[str, ...]:
-    """Joints after index ``first`` with position channels that are all constant."""
-    out = []
+    """Joints after index ``first`` with position channels that are all constant (none
+    for a single frame, where nothing can be seen to move)."""
+    out: list[str] = []
+    if motion.n_frames < 2:
+        return ()
     for j in motion.skeleton.joints[first + 1 :]:
         chans = _joint_channels(motion, j, "t")
         if chans and _constant(motion, chans):
@@ -659,7 +668,9 @@ class RigAdapter:
         )
 
 
-def normalize_rig(motion: Motion, info: RigInfo | None = None) -> tuple[Motion, RigAdapter]:
+def normalize_rig(
+    motion: Motion, info: RigInfo | None = None, *, drop_reference: bool = True
+) -> tuple[Motion, RigAdapter]:
     """The motion the analysis should see, and the adapter that writes results back.
 
     Steps, each only where :func:`describe_rig` found it:
@@ -686,6 +697,8 @@ def normalize_rig(motion: Motion, info: RigInfo | None = None) -> tuple[Motion, 
         A capture with a skeleton, frames ``(T, D)``.
     info : RigInfo, optional
         :func:`describe_rig` of ``motion`` when already computed.
+    drop_reference : bool, default True
+        Drop a reference first frame (False keeps every frame, e.g. for drawing).
 
     Returns
     -------
@@ -700,7 +713,8 @@ def normalize_rig(motion: Motion, info: RigInfo | None = None) -> tuple[Motion, 
     if info is None:
         info = describe_rig(motion)
     channels = tuple(motion.channels)
-    m = motion[1:] if info.reference_frame and motion.n_frames > 1 else motion
+    drop = drop_reference and info.reference_frame and motion.n_frames > 1
+    m = motion[1:] if drop else motion
     dropped = motion.n_frames - m.n_frames
     fold = info.static_root
     up = Z_TO_Y if info.up_axis == "Z" else np.eye(3)
