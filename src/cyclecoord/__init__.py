@@ -1,8 +1,9 @@
 """cyclecoord: find, parameterise and reuse periodic motion in motion capture.
 
 The package follows the data: :mod:`~cyclecoord.motion` and :mod:`~cyclecoord.io` get a
-capture in and out, :mod:`~cyclecoord.skeleton` poses it, :mod:`~cyclecoord.preprocess`
-prepares it, :mod:`~cyclecoord.barcode` computes the persistent cohomology barcode,
+capture in and out, :mod:`~cyclecoord.skeleton` poses it, :mod:`~cyclecoord.rig` finds and
+undoes its rig conventions, :mod:`~cyclecoord.preprocess` prepares it,
+:mod:`~cyclecoord.barcode` computes the persistent cohomology barcode,
 :mod:`~cyclecoord.coordinates` turns a cocycle into a circular coordinate,
 :mod:`~cyclecoord.density` and :mod:`~cyclecoord.cycle` build the typical cycle,
 :mod:`~cyclecoord.metrics` measures it and :mod:`~cyclecoord.pipeline` runs it all.
@@ -55,6 +56,10 @@ _LAZY = {
     "TransitionResult": "synthesis.blend",
     "align": "synthesis.align",
     "run_batch": "batch",
+    "RigAdapter": "rig",
+    "RigInfo": "rig",
+    "describe_rig": "rig",
+    "normalize_rig": "rig",
 }
 _SUBMODULES = {
     "batch",
@@ -65,6 +70,7 @@ _SUBMODULES = {
     "periodic",
     "plot",
     "quality",
+    "rig",
     "skeleton",
     "synthesis",
 }
@@ -103,6 +109,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs
     from .synthesis.align import align
     from .synthesis.blend import BlendResult, TransitionResult, blend, transition
     from .batch import run_batch
+    from .rig import RigAdapter, RigInfo, describe_rig, normalize_rig
 
 __version__ = "0.1.0"
 
@@ -127,6 +134,8 @@ __all__ = [
     "PhaseModel",
     "PreparedData",
     "Preprocessor",
+    "RigAdapter",
+    "RigInfo",
     "Skeleton",
     "TransitionResult",
     "TypicalCycle",
@@ -135,10 +144,12 @@ __all__ = [
     "compute_barcode",
     "convert",
     "datasets",
+    "describe_rig",
     "detect",
     "extract",
     "forward_kinematics",
     "load",
+    "normalize_rig",
     "run_batch",
     "save",
     "transition",

@@ -122,8 +122,8 @@ class RigInfo:
         ``"m"``, ``"cm"``, ``"mm"``, ``"in"``, ``"cmu"`` (1/0.45 inch), ``"asf"`` (the
         ASF ``:units length``) or ``"custom"`` (a number given).
     units_source : str
-        ``"measured"`` (guessed from the height), ``"skeleton"`` (the ASF length unit) or
-        ``"given"``.
+        ``"measured"`` (guessed from the height), ``"skeleton"`` (the ASF length unit, or
+        a glTF's metres) or ``"given"``.
     metres_per_unit : float
         Metres per skeleton length unit.
     height : float
@@ -294,17 +294,26 @@ def _joint_channels(motion: Motion, joint: Joint, kind: str = "") -> list[tuple[
 
 
 def _static_root(motion: Motion) -> bool:
-    """Root with constant channels, no end site and exactly one child joint."""
+    """Root with constant channels over two frames or more, no end site and exactly one
+    child joint."""
     skel = motion.skeleton
     root = skel.joints[0]
-    if len(skel.joints) < 2 or root.end_site is not None or len(skel.children(0)) != 1:
+    if (
+        motion.n_frames < 2
+        or len(skel.joints) < 2
+        or root.end_site is not None
+        or len(skel.children(0)) != 1
+    ):
         return False
     return _constant(motion, _joint_channels(motion, root))
 
 
 def _constant_position_joints(motion: Motion, first: int) -> tuple[str, ...]:
-    """Joints after index ``first`` with position channels that are all constant."""
-    out = []
+    """Joints after index ``first`` with position channels that are all constant (none
+    for a single frame, where nothing can be seen to move)."""
+    out: list[str] = []
+    if motion.n_frames < 2:
+        return ()
     for j in motion.skeleton.joints[first + 1 :]:
         chans = _joint_channels(motion, j, "t")
         if chans and _constant(motion, chans):
@@ -352,8 +361,9 @@ def describe_rig(motion: Motion, units: Units = "auto") -> RigInfo:
     units : {"auto", "m", "cm", "mm", "in"} or float, default "auto"
         Length unit of the skeleton, or a number of metres per unit.  ``"auto"`` uses the
         ASF ``:units length`` when the skeleton has one (ASF: ``0.0254 / length_unit``
-        metres per unit, CMU 0.0564), otherwise guesses from the body's height: the unit
-        among m, cm, mm, in and CMU's 1/0.45 in that makes it closest to 1.7 m.
+        metres per unit, CMU 0.0564) and metres for a glTF from elsewhere, otherwise
+        guesses from the body's height: the unit among m, cm, mm, in and CMU's 1/0.45 in
+        that makes it closest to 1.7 m (right for bodies of about 1.1 to 2.5 m).
 
     Returns
     -------
@@ -391,8 +401,8 @@ def describe_rig(motion: Motion, units: Units = "auto") -> RigInfo:
     if given is not None:
         named = [u for u, v in UNITS.items() if v == given]
         unit, source, mpu = (named[0] if named else "custom"), "given", given
-    elif skel.source_format == "asf" or (skel.length_unit != 1.0 and skel.length_unit > 0):
-        unit, source, mpu = "asf", "skeleton", 0.0254 / skel.length_unit
+    elif _unit_from_skeleton(skel) is not None:
+        unit, source, mpu = _unit_from_skeleton(skel)
     else:
         unit, mpu = _guess_units(height)
         source = "measured"
@@ -428,26 +438,59 @@ def describe_rig(motion: Motion, units: Units = "auto") -> RigInfo:
     )
 
 
-def metres_per_unit(motion: Motion, units: Units = "auto") -> float:
-    """Metres per skeleton length unit (see :func:`describe_rig`), what glTF and USD
-    exports scale by.
+def _unit_from_skeleton(skel: Skeleton) -> tuple[str, str, float] | None:
+    """``(units, units_source, metres per unit)`` when the skeleton or its format says it:
+    an ASF ``:units length`` (``0.0254 / length_unit``; also kept by skeletons converted
+    from ASF), or glTF's metres."""
+    if skel.source_format == "asf" or (skel.length_unit != 1.0 and skel.length_unit > 0):
+        return "asf", "skeleton", 0.0254 / skel.length_unit
+    if skel.source_format == "gltf":
+        return "m", "skeleton", 1.0
+    return None
 
-    ``units`` given (a name or a number) is returned without looking at the motion; an ASF
-    skeleton gives ``0.0254 / length_unit`` as before; otherwise the unit is measured.
+
+def metres_per_unit(motion: Motion, units: Units = "auto") -> float:
+    """Metres per skeleton length unit, what glTF and USD exports scale by.
+
+    Parameters
+    ----------
+    motion : Motion
+        A capture with a skeleton.
+    units : {"auto", "m", "cm", "mm", "in"} or float, default "auto"
+        A given unit is returned without looking at the motion; ``"auto"`` takes an ASF
+        skeleton's ``0.0254 / length_unit`` (as exports always did) and measures the others
+        (:func:`describe_rig`).
+
+    Returns
+    -------
+    float
+        Metres per unit.
     """
     given = parse_units(units)
     if given is not None:
         return given
-    skel = _skeleton_of(motion)
-    if skel.source_format == "asf" or (skel.length_unit != 1.0 and skel.length_unit > 0):
-        return 0.0254 / skel.length_unit
+    known = _unit_from_skeleton(_skeleton_of(motion))
+    if known is not None:
+        return known[2]
     return describe_rig(motion).metres_per_unit
 
 
 def rig_summary(motion: Motion, units: Units = "auto") -> str:
     """The console's first line: what :func:`describe_rig` found, in one sentence.
 
-    A motion without a skeleton gets a line saying so (channels and rate only).
+    Parameters
+    ----------
+    motion : Motion
+        A capture, frames ``(T, D)``.
+    units : {"auto", "m", "cm", "mm", "in"} or float, default "auto"
+        As for :func:`describe_rig`.
+
+    Returns
+    -------
+    str
+        :meth:`RigInfo.summary`, e.g. ``"BVH rig: Hips travels, 25 joints (6 channels on
+        the root, 3 on the others), mm (1.74 m tall), Y-up, 100 fps"``; for a motion
+        without a skeleton (or frames) a line saying so, with its channels and rate.
     """
     if not isinstance(motion, Motion):
         raise ParameterError(f"expected a Motion, got {type(motion).__name__}")
@@ -659,7 +702,9 @@ class RigAdapter:
         )
 
 
-def normalize_rig(motion: Motion, info: RigInfo | None = None) -> tuple[Motion, RigAdapter]:
+def normalize_rig(
+    motion: Motion, info: RigInfo | None = None, *, drop_reference: bool = True
+) -> tuple[Motion, RigAdapter]:
     """The motion the analysis should see, and the adapter that writes results back.
 
     Steps, each only where :func:`describe_rig` found it:
@@ -686,6 +731,8 @@ def normalize_rig(motion: Motion, info: RigInfo | None = None) -> tuple[Motion, 
         A capture with a skeleton, frames ``(T, D)``.
     info : RigInfo, optional
         :func:`describe_rig` of ``motion`` when already computed.
+    drop_reference : bool, default True
+        Drop a reference first frame (False keeps every frame, e.g. for drawing).
 
     Returns
     -------
@@ -700,7 +747,8 @@ def normalize_rig(motion: Motion, info: RigInfo | None = None) -> tuple[Motion, 
     if info is None:
         info = describe_rig(motion)
     channels = tuple(motion.channels)
-    m = motion[1:] if info.reference_frame and motion.n_frames > 1 else motion
+    drop = drop_reference and info.reference_frame and motion.n_frames > 1
+    m = motion[1:] if drop else motion
     dropped = motion.n_frames - m.n_frames
     fold = info.static_root
     up = Z_TO_Y if info.up_axis == "Z" else np.eye(3)

@@ -3,7 +3,8 @@
 :func:`new_figure` is for the ``plot_*`` functions (a pyplot figure a notebook shows, or
 the caller's own); :func:`detached_figure` for the functions that write files (an Agg
 canvas pyplot never sees: headless, nothing left open); :func:`check_result` is the
-argument check of the figures that need a complete extraction.
+argument check of the figures that need a complete extraction; :func:`drawn` is the motion
+the stick figures draw (the capture in the analysis rig, every frame kept).
 """
 
 from __future__ import annotations
@@ -15,9 +16,19 @@ from ..errors import ParameterError
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
+    from ..motion import Motion
     from ..periodic.pipeline import ExtractionResult
 
-__all__ = ["new_figure", "detached_figure", "check_result"]
+__all__ = ["new_figure", "detached_figure", "check_result", "drawn"]
+
+
+def drawn(motion: "Motion") -> "Motion":
+    """The motion a stick figure draws: :func:`cyclecoord.rig.normalize_rig` with every
+    frame kept, so a static root draws no bone from the origin to the hips and a Z-up rig
+    stands y up.  ``motion`` needs a skeleton and at least one frame."""
+    from ..rig import normalize_rig
+
+    return normalize_rig(motion, drop_reference=False)[0]
 
 
 def new_figure(figsize: tuple[float, float], fig: "Figure | None" = None) -> "Figure":

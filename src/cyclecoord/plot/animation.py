@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Sequence
 import numpy as np
 
 from ..errors import ParameterError
-from ._canvas import detached_figure
+from ._canvas import detached_figure, drawn
 
 if TYPE_CHECKING:  # pragma: no cover
 
@@ -87,7 +87,7 @@ def _make_track(motion: "Motion", title: str | None) -> _Track:
         )
     if motion.n_frames < 1:
         raise ParameterError("nothing to render: the motion has no frames")
-    jp = motion.positions()
+    jp = drawn(motion).positions()
     pos = np.asarray(jp.positions, dtype=float)
     if not np.all(np.isfinite(pos)):
         raise ParameterError(
@@ -154,7 +154,9 @@ def render(
     Parameters
     ----------
     motion : Motion
-        A capture with a skeleton (y up, as ASF and BVH are).
+        A capture with a skeleton, drawn as :func:`cyclecoord.rig.normalize_rig` gives it
+        (every frame kept): a static root is left out (no bone from the origin to the
+        hips) and a Z-up rig is turned y up.
     path : path-like
         ``.gif`` (Pillow, always available) or ``.mp4`` (needs ffmpeg on the PATH).  The
         file is rendered beside the target under a temporary name and renamed, so a

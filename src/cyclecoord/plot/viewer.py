@@ -9,8 +9,10 @@ slider labels say which frame is the seam.  Planted foot points
 is drawn.  :func:`write_viewer` writes the page with plotly.js inlined, so it opens with
 no network; in Jupyter the figure itself displays inline.
 
-Coordinates: the skeleton's y axis is up; plotly's scene has z up, so the page shows
-``(x, -z, y)`` (a rotation, not a mirror).
+Coordinates: motions are drawn as :func:`cyclecoord.rig.normalize_rig` gives them (every
+frame kept): a static root is left out and a Z-up rig is turned y up.  Their y axis is
+then up; plotly's scene has z up, so the page shows ``(x, -z, y)`` (a rotation, not a
+mirror).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Motion
+from ._canvas import drawn
 
 __all__ = ["ViewerInput", "skeleton_figure", "write_viewer"]
 
@@ -78,6 +81,7 @@ def _prepare(item: ViewerInput, offset: float, contacts: bool, center: bool):
         raise ParameterError(
             f"{item.label}: frame {m.start_frame + int(bad[0])} holds NaN or infinite values"
         )
+    m = drawn(m)
     fk = m.positions()
     pos = fk.positions.copy()
     if center:  # start above the origin, so motions stand side by side whatever their capture
