@@ -186,7 +186,8 @@ def _commands():
 
 
 #: Options that take a value and say they write, but name no file.
-NOT_OUTPUTS = {("batch", "--cycles"): "the cycles' format"}
+NOT_OUTPUTS = {("batch", "--cycles"): "the cycles' format",
+               **{(c, "--units"): "the length unit written" for c in ("convert", "feet")}}
 
 
 def test_every_command_declares_what_it_reads_and_writes():
