@@ -825,7 +825,7 @@ def normalize_rig(
             p = t0 + np.einsum("ab,tb->ta", R0, trans[:, 1])
         else:
             R, p = rots[:, 0], trans[:, 0]
-        for d in [d for d in new_root.dofs]:
+        for d in new_root.dofs:
             columns.pop((new_root.name, d), None)
         if rotates:
             R = np.einsum("ab,tbc->tac", up, R)
@@ -842,7 +842,7 @@ def normalize_rig(
             columns[(new_root.name, d)] = (
                 p[:, AXIS_INDEX[d[1]]] if d.startswith("t") else angles.get(d, np.zeros(T))
             )
-        joints[0] = replace_joint(joints[0], dofs=dofs, rotation_order=order)
+        joints[0] = _replace_joint(joints[0], dofs=dofs, rotation_order=order)
 
     analysis_skel = Skeleton(
         joints=tuple(joints),
@@ -877,7 +877,7 @@ def normalize_rig(
     return out, adapter
 
 
-def replace_joint(joint: Joint, **changes) -> Joint:
+def _replace_joint(joint: Joint, **changes) -> Joint:
     """A copy of ``joint`` with some fields changed (re-validated)."""
     fields = {
         "name": joint.name,

@@ -81,7 +81,10 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.report, "report")
     motion = load_input(args.input, args.skeleton, args.fps).window(frame_window(args.frames))
     print(rig_line(motion, args))
-    options = {"height": args.height, "speed": args.speed}
+    from ..rig import describe_rig
+
+    up = describe_rig(motion).up_axis.lower() if motion.skeleton is not None else "y"
+    options = {"height": args.height, "speed": args.speed, "up": up}
     contacts = foot_contacts(motion, **options)
     skating = foot_skating(motion, contacts, skate_speed=args.skate_speed)
     print(
