@@ -16,6 +16,7 @@ from ._options import (
     check_output,
     named,
     positive_int,
+    rig_line,
 )
 from ._outputs import Outputs, declare
 from .report import clean, load_input, summary_barcode, write_json
@@ -130,6 +131,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
     motion = load_input(args.input, args.skeleton, args.fps)
+    if motion.skeleton is not None:
+        print(f"rig: {rig_line(motion, args)}")
     with Outputs() as out:  # every output moves into place at the end, or none does
         return _detect(args, motion, out)
 

@@ -201,6 +201,8 @@ def motion_cycles(
             typ, clip = loop_cycle(
                 typ, motion, prepared, prep, cycle_start=cycle_start, rows=rows, metadata=meta
             )
+        if result.rig_adapter is not None:
+            clip = result.rig_adapter.restore(clip)  # in the capture's own rig
         out.append(MotionCycle(
             motion=mid, start=a, stop=b, phase_from=source, n_frames_used=int(rows.size),
             period_frames=period, cycle=clip, loop_closure=float(loop_closure(typ.frames)),

@@ -42,6 +42,7 @@ def detect(
     temporal: bool = False,
     difference_root: bool = True,
     rotations: str = "auto",
+    rig: bool = True,
     prime: int = DEFAULT_PRIME,
     max_scale: float | None = None,
     delay: float | tuple | None = 0.25,
@@ -75,7 +76,9 @@ def detect(
     frames : (start, stop), optional
         0-based half-open frame range to analyse.
     pca, normalize, temporal, difference_root, rotations, prime, max_scale, landmarks
-        As for :func:`cyclecoord.extract`; so is ``memory_limit``.
+        As for :func:`cyclecoord.extract`; so are ``memory_limit`` and ``rig`` (the
+        capture's rig read first: ``result.motion`` is the analysed motion, and the cycles
+        of :func:`motion_cycles` are written back in the capture's own rig).
     delay : float, sequence of float, or None, default 0.25
         Delay embedding in seconds (each pose joined by the poses this long before), so
         that out-and-back movements (squats, jumping jacks, knee raises) form loops.
@@ -165,7 +168,7 @@ def detect(
     params = dict(
         frames=None if frames is None else list(frames), pca=pca, normalize=normalize,
         temporal=temporal, difference_root=difference_root, prime=prime, max_scale=max_scale,
-        rotations=rotations, landmarks=landmarks, delay=delay, n_classes=n_classes,
+        rotations=rotations, rig=rig, landmarks=landmarks, delay=delay, n_classes=n_classes,
         max_classes=max_classes,
         min_persistence=min_persistence, scale_fraction=scale_fraction, window=window,
         max_period=max_period, min_consistency=min_consistency, min_cycles=min_cycles,
@@ -174,6 +177,13 @@ def detect(
         window_cycles=window_cycles, window_steadiness=window_steadiness, similarity=similarity,
     )
     motion = motion.window(frames)
+    adapter = None
+    if rig and motion.skeleton is not None:
+        from ...rig import normalize_rig
+
+        motion, adapter = normalize_rig(motion)
+        if adapter.identity:
+            adapter = None
     T = motion.n_frames
     if T < 20:
         raise ParameterError(f"{T} frames are too few to look for periodic motion")
@@ -252,7 +262,7 @@ def detect(
     result = DetectionResult(
         motion=motion, barcode=barcode, classes=classes, segments=segments, labels=labels,
         n_motions=n_motions, timings=timings, parameters=params, warnings=notes, estimator=est,
-        windows=windows, method=method,
+        windows=windows, method=method, rig_adapter=adapter,
     )
     if not segments:
         looping = sum(wi.looping for wi in windows)
