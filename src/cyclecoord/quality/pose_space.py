@@ -43,13 +43,16 @@ MAX_SEAM = 1.5
 MAX_REFERENCE_FRAMES = 20_000
 
 
-def root_frame_points(motion: Motion) -> np.ndarray:
+def root_frame_points(motion: Motion, rig=None) -> np.ndarray:
     """Joint and end-site positions in the root's frame, plus the root's height.
 
     Parameters
     ----------
     motion : Motion
         With a skeleton.
+    rig : RigInfo, optional
+        How to read the rig (:func:`cyclecoord.rig.describe_rig`), so that a cycle is read
+        as the capture it came from; default: described afresh.
 
     Returns
     -------
@@ -62,7 +65,7 @@ def root_frame_points(motion: Motion) -> np.ndarray:
     from ..rig import normalize_rig
 
     if motion.skeleton is not None:
-        motion, _ = normalize_rig(motion)  # the travelling joint is the root
+        motion, _ = normalize_rig(motion, rig, drop_reference=False)  # travelling joint first
     pos = np.asarray(motion.positions().positions, dtype=float)  # (T, N, 3)
     layout = root_layout(motion)
     root = pos[:, :1, :]
@@ -142,14 +145,14 @@ class PoseQuality:
         return {k: (None if not np.isfinite(v) else float(v)) for k, v in asdict(self).items()}
 
 
-def _runs_points(capture: Motion, runs: list[tuple[int, int]]) -> list[np.ndarray]:
+def _runs_points(capture: Motion, runs: list[tuple[int, int]], rig) -> list[np.ndarray]:
     total = sum(b - a for a, b in runs)
     every = max(1, int(np.ceil(total / MAX_REFERENCE_FRAMES)))
     out = []
     for a, b in runs:
         if b - a >= 2:
             # whole runs, sampled evenly on long takes (steps then span ``every`` frames)
-            out.append(root_frame_points(capture.window((a, b)))[::every])
+            out.append(root_frame_points(capture.window((a, b)), rig)[::every])
     return out
 
 
@@ -177,15 +180,18 @@ def pose_quality(
     """
     if cycle.skeleton is None or capture.skeleton is None or cycle.n_frames < 3:
         return None
-    parts = _runs_points(capture, runs)
+    from ..rig import describe_rig
+
+    rig = describe_rig(capture)
+    parts = _runs_points(capture, runs, rig)
     if not parts:
         return None
     every = max(1, int(np.ceil(sum(b - a for a, b in runs) / MAX_REFERENCE_FRAMES)))
-    cyc = root_frame_points(cycle)
+    cyc = root_frame_points(cycle, rig)
     csteps = _steps(cyc, cyclic=True)
     seam = float(csteps[-1] / np.median(csteps)) if np.median(csteps) > 0 else float("nan")
     cap_steps = np.concatenate([_steps(p) for p in parts if len(p) > 1]) if every == 1 else \
-        _steps(root_frame_points(capture.window(max(runs, key=lambda r: r[1] - r[0]))))
+        _steps(root_frame_points(capture.window(max(runs, key=lambda r: r[1] - r[0])), rig))
     p99 = float(np.percentile(cap_steps, 99)) if cap_steps.size else float("nan")
     pop = float(csteps.max() / p99) if p99 > 0 else float("nan")
     pts = np.concatenate(parts)
