@@ -352,3 +352,26 @@ def test_cmu_walk_to_jog_transition(cmu_cycles, tmp_path):
     cc.save(clip, path)
     back = cc.load(path)
     assert np.abs(back.positions().positions - clip.positions().positions).max() < 1e-6
+
+
+def test_blend_is_on_rotations_not_euler_numbers():
+    """A cycle blended with itself written as flipped, wrapped Euler numbers is the cycle
+    (averaging the numbers would fold every joint on the flipped frames)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "periodic"))
+    from test_rotations import scrambled
+
+    import cyclecoord as cc
+    from cyclecoord.synthesis.blend import blend
+
+    cycle = cc.extract(cc.datasets.example_capture().motion).cycle
+    mixed = blend([cycle, scrambled(cycle, seed=3)], [0.5, 0.5], align_heading=False)
+    a = cycle.positions().positions
+    b = mixed.positions().positions
+    a = a - a[:, :1]
+    b = b - b[:, :1]
+    assert np.abs(a - b).max() < 1e-3 * np.ptp(a)
+    joints = np.setdiff1d(np.arange(cycle.n_channels), np.asarray(cycle.root_channels()))
+    assert np.abs(np.diff(mixed.frames[:, joints], axis=0)).max() < 20  # written continuous
