@@ -160,38 +160,48 @@ def cmd_extract(args: argparse.Namespace) -> int:
 
 def _extract(args: argparse.Namespace, motion, out: Outputs) -> int:
     from ..periodic.pipeline import extract
+    from ..periodic.suggest import MAX_FRAMES as SUGGEST_MAX_FRAMES, what_would_help
 
     report_payload = None
     code = EXIT_OK
+    options = dict(
+        frames=args.frames,
+        pca=args.pca,
+        normalize=args.normalize,
+        rotations=args.rotations,
+        temporal=args.temporal,
+        delay=args.delay,
+        difference_root=not args.no_root_diff,
+        prime=args.prime,
+        max_scale=args.max_scale,
+        scale=args.scale,
+        class_index=args.class_index,
+        n_samples=args.samples,
+        n_neighbors=args.neighbors,
+        weighting=args.weighting,
+        sampling=args.sampling,
+        landmarks=args.landmarks,
+        memory_limit=args.memory_limit,
+        random_state=args.seed,
+        **cycle_options(args),
+    )
     try:
-        res = extract(
-            motion,
-            frames=args.frames,
-            pca=args.pca,
-            normalize=args.normalize,
-            rotations=args.rotations,
-            temporal=args.temporal,
-            delay=args.delay,
-            difference_root=not args.no_root_diff,
-            prime=args.prime,
-            max_scale=args.max_scale,
-            scale=args.scale,
-            class_index=args.class_index,
-            n_samples=args.samples,
-            n_neighbors=args.neighbors,
-            weighting=args.weighting,
-            sampling=args.sampling,
-            landmarks=args.landmarks,
-            memory_limit=args.memory_limit,
-            random_state=args.seed,
-            **cycle_options(args),
-        )
+        res = extract(motion, **options)
     except NoPeriodicMotionError as exc:
         partial = exc.result
         print(f"cyclecoord: {named(args.input, exc)}", file=sys.stderr)
+        helps = what_would_help(motion, options)
+        if helps:
+            print("would help here (tried): " + "; ".join(h.text() for h in helps),
+                  file=sys.stderr)
+        elif motion.n_frames <= SUGGEST_MAX_FRAMES:
+            print("tried --rotations rotvec, --no-steady, --pca 3 and --normalize: none finds a "
+                  "clean cycle here; look at the barcode (--plot) or pick frames (--frames)",
+                  file=sys.stderr)
         if partial is not None:
             print(summary_barcode(partial.barcode))
             report_payload = partial_report(exc)
+            report_payload["suggestions"] = [h.to_dict() for h in helps]
             if args.plot:
                 _save_plots(partial, args.plot, out)
         code = EXIT_NO_PERIODIC
