@@ -41,6 +41,8 @@ MAX_POP = 2.0
 MAX_SEAM = 1.5
 #: Captured frames compared against (a long take is sampled evenly down to this).
 MAX_REFERENCE_FRAMES = 20_000
+#: Captured poses (evenly spaced) whose nearest other repetition gives the spread.
+MAX_SPREAD_PROBES = 2_000
 
 
 def root_frame_points(motion: Motion, rig=None) -> np.ndarray:
@@ -151,9 +153,22 @@ def _runs_points(capture: Motion, runs: list[tuple[int, int]], rig) -> list[np.n
     out = []
     for a, b in runs:
         if b - a >= 2:
-            # whole runs, sampled evenly on long takes (steps then span ``every`` frames)
-            out.append(root_frame_points(capture.window((a, b)), rig)[::every])
+            # whole runs, sampled evenly on long takes before forward kinematics
+            part = capture.with_frames(capture.frames[a:b:every])
+            out.append(root_frame_points(part, rig))
     return out
+
+
+def _capture_steps(capture: Motion, runs: list[tuple[int, int]], rig) -> np.ndarray:
+    """Frame steps of the capture: every run whole, or on a long take the middle
+    :data:`MAX_REFERENCE_FRAMES` frames of its longest run."""
+    if sum(b - a for a, b in runs) <= MAX_REFERENCE_FRAMES:
+        parts = [root_frame_points(capture.window((a, b)), rig) for a, b in runs if b - a >= 2]
+        return np.concatenate([_steps(p) for p in parts]) if parts else np.zeros(0)
+    a, b = max(runs, key=lambda r: r[1] - r[0])
+    mid = (a + b) // 2
+    lo, hi = max(a, mid - MAX_REFERENCE_FRAMES // 2), min(b, mid + MAX_REFERENCE_FRAMES // 2)
+    return _steps(root_frame_points(capture.window((lo, hi)), rig))
 
 
 def pose_quality(
@@ -190,8 +205,7 @@ def pose_quality(
     cyc = root_frame_points(cycle, rig)
     csteps = _steps(cyc, cyclic=True)
     seam = float(csteps[-1] / np.median(csteps)) if np.median(csteps) > 0 else float("nan")
-    cap_steps = np.concatenate([_steps(p) for p in parts if len(p) > 1]) if every == 1 else \
-        _steps(root_frame_points(capture.window(max(runs, key=lambda r: r[1] - r[0])), rig))
+    cap_steps = _capture_steps(capture, runs, rig)
     p99 = float(np.percentile(cap_steps, 99)) if cap_steps.size else float("nan")
     pop = float(csteps.max() / p99) if p99 > 0 else float("nan")
     pts = np.concatenate(parts)
@@ -199,13 +213,15 @@ def pose_quality(
         np.arange(a, b)[::every][: len(p)] for (a, b), p in zip(
             [r for r in runs if r[1] - r[0] >= 2], parts)
     ])
-    tree = cKDTree(pts)
-    near, _ = tree.query(cyc)
+    rms = 1.0 / np.sqrt(max(1, pts.shape[1] // 3))  # distances as RMS point distances
+    tree = cKDTree(pts * rms)
+    near, _ = tree.query(cyc * rms)
     # spread: each captured pose's nearest pose in another repetition
     half = max(1.0, 0.5 * float(period))
     k = int(min(len(pts), max(8, 4 * np.ceil(period / every))))
-    d, idx = tree.query(pts, k=k)
-    far = np.abs(frame_of[idx] - frame_of[:, None]) >= half
+    probe = np.unique(np.linspace(0, len(pts) - 1, min(len(pts), MAX_SPREAD_PROBES)).astype(int))
+    d, idx = tree.query(pts[probe] * rms, k=k)
+    far = np.abs(frame_of[idx] - frame_of[probe][:, None]) >= half
     d = np.where(far, d, np.inf)
     best = d.min(axis=1)
     best = best[np.isfinite(best)]
