@@ -15,6 +15,8 @@ from ._options import (
     EXIT_OK,
     add_cycle_options,
     add_selection_options,
+    add_units_option,
+    export_units,
     check_output,
     cycle_options,
     delay,
@@ -40,7 +42,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         ),
     )
     e.add_argument("input", metavar="INPUT")
-    add_selection_options(e)
+    add_units_option(add_selection_options(e))
     g = e.add_argument_group("class, scale and cycle")
     g.add_argument(
         "--scale",
@@ -214,7 +216,7 @@ def _extract(args: argparse.Namespace, motion, out: Outputs) -> int:
             print(locked.summary() if locked is not None else
                   "feet: not locked: the cycle has no skeleton with recognisable feet")
         if args.output:
-            out.save(cycle, args.output)
+            out.save(cycle, args.output, **export_units(args, args.output))
         if args.save_model:
             res.model.save(out.file(args.save_model))
             out.wrote(args.save_model)
