@@ -430,8 +430,9 @@ def _lock_once(
     frames = np.array(motion.frames, dtype=float)
     scale = contacts.leg_length
     worst = 0.0
-    for side in sorted(set(contacts.sides)):
-        cols = [i for i, s in enumerate(contacts.sides) if s == side]
+    labels = contacts.leg_labels
+    for leg in sorted(set(labels)):
+        cols = [i for i, g in enumerate(labels) if g == leg]
         pts = [skel.index(contacts.feet[i]) for i in cols]
         depth = {p: 0 for p in pts}
         for p in pts:
