@@ -349,3 +349,29 @@ def test_shared_cmu_feet_by_name_and_by_geometry(cmu_dir, subject, take):
     _, new, anon = anonymous(motion.skeleton, motion)
     assert find_feet(anon.skeleton, anon) == tuple(
         new[f] for f in ("lfoot", "ltoes", "rfoot", "rtoes"))
+
+
+def test_person_on_all_fours_keeps_two_legs():
+    """A rig named like a person whose hands reach the floor in the take (crawling) keeps
+    two legs when its rest pose holds the arms up: only a rig that stands on four in its
+    rest pose (a dog named like a person) gets front legs from the geometry."""
+    names = quadruped_names("human")
+    dog = quadruped_skeleton(names)
+    arms = {names[f"{leg}_{p}"] for leg in ("fl", "fr") for p in ("knee", "ankle", "toe")}
+    # the same body with the arms raised in the rest pose (bones pointing up and back) ...
+    raised = Skeleton(tuple(
+        replace(j, offset=j.offset * [1, -1, -1],
+                end_site=None if j.end_site is None else j.end_site * [1, -1, -1])
+        if j.name in arms else j
+        for j in dog.joints))
+    motion = trot(dog, names)
+    frames = motion.frames.copy()
+    for leg in ("fl", "fr"):  # ... turned down at the shoulder: the same crawl
+        frames[:, motion.channel_index(names[f"{leg}_hip"], "rx")] += 180.0
+    crawl = Motion(frames, motion.channels, fps=motion.fps, skeleton=raised)
+    np.testing.assert_allclose(crawl.positions().positions, motion.positions().positions,
+                               atol=1e-9)
+    assert find_legs(dog, motion).method == "names and geometry"
+    legs = find_legs(raised, crawl)
+    assert legs.method == "names" and legs.feet == ("LeftFoot", "LeftToeBase", "RightFoot",
+                                                    "RightToeBase")

@@ -51,6 +51,7 @@ __all__ = [
     "find_feet",
     "legs_of_feet",
     "resolve_feet",
+    "feet_names",
     "check_feet",
     "nearest_joints",
 ]
@@ -223,6 +224,16 @@ def resolve_feet(skeleton: Skeleton, spec: str | tuple[str, ...] | list[str]) ->
             "(a quadruped), each a joint or ANKLE:TOE"
         )
     return feet
+
+
+def feet_names(skeleton: Skeleton, feet) -> tuple[str, ...]:
+    """Foot point names from joint names or the command line's ``"LEFT,RIGHT"`` text.
+
+    A string goes through :func:`resolve_feet`, a sequence through :func:`check_feet`.
+    """
+    if isinstance(feet, str):
+        return resolve_feet(skeleton, feet)
+    return check_feet(skeleton, feet)
 
 
 def _ancestors(skeleton: Skeleton, index: int) -> list[str]:
@@ -507,14 +518,23 @@ def _pairings(four):
 
 def _extra_legs(geo: _Geometry, named: list[Leg]) -> list[Leg] | None:
     """Two more legs reaching the ground beside a biped's named ones (a quadruped named
-    like a human: front legs called arms), or None."""
+    like a human: front legs called arms), or None.  They must reach it in the motion and
+    in the rest pose, so a person crawling or doing push-ups keeps two legs (a human rig's
+    rest pose holds the arms up, a dog rig's stands on four)."""
     if not (geo.usable and geo.in_motion):
         return None
     sk = geo.skeleton
+    rest = _Geometry(sk, None, "xyz"[geo.up])
     taken = [sk.index(p) for leg in named for p in leg.points]
+    if not rest.usable or not rest.upright(
+        [(rest.part(taken[0], taken[-1]), t) for t in (taken[0], taken[-1])]
+    ):
+        return None
+    on_floor = set(rest.grounded(_EXTRA_MEDIAN))
     free = [
         e for e in geo.grounded(_EXTRA_MEDIAN)
-        if all(geo.median[geo.part(e, t)] > _PART_HEIGHT * geo.height for t in taken)
+        if e in on_floor
+        and all(geo.median[geo.part(e, t)] > _PART_HEIGHT * geo.height for t in taken)
     ]
     scored = [(geo.pair_score(a, b), (a, b)) for a, b in combinations(free[:4], 2)]
     scored = [s for s in scored if s[0] is not None]
@@ -619,9 +639,10 @@ def legs_of_feet(
     Parameters
     ----------
     skeleton : Skeleton
-    feet : sequence of str
-        Foot point joint names (e.g. ``("j4", "j5", "j9", "j10")``); points on one chain
-        make one leg.
+    feet : sequence of str, or str
+        Foot point joint names (e.g. ``("j4", "j5", "j9", "j10")``), or the command
+        line's text (``"j4:j5,j9:j10"``, :func:`resolve_feet`); points on one chain make
+        one leg.
     motion : Motion, optional
         Poses for the geometry (else the rest pose).
     up : {"x", "y", "z"}
@@ -631,7 +652,7 @@ def legs_of_feet(
     Legs
         Legs in the order given, with method ``"given"``.
     """
-    feet = check_feet(skeleton, feet)
+    feet = feet_names(skeleton, feet)
     groups = _group(skeleton, feet)
     roles = classify_skeleton(skeleton)
 
