@@ -699,18 +699,14 @@ def _given_geometry(
             return None
         sides = _label_pair(geo, [(top, ends[0]), (top, ends[1])], fwd)
         return sides, [None, None]
-    best = None
-    for p, q in _pairings(range(4)):
-        depth = len(geo.chain(geo.part(ends[p[0]], ends[p[1]]))) + len(
-            geo.chain(geo.part(ends[q[0]], ends[q[1]]))
-        )
-        if best is None or depth > best[0]:
-            best = (depth, p, q)
-    assert best is not None
+    def depth(pq) -> int:  # legs pair up where their chains part lowest in the tree
+        return sum(len(geo.chain(geo.part(ends[a], ends[b]))) for a, b in pq)
+
+    pairing = max(_pairings(range(4)), key=depth)
     sides: list[str] = ["?"] * 4
     limbs: list[str | None] = [None] * 4
     centre = []
-    for pair in (best[1], best[2]):
+    for pair in pairing:
         top = geo.part(ends[pair[0]], ends[pair[1]])
         if top in (ends[pair[0]], ends[pair[1]]):
             return None
@@ -719,7 +715,7 @@ def _given_geometry(
             sides[k] = s
         centre.append(geo.pos[:, [ends[k] for k in pair]].mean(axis=1))
     order = ("front", "hind") if geo.ahead_of(centre[0], centre[1], fwd) else ("hind", "front")
-    for pair, limb in zip((best[1], best[2]), order):
+    for pair, limb in zip(pairing, order):
         for k in pair:
             limbs[k] = limb
     return sides, limbs
