@@ -1,4 +1,4 @@
-"""Shared fixtures: where the real CMU captures live (beside the checkout)."""
+"""Shared fixtures: where the real CMU and other-rig BVH captures live (beside the checkout)."""
 
 from pathlib import Path
 
@@ -6,6 +6,7 @@ import pytest
 
 SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 CMU = SHARED_DATA / "cmu"
+BVH = SHARED_DATA / "bvh"
 
 
 @pytest.fixture(scope="session")
@@ -13,6 +14,14 @@ def cmu_dir() -> Path:
     if not CMU.is_dir():
         pytest.skip(f"real CMU captures not found at {CMU} (../shared/data beside the checkout)")
     return CMU
+
+
+@pytest.fixture(scope="session")
+def bvh_dir() -> Path:
+    """Real BVH captures of other rigs (Bandai Namco, Xsens MVN): internal testing only."""
+    if not BVH.is_dir():
+        pytest.skip(f"real BVH captures not found at {BVH} (../shared/data beside the checkout)")
+    return BVH
 
 
 @pytest.fixture(scope="session")
