@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from cyclecoord.errors import ParameterError
+from _skips import need_data
 
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_extract.py"
 
@@ -25,7 +26,8 @@ def _load_bench():
 
 
 bench = _load_bench()
-HAVE_DREIMAC = bench.dreimac_status()[0]
+# dreimac is in the 'test' extra: the DREiMac baseline runs wherever the suite does
+HAVE_DREIMAC, DREIMAC_STATUS = bench.dreimac_status()
 
 
 # ----------------------------------------------------------------- agreement measures
@@ -74,8 +76,7 @@ def test_quick_selection_without_data(tmp_path):
 
 
 def test_quick_selection_with_data():
-    if not (bench.DATA_DIR / "cmu" / "69" / "69_01.amc").is_file():
-        pytest.skip(f"real CMU captures not found under {bench.DATA_DIR}")
+    need_data(bench.DATA_DIR / "cmu" / "69" / "69_01.amc")
     cases, skipped = bench.select_cases(quick=True)
     assert len(cases) == 1 and skipped == []
     assert cases[0].frames == (200, 450) and cases[0].max_scale == 50.0
@@ -93,7 +94,7 @@ def test_missing_dreimac_is_reported_not_raised(monkeypatch):
 @pytest.fixture(scope="module")
 def tiny_report():
     case = bench.synthetic_case(200, seed=0)
-    return bench.run_benchmark([case], repeat=1, with_dreimac=HAVE_DREIMAC, progress=False)
+    return bench.run_benchmark([case], repeat=1, with_dreimac=True, progress=False)
 
 
 def test_report_structure_and_stage_timings(tiny_report):
@@ -122,10 +123,7 @@ def test_report_ratios(tiny_report):
     total = case["cyclecoord"]["stages"]["total"]
     assert r["cyclecoord_over_ripser"] == pytest.approx(total / case["ripser"]["seconds"])
     assert r["cyclecoord_over_paper"] is None  # the paper timed only the 69_01 window
-    if HAVE_DREIMAC:
-        assert r["cyclecoord_over_dreimac"] == pytest.approx(total / case["dreimac"]["total"])
-    else:
-        assert r["cyclecoord_over_dreimac"] is None
+    assert r["cyclecoord_over_dreimac"] == pytest.approx(total / case["dreimac"]["total"])
 
 
 def test_agreement_with_truth(tiny_report):
@@ -140,8 +138,7 @@ def test_agreement_with_truth(tiny_report):
 
 
 def test_dreimac_baseline(tiny_report):
-    if not HAVE_DREIMAC:
-        pytest.skip('dreimac not installed (pip install -e ".[bench]")')
+    assert HAVE_DREIMAC, f'dreimac is in the test extra (pip install -e ".[test]"): {DREIMAC_STATUS}'
     (case,) = tiny_report["cases"]
     d = case["dreimac"]
     assert d["n_landmarks"] == 200 and d["all_points"]
@@ -330,8 +327,7 @@ def test_scaling_child_process_and_timeout(tmp_path):
 
 def test_scaling_mixed_capture_is_timed_both_ways():
     path = bench.DATA_DIR / "cmu" / "01" / "01_09.amc"
-    if not path.is_file():
-        pytest.skip(f"real CMU capture not found at {path}")
+    need_data(path)
     case = scaling.Case("01_09", "cmu", 4242, str(path))
     c = scaling.run_case(case, with_dreimac=False, with_ripser=False, trace=False, isolate=False)
     modes = c["cyclecoord"]["modes"]
@@ -450,7 +446,6 @@ def test_detect_bench_scoring_helpers(tmp_path):
 
 def test_detect_bench_real_labels_match_capture():
     path = detect_bench.DATA_DIR / "labels" / "13_29.csv"
-    if not path.is_file():
-        pytest.skip(f"13_29 labels not found at {path}")
+    need_data(path)
     spans = detect_bench.load_activity_labels(path, 4592)
     assert len(spans) == 6 and spans[0] == (0, 456, "JumpJack") and spans[-1][1] == 4584

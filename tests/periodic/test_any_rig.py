@@ -9,6 +9,7 @@ from cyclecoord.conventions import to_bvh_convention
 from cyclecoord.rig import Z_TO_Y
 
 from _rigs import BANDAI, BVH, XSENS, static_root, turn_root  # tests/ is on the path
+from _skips import need_data
 
 
 def bvh_walk():
@@ -43,8 +44,7 @@ def test_z_up_rig_gives_the_same_cycle():
 def test_shared_bandai_walks_get_an_honest_cycle(k):
     """Measured at this commit: periods 23.0-43.0 frames, pop 0.96-1.06, seam 0.52-0.76
     (benchmarks/bench_rigs.py gives the same from its own forward kinematics)."""
-    if len(BANDAI) <= k:
-        pytest.skip(f"shared Bandai captures not found under {BVH / 'bandai'}")
+    need_data(BVH / "bandai")  # five walks: a folder with fewer fails here
     m = cc.load(BANDAI[k])
     res = cc.extract(m)
     q = res.pose_quality
@@ -54,8 +54,7 @@ def test_shared_bandai_walks_get_an_honest_cycle(k):
 
 
 def test_shared_xsens_walk_drops_its_reference_pose():
-    if not XSENS.is_file():
-        pytest.skip(f"shared Xsens capture not found at {XSENS}")
+    need_data(XSENS)
     res = cc.extract(cc.load(XSENS))
     assert res.rig.units == "mm" and res.rig.reference_frame
     assert "reference first frame dropped" in res.rig_changes

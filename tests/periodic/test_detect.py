@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import cyclecoord as cc
+from _skips import need_data
 from cyclecoord.cli import main
 from cyclecoord.quality.metrics import distance_to_cycle
 from cyclecoord.periodic.detection import (
@@ -245,8 +246,7 @@ def test_13_29_windows_find_the_slow_exercises(cmu_dir):
     import csv
 
     path = cmu_dir.parent / "labels" / "13_29.csv"
-    if not path.is_file():
-        pytest.skip(f"labels not found at {path}")
+    need_data(path)
     m = cc.load(cmu_dir / "13" / "13_29.amc")
     with open(path, newline="") as fh:
         spans = [(int(r["start_frame"]), int(r["stop_frame"]), r["activity"]) for r in csv.DictReader(fh)]

@@ -9,6 +9,7 @@ import pytest
 
 import cyclecoord as cc
 from cyclecoord.cli.main import main
+from _skips import need_data
 
 W1 = ("35_16", "35_07", "35_08", "35_13")
 
@@ -129,8 +130,7 @@ def test_bad_input_one_line_each(synthetic_takes, tmp_path, capsys):
 
 def test_different_skeletons_one_line(cmu_dir, capsys):
     a, b = cmu_dir / "35" / "35_16.amc", cmu_dir / "69" / "69_01.amc"
-    if not (a.is_file() and b.is_file()):
-        pytest.skip("35_16 / 69_01 not in the shared data")
+    need_data(a, b)
     assert main(["graph", str(a), str(b)]) == 1
     assert "skeleton differs" in one_error_line(capsys)
 
@@ -138,8 +138,7 @@ def test_different_skeletons_one_line(cmu_dir, capsys):
 @pytest.fixture(scope="module")
 def w1(cmu_dir):
     paths = [cmu_dir / "35" / f"{n}.amc" for n in W1]
-    if not all(p.is_file() for p in paths):
-        pytest.skip("set w1 (CMU 35_16, 35_07, 35_08, 35_13) not in the shared data")
+    need_data(*paths)  # set w1: CMU 35_16, 35_07, 35_08, 35_13
     return [cc.load(p) for p in paths]
 
 
