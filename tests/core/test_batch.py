@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 import cyclecoord as cc
+from _measured import at_most
 from cyclecoord import batch
 from cyclecoord.batch import SUMMARY_COLUMNS, find_captures, run_batch
 from cyclecoord.errors import ParameterError
@@ -114,12 +115,14 @@ def test_statuses_summary_and_reports(first, folder):
         assert row["cycles"] == report["cycles"]
         # the period is the median complete winding (the capture's speed wobbles by up to 30%)
         assert float(r["period_frames"]) == pytest.approx(report["period_frames"], rel=1e-4)
-        assert float(r["period_frames"]) == pytest.approx(PERIOD, rel=0.2)
+        # measured 10.1-13.6 % from 120 (the capture's cadence wobbles by up to 30 %)
+        assert abs(float(r["period_frames"]) / PERIOD - 1) <= at_most(0.136)
         assert float(r["period_seconds"]) == pytest.approx(float(r["period_frames"]) / 120.0, rel=1e-4)
         assert int(r["frames"]) == N_FRAMES and int(r["dims"]) == report["dims"] > 0
         assert 0 < float(r["birth"]) < float(r["scale"]) < float(r["death"])  # "inf" parses too
         assert float(r["birth"]) == pytest.approx(report["selected"]["birth"], rel=1e-5)
-        assert 0 < float(r["jerk_ratio"]) < 1  # the typical cycle is smoother than the noisy capture
+        # the typical cycle is smoother than the noisy capture: measured 0.050-0.055 of its jerk
+        assert 0 < float(r["jerk_ratio"]) <= at_most(0.055)
         assert float(r["jerk_ratio"]) == pytest.approx(report["jerk"]["cycle"] / report["jerk"]["original"], rel=1e-5)
         assert float(r["loop_closure"]) == pytest.approx(report["loop_closure"], rel=1e-5)
         assert float(r["seconds"]) >= 0

@@ -10,6 +10,7 @@ import pytest
 import cyclecoord as cc
 from cyclecoord.cli.main import main
 from _skips import need_data
+from _measured import at_most
 
 W1 = ("35_16", "35_07", "35_08", "35_13")
 
@@ -174,7 +175,8 @@ def test_w1_generated_walk_loops_and_is_plausible(w1):
     )
     res = cc.extract(gen.motion)
     assert res.cycles >= 1.5
-    assert 100 < res.period_frames < 180  # the takes' own: about 131-134 frames
+    # the takes' own: 130.8-134.3 frames; measured 134.7, 1.6 % over their mean 132.5
+    assert abs(res.period_frames / 132.5 - 1) <= at_most(0.016)
     assert check_plausibility(gen.motion, w1).clean
     travel = np.linalg.norm(gen.motion.frames[-1, [0, 2]] - gen.motion.frames[0, [0, 2]])
     assert travel > 50  # it walks: about 79 units (4.4 m) in 3.75 s
