@@ -61,6 +61,25 @@ def test_sliding_feet_skate_at_the_root_speed():
     assert np.allclose(s.foot_mean_speed, v)
 
 
+def test_vertical_speed_is_neither_contact_speed_nor_skating():
+    """Known answer: feet that bob up and down inside the contact height band (0.3 units of
+    its 0.4), at up to 5.7 units/s vertically (the contact speed limit is 4, the skating
+    one 0.8), never move horizontally: always planted, never skating."""
+    skel = legs_skeleton()
+    m = make_motion(skel, T=240, fps=120.0, bob=(0.15, 6.0))
+    pos = m.positions()
+    feet = [pos.names.index(f) for f in find_feet(skel)]
+    vertical = np.abs(np.gradient(pos.positions[:, feet, 1], axis=0)) * m.fps
+    assert vertical.max() > 1.3 * 0.5 * leg_length(skel)  # well over the contact speed limit
+    c = foot_contacts(m)
+    np.testing.assert_allclose(c.speed, 0.0, atol=1e-9)
+    assert c.planted.all()
+    s = foot_skating(m, c)
+    assert s.skating_frames == 0 and s.mean_speed == pytest.approx(0.0, abs=1e-9)
+    # measured on the contacts found afresh too (foot_skating's own call)
+    assert foot_skating(m).skating_frames == 0
+
+
 def test_lifted_foot_is_not_planted():
     T = 120
     lift = np.zeros(T, bool)
