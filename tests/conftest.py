@@ -1,6 +1,6 @@
-"""Shared fixtures: where the real CMU captures live (beside the checkout); and the skip
-gate: a test may skip only for a missing external program or missing shared data
-(``tests/_skips.py``), anything else fails."""
+"""Shared fixtures: where the real CMU and other-rig BVH captures live (beside the
+checkout); and the skip gate: a test may skip only for a missing external program or
+missing shared data (``tests/_skips.py``), anything else fails."""
 
 from pathlib import Path
 
@@ -10,6 +10,7 @@ from _skips import allowed, need_data, skip_reason
 
 SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 CMU = SHARED_DATA / "cmu"
+BVH = SHARED_DATA / "bvh"
 
 _GATE = (
     "skipped for a reason the suite does not accept: {reason!r}. A test may skip only when "
@@ -44,6 +45,12 @@ def pytest_make_collect_report(collector):
 @pytest.fixture(scope="session")
 def cmu_dir() -> Path:
     return need_data(CMU)
+
+
+@pytest.fixture(scope="session")
+def bvh_dir() -> Path:
+    """Real BVH captures of other rigs (Bandai Namco, Xsens MVN): internal testing only."""
+    return need_data(BVH)
 
 
 @pytest.fixture(scope="session")

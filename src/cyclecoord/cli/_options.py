@@ -321,6 +321,40 @@ def cycle_options(args: argparse.Namespace) -> dict:
     }
 
 
+#: Help of ``--feet``, the same on every command that finds foot contacts.
+FEET_HELP = (
+    "foot joints: LEFT,RIGHT (four names for a quadruped), each a joint or ANKLE:TOE for both "
+    "points of a leg, e.g. Foot_L,Foot_R or lfoot:ltoes,rfoot:rtoes (default: found by joint "
+    "name on the common rigs, else as the lowest ends of two leg chains)"
+)
+
+
+def add_feet_option(g) -> None:
+    """``--feet LEFT,RIGHT`` on a parser or group."""
+    g.add_argument("--feet", metavar="LEFT,RIGHT", help=FEET_HELP)
+
+
+def feet_option(args: argparse.Namespace, motion) -> tuple[str, ...] | None:
+    """The foot points ``--feet`` names, checked on ``motion``'s skeleton (None: not given).
+
+    Raises
+    ------
+    ParameterError
+        A name that is not a joint (with the nearest names), or a motion without a
+        skeleton.
+    """
+    from ..quality.legs import resolve_feet
+
+    spec = getattr(args, "feet", None)
+    if not spec:
+        return None
+    if motion.skeleton is None:
+        raise ParameterError(
+            f"--feet: {motion.source or 'the input'} has no skeleton (forward kinematics)"
+        )
+    return resolve_feet(motion.skeleton, spec)
+
+
 def check_output(path: str | None, what: str = "output") -> None:
     """Fail fast, before any computation, on an output we could not write."""
     if not path:

@@ -6,6 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
+from ._options import add_feet_option
 from ._outputs import Outputs, declare
 
 __all__ = ["add_parser", "run"]
@@ -27,6 +28,7 @@ def add_parser(subparsers) -> None:
         "--report", metavar="R.json", help="write a JSON report (commands, bridges, timing, checks)"
     )
     p.add_argument("--no-check", action="store_true", help="skip the plausibility checks")
+    add_feet_option(p)
     p.set_defaults(func=run)
     declare(p, inputs=_script_files, files=("-o", "--report"), derived=_skeleton_output)
 
@@ -53,7 +55,9 @@ def run(args: argparse.Namespace) -> int:
     for target in [out] + ([Path(args.report)] if args.report else []):
         if not (target.parent if str(target.parent) else Path(".")).is_dir():
             raise ParameterError(f"{target}: folder {target.parent} does not exist")
-    motion, report = run_script(script, check=not args.no_check, progress=True)
+    motion, report = run_script(
+        script, check=not args.no_check, progress=True, feet=args.feet or None
+    )
     # every output moves into place at the end, so a failure or Ctrl-C leaves none
     with Outputs() as staged:
         skeleton = [asf for _option, asf in _skeleton_output(args)]

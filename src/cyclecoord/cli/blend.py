@@ -10,7 +10,9 @@ from ..io import input_files
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
+    add_feet_option,
     check_output,
+    feet_option,
     frame_range,
     positive_float,
     positive_int,
@@ -124,6 +126,7 @@ def add_input_options(q: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--seed", type=int, default=0, metavar="S", help="random seed for extraction (0)"
     )
+    add_feet_option(g)
     m = q.add_argument_group("matching and checks")
     m.add_argument(
         "--allow-reverse",
@@ -208,6 +211,9 @@ def _load_cycles(args: argparse.Namespace) -> list:
     ):
         motion = load_input(path, None, fps)
         options = {"random_state": args.seed}
+        feet = feet_option(args, motion)
+        if feet is not None:
+            options["feet"] = feet
         if max_scale is not None:
             options["max_scale"] = max_scale
         if scale is not None:
@@ -311,7 +317,7 @@ def cmd_blend(args: argparse.Namespace) -> int:
     )
     for note in info["notes"]:
         print(f"note: {note}")
-    skating, inputs_skating = _skating(out, cycles, "blend")
+    skating, inputs_skating = _skating(out, cycles, "blend", args.feet)
     report = check_plausibility(out, cycles, margin_deg=args.margin)
     payload = {
         "inputs": [
@@ -327,13 +333,16 @@ def cmd_blend(args: argparse.Namespace) -> int:
     return finish(args, out, payload, report, "blend")
 
 
-def _skating(motion, inputs: list, what: str) -> tuple[dict | None, list]:
+def _skating(
+    motion, inputs: list, what: str, feet: str | None = None
+) -> tuple[dict | None, list]:
     """Foot skating of the result and of each input cycle (``skating_report`` dicts, None
-    where not measurable), and one console line for them."""
+    where not measurable), and one console line for them; ``feet`` is ``--feet``'s text
+    (None: found on each)."""
     from ..quality.contacts import skating_report, skating_line
 
-    result = skating_report(motion)
-    per_input = [skating_report(c) for c in inputs]
+    result = skating_report(motion, feet=feet)
+    per_input = [skating_report(c, feet=feet) for c in inputs]
     line = skating_line(result, what)
     if any(r is not None for r in per_input):
         line += (
@@ -382,7 +391,7 @@ def cmd_transition(args: argparse.Namespace) -> int:
     )
     for note in info["notes"]:
         print(f"note: {note}")
-    skating, inputs_skating = _skating(clip, [a, b], "transition")
+    skating, inputs_skating = _skating(clip, [a, b], "transition", args.feet)
     report = check_plausibility(clip, [a, b], margin_deg=args.margin)
     meta = {k: v for k, v in info.items() if k not in ("weight", "phase")}
     payload = {

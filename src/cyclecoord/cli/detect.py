@@ -11,9 +11,11 @@ from ..io import input_files
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
+    add_feet_option,
     add_selection_options,
     bandwidth,
     check_output,
+    feet_option,
     named,
     positive_int,
     rig_line,
@@ -98,6 +100,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default="slowest",
         help="begin each cycle at its slowest pose (default) or at phase 0",
     )
+    add_feet_option(dc)
     d.add_argument(
         "--extract-format",
         default="bvh",
@@ -131,6 +134,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
     motion = load_input(args.input, args.skeleton, args.fps)
+    if args.extract:  # a wrong --feet name fails before the detection runs
+        feet_option(args, motion)
     if motion.skeleton is not None:
         print(f"rig: {rig_line(motion, args)}")
     with Outputs() as out:  # every output moves into place at the end, or none does
@@ -141,6 +146,7 @@ def _detect(args: argparse.Namespace, motion, out: Outputs) -> int:
     from ..periodic.detection import detect, motion_cycles
 
     code = EXIT_OK
+    feet = feet_option(args, motion) if args.extract else None
     try:
         res = detect(
             motion,
@@ -197,6 +203,7 @@ def _detect(args: argparse.Namespace, motion, out: Outputs) -> int:
             cycle_start=args.cycle_start,
             timing=args.timing,
             travel=args.travel,
+            feet=feet,
         )
         have = {mc.motion for mc in cycles}
         for mid in range(res.n_motions):
@@ -226,7 +233,7 @@ def _detect(args: argparse.Namespace, motion, out: Outputs) -> int:
                     "99th-percentile step in one frame (its repetitions disagree there); look "
                     "at it, and try --bandwidth 2"
                 )
-            skating = skating_report(mc.cycle)
+            skating = skating_report(mc.cycle, feet=feet)
             print("  " + skating_line(skating))
             extracted.append(
                 {

@@ -14,10 +14,14 @@ from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
     add_cycle_options,
+    add_feet_option,
     add_selection_options,
+    add_units_option,
+    export_units,
     check_output,
     cycle_options,
     delay,
+    feet_option,
     named,
     positive_float,
     positive_int,
@@ -40,7 +44,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         ),
     )
     e.add_argument("input", metavar="INPUT")
-    add_selection_options(e)
+    add_units_option(add_selection_options(e))
     g = e.add_argument_group("class, scale and cycle")
     g.add_argument(
         "--scale",
@@ -92,7 +96,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="delay embedding in seconds so out-and-back motions (squats, jumping jacks) form "
         "loops; auto (default): none, and 0.25 s when the poses alone show no periodic motion",
     )
-    add_cycle_options(e.add_argument_group("the cycle"))
+    cyc = e.add_argument_group("the cycle")
+    add_cycle_options(cyc)
+    add_feet_option(cyc)
     e.add_argument(
         "-v",
         "--verbose",
@@ -164,6 +170,7 @@ def _extract(args: argparse.Namespace, motion, out: Outputs) -> int:
 
     report_payload = None
     code = EXIT_OK
+    feet = feet_option(args, motion)
     options = dict(
         frames=args.frames,
         pca=args.pca,
@@ -183,6 +190,7 @@ def _extract(args: argparse.Namespace, motion, out: Outputs) -> int:
         landmarks=args.landmarks,
         memory_limit=args.memory_limit,
         random_state=args.seed,
+        feet=feet,
         **cycle_options(args),
     )
     try:
@@ -210,11 +218,10 @@ def _extract(args: argparse.Namespace, motion, out: Outputs) -> int:
             print(line)
         cycle, locked = res.cycle, None
         if args.lock_feet:
-            cycle, locked = _lock(res.cycle)
-            print(locked.summary() if locked is not None else
-                  "feet: not locked: the cycle has no skeleton with recognisable feet")
+            cycle, locked, why = _lock(res.cycle, feet)
+            print(locked.summary() if locked is not None else f"feet: not locked: {why}")
         if args.output:
-            out.save(cycle, args.output)
+            out.save(cycle, args.output, **export_units(args, args.output))
         if args.save_model:
             res.model.save(out.file(args.save_model))
             out.wrote(args.save_model)
@@ -311,7 +318,7 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
             "in_place": "removed, and the cycle stays in place (--travel in_place)",
         }[travel]
         lines.append(f"heading: turns {res.heading_per_cycle:+.1f} degrees per cycle ({kept})")
-    feet = _feet_line(res.cycle)
+    feet = _feet_line(res.cycle, res.parameters.get("feet"))
     if feet:
         lines.append(feet)
     for w in res.warnings:
@@ -350,29 +357,40 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
     return lines
 
 
-def _lock(cycle):
-    """The cycle with its planted feet pinned over the loop, or ``(cycle, None)`` when it
-    has no skeleton with feet."""
+def _lock(cycle, feet=None):
+    """The cycle with its planted feet pinned over the loop: ``(motion, result, None)``,
+    or ``(cycle, None, why)`` when it has no skeleton or no feet are found (named ``feet``
+    that are not joints raise)."""
     from ..errors import ParameterError
     from ..synthesis.footlock import lock_feet
 
     if cycle.skeleton is None:
-        return cycle, None
+        return cycle, None, "the cycle has no skeleton"
+    if feet is not None:
+        result = lock_feet(cycle, cyclic=True, feet=tuple(feet))
+        return result.motion, result, None
     try:
         result = lock_feet(cycle, cyclic=True)
-    except ParameterError:
-        return cycle, None
-    return result.motion, result
+    except ParameterError as exc:
+        return cycle, None, str(exc)
+    return result.motion, result, None
 
 
-def _feet_line(cycle) -> str | None:
-    """One line on the cycle's planted feet (the report's ``foot_skating``), or None."""
-    from ..quality.contacts import skating_report
+def _feet_line(cycle, feet=None) -> str | None:
+    """One line on the cycle's planted feet (the report's ``foot_skating``), or on why
+    they are not measured; None without a skeleton."""
+    from ..errors import ParameterError
+    from ..quality.contacts import foot_contacts, skating_report
 
     if cycle is None or cycle.skeleton is None:
         return None
-    sk = skating_report(cycle)
+    feet = None if feet is None else tuple(feet)
+    sk = skating_report(cycle, feet=feet)
     if sk is None:
+        try:
+            foot_contacts(cycle, feet=feet)
+        except ParameterError as exc:
+            return f"feet: not measured: {exc}"
         return None
     return (
         f"feet: planted feet slide {sk['mean_speed_leg_lengths_per_s']:.2f} leg lengths/s on "

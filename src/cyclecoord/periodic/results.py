@@ -262,7 +262,7 @@ class ExtractionResult:
             "bandwidth_frames": float(self.typical.bandwidth)
             if np.isfinite(self.typical.bandwidth)
             else None,
-            "foot_skating": _cycle_skating(self.cycle),
+            "foot_skating": _cycle_skating(self.cycle, self.parameters.get("feet")),
             "distance_to_cycle": self.distance,
             "pose_quality": None if self.pose_quality is None else self.pose_quality.to_dict(),
             "rig": self._rig_dict(),
@@ -283,11 +283,14 @@ class ExtractionResult:
         }
 
 
-def _cycle_skating(cycle: Motion) -> dict | None:
-    """Foot skating of the cycle (:func:`~cyclecoord.quality.contacts.skating_report`)."""
+def _cycle_skating(cycle: Motion, feet=None) -> dict | None:
+    """Foot skating of the cycle (:func:`~cyclecoord.quality.contacts.skating_report`) on
+    ``feet`` (None: found)."""
     from ..quality.contacts import skating_report
 
-    return skating_report(cycle) if cycle is not None and cycle.skeleton is not None else None
+    if cycle is None or cycle.skeleton is None:
+        return None
+    return skating_report(cycle, feet=None if feet is None else tuple(feet))
 
 
 def _nullable(values: np.ndarray | None) -> list | None:

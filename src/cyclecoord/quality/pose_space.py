@@ -45,7 +45,7 @@ MAX_REFERENCE_FRAMES = 20_000
 MAX_SPREAD_PROBES = 2_000
 
 
-def root_frame_points(motion: Motion, rig=None) -> np.ndarray:
+def root_frame_points(motion: Motion, rig=None, names=None) -> np.ndarray:
     """Joint and end-site positions in the root's frame, plus the root's height.
 
     Parameters
@@ -55,6 +55,10 @@ def root_frame_points(motion: Motion, rig=None) -> np.ndarray:
     rig : RigInfo, optional
         How to read the rig (:func:`cyclecoord.rig.describe_rig`), so that a cycle is read
         as the capture it came from; default: described afresh.
+    names : sequence of str, optional
+        Only these points, in this order (forward-kinematics names, end sites
+        ``"<joint>/end"``): a cycle read back from a format that lays out its skeleton
+        otherwise (ASF bones against BVH joints) is compared point for point.
 
     Returns
     -------
@@ -68,7 +72,11 @@ def root_frame_points(motion: Motion, rig=None) -> np.ndarray:
 
     if motion.skeleton is not None:
         motion, _ = normalize_rig(motion, rig, drop_reference=False)  # travelling joint first
-    pos = np.asarray(motion.positions().positions, dtype=float)  # (T, N, 3)
+    fk = motion.positions()
+    pos = np.asarray(fk.positions, dtype=float)  # (T, N, 3)
+    if names is not None:
+        index = {n: i for i, n in enumerate(fk.names)}
+        pos = pos[:, [0] + [index[n] for n in names if n != fk.names[0]], :]
     layout = root_layout(motion)
     root = pos[:, :1, :]
     rel = pos - root
@@ -147,7 +155,15 @@ class PoseQuality:
         return {k: (None if not np.isfinite(v) else float(v)) for k, v in asdict(self).items()}
 
 
-def _runs_points(capture: Motion, runs: list[tuple[int, int]], rig) -> list[np.ndarray]:
+def _point_names(motion: Motion, rig) -> list[str]:
+    from ..rig import normalize_rig
+
+    one = motion.with_frames(motion.frames[:1])
+    return list(normalize_rig(one, rig, drop_reference=False)[0].positions().names)
+
+
+def _runs_points(capture: Motion, runs: list[tuple[int, int]], rig, names=None
+                 ) -> list[np.ndarray]:
     total = sum(b - a for a, b in runs)
     every = max(1, int(np.ceil(total / MAX_REFERENCE_FRAMES)))
     out = []
@@ -155,20 +171,22 @@ def _runs_points(capture: Motion, runs: list[tuple[int, int]], rig) -> list[np.n
         if b - a >= 2:
             # whole runs, sampled evenly on long takes before forward kinematics
             part = capture.with_frames(capture.frames[a:b:every])
-            out.append(root_frame_points(part, rig))
+            out.append(root_frame_points(part, rig, names))
     return out
 
 
-def _capture_steps(capture: Motion, runs: list[tuple[int, int]], rig) -> np.ndarray:
+def _capture_steps(capture: Motion, runs: list[tuple[int, int]], rig, names=None
+                   ) -> np.ndarray:
     """Frame steps of the capture: every run whole, or on a long take the middle
     :data:`MAX_REFERENCE_FRAMES` frames of its longest run."""
     if sum(b - a for a, b in runs) <= MAX_REFERENCE_FRAMES:
-        parts = [root_frame_points(capture.window((a, b)), rig) for a, b in runs if b - a >= 2]
+        parts = [root_frame_points(capture.window((a, b)), rig, names)
+                 for a, b in runs if b - a >= 2]
         return np.concatenate([_steps(p) for p in parts]) if parts else np.zeros(0)
     a, b = max(runs, key=lambda r: r[1] - r[0])
     mid = (a + b) // 2
     lo, hi = max(a, mid - MAX_REFERENCE_FRAMES // 2), min(b, mid + MAX_REFERENCE_FRAMES // 2)
-    return _steps(root_frame_points(capture.window((lo, hi)), rig))
+    return _steps(root_frame_points(capture.window((lo, hi)), rig, names))
 
 
 def pose_quality(
@@ -198,14 +216,21 @@ def pose_quality(
     from ..rig import describe_rig
 
     rig = describe_rig(capture)
-    parts = _runs_points(capture, runs, rig)
+    names = None
+    cap_names = _point_names(capture, rig)
+    cyc_names = _point_names(cycle, rig)
+    if cap_names != cyc_names:  # another layout of the same body: the points both have
+        names = [n for n in cap_names if n in set(cyc_names)]
+        if cap_names[0] != cyc_names[0] or len(names) < 3:
+            return None
+    parts = _runs_points(capture, runs, rig, names)
     if not parts:
         return None
     every = max(1, int(np.ceil(sum(b - a for a, b in runs) / MAX_REFERENCE_FRAMES)))
-    cyc = root_frame_points(cycle, rig)
+    cyc = root_frame_points(cycle, rig, names)
     csteps = _steps(cyc, cyclic=True)
     seam = float(csteps[-1] / np.median(csteps)) if np.median(csteps) > 0 else float("nan")
-    cap_steps = _capture_steps(capture, runs, rig)
+    cap_steps = _capture_steps(capture, runs, rig, names)
     p99 = float(np.percentile(cap_steps, 99)) if cap_steps.size else float("nan")
     pop = float(csteps.max() / p99) if p99 > 0 else float("nan")
     pts = np.concatenate(parts)

@@ -78,6 +78,7 @@ def motion_cycles(
     travel: str = "keep",
     min_cycles: float = 1.5,
     cycle: CycleOptions | None = None,
+    feet: tuple[str, ...] | None = None,
 ) -> list[MotionCycle]:
     """A typical cycle for every motion :func:`detect` found, with the phase it found.
 
@@ -109,6 +110,9 @@ def motion_cycles(
         A motion whose longest segment holds fewer cycles gets no cycle: one repetition
         and a part is no typical cycle (the rule :func:`cyclecoord.extract` applies with
         ``min_turns``; 13_29's twist holds 1.4).
+    feet : tuple of str, optional
+        Foot points whose contacts carry each cycle's root (default found, as
+        :func:`cyclecoord.extract` finds them).
 
     Returns
     -------
@@ -132,7 +136,7 @@ def motion_cycles(
             result, n_samples=chosen["n_samples"], n_neighbors=chosen["n_neighbors"],
             bandwidth=chosen["bandwidth"], cycle_start=chosen["cycle_start"],
             random_state=random_state, timing=chosen["timing"], travel=chosen["travel"],
-            min_cycles=chosen["min_turns"],
+            min_cycles=chosen["min_turns"], feet=feet,
         )
     if not isinstance(result, DetectionResult):
         raise ParameterError(
@@ -191,6 +195,7 @@ def motion_cycles(
                 travel=travel,
                 k=n_neighbors,
                 metadata=meta,
+                feet=feet,
             )
         else:
             density = PeriodicDensity(random_state=random_state).fit(theta)

@@ -156,6 +156,10 @@ class Synthesizer:
         frames instead of 54 %, but the locks' easing makes joints accelerate up to 3.1x
         the training 99th percentile (4 of 56 blend windows over 1.5x, 8 of 56 whole
         transitions), so it is off.
+    feet : tuple of str, optional
+        Foot point joint names the planting and locking use (default
+        :func:`~cyclecoord.quality.legs.find_legs` on the motion: names of the common
+        rigs, else its geometry).
     """
 
     models: dict[str, LatentModel]
@@ -167,6 +171,7 @@ class Synthesizer:
     ease: float = 0.25
     plant: str = "transitions"
     lock: bool = False
+    feet: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
         if not self.models:
@@ -706,11 +711,15 @@ class Synthesizer:
         layout = root_layout(motion)
         if not mask.any() or layout is None or motion.n_frames < 3:
             return motion
-        try:
-            feet = find_feet(motion.skeleton)
+        if self.feet is not None:  # named feet: a wrong name is an error, not skipped
+            feet = self.feet
             found = foot_contacts(motion, feet).planted
-        except CycleCoordError:
-            return motion
+        else:
+            try:
+                feet = find_feet(motion.skeleton, motion)
+                found = foot_contacts(motion, feet).planted
+            except CycleCoordError:
+                return motion
         cols = [layout.column("tx"), layout.column("tz")]
         own = np.diff(motion.frames[:, cols], axis=0)
         frames = motion.frames.copy()

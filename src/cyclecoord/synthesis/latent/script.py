@@ -49,6 +49,7 @@ TOP_KEYS = {
     "bridge_threshold",
     "plant",
     "lock_feet",
+    "feet",
     "commands",
 }
 #: Each command's allowed keys (besides "command").
@@ -158,6 +159,11 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
         raise _fail(p, "plant", f"must be transitions, all or off, got {spec['plant']!r}")
     if not isinstance(spec.get("lock_feet", False), bool):
         raise _fail(p, "lock_feet", f"must be true or false, got {spec['lock_feet']!r}")
+    feet = spec.get("feet")
+    if feet is not None and (
+        not isinstance(feet, list) or not feet or not all(isinstance(f, str) for f in feet)
+    ):
+        raise _fail(p, "feet", f"must be a list of joint names, got {feet!r}")
     commands = spec.get("commands")
     if not isinstance(commands, list) or not commands:
         raise _fail(p, "commands", "must be a non-empty list")
@@ -182,7 +188,12 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
     return spec, models
 
 
-def run_script(path: str | Path, check: bool = True, progress: bool = False):
+def run_script(
+    path: str | Path,
+    check: bool = True,
+    progress: bool = False,
+    feet: str | tuple[str, ...] | None = None,
+):
     """Run a script: the synthesised :class:`~cyclecoord.motion.Motion` and a report dict.
 
     Parameters
@@ -193,9 +204,23 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
         new limb contacts) for the report.
     progress : bool
         A tqdm bar over the commands.
+    feet : str or tuple of str, optional
+        Foot points for planting, locking and the skating figures: joint names, or the
+        command line's ``"LEFT,RIGHT"`` text (:func:`~cyclecoord.quality.legs.feet_names`);
+        default the script's ``"feet"`` list, else found.
     """
+    from ...quality.legs import feet_names
+
     p = Path(path)
     spec, models = load_script(p)
+    if feet is None and spec.get("feet") is not None:
+        feet = tuple(spec["feet"])
+    if feet is not None:
+        skeleton = models[spec.get("start", {"model": next(iter(models))})["model"]].skeleton_
+        try:
+            feet = feet_names(skeleton, feet)
+        except ParameterError as exc:
+            raise _fail(p, "feet", str(exc)) from None
     params = ParticleParams().replace(**(spec.get("particle") or {}))
     syn = Synthesizer(
         models,
@@ -205,6 +230,7 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
         bridge_threshold=spec.get("bridge_threshold"),
         plant=spec.get("plant", "transitions"),
         lock=spec.get("lock_feet", False),
+        feet=feet,
     )
     start = spec.get("start", {"model": next(iter(models))})
     t0 = time.perf_counter()
@@ -247,7 +273,7 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
         "commands": syn.segments(),
         "transitions": syn.events,
         "clamped_to_training_range": syn.clamped,
-        "foot_skating": skating_report(motion),
+        "foot_skating": skating_report(motion, feet=feet),
         "bridges": {f"{a}->{b}": br.to_dict() for (a, b), br in syn.bridges_found().items()},
         "timing": {
             "total_s": total,
