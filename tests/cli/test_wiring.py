@@ -3,7 +3,7 @@
 Each test runs ``cyclecoord ...`` with the option and catches the library function the
 option is for (a spy in its place: it records the call and stops the run, or passes it on)
 and checks the keyword or the data it received, against a run without the option.  The
-registry of which test covers which option is ``tests/cli/wiring.py``; the meta-test
+registry of which test covers which option is ``tests/cli/wired_options.py``; the meta-test
 ``test_every_option_is_wired.py`` holds every parser's options to it.
 """
 
@@ -234,7 +234,9 @@ def test_detect_cycle_options_reach_motion_cycles(monkeypatch, files, tmp_path):
     got = reach(monkeypatch, target, *argv, "--timing", "coordinate", "--travel", "straight",
                 "--bandwidth", "2.5", "--cycle-start", "first").kwargs
     want = {"timing": "coordinate", "travel": "straight", "bandwidth": 2.5, "cycle_start": "first"}
-    assert got == want and all(plain[k] != v for k, v in want.items())
+    assert {k: got[k] for k in want} == want and all(plain[k] != v for k, v in want.items())
+    assert {k: v for k, v in got.items() if k not in want} == {
+        k: v for k, v in plain.items() if k not in want}
 
 
 def test_detect_extract_format_names_the_cycles_written(files, tmp_path, capsys):
@@ -339,16 +341,58 @@ def test_feet_frames_cycle_and_lock_reach_lock_feet(monkeypatch, files, tmp_path
     assert not out.exists()
 
 
-@pytest.mark.parametrize("command", ["convert", "feet"])
+@pytest.mark.parametrize("command", ["convert", "feet", "extract"])
 def test_units_reach_the_gltf_and_usd_writers(monkeypatch, files, tmp_path, command):
     target = "cyclecoord.cli._outputs.Outputs.save"
-    save = reach(monkeypatch, target, command, files.walk, "-o", tmp_path / "a.glb")
+    take = files.long if command == "extract" else files.walk  # extract needs 1.5 cycles
+    save = reach(monkeypatch, target, command, take, "-o", tmp_path / "a.glb")
     assert "scale" not in save.kwargs  # auto: the writer measures the unit itself
-    save = reach(monkeypatch, target, command, files.walk, "-o", tmp_path / "a.glb", "--units", "cm")
+    save = reach(monkeypatch, target, command, take, "-o", tmp_path / "a.glb", "--units", "cm")
     assert save.kwargs["scale"] == 0.01
-    save = reach(monkeypatch, target, command, files.walk, "-o", tmp_path / "a.usda", "--units",
+    save = reach(monkeypatch, target, command, take, "-o", tmp_path / "a.usda", "--units",
                  "0.3048")
     assert save.kwargs["meters_per_unit"] == 0.3048
+
+
+#: command -> (spied call, extra arguments, how to read the feet it received)
+FEET = {
+    "extract": (PIPELINE["extract"], [], lambda s: s.kwargs["feet"]),
+    "detect": ("cyclecoord.periodic.detection.motion_cycles",
+               ["--method", "global", "--no-progress", "--extract", "{tmp}/c"],
+               lambda s: s.kwargs["feet"]),
+    "blend": ("cyclecoord.synthesis.sources.as_cycle", [], lambda s: s.kwargs.get("feet")),
+    "transition": ("cyclecoord.synthesis.sources.as_cycle", ["--cycles", "1"],
+                   lambda s: s.kwargs.get("feet")),
+    "batch": ("cyclecoord.batch.run_batch", ["-o", "{tmp}/out"],
+              lambda s: s.kwargs["extract_options"].get("feet")),
+    "view": ("cyclecoord.plot.viewer.skeleton_figure", ["-o", "{tmp}/a.html"],
+             lambda s: s.args[0][0].feet),
+    "feet": ("cyclecoord.quality.contacts.foot_contacts", [], lambda s: s.kwargs["feet"]),
+}
+
+
+@pytest.mark.parametrize("command", sorted(FEET))
+def test_feet_reach_the_library(monkeypatch, files, tmp_path, command):
+    """--feet: the named foot joints (here the toes, not the ankles found by default)
+    reach the call that measures feet, checked against the skeleton where the command reads
+    one; batch passes the text on for each capture to check."""
+    target, extra, feet_of = FEET[command]
+    extra = [a.replace("{tmp}", str(tmp_path)) for a in extra]
+    take = files.dir if command == "batch" else files.long
+    inputs = [take, files.jog] if command in ("blend", "transition") else [take]
+    plain = feet_of(reach(monkeypatch, target, command, *inputs, *extra))
+    got = feet_of(reach(monkeypatch, target, command, *inputs, *extra, "--feet", "ltoes,rtoes"))
+    want = "ltoes,rtoes" if command == "batch" else ("ltoes", "rtoes")
+    assert got == want and plain != want
+
+
+def test_animate_feet_reach_the_script(monkeypatch, tmp_path):
+    script = tmp_path / "s.json"
+    script.write_text(json.dumps({"models": {}, "commands": []}))
+    target = "cyclecoord.synthesis.latent.script.run_script"
+    argv = ["animate", script, "-o", tmp_path / "a.bvh"]
+    assert reach(monkeypatch, target, *argv).kwargs["feet"] is None
+    assert reach(monkeypatch, target, *argv, "--feet", "ltoes,rtoes").kwargs["feet"] == "ltoes,rtoes"
 
 
 def test_feet_lock_writes_the_locked_motion_and_the_report(files, tmp_path, capsys):

@@ -29,6 +29,8 @@ GRAPH = (W + "test_graph_options_reach_the_synthesiser",
          W + "test_graph_crossval_options_reach_cross_validate")
 GRAPH_WALK = W + "test_graph_start_target_and_frames_reach_the_walk"
 LATENT = W + "test_latent_fit_options_reach_the_model"
+FEET = W + "test_feet_reach_the_library"
+UNITS = W + "test_units_reach_the_gltf_and_usd_writers"
 CLI = "tests/cli/test_cli.py::"
 BLEND = "tests/cli/test_cli_blend.py::"
 
@@ -51,6 +53,8 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         "--lock-feet": CLI + "test_extract_lock_feet_writes_a_cycle_whose_feet_stay",
         "--save-model": "tests/periodic/test_landmarks.py::test_cli_save_and_apply",
         "--apply": "tests/periodic/test_landmarks.py::test_cli_save_and_apply",
+        "--units": UNITS,
+        "--feet": FEET,
     },
     "barcode": {
         "--skeleton": READER,
@@ -65,7 +69,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         "--skeleton": READER,
         "--fps": READER,
         "--frames": W + "test_convert_frames_reach_the_written_motion",
-        "--units": W + "test_units_reach_the_gltf_and_usd_writers",
+        "--units": UNITS,
     },
     "detect": {
         "--skeleton": READER,
@@ -80,6 +84,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         **dict.fromkeys(("--timing", "--travel", "--bandwidth", "--cycle-start"),
                         W + "test_detect_cycle_options_reach_motion_cycles"),
         "--extract-format": W + "test_detect_extract_format_names_the_cycles_written",
+        "--feet": FEET,
     },
     "render": {
         "-o": "tests/plot/test_plot.py::test_cli_extract_plot_and_render_side_by_side",
@@ -96,6 +101,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
                          "--scale", "--seed"), AS_CYCLE),
         **dict.fromkeys(("--allow-reverse", "--no-heading", "--up"), MATCHING),
         "--margin": W + "test_margin_reaches_the_plausibility_check",
+        "--feet": FEET,
     } for command in ("blend", "transition")},
     "batch": {
         **dict.fromkeys(("-o", "-j", "--scheduler", "--force", "--pattern", "--cycles",
@@ -103,6 +109,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
                          "--temporal", "--prime", "--max-scale", "--landmarks", "--memory-limit",
                          "--seed", "--no-steady", "--timing", "--travel", "--min-turns",
                          "--bandwidth", "--cycle-start"), BATCH),
+        "--feet": FEET,
     },
     "view": {
         "-o": W + "test_view_writes_the_page",
@@ -111,11 +118,13 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         **dict.fromkeys(("--side-by-side", "--frames", "--other-frames", "--cycle",
                          "--other-cycle", "--max-fps", "--no-contacts"),
                         W + "test_view_options_reach_the_figure"),
+        "--feet": FEET,
     },
     "feet": {
         "--skeleton": READER,
         "--fps": READER,
-        "--units": W + "test_units_reach_the_gltf_and_usd_writers",
+        "--units": UNITS,
+        "--feet": FEET,
         **dict.fromkeys(("--height", "--speed", "--skate-speed"),
                         W + "test_feet_thresholds_reach_contacts_and_skating"),
         **dict.fromkeys(("--frames", "--cycle"), W + "test_feet_frames_cycle_and_lock_reach_lock_feet"),
@@ -138,6 +147,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         **dict.fromkeys(("-o", "--report"), "tests/synthesis/test_latent_cli.py::"
                         "test_animate_writes_bvh_and_report_reproducibly"),
         "--no-check": W + "test_animate_no_check_reaches_run_script",
+        "--feet": W + "test_animate_feet_reach_the_script",
     },
 }
 
