@@ -6,20 +6,18 @@ vertical extent of its bone heads (``blender/measure_height.py``).
 """
 
 import json
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
 
 import cyclecoord as cc
-from _rigs import BANDAI, XSENS, in_units, walk
+from _rigs import BANDAI, BVH, XSENS, in_units, walk
+from _skips import need_data, needs_program, program
 
-BLENDER = shutil.which("blender")
+BLENDER = program("blender")
 SCRIPT = Path(__file__).resolve().parent / "blender" / "measure_height.py"
-pytestmark = pytest.mark.skipif(
-    BLENDER is None, reason="Blender is not installed: apt-get install -y blender python3-numpy"
-)
+pytestmark = needs_program("blender")
 
 
 def blender_height(motion, tmp_path, name):
@@ -39,8 +37,7 @@ def test_synthetic_walk_in_any_unit_is_life_size(tmp_path, unit, mpu):
 
 
 def test_xsens_millimetres_is_life_size(tmp_path):
-    if not XSENS.is_file():
-        pytest.skip(f"shared Xsens capture not found at {XSENS}")
+    need_data(XSENS)
     h = blender_height(cc.load(XSENS), tmp_path, "xsens")
     assert 1.4 <= h <= 2.1  # measured 1.74 m
 
@@ -48,8 +45,7 @@ def test_xsens_millimetres_is_life_size(tmp_path):
 def test_bandai_centimetres_keeps_its_scale(tmp_path):
     """The Bandai skeleton ends at its head joint (the head's end site has no length): its
     bone heads span 1.33 m in the file's own centimetres, and so they must in Blender."""
-    if not BANDAI:
-        pytest.skip("shared Bandai captures not found")
+    need_data(BVH / "bandai")
     m = cc.load(BANDAI[2])
     h = blender_height(m, tmp_path, "bandai")
     info = cc.rig.describe_rig(m)

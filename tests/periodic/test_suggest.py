@@ -25,7 +25,8 @@ def test_refusal_names_what_helps(tmp_path, capsys):
     assert "would help here (tried): --rotations rotvec (period" in err
     sugg = json.loads(rep.read_text())["suggestions"]
     assert sugg[0]["option"] == "--rotations rotvec"
-    assert 110 < sugg[0]["period_frames"] < 130  # the example's period is 120 frames
+    # the example's period is 120 frames: measured 119.6, as extract finds on the clean walk
+    assert abs(sugg[0]["period_frames"] - 120) <= 1
 
 
 def test_nothing_is_tried_that_was_already_given(monkeypatch):

@@ -93,6 +93,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
     options = dict(
         pca=args.pca,
         normalize=args.normalize,
+        rotations=args.rotations,
         temporal=args.temporal,
         prime=args.prime,
         max_scale=args.max_scale,
