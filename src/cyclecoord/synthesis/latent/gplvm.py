@@ -1,7 +1,7 @@
 """The GPLVM of Bailey et al. (Eq. 4-7): RBF + white kernel, dynamics and connectivity priors.
 
 The negative log posterior of latent points ``X`` (N, q) and kernel hyperparameters
-given data ``Y`` (N, d) is
+given data ``Y`` (N, d) is::
 
     D/2 log|K| + 1/2 tr(K^-1 Y Y^T)                      (Eq. 4, RBF + white kernel, Eq. 5)
   + 1/2 tr(X^T K_t^-1 X)                                 (dynamics prior, Eq. 6)
