@@ -102,6 +102,8 @@ sphinx_gallery_conf = {
     "show_memory": False,
     "backreferences_dir": None,
     "write_computation_times": False,
+    # CYCLECOORD_DOCS_RERUN=1 runs every example even when unchanged since the last build
+    "run_stale_examples": os.environ.get("CYCLECOORD_DOCS_RERUN", "0") == "1",
 }
 
 # ------------------------------------------------------------------ HTML
