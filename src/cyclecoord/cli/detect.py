@@ -9,6 +9,7 @@ from pathlib import Path
 from ..errors import NoPeriodicMotionError, ParameterError
 from ..io import input_files
 from ._options import (
+    INPUT_HELP,
     EXIT_NO_PERIODIC,
     EXIT_OK,
     add_feet_option,
@@ -40,7 +41,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
             "report. Exit code 3 when nothing is found."
         ),
     )
-    d.add_argument("input", metavar="INPUT")
+    d.add_argument("input", metavar="INPUT", help=INPUT_HELP)
     add_selection_options(d)
     d.add_argument(
         "--classes",

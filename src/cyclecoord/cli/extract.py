@@ -11,6 +11,7 @@ import numpy as np
 from ..errors import NoPeriodicMotionError, ParameterError
 from ..io import input_files
 from ._options import (
+    INPUT_HELP,
     EXIT_NO_PERIODIC,
     EXIT_OK,
     add_cycle_options,
@@ -43,7 +44,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
             "report is still written."
         ),
     )
-    e.add_argument("input", metavar="INPUT")
+    e.add_argument("input", metavar="INPUT", help=INPUT_HELP)
     add_units_option(add_selection_options(e))
     g = e.add_argument_group("class, scale and cycle")
     g.add_argument(

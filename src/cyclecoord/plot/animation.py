@@ -148,6 +148,7 @@ def render(
     dpi: float = 80,
     size: float = 4.0,
     max_frames: int = 2000,
+    progress: bool = False,
 ) -> Path:
     """Animate a capture as a stick figure (forward kinematics) and write a GIF or MP4.
 
@@ -190,6 +191,8 @@ def render(
         pixels tall).
     max_frames : int, default 2000
         Upper bound on drawn frames when ``step`` is automatic.
+    progress : bool, default False
+        A tqdm bar on stderr over the drawn frames (shown after 1 s).
 
     Returns
     -------
@@ -256,7 +259,7 @@ def render(
                 dots.set_data(q[:, 0], q[:, 1])
             text.set_text(f"{tr.title}  frame {tr.start_frame + int(frames_used[k][i])}")
 
-    _write_frames(fig, out, suffix, play_fps, dpi, len(times), draw_frame)
+    _write_frames(fig, out, suffix, play_fps, dpi, len(times), draw_frame, progress)
     return out
 
 
@@ -458,10 +461,11 @@ def _panel_2d(fig, k: int, n_panels: int, tr: _Track, st: _Stage) -> tuple:
 
 
 def _write_frames(fig, out: Path, suffix: str, play_fps: float, dpi: float, n: int,
-                  draw_frame) -> None:
+                  draw_frame, progress: bool = False) -> None:
     """Draw the ``n`` frames one by one into a GIF or MP4 written atomically at ``out``."""
     import matplotlib as mpl
     from matplotlib import animation as anim
+    from tqdm import tqdm
 
     from ..io import atomic_path
 
@@ -477,7 +481,8 @@ def _write_frames(fig, out: Path, suffix: str, play_fps: float, dpi: float, n: i
         # (a 'tight' bbox would change the frame size)
         writer.setup(fig, str(tmp), dpi)
         try:
-            for i in range(n):
+            for i in tqdm(range(n), desc="drawing", unit="frame", disable=not progress,
+                          delay=1.0, leave=False):
                 draw_frame(i)
                 writer.grab_frame()
         except BaseException:
