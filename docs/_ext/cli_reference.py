@@ -17,7 +17,7 @@ from docutils import nodes
 from docutils.parsers.rst import Directive
 
 #: Width the help is wrapped to, so the pages do not depend on the terminal of the build.
-COLUMNS = 88
+COLUMNS = 79
 
 
 @contextmanager
