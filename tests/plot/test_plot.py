@@ -449,6 +449,24 @@ def test_mp4_rate_is_passed_as_an_exact_fraction():
     assert str(_rate_fraction(120 / 7)) == "120/7"
 
 
+def test_mp4_keeps_the_rate_exactly(capture, tmp_path):
+    import shutil
+
+    from matplotlib import animation
+
+    if not animation.FFMpegWriter.isAvailable() or shutil.which("ffprobe") is None:
+        pytest.skip("ffmpeg/ffprobe are not installed; the MP4 rate cannot be read back here")
+    m = capture.motion
+    m = m.with_frames(m.frames[::4][:63], fps=30000 / 1001)
+    out = plot.render(m, tmp_path / "ntsc.mp4", dpi=30, size=2)
+    probe = subprocess.run(
+        ["ffprobe", "-v", "error", "-select_streams", "v:0", "-show_entries",
+         "stream=avg_frame_rate,nb_frames", "-of", "default=nw=1", str(out)],
+        capture_output=True, text=True, check=True,
+    ).stdout
+    assert "avg_frame_rate=30000/1001" in probe and "nb_frames=63" in probe
+
+
 def test_render_mp4_needs_ffmpeg(capture, tmp_path, monkeypatch):
     from matplotlib import animation
 
