@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ..errors import NoPeriodicMotionError, ParameterError
 from ..io import input_files
+from .._words import plural
 from ._options import (
     INPUT_HELP,
     EXIT_NO_PERIODIC,
@@ -183,7 +184,7 @@ def _detect(args: argparse.Namespace, motion, out: Outputs) -> int:
         print(
             f"; {len(res.windows)} windows, {sum(w.looping for w in res.windows)} looping", end=""
         )
-    print(f": {res.n_motions} motion(s)")
+    print(f": {plural(res.n_motions, 'motion')}")
     for sg in res.segments:
         print(
             f"  motion {sg.motion}: frames {m.start_frame + sg.start}-{m.start_frame + sg.stop} "
