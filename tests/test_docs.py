@@ -189,3 +189,13 @@ def test_the_latent_page_shows_the_example_script():
     text = (DOCS / "guide" / "latent.rst").read_text(encoding="utf-8")
     assert ".. literalinclude:: ../../examples/latent_script.json" in text
     assert (DOCS / "../examples/latent_script.json").resolve().is_file()
+
+
+def test_getting_started_has_the_readme_set_up_commands():
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    setup = readme[readme.index("## Set up\n"):readme.index("\n## ", readme.index("## Set up\n") + 1)]
+    commands = [ln for b in re.findall(r"```bash\n(.*?)```", setup, flags=re.DOTALL)
+                for ln in b.splitlines() if ln.strip()]
+    page = (DOCS / "getting_started.rst").read_text(encoding="utf-8")
+    shown = [ln.strip() for ln in page[page.index(".. code-block:: bash"):].splitlines()[2:4]]
+    assert commands == shown
