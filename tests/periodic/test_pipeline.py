@@ -319,6 +319,9 @@ def test_out_and_back_motion_is_read_with_a_delay(cmu_dir):
         cc.extract(m, frames=(0, 456), delay=None)
     res = cc.extract(m, frames=(0, 456))
     assert "delay embedding" in res.warnings[0]
+    # issue 25: the warning says what the poses alone showed, not a guess at the movement
+    assert "the poses alone showed no periodic motion: the coordinate turns only" in res.warnings[0]
+    assert "squat" not in res.warnings[0]
     ref = autocorrelation_period(m.frames[0:456], lo=90, hi=200)
     assert abs(res.period_frames / ref - 1) <= at_most(0.0018, frame(ref))  # measured 133.75 / 134
     # no pop: the take's first repetition, still getting going, dwells a dozen frames on one

@@ -11,6 +11,16 @@ from ..errors import ParameterError
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_NO_PERIODIC = 0, 1, 2, 3
 
+#: Every format cyclecoord reads and writes, as the help texts list them.
+FORMATS = "ASF/AMC, BVH, NPZ, CSV, glTF (.glb/.gltf) and USD (.usda/.usdc/.usd)"
+
+#: Help of the INPUT argument of the commands that read one capture.
+INPUT_HELP = (
+    "capture to read: .amc (its .asf found beside it), .bvh, .npz, .csv, .glb/.gltf or "
+    ".usda/.usdc/.usd, or 'example' (example:jog, example:chain, example:take, ...) for a "
+    "built-in synthetic capture"
+)
+
 
 def frame_range(text: str) -> tuple[int | None, int | None]:
     """Parse ``A:B`` (0-based, half-open; either side may be empty)."""

@@ -22,12 +22,20 @@ def add_parser(subparsers) -> None:
             "the script fails."
         ),
     )
-    p.add_argument("script", metavar="SCRIPT.json")
-    p.add_argument("-o", "--output", required=True, metavar="OUT.bvh")
+    p.add_argument(
+        "script", metavar="SCRIPT.json",
+        help="the script: models by name, start, commands (see examples/latent_script.json)",
+    )
+    p.add_argument(
+        "-o", "--output", required=True, metavar="OUT.bvh",
+        help="the synthesised motion; its suffix chooses the format (.bvh, .amc, .npz, .csv, "
+        ".glb/.gltf, .usda/.usdc/.usd)",
+    )
     p.add_argument(
         "--report", metavar="R.json", help="write a JSON report (commands, bridges, timing, checks)"
     )
     p.add_argument("--no-check", action="store_true", help="skip the plausibility checks")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar over the commands")
     add_feet_option(p)
     p.set_defaults(func=run)
     declare(p, inputs=_script_files, files=("-o", "--report"), derived=_skeleton_output)
@@ -56,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
         if not (target.parent if str(target.parent) else Path(".")).is_dir():
             raise ParameterError(f"{target}: folder {target.parent} does not exist")
     motion, report = run_script(
-        script, check=not args.no_check, progress=True, feet=args.feet or None
+        script, check=not args.no_check, progress=not args.no_progress, feet=args.feet or None
     )
     # every output moves into place at the end, so a failure or Ctrl-C leaves none
     with Outputs() as staged:

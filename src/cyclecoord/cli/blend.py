@@ -311,9 +311,7 @@ def cmd_blend(args: argparse.Namespace) -> int:
         f"blend {', '.join(f'{w:g}' for w in info['weights'])}: {out.n_frames} frames "
         f"({s['seconds']:.3f} s; inputs "
         + ", ".join(f"{v['frames']}" for v in summaries)
-        + f"), loop closure {s['loop_closure']:.2f}, jerk {s['jerk']:.4g} (inputs "
-        + ", ".join(f"{v['jerk']:.4g}" for v in summaries)
-        + ")"
+        + f"), loop closure {s['loop_closure']:.2f}, {_jerk_words(s, summaries)}"
     )
     for note in info["notes"]:
         print(f"note: {note}")
@@ -331,6 +329,21 @@ def cmd_blend(args: argparse.Namespace) -> int:
         "blend": info,
     }
     return finish(args, out, payload, report, "blend")
+
+
+def _jerk_words(out: dict, inputs: list[dict]) -> str:
+    """The blend's jerk against its inputs': a ratio, then the figures with an SI prefix
+    (mean jerk norm of the channels, degrees / s³ for joint angles)."""
+    import math
+
+    from .._words import si
+
+    mean = sum(v["jerk"] for v in inputs) / max(len(inputs), 1)
+    if not (math.isfinite(mean) and mean > 0 and math.isfinite(out["jerk"])):
+        return "jerk not measured (fewer than 7 frames)"
+    ratio = f"{out['jerk'] / mean:.2f}x the inputs' mean"
+    figures = ", ".join(si(v["jerk"], "deg/s³") for v in inputs)
+    return f"jerk {ratio} ({si(out['jerk'], 'deg/s³')}; inputs {figures})"
 
 
 def _skating(

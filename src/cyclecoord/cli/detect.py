@@ -8,7 +8,9 @@ from pathlib import Path
 
 from ..errors import NoPeriodicMotionError, ParameterError
 from ..io import input_files
+from .._words import plural
 from ._options import (
+    INPUT_HELP,
     EXIT_NO_PERIODIC,
     EXIT_OK,
     add_feet_option,
@@ -40,7 +42,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
             "report. Exit code 3 when nothing is found."
         ),
     )
-    d.add_argument("input", metavar="INPUT")
+    d.add_argument("input", metavar="INPUT", help=INPUT_HELP)
     add_selection_options(d)
     d.add_argument(
         "--classes",
@@ -182,7 +184,7 @@ def _detect(args: argparse.Namespace, motion, out: Outputs) -> int:
         print(
             f"; {len(res.windows)} windows, {sum(w.looping for w in res.windows)} looping", end=""
         )
-    print(f": {res.n_motions} motion(s)")
+    print(f": {plural(res.n_motions, 'motion')}")
     for sg in res.segments:
         print(
             f"  motion {sg.motion}: frames {m.start_frame + sg.start}-{m.start_frame + sg.stop} "

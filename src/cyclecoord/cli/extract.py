@@ -11,6 +11,7 @@ import numpy as np
 from ..errors import NoPeriodicMotionError, ParameterError
 from ..io import input_files
 from ._options import (
+    INPUT_HELP,
     EXIT_NO_PERIODIC,
     EXIT_OK,
     add_cycle_options,
@@ -43,7 +44,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
             "report is still written."
         ),
     )
-    e.add_argument("input", metavar="INPUT")
+    e.add_argument("input", metavar="INPUT", help=INPUT_HELP)
     add_units_option(add_selection_options(e))
     g = e.add_argument_group("class, scale and cycle")
     g.add_argument(
@@ -304,7 +305,7 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
     width = ""
     if res.parameters.get("bandwidth") is not None:
         chosen = " (cross-validated)" if res.typical.bandwidth_selection is not None else ""
-        width = f"; kernel width {res.typical.bandwidth:.3g} frames{chosen}"
+        width = f"; kernel width {_frames(res.typical.bandwidth)}{chosen}"
     lines.append(
         f"cycle: {res.cycle.n_frames} frames ({res.cycle.n_frames / fps:.3f} s), {seam} "
         f"(last-to-first step {closure:.2f} median steps), {smooth} (jerk ratio "
@@ -340,7 +341,7 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
     )
     lines.append(
         f"frames to cycle: median distance {res.distance['median']:.3g} (median frame step "
-        f"{res.distance['median_frame_step']:.3g}); kernel width {res.typical.bandwidth:.3g} frames"
+        f"{res.distance['median_frame_step']:.3g}); kernel width {_frames(res.typical.bandwidth)}"
     )
     lines.append(
         f"largest cycle step {res.distance['largest_cycle_step']:.3g} (capture's 99th "
@@ -433,3 +434,8 @@ def _save_plots(result, folder: str, out: Outputs) -> None:
 
     for path in save_figures(result, out.folder(folder)):
         out.wrote(Path(folder) / path.name)
+
+
+def _frames(n: float) -> str:
+    """``"1 frame"``, ``"2.5 frames"``: a kernel width in words."""
+    return f"{n:.3g} frame" + ("" if float(f"{n:.3g}") == 1 else "s")

@@ -105,6 +105,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="write nothing when the motion fails the plausibility checks",
     )
     p.add_argument("--no-topo", action="store_true", help="crossval: skip the bottleneck distances")
+    p.add_argument(
+        "--no-progress", action="store_true",
+        help="no progress bars (loading the takes, crossval's folds)",
+    )
     p.set_defaults(func=run)
     declare(p, inputs=_files_read, files=("-o", "--report"), folders={"--plot": r".*\.png"})
     return p
@@ -126,16 +130,41 @@ def _take_spec(text: str) -> tuple[str, int]:
 
 
 def _find(path: str, inputs: list[str], motions: list):
-    """The motion of ``path``: a training take when it names one, else loaded."""
-    for name, m in zip(inputs, motions):
-        if (
-            Path(name).exists()
-            and Path(path).exists()
-            and Path(name).resolve() == Path(path).resolve()
-            or name == path
-        ):
-            return m
+    """The motion ``--start``/``--target`` names: a training take when it names one, else
+    the file loaded.
+
+    Paths are matched as files: the same file named two ways (``35_16.amc``,
+    ``./data/35_16.amc``, an absolute path or a link) is the same take; a name that is
+    not a file here but is the name (or the trailing path) of one training take is that
+    take, and of two is an error naming both.
+    """
+    given = Path(path)
+    if given.is_file():
+        for name, m in zip(inputs, motions):
+            if Path(name).is_file() and _same_file(Path(name), given):
+                return m
+        return load_input(path)
+    parts = given.parts
+    matches = [
+        (name, m)
+        for name, m in zip(inputs, motions)
+        if parts and Path(name).parts[-len(parts):] == parts
+    ]
+    if len(matches) > 1:
+        raise ParameterError(
+            f"{path}: names more than one training take ({', '.join(n for n, _ in matches)}); "
+            "give the path of the one you mean"
+        )
+    if matches:
+        return matches[0][1]
     return load_input(path)
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.samefile(b)
+    except OSError:
+        return a.resolve() == b.resolve()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -149,7 +178,9 @@ def run(args: argparse.Namespace) -> int:
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder")
     motions = [
-        load_input(p) for p in tqdm(inputs, desc="loading", unit="take", disable=len(inputs) < 4)
+        load_input(p)
+        for p in tqdm(inputs, desc="loading", unit="take",
+                      disable=len(inputs) < 4 or args.no_progress)
     ]
     with Outputs() as out:  # every output moves into place at the end, or none does
         if crossval:
@@ -170,7 +201,7 @@ def _crossval(args: argparse.Namespace, motions: list, out: Outputs) -> int:
         integrator=args.integrator,
         step_scale=args.step_scale or 1.0,
         topo=not args.no_topo,
-        progress=True,
+        progress=not args.no_progress,
     )
     print(cv.table())
     outside = sum(f["outside_hull_steps"] for f in cv.folds)

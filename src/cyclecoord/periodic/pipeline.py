@@ -253,10 +253,15 @@ def extract(
                 res = extract(motion, frames=frames, delay=AUTO_DELAY, **options)
             except NoPeriodicMotionError:
                 raise first from None
+            # what the poses alone showed: the refusal's reason, without the file it names
+            # and without its advice (the delay was what helped)
+            reason = getattr(first.result, "reason", None) or str(first)
+            seen = reason.removeprefix("no periodic motion found: ").split("; ")[0]
             res.warnings.insert(
                 0,
-                f"read with a {AUTO_DELAY:g} s delay embedding: the poses alone show no "
-                "periodic motion (an out-and-back movement, such as a squat)",
+                f"read with a {AUTO_DELAY:g} s delay embedding (each pose joined by the pose "
+                f"{AUTO_DELAY:g} s later), because the poses alone showed no periodic motion: "
+                f"{seen}",
             )
             return res
     opts = _check_options(

@@ -116,6 +116,10 @@ class PartialExtraction:
     estimator: CircularCoordinates | None = None
     preprocessor: Preprocessor | None = None
 
+    def __repr__(self) -> str:  # one line, not the arrays it holds
+        bars = "no barcode" if self.barcode is None else f"{len(self.barcode.h1)} H1 bars"
+        return f"PartialExtraction({self.motion!r}, {bars}, reason={self.reason!r})"
+
 
 @dataclass
 class ExtractionResult:
@@ -209,6 +213,12 @@ class ExtractionResult:
     pose_quality: Any = None
     rig: Any = None
     rig_changes: list = field(default_factory=list)
+
+    def __repr__(self) -> str:  # one line, not the arrays it holds
+        return (
+            f"ExtractionResult({self.motion!r}, period {self.period_frames:.1f} frames, "
+            f"{self.cycles:.2f} cycles over frames {self.used_frames})"
+        )
 
     def _rig_dict(self) -> dict | None:
         if self.rig is None:

@@ -86,8 +86,9 @@ def motion_cycles(
     global H1 class, that class's circular coordinate on the frames it excites inside
     the segment (the class the motion was detected by, so the cycle has the segment's
     period); for a motion found by the windows alone, time over the segment's period
-    (:func:`autocorrelation_period`), which is accurate for the one to three cycles such
-    segments hold.  The typical cycle is then built as :func:`cyclecoord.extract` builds
+    (:func:`~cyclecoord.periodic.detection.windows.autocorrelation_period`), which is accurate for
+    the one to three cycles such segments hold.  The typical cycle is then built as
+    :func:`cyclecoord.extract` builds
     it: by default (``timing="capture"``) in a phase re-timed to the capture's pace
     between the coordinate's crossings and aligned by time warping
     (:func:`~cyclecoord.periodic.clip.capture_cycle`), slowest pose first, root tilt

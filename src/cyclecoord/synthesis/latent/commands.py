@@ -500,7 +500,7 @@ class Synthesizer:
         true, the default: possibly through other models, one hop each) or directly:
         a hop without a bridge crosses at its closest pair of poses.  The blend lasts
         ``blend`` seconds or longer when the two poses are far apart
-        (:meth:`blend_frames`).  Each hop is reported in :attr:`events` with its route,
+        (:meth:`blend_frames`).  Each hop is reported in ``self.events`` with its route,
         pose distance and blend length.
         """
         self._need_start("TRANSITION")
