@@ -216,6 +216,9 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         )
     else:
         gen = synth.generate(args.frames, start, frame)
+    from .blend import _lead
+
+    quality = _lead(gen.motion, motions)
     conn = synth.graph_.connectivity()
     print(
         f"{synth.graph_.method} graph ({synth.field_.name} field) over {conn['nodes']} frames of "
@@ -263,4 +266,4 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         for p in save_graph_figures(synth, gen, out.folder(args.plot)):
             out.wrote(Path(args.plot) / p.name)
     report = check_plausibility(gen.motion, motions)
-    return finish(args, gen.motion, payload, report, "generated motion", out=out)
+    return finish(args, gen.motion, payload, report, "generated motion", out=out, quality=quality)

@@ -582,3 +582,25 @@ def measure_generated(
         held_frames=int(held.sum()),
         notes=notes,
     )
+
+
+def lead_lines(
+    motion: Motion,
+    sources: Sequence[Motion],
+    *,
+    feet: Sequence[str] | str | None = None,
+    hold: np.ndarray | None = None,
+    reference: SourceFigures | None = None,
+) -> tuple[dict | None, list[str]]:
+    """The measure as a report dict and the console lines that lead a command's output;
+    ``(None, [why])`` when it cannot be measured (no skeleton, no legs found)."""
+    from ..errors import CycleCoordError
+    from .legs import resolve_feet
+
+    try:
+        if isinstance(feet, str):
+            feet = resolve_feet(motion.skeleton, feet)
+        q = measure_generated(motion, sources, feet=feet, hold=hold, reference=reference)
+    except CycleCoordError as exc:
+        return None, [f"generated motion: not measured ({exc})"]
+    return q.to_dict(), q.summary()

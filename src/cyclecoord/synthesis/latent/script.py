@@ -188,6 +188,41 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
     return spec, models
 
 
+def training_takes(models: dict[str, LatentModel], names=None) -> list:
+    """The training segments of ``models`` (all, or those in ``names``) as motions."""
+    from ...motion import Motion
+
+    out = []
+    for k in sorted(models if names is None else names):
+        m = models[k]
+        for seg in np.unique(m.segments_):
+            rows = np.flatnonzero(m.segments_ == seg)
+            if rows.size >= 3:
+                out.append(
+                    Motion(
+                        frames=m.frames_[rows],
+                        channels=m.all_channels_,
+                        fps=m.fps_,
+                        skeleton=m.skeleton_,
+                    )
+                )
+    return out
+
+
+def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None, list[str]]:
+    """The measure of generated motion (:mod:`cyclecoord.quality.generated`) against the
+    training segments of the models the script used, IDLE frames counted as asked holds."""
+    from ...quality.generated import lead_lines
+
+    hold = np.zeros(motion.n_frames, dtype=bool)
+    for seg in syn.segments():
+        idx = seg["command"]
+        if 0 <= idx < len(commands) and str(commands[idx]["command"]).upper() == "IDLE":
+            hold[seg["start"] : seg["stop"]] = True
+    sources = training_takes(syn.models, {c.model for c in syn.chunks})
+    return lead_lines(motion, sources, feet=feet, hold=hold)
+
+
 def run_script(
     path: str | Path,
     check: bool = True,
@@ -262,7 +297,10 @@ def run_script(
             raise _fail(p, f"commands[{i}] ({c['command']})", str(exc)) from None
     total = time.perf_counter() - t0
     motion = syn.motion()
+    quality, quality_lines = script_quality(syn, motion, commands, feet)
     report: dict[str, Any] = {
+        "motion_quality": quality,
+        "motion_quality_lines": quality_lines,
         "script": str(p),
         "fps": syn.fps,
         "seed": syn.seed,
