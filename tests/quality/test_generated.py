@@ -119,3 +119,23 @@ def test_freezes_and_held_frames(walks):
     hold = np.zeros(m.n_frames, dtype=bool)
     hold[100:161] = True
     assert not measure_generated(frozen, walks, hold=hold).freezes
+
+
+@needs_data
+def test_graph_feet_carry_the_body(walks):
+    """cyclecoord graph's defaults (auto dims, root carried by the feet, feet pinned where
+    that adds no pop) plant the feet; the paper's 2 dims with the mean root step glide."""
+    from cyclecoord.synthesis.graph import MotionGraphSynth
+
+    old = MotionGraphSynth(dims=2, step_scale=2.0, carry=False).fit(walks)
+    glide = measure_generated(old.generate(360, walks[0], 0).motion, walks)
+    assert glide.feet_word == "gliding"
+    synth = MotionGraphSynth(dims="auto", step_scale=2.0).fit(walks)
+    gen = synth.generate(360, walks[0], 0)
+    q = measure_generated(gen.motion, walks)
+    assert synth.dims_ == 4
+    assert q.feet_word == "planted" and q.support_slip < 0.05
+    assert q.penetration_m < 0.01 and not q.freezes
+    assert min(q.knee_ratio) > 0.85 and q.largest_accel < 1.5
+    assert 0.7 < q.root_ratio < 1.2
+    assert any(n.startswith("foot locking:") for n in gen.notes)

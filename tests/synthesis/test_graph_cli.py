@@ -171,7 +171,9 @@ def test_w1_generated_walk_loops_and_is_plausible(w1):
     from cyclecoord.synthesis.graph import MotionGraphSynth
 
     gen = (
-        MotionGraphSynth(method="delaunay", dims=2, step_scale=2.0).fit(w1).generate(450, w1[0], 0)
+        MotionGraphSynth(method="delaunay", dims="auto", step_scale=2.0)
+        .fit(w1)
+        .generate(450, w1[0], 0)
     )
     res = cc.extract(gen.motion)
     assert res.cycles >= 1.5

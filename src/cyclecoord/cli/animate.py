@@ -92,6 +92,8 @@ def run(args: argparse.Namespace) -> int:
                 f"{kind} (pose distance {ev['bridge_distance']:.3g}, blend {ev['blend_frames']} "
                 "frames)"
             )
+    for note in report.get("notes", []):
+        print(note)
     if "plausibility" in report:
         pl = report["plausibility"]
         print("plausibility: " + ("clean" if pl["clean"] else "; ".join(pl["notes"])))
