@@ -119,6 +119,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="write nothing when the motion fails the plausibility checks",
     )
     p.add_argument("--no-topo", action="store_true", help="crossval: skip the bottleneck distances")
+    p.add_argument(
+        "--horizon",
+        type=int,
+        default=3,
+        help="crossval: also follow the field for this many times each left-out take, with "
+        "freeze and slip columns (default 3; 0 skips it)",
+    )
     p.set_defaults(func=run)
     declare(p, inputs=_files_read, files=("-o", "--report"), folders={"--plot": r".*\.png"})
     return p
@@ -190,6 +197,7 @@ def _crossval(args: argparse.Namespace, motions: list, out: Outputs) -> int:
         step_scale=args.step_scale or 1.0,
         topo=not args.no_topo,
         progress=True,
+        horizon=args.horizon,
     )
     print(cv.table())
     outside = sum(f["outside_hull_steps"] for f in cv.folds)
@@ -198,6 +206,15 @@ def _crossval(args: argparse.Namespace, motions: list, out: Outputs) -> int:
         "pos (RMS joint distance, skeleton units); topo: bottleneck of H1 barcodes; "
         f"{outside} steps outside the hull"
     )
+    if cv.long:
+        print()
+        print(cv.long_table())
+        print(
+            f"longer horizon: the field followed for {args.horizon}x each left-out take; "
+            "freeze: longest stretch (s) under 10 % of the training takes' median pose speed "
+            "(folds fz: folds with one over 0.2 s); slip: support-foot speed (m/s; x the "
+            "training takes'), root carried by the feet, no foot locking"
+        )
     if args.report:
         write_json(out.file(args.report), clean(cv.to_report()))
         out.wrote(args.report)
