@@ -80,8 +80,11 @@ def test_crossval_report_keys(synthetic_takes, tmp_path, capsys):
     )
     assert rc == 0
     out = capsys.readouterr().out
-    assert "paper w1: delaunay" in out and "baseline: standing still" in out
+    # synthetic takes are none of the paper's sets: no paper row; the longer horizon's table
+    assert "no paper row" in out and "baseline: standing still" in out
+    assert "3x the left-out take" in out and "slip m/s" in out
     r = json.loads(rep.read_text())
+    assert set(r["long_horizon"]) == {"delaunay", "knn", "delaunay+ring+agree"}
     fold_keys = {
         "held_out",
         "method",
@@ -148,7 +151,7 @@ def test_w1_table_against_baselines(w1):
     from cyclecoord.synthesis.graph import cross_validate
 
     assert [m.n_frames for m in w1] == [443, 360, 455, 454]  # the paper's Table I
-    cv = cross_validate(w1, methods=("delaunay", "knn"), dims=3, topo=False)
+    cv = cross_validate(w1, methods=("delaunay", "knn"), dims=3, topo=False, horizon=0)
     still = cv.baselines["standing_still"]["median"]
     for m in ("delaunay", "knn"):
         assert cv.median[m]["error_f"] < 0.25 * still["error_f"]
@@ -163,6 +166,11 @@ def test_w1_table_against_baselines(w1):
     assert cv2.median["delaunay"]["error_f"] > knn["error_f"]
     assert ours["error_a"] <= knn["error_a"] and ours["error_f"] <= knn["error_f"]
     assert ours["error_a"] < 0.03 and ours["error_f"] < 0.03
+    # set w1 found by its take lengths: the paper's w1 row; three times the take, the
+    # paper's Delaunay and k-NN fields stall (the freezes one take's length never meets)
+    assert cv2.parameters["paper_set"] == "w1" and "paper w1: delaunay" in cv2.table()
+    assert cv2.long["delaunay+ring+agree"]["freeze_folds"] == 0
+    assert cv2.long["knn"]["longest_freeze_s"] > 1.0
 
 
 @pytest.mark.slow
@@ -171,7 +179,9 @@ def test_w1_generated_walk_loops_and_is_plausible(w1):
     from cyclecoord.synthesis.graph import MotionGraphSynth
 
     gen = (
-        MotionGraphSynth(method="delaunay", dims=2, step_scale=2.0).fit(w1).generate(450, w1[0], 0)
+        MotionGraphSynth(method="delaunay", dims="auto", step_scale=2.0)
+        .fit(w1)
+        .generate(450, w1[0], 0)
     )
     res = cc.extract(gen.motion)
     assert res.cycles >= 1.5

@@ -73,6 +73,8 @@ def run(args: argparse.Namespace) -> int:
         if args.report:
             with atomic_write(staged.file(args.report)) as fh:
                 json.dump(report, fh, indent=2, default=float)
+    for line in report.get("motion_quality_lines", []):
+        print(line)
     t = report["timing"]
     fps = t["frames_per_second"]
     cpu = t.get("frames_per_cpu_second")
@@ -98,8 +100,8 @@ def run(args: argparse.Namespace) -> int:
                 f"{kind} (pose distance {ev['bridge_distance']:.3g}, blend {ev['blend_frames']} "
                 "frames)"
             )
-    if report.get("foot_skating"):
-        print(f"foot skating: {report['foot_skating']['skating_fraction']:.0%} of frames")
+    for note in report.get("notes", []):
+        print(note)
     if "plausibility" in report:
         pl = report["plausibility"]
         print("plausibility: " + ("clean" if pl["clean"] else "; ".join(pl["notes"])))

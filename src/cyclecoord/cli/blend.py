@@ -245,8 +245,12 @@ def finish(
     what: str,
     problem: str | None = None,
     out: Outputs | None = None,
+    quality: dict | None = None,
 ) -> int:
     """Print the plausibility verdict, honour --strict, write the motion and the report.
+
+    ``quality`` (the measure of generated motion, :func:`~cyclecoord.quality.generated.
+    lead_lines`; printed by the command first) leads the report as ``motion_quality``.
 
     The outputs go through ``out`` (the command's staged outputs; a new one when None) and
     move into place together; with --strict and a failed check the report (and what was
@@ -256,7 +260,9 @@ def finish(
 
     if out is None:
         with Outputs() as own:
-            return finish(args, motion, payload, report, what, problem, own)
+            return finish(args, motion, payload, report, what, problem, own, quality)
+    if quality is not None:
+        payload = {"motion_quality": quality, **payload}
     print(report.summary())
     payload["plausibility"] = report.to_dict()
     refused = args.strict and (not report.clean or problem is not None)
@@ -297,6 +303,7 @@ def cmd_blend(args: argparse.Namespace) -> int:
         align_heading=not args.no_heading,
         up=args.up,
     )
+    quality = _lead(out, cycles, args.feet)
     info = out.metadata["blend"]
     for i, al in enumerate(info["alignments"][1:], start=1):
         rev = ", reversed" if al["reversed"] else ""
@@ -328,7 +335,7 @@ def cmd_blend(args: argparse.Namespace) -> int:
         "foot_skating": skating,
         "blend": info,
     }
-    return finish(args, out, payload, report, "blend")
+    return finish(args, out, payload, report, "blend", quality=quality)
 
 
 def _jerk_words(out: dict, inputs: list[dict]) -> str:
@@ -346,9 +353,18 @@ def _jerk_words(out: dict, inputs: list[dict]) -> str:
     return f"jerk {ratio} ({si(out['jerk'], 'deg/s³')}; inputs {figures})"
 
 
-def _skating(
-    motion, inputs: list, what: str, feet: str | None = None
-) -> tuple[dict | None, list]:
+def _lead(motion, sources: list, feet: str | None = None) -> dict | None:
+    """Print the measure of generated motion against ``sources`` (the console's first
+    lines) and return its report dict (None when it cannot be measured)."""
+    from ..quality.generated import lead_lines
+
+    quality, lines = lead_lines(motion, sources, feet=feet or None)
+    for line in lines:
+        print(line)
+    return quality
+
+
+def _skating(motion, inputs: list, what: str, feet: str | None = None) -> tuple[dict | None, list]:
     """Foot skating of the result and of each input cycle (``skating_report`` dicts, None
     where not measurable), and one console line for them; ``feet`` is ``--feet``'s text
     (None: found on each)."""
@@ -389,6 +405,7 @@ def cmd_transition(args: argparse.Namespace) -> int:
         align_heading=not args.no_heading,
         up=args.up,
     )
+    quality = _lead(clip, [a, b], args.feet)
     info = clip.metadata["transition"]
     al = info["alignment"]
     cont = info["continuity"]
@@ -421,4 +438,4 @@ def cmd_transition(args: argparse.Namespace) -> int:
     problem = None
     if cont["max_ratio"] > cont["limit"]:
         problem = f"has a step {cont['max_ratio']:.2f}x the typical step (limit {cont['limit']:g})"
-    return finish(args, clip, payload, report, "transition", problem)
+    return finish(args, clip, payload, report, "transition", problem, quality=quality)

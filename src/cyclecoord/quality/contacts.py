@@ -324,7 +324,7 @@ def foot_contacts(
     feet: tuple[str, ...] | list[str] | None = None,
     *,
     height: float = DEFAULT_HEIGHT,
-    speed: float = DEFAULT_SPEED,
+    speed: float | None = DEFAULT_SPEED,
     min_duration: float = DEFAULT_MIN_DURATION,
     up: str = "y",
     floor: float | None = None,
@@ -343,9 +343,11 @@ def foot_contacts(
     height : float
         Height band above a point's contact level, as a fraction of the leg length
         (0.05: about 4 cm on an adult).
-    speed : float
+    speed : float or None
         Horizontal speed limit of a planted point, in leg lengths per second (0.5:
-        about 0.4 m/s).
+        about 0.4 m/s).  None: contact from height alone, not gated by speed (what
+        :mod:`cyclecoord.quality.generated` judges generated motion by: a foot that
+        glides along the floor is on the floor, and its speed is the slip).
     min_duration : float
         Contacts shorter than this (seconds) are dropped and gaps shorter than this
         closed.
@@ -367,7 +369,8 @@ def foot_contacts(
     skel = contact_skeleton(motion)
     if up not in _UP:
         raise ParameterError(f"up axis must be one of x, y, z, got {up!r}")
-    for label, value in (("height", height), ("speed", speed)):
+    gates = (("height", height),) if speed is None else (("height", height), ("speed", speed))
+    for label, value in gates:
         if not (np.isfinite(value) and value > 0):
             raise ParameterError(f"{label} threshold must be a positive number, got {value!r}")
     if not (np.isfinite(min_duration) and min_duration >= 0):
@@ -402,7 +405,7 @@ def foot_contacts(
     spd = np.linalg.norm(vel, axis=2)
 
     h_thr = height * scale
-    v_thr = speed * scale
+    v_thr = np.inf if speed is None else speed * scale
     planted = (rel < h_thr) & (spd < v_thr)
     min_frames = round(min_duration * motion.fps)
     planted = np.stack([_clean(planted[:, i], min_frames) for i in range(len(feet))], axis=1)

@@ -585,7 +585,11 @@ def lock_feet(
     if not contact_options:  # find contacts afresh with the thresholds of the given ones
         contact_options = {
             "height": contacts.height_threshold / contacts.leg_length,
-            "speed": contacts.speed_threshold / contacts.leg_length,
+            "speed": (
+                contacts.speed_threshold / contacts.leg_length
+                if np.isfinite(contacts.speed_threshold)
+                else None
+            ),
             "up": "xyz"[contacts.up],
         }
     out, worst = _lock_once(motion, contacts, nb, cyclic)

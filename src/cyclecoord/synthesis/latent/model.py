@@ -314,6 +314,12 @@ class LatentModel:
             "latent_speed_per_s": self.speed_,
         }
 
+    def training_motion(self) -> Motion:
+        """The training frames as one motion (segments end to end)."""
+        return Motion(
+            frames=self.frames_, channels=self.all_channels_, fps=self.fps_, skeleton=self.skeleton_
+        )
+
     # --------------------------------------------------------------- storage
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the model and its training frames to ``path`` (``.npz``, atomic)."""

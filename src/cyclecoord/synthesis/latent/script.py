@@ -8,7 +8,7 @@ A script is a JSON object::
       "start": {"model": "jumpjack", "at": {"frame": 0}},
       "particle": {"radius": 0.15, "random": 6},
       "bridge_threshold": null,
-      "plant": "transitions", "lock_feet": false,
+      "plant": "all", "lock_feet": true,
       "commands": [
         {"command": "IDLE", "duration": 1.5},
         {"command": "MOVE", "to": {"segment": "JumpJack", "time": 2.0}, "path": "graph"},
@@ -155,9 +155,9 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
         raise _fail(
             p, "bridge_threshold", f"must be a positive number of skeleton units, got {thr!r}"
         )
-    if spec.get("plant", "transitions") not in ("transitions", "all", "off"):
+    if spec.get("plant", "all") not in ("transitions", "all", "off"):
         raise _fail(p, "plant", f"must be transitions, all or off, got {spec['plant']!r}")
-    if not isinstance(spec.get("lock_feet", False), bool):
+    if not isinstance(spec.get("lock_feet", True), bool):
         raise _fail(p, "lock_feet", f"must be true or false, got {spec['lock_feet']!r}")
     feet = spec.get("feet")
     if feet is not None and (
@@ -186,6 +186,37 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
         if kind == "TRANSITION" and c["to"] not in models:
             raise _fail(p, where, f"unknown model {c['to']!r}; the script defines {sorted(models)}")
     return spec, models
+
+
+def training_takes(models: dict[str, LatentModel], names=None) -> list:
+    """The training segments of ``models`` (all, or those in ``names``) as motions."""
+    from ...motion import Motion
+
+    out = []
+    for k in sorted(models if names is None else names):
+        m = models[k]
+        for seg in np.unique(m.segments_):
+            rows = np.flatnonzero(m.segments_ == seg)
+            if rows.size >= 3:
+                out.append(
+                    Motion(
+                        frames=m.frames_[rows],
+                        channels=m.all_channels_,
+                        fps=m.fps_,
+                        skeleton=m.skeleton_,
+                    )
+                )
+    return out
+
+
+def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None, list[str]]:
+    """The measure of generated motion (:mod:`cyclecoord.quality.generated`) against the
+    training segments of the models the script used, IDLE frames counted as asked holds."""
+    from ...quality.generated import lead_lines
+
+    hold = syn.hold_mask(motion.n_frames)
+    sources = training_takes(syn.models, {c.model for c in syn.chunks})
+    return lead_lines(motion, sources, feet=feet, hold=hold)
 
 
 def run_script(
@@ -228,8 +259,8 @@ def run_script(
         seed=int(spec.get("seed", 0)),
         params=params,
         bridge_threshold=spec.get("bridge_threshold"),
-        plant=spec.get("plant", "transitions"),
-        lock=spec.get("lock_feet", False),
+        plant=spec.get("plant", "all"),
+        lock=spec.get("lock_feet", True),
         feet=feet,
     )
     start = spec.get("start", {"model": next(iter(models))})
@@ -262,7 +293,11 @@ def run_script(
             raise _fail(p, f"commands[{i}] ({c['command']})", str(exc)) from None
     total = time.perf_counter() - t0
     motion = syn.motion()
+    quality, quality_lines = script_quality(syn, motion, commands, feet)
     report: dict[str, Any] = {
+        "motion_quality": quality,
+        "motion_quality_lines": quality_lines,
+        "notes": list(syn.notes),
         "script": str(p),
         "fps": syn.fps,
         "seed": syn.seed,
@@ -287,7 +322,7 @@ def run_script(
     }
     sizes = {round(m.skeleton_.total_length(), 6) for m in models.values()}
     if len(sizes) > 1:
-        report["notes"] = [
+        report["notes"] += [
             "the models' skeletons have the same joints but different bone lengths; "
             f"the output uses {syn.chunks[0].model!r}'s"
         ]
