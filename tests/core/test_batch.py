@@ -13,11 +13,11 @@ import pytest
 
 import cyclecoord as cc
 from _measured import at_most
-from cyclecoord import batch
+from cyclecoord.batch import runner
 from cyclecoord.batch import SUMMARY_COLUMNS, find_captures, run_batch
 from cyclecoord.errors import ParameterError
 
-_ORIGINAL_PROCESS_ONE = batch._process_one
+_ORIGINAL_PROCESS_ONE = runner._process_one
 
 # relative path -> (kind, seed); the two "walk" files share a stem on purpose
 PERIODIC = {"walk.npz": ("walk", 1), "walk.bvh": ("walk", 2), "sub/deep/jog.bvh": ("jog", 3)}
@@ -242,7 +242,7 @@ def _crash_on_marker(task):
 def test_a_dying_worker_fails_only_its_capture(tmp_path, monkeypatch):
     src = _build(tmp_path / "in", {"a.npz": ("walk", 1), "crash.npz": ("walk", 2), "z.npz": ("squat", 4)},
                  static=False, broken=False)
-    monkeypatch.setattr(batch, "_process_one", _crash_on_marker)
+    monkeypatch.setattr(runner, "_process_one", _crash_on_marker)
     result = run_batch(src, tmp_path / "out", jobs=2, progress=False)
     assert {r["file"]: r["status"] for r in result.rows} == {"a.npz": "ok", "crash.npz": "error", "z.npz": "ok"}
     assert "worker process died" in result.row("crash.npz")["message"]

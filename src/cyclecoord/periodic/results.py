@@ -240,7 +240,7 @@ class ExtractionResult:
 
     def to_report(self) -> dict[str, Any]:
         """JSON-ready summary (see the CLI's ``--report``)."""
-        from ..report import capture_header
+        from .report import capture_header
 
         return {
             **capture_header(self.motion),
