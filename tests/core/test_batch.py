@@ -121,8 +121,9 @@ def test_statuses_summary_and_reports(first, folder):
         assert int(r["frames"]) == N_FRAMES and int(r["dims"]) == report["dims"] > 0
         assert 0 < float(r["birth"]) < float(r["scale"]) < float(r["death"])  # "inf" parses too
         assert float(r["birth"]) == pytest.approx(report["selected"]["birth"], rel=1e-5)
-        # the typical cycle is smoother than the noisy capture: measured 0.050-0.055 of its jerk
-        assert 0 < float(r["jerk_ratio"]) <= at_most(0.055)
+        # the typical cycle is smoother than the noisy capture: measured 0.090-0.095 of its
+        # jerk (joint positions, as extract prints it)
+        assert 0 < float(r["jerk_ratio"]) <= at_most(0.095)
         assert float(r["jerk_ratio"]) == pytest.approx(report["jerk"]["cycle"] / report["jerk"]["original"], rel=1e-5)
         assert float(r["loop_closure"]) == pytest.approx(report["loop_closure"], rel=1e-5)
         assert float(r["seconds"]) >= 0

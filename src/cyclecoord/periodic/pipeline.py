@@ -414,6 +414,10 @@ def _finish(
     t0 = time.perf_counter()
     jerk, closure, distance = _cycle_figures(prepared, typ, runs, rows, motion.fps)
     poses = pose_quality(cycle_motion, motion, runs, period)
+    if poses is not None and poses.figures is not None:
+        # the figures every command prints, on joint positions (quality.pose_space)
+        jerk = {"original": poses.capture_jerk, "cycle": poses.figures.jerk}
+        closure = poses.figures.loop_closure
     pop = poses.pop if poses is not None else (
         distance["largest_cycle_step"] / distance["p99_frame_step"])
     if np.isfinite(pop) and pop > MAX_POP:
