@@ -33,7 +33,7 @@ from .crossing import (  # noqa: F401  (re-exported: the module's names before t
     Crossings,
     Point,
 )
-from .easing import eased, resample, smootherstep, smoothstep
+from .easing import eased, resample, smootherstep, smoothstep  # noqa: F401
 from .gplvm import sqdist
 from .model import LatentModel
 from .output import (  # noqa: F401
@@ -45,11 +45,32 @@ from .output import (  # noqa: F401
     OutputMixin,
 )
 from .particle import ParticleParams, RandomForce, simulate
+from .stepping import GaitMixin
 
 __all__ = ["CommandGraph", "Crossings", "Synthesizer", "resample", "smootherstep", "smoothstep"]
 
 #: A latent target whose density proxy is below this lies outside the model.
 OUTSIDE_DENSITY = 0.05
+#: Joint angles may pass the training range by at most this fraction of it (eased).
+LIMIT_MARGIN = 0.1
+#: Path radius of a MOVE ahead along the gait, as a fraction of the particle's: on the
+#: synthetic run the full radius let the random force throw the pose 3.2x the training
+#: 99th percentile of pose speed in one step.
+AHEAD_RADIUS = 0.25
+#: Training frames this close in a segment are joined at their captured pace by a MOVE.
+PACE_GAP = 2
+
+
+def _path_times(m: LatentModel, poly: np.ndarray, nodes: list[int]) -> np.ndarray:
+    """Seconds at each vertex of a MOVE's polyline (``nodes``: its training frames, -1
+    for the ends): consecutive frames of a segment at their captured pace, the rest at
+    the model's median latent speed."""
+    seg = np.linalg.norm(np.diff(poly, axis=0), axis=1)
+    dt = seg / m.speed_
+    for i, (a, b) in enumerate(zip(nodes[:-1], nodes[1:])):
+        if a >= 0 and b >= 0 and m.segments_[a] == m.segments_[b] and abs(a - b) <= PACE_GAP:
+            dt[i] = abs(float(m.times_[b] - m.times_[a]))
+    return np.concatenate([[0.0], np.cumsum(dt)])
 
 
 class CommandGraph:
@@ -65,8 +86,9 @@ class CommandGraph:
         self.graph = nx.Graph()
         self.graph.add_weighted_edges_from(zip(i.tolist(), j.tolist(), cost.tolist()))
 
-    def path(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """Polyline from ``a`` to ``b`` through training points, ``(M, q)``."""
+    def path(self, a: np.ndarray, b: np.ndarray, nodes: bool = False):
+        """Polyline from ``a`` to ``b`` through training points, ``(M, q)`` (and with
+        ``nodes`` the training frame of each vertex, -1 for the ends)."""
         X = self.model.X_
         g = self.graph
         da = np.sqrt(((X - a) ** 2).sum(1)) ** self.power
@@ -75,10 +97,11 @@ class CommandGraph:
         g.add_weighted_edges_from(("b", k, float(c)) for k, c in enumerate(db))
         g.add_edge("a", "b", weight=float(np.linalg.norm(a - b) ** self.power))
         try:
-            nodes = nx.dijkstra_path(g, "a", "b")
+            path = nx.dijkstra_path(g, "a", "b")
         finally:
             g.remove_nodes_from(["a", "b"])
-        return np.vstack([a] + [X[k] for k in nodes[1:-1]] + [b])
+        poly = np.vstack([a] + [X[k] for k in path[1:-1]] + [b])
+        return (poly, [-1] + list(path[1:-1]) + [-1]) if nodes else poly
 
 
 @dataclass
@@ -91,7 +114,7 @@ class _Chunk:
 
 
 @dataclass
-class Synthesizer(CrossingMixin, OutputMixin):
+class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
     """Runs commands over named latent models and collects the frames.
 
     Parameters
@@ -173,6 +196,10 @@ class Synthesizer(CrossingMixin, OutputMixin):
         self.held: list[tuple[int, int]] = []  # frame ranges of IDLE commands
         self.notes: list[str] = []
         self._ranges: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self._gaits: dict = {}
+        # (model, segment, unwrapped phase) where the last stepping command left the
+        # particle, and the one the MOVE being made will leave
+        self._cursor = self._next_cursor = None
 
     def _range(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         if name not in self._ranges:
@@ -249,22 +276,28 @@ class Synthesizer(CrossingMixin, OutputMixin):
             )
         return self.models[self.current]
 
-    def _run(self, path: np.ndarray, radius: float | None = None) -> None:
+    def _run(self, path: np.ndarray, radius: float | None = None, ride: bool = False) -> None:
         m = self._need_start("moving")
+        self._cursor, self._next_cursor = self._next_cursor, None
         params = self.params if radius is None else self.params.replace(radius=radius)
         t0, c0 = time.perf_counter(), time.process_time()
-        X, V = simulate(m, path, self.x, self.v, self.fps, params, self.force, self.t)
+        X, V = simulate(m, path, self.x, self.v, self.fps, params, self.force, self.t, ride)
         self._emit(self.current, X, m.pose(X), self._root(m, X))
         self.sim_seconds += time.perf_counter() - t0
         self.sim_cpu_seconds += time.process_time() - c0
         self.x, self.v = X[-1], V[-1]
 
     def _clip(self, name: str, angles: np.ndarray) -> np.ndarray:
-        """Joint limits: clip to the training range of model ``name`` (counted)."""
+        """Joint limits: angles beyond the training range of model ``name`` are eased
+        back towards it, never past :data:`LIMIT_MARGIN` of the range beyond it
+        (``hi + m tanh((a - hi) / m)``: slope 1 at the limit and rising, so a joint
+        never flattens against it as a hard clip made it; counted)."""
         if not self.clamp:
             return angles
         lo, hi = self._range(name)
-        clipped = np.clip(angles, lo, hi)
+        mg = np.maximum(LIMIT_MARGIN * (hi - lo), 1e-6)
+        clipped = np.where(angles > hi, hi + mg * np.tanh((angles - hi) / mg), angles)
+        clipped = np.where(clipped < lo, lo - mg * np.tanh((lo - clipped) / mg), clipped)
         over = np.abs(clipped - angles)
         self.clamped["values"] += int((over > 1e-9).sum())
         self.clamped["max_deg"] = max(self.clamped["max_deg"], float(over.max(initial=0.0)))
@@ -302,38 +335,54 @@ class Synthesizer(CrossingMixin, OutputMixin):
         duration: float | None = None,
         speed: float = 1.0,
         radius: float | None = None,
+        stop: bool = True,
     ) -> None:
-        """MOVE to a target along a line or the command graph's shortest path."""
+        """MOVE to a target along a line or the command graph's shortest path, or
+        ``{"ahead": seconds}`` along the gait.
+
+        The path is timed from the training takes: a stretch between two consecutive
+        training frames of a segment takes the time it took in the capture, the rest
+        (a line, a jump between takes) its length at the model's median latent speed;
+        ``speed`` scales and ``duration`` sets the whole.  The particle speeds up over
+        ``ease`` seconds only when it starts from rest and slows down only with ``stop``
+        (a script passes ``stop=False`` when a MOVE or TRANSITION follows), so a chain of
+        MOVEs flows through its waypoints.
+        """
         m = self._need_start("MOVE")
-        goal = self.target(to)
-        if path == "line":
-            poly = np.vstack([self.x, goal])
-        elif path == "graph":
-            if self.current not in self._graphs:
-                self._graphs[self.current] = CommandGraph(m)
-            poly = self._graphs[self.current].path(self.x, goal)
-        else:
-            raise ParameterError(f"MOVE path must be 'line' or 'graph', got {path!r}")
         if not (isinstance(speed, (int, float)) and speed > 0):
             raise ParameterError(f"MOVE speed must be a positive number, got {speed!r}")
-        length = float(np.linalg.norm(np.diff(poly, axis=0), axis=1).sum())
-        if duration is None:
-            n = max(1, int(np.ceil(length / (m.speed_ * speed) * self.fps)))
+        if isinstance(to, dict) and "ahead" in to:
+            if set(to) != {"ahead"}:
+                raise ParameterError(f"an ahead target takes no other keys, got {sorted(to)}")
+            timed = self.ahead_path(to["ahead"]) or self.segment_ahead(to["ahead"])
+            poly, times = timed
+            if radius is None:
+                radius = AHEAD_RADIUS * self.params.radius
         else:
+            goal = self.target(to)
+            if path == "line":
+                poly, nodes = np.vstack([self.x, goal]), [-1, -1]
+            elif path == "graph":
+                if self.current not in self._graphs:
+                    self._graphs[self.current] = CommandGraph(m)
+                poly, nodes = self._graphs[self.current].path(self.x, goal, nodes=True)
+            else:
+                raise ParameterError(f"MOVE path must be 'line' or 'graph', got {path!r}")
+            times = _path_times(m, poly, nodes)
+        times = times / speed
+        if duration is not None:
             if not (isinstance(duration, (int, float)) and duration > 0):
                 raise ParameterError(
                     f"MOVE duration must be a positive number of seconds, got {duration!r}"
                 )
-            n = max(1, int(round(duration * self.fps)))
+            times = times * (duration / max(times[-1], 1e-12))
         ramp = int(round(self.ease * self.fps))
-        if ramp:
-            n += ramp  # the ramps lose about half their length each
-        dense = resample(poly, max(length / (4 * n), 1e-12))
-        s = (eased(n, ramp) if ramp else np.linspace(0, 1, n + 1)) * (dense.shape[0] - 1)
-        samples = np.stack(
-            [np.interp(s, np.arange(dense.shape[0]), dense[:, k]) for k in range(dense.shape[1])], 1
-        )
-        self._run(samples, radius)
+        still = self.v is None or np.linalg.norm(self.v) < 0.25 * m.speed_
+        r_in, r_out = (ramp if still else 0), (ramp if stop else 0)
+        n = max(1, int(round(times[-1] * self.fps)) + (r_in + r_out) // 2)
+        u = eased(n, r_in, r_out) * times[-1]
+        samples = np.stack([np.interp(u, times, poly[:, k]) for k in range(poly.shape[1])], 1)
+        self._run(samples, radius, ride=True)
 
     def idle(
         self, at: Any = None, duration: float = 1.0, radius: float | None = None, hover: float = 1.0

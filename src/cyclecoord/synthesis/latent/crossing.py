@@ -16,7 +16,7 @@ import networkx as nx
 import numpy as np
 
 from ...errors import ParameterError
-from .bridges import Bridges, check_compatible, find_bridges
+from .bridges import DEFAULT_THRESHOLD, Bridges, check_compatible, find_bridges
 from .easing import smootherstep
 from .influence import pose_points
 from .particle import simulate
@@ -178,12 +178,27 @@ class CrossingMixin:
             return 1
         return int(np.ceil(self.fps * np.sqrt(10.0 / np.sqrt(3.0) * D / budget)))
 
-    def transition(
-        self, to: str, blend: float = 0.4, radius: float | None = None, route: bool = True
-    ) -> None:
-        """TRANSITION: move to the nearest bridge, blend into model ``to`` while both idle.
+    def crossings_threshold(self, src: str) -> float:
+        """The bridge threshold (skeleton units) of crossings from model ``src``."""
+        if self.bridge_threshold is not None:
+            return float(self.bridge_threshold)
+        return DEFAULT_THRESHOLD * self.models[src].skeleton_.total_length()
 
-        Bridges of both directions count.  Without a bridge under the threshold the
+    def transition(
+        self,
+        to: str,
+        blend: float = 0.4,
+        radius: float | None = None,
+        route: bool = True,
+        in_step: bool = True,
+    ) -> None:
+        """TRANSITION into model ``to``.
+
+        Between two models with a gait phase (:meth:`~.stepping.GaitMixin.gait_hop`,
+        ``in_step`` true, the default): at once and in step, the two gaits blending over
+        ``blend`` seconds while both keep stepping.  Otherwise: move to the nearest
+        bridge, blend into model ``to`` while both idle.  Bridges of both directions
+        count.  Without a bridge under the threshold the
         transition still happens, by the cheapest route of :meth:`route` (``route``
         true, the default: possibly through other models, one hop each) or directly:
         a hop without a bridge crosses at its closest pair of poses.  The blend lasts
@@ -201,6 +216,9 @@ class CrossingMixin:
             )
         if src == to:
             raise ParameterError(f"TRANSITION to {to!r}: the particle is already in it")
+        if in_step and self.can_step_across(src, to):
+            self.gait_hop(src, to, blend)
+            return
         hops = [src, to]
         if route:
             c = self.crossings(src, to)
