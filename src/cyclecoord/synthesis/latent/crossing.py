@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import networkx as nx
 import numpy as np
 
+from ..._words import plural
 from ...errors import ParameterError
 from .bridges import DEFAULT_THRESHOLD, Bridges, check_compatible, find_bridges
 from .easing import smootherstep
@@ -38,6 +39,15 @@ MAX_BLEND = 4.0
 #: Without a bridge, pairs within this factor of the closest distance are candidates
 #: (the one nearest the particle is taken).
 CLOSE_ENOUGH = 1.1
+
+
+def blend_asked(blend: float, fps: float) -> int:
+    """Frames of a blend of ``blend`` seconds; shorter than one frame is an error."""
+    if blend * fps < 1.0 - 1e-9:
+        raise ParameterError(
+            f"TRANSITION blend {blend:g} s is shorter than one frame at {fps:g} fps"
+        )
+    return int(round(blend * fps))
 
 
 class Point(list):
@@ -241,8 +251,17 @@ class CrossingMixin:
         x1, x2 = c.source_points[b], c.target_points[b]
         small = 0.5 * (self.params.radius if radius is None else radius)
         self.move(Point(x1), radius=small, speed=APPROACH_SPEED)
-        asked = max(1, int(round(blend * self.fps)))
+        asked = blend_asked(blend, self.fps)
         n = min(max(asked, self.blend_frames(src, to, x1, x2)), int(MAX_BLEND * self.fps))
+        if n != asked:
+            self.notes.append(
+                f"commands[{self.command}] TRANSITION {src} -> {to}: blend raised from "
+                f"{blend:g} s ({plural(asked, 'frame')}) to {n / self.fps:.2f} s ({n} frames): "
+                "blending "
+                f"poses {c.distances[b]:.3g} units apart faster "
+                f"would accelerate joints over {BLEND_ACCELERATION:g}x the models' training "
+                "99th percentile"
+            )
         still = np.repeat(x1[None, :], n + 1, axis=0)
         p1 = self.params.replace(radius=small)
         X1, _ = simulate(m1, still, self.x, self.v, self.fps, p1, self.force, self.t)

@@ -20,12 +20,18 @@ from typing import Any
 
 import numpy as np
 
+from ..._words import plural
 from ...errors import ParameterError
+from .crossing import BLEND_ACCELERATION, blend_asked
 from .easing import smootherstep
 from .gait import Gait
 from .influence import pose_points
 
-__all__ = ["GaitMixin"]
+__all__ = ["GaitMixin", "IN_STEP_LONGEST"]
+
+#: An in-step blend is raised (and said) up to this many seconds at most, so the
+#: TRANSITION completes within a second of the command.
+IN_STEP_LONGEST = 1.0
 
 
 class GaitMixin:
@@ -125,12 +131,18 @@ class GaitMixin:
         m1, m2 = self.models[src], self.models[to]
         sa, ua = self._gait_place(src)
         sb, ub, dist = self._matched(src, to, ua, self.x)
-        asked = blend * self.fps
-        if asked < 1.0:
-            raise ParameterError(
-                f"TRANSITION blend {blend:g} s is shorter than one frame at {self.fps:g} fps"
+        asked = blend_asked(blend, self.fps)
+        x2 = self.gait(to).at(m2.X_, sb, np.array([ub]))[0]
+        need = min(self.blend_frames(src, to, self.x, x2), int(IN_STEP_LONGEST * self.fps))
+        n = max(asked, need)
+        if n != asked:
+            self.notes.append(
+                f"commands[{self.command}] TRANSITION {src} -> {to}: blend raised from "
+                f"{blend:g} s ({plural(asked, 'frame')}) to {n / self.fps:.2f} s ({n} frames): "
+                "blending "
+                f"poses {dist:.3g} units apart faster would accelerate joints over "
+                f"{BLEND_ACCELERATION:g}x the models' training 99th percentile"
             )
-        n = int(round(asked))
         ga, gb = self.gait(src), self.gait(to)
         w = smootherstep(n)
         ra, rb = self._rate(src, sa), self._rate(to, sb)
@@ -162,7 +174,7 @@ class GaitMixin:
                 "under_threshold": bool(dist < c),
                 "bridges": 0,
                 "blend_frames": n,
-                "blend_asked_frames": n,
+                "blend_asked_frames": asked,
                 "start_frame": self.n_frames - n,
             }
         )
