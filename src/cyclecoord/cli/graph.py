@@ -52,8 +52,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=None,
         help="delaunay, knn or union, the Delaunay ones optionally with +ring (the simplices "
         "adjacent to the containing one) and +agree (neighbours weighted by agreement with the "
-        "path's heading), e.g. delaunay+ring+agree (generation; default delaunay, the paper's); "
-        "crossval takes a comma list (default delaunay,delaunay+ring+agree,knn,union)",
+        "path's heading), e.g. delaunay+ring+agree; any of them with +phase: the phase-aware "
+        "field that follows the gait's circular coordinate and never stalls (generation "
+        "default delaunay+phase; 'delaunay' is the paper's field); crossval takes a comma list "
+        "(default delaunay,delaunay+ring+agree,knn,union)",
     )
     p.add_argument(
         "--dims",
@@ -262,7 +264,7 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
     from ..synthesis.graph import MotionGraphSynth
     from .blend import finish
 
-    method = args.method or "delaunay"
+    method = args.method or "delaunay+phase"
     if "," in method:
         raise ParameterError(
             f"--method {method}: generation uses one method (a list is for 'graph crossval')"
@@ -310,7 +312,7 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         f"generated {gen.motion.n_frames} frames from {gen.start['take']}:{gen.start['frame']} "
         f"({gen.path.kind}; {gen.path.outside_hull_steps} steps outside the hull)"
     )
-    for note in gen.notes:
+    for note in synth.phase_notes_ + gen.notes:
         print(note)
     payload = {
         "method": method,

@@ -72,6 +72,8 @@ CONTACT_HEIGHT = 0.03
 FAST_CONTACT = 0.5
 #: Cadence search window, seconds.
 CYCLE_RANGE = (0.4, 2.5)
+#: The leg cycle is the first autocorrelation peak reaching this fraction of the highest.
+SUBHARMONIC = 0.9
 
 
 # ------------------------------------------------------------------ geometry
@@ -205,7 +207,14 @@ def _cycle(signal: np.ndarray, fps: float) -> float:
     spec = np.fft.rfft(k, 2 * n)
     ac = np.fft.irfft(spec * np.conj(spec))[:n] / np.arange(n, 0, -1)
     ac = ac / ac[0]
-    return (lo + int(np.argmax(ac[lo:hi]))) / fps
+    seg = ac[lo:hi]
+    best = float(seg.max())
+    # the first peak nearly as high as the best: a steady gait correlates about as well
+    # two cycles on as one, and the second must not win (a 1,200-frame graph walk read
+    # 2.04x the captured cycle)
+    peak = (seg[1:-1] >= seg[:-2]) & (seg[1:-1] >= seg[2:]) & (seg[1:-1] >= SUBHARMONIC * best)
+    first = np.flatnonzero(peak)
+    return (lo + (int(first[0]) + 1 if first.size else int(np.argmax(seg)))) / fps
 
 
 def _support(kin: _Kin, rig: _Rig) -> np.ndarray:
