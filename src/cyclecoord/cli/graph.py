@@ -120,6 +120,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         action="store_true",
         help="write nothing when the motion fails the plausibility checks",
     )
+    p.add_argument(
+        "--allow-contacts",
+        action="store_true",
+        help="write the motion even when its limbs pass through each other (bone contacts the "
+        "training takes never make); by default such a motion is refused and only the report "
+        "is written",
+    )
     p.add_argument("--no-topo", action="store_true", help="crossval: skip the bottleneck distances")
     p.add_argument(
         "--no-progress", action="store_true",
@@ -346,4 +353,27 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         for p in save_graph_figures(synth, gen, out.folder(args.plot)):
             out.wrote(Path(args.plot) / p.name)
     report = check_plausibility(gen.motion, motions)
+    crossing = [int(f) for f in getattr(report, "new_contact_frames", None) or []]
+    if crossing and not args.allow_contacts:
+        return _refuse_crossing(args, gen.motion, payload, report, crossing, out, quality)
     return finish(args, gen.motion, payload, report, "generated motion", out=out, quality=quality)
+
+
+def _refuse_crossing(args, motion, payload, report, frames, out, quality) -> int:
+    """Write the report, not a motion whose limbs pass through each other."""
+    from ..errors import ImplausibleMotionError
+    from .blend import finish
+
+    where = f"frames {frames[0]}-{frames[-1]}" if len(frames) > 1 else f"frame {frames[0]}"
+    why = (
+        f"generated motion has limbs passing through each other in {len(frames)} frames "
+        f"({where}); nothing written (--allow-contacts writes it anyway; another --start or "
+        "--method may avoid it)"
+    )
+    payload = {**payload, "refused": why}
+    try:
+        finish(argparse.Namespace(**{**vars(args), "strict": True}), motion, payload, report,
+               "generated motion", out=out, quality=quality)
+    except ImplausibleMotionError:
+        raise ImplausibleMotionError(why) from None
+    raise ImplausibleMotionError(why)  # pragma: no cover (finish refuses an unclean report)
