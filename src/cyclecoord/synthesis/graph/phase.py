@@ -50,6 +50,8 @@ PULL = 0.1
 WEIGHT = 0.5
 #: Phase bins used to align the takes' phase origins.
 BINS = 48
+#: Turns of the coordinate a take shorter than two cycles may have (extract asks 1.5).
+SHORT_TURNS = 0.75
 #: Slowest phase rate kept, as a fraction of the median.
 MIN_RATE = 0.25
 
@@ -96,10 +98,19 @@ def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePh
     phases, source, notes = [], [], []
     for i, (m, z) in enumerate(zip(takes, latent)):
         u = None
-        try:
-            u = _fill(np.asarray(extract(m, random_state=0).coordinate, dtype=float))
-        except CycleCoordError as exc:
-            notes.append(f"phase of take {i}: no circular coordinate ({exc}); latent angle")
+        for turns in (None, SHORT_TURNS):  # a short take: fewer turns than extract asks
+            try:
+                kw = {} if turns is None else {"min_turns": turns, "steady": False}
+                u = _fill(np.asarray(extract(m, random_state=0, **kw).coordinate, dtype=float))
+            except CycleCoordError as exc:
+                why = str(exc)
+                continue
+            if turns is not None:
+                notes.append(f"phase of take {i}: circular coordinate of a short take "
+                             f"({turns} turns accepted, extract asks 1.5)")
+            break
+        if u is None:
+            notes.append(f"phase of take {i}: no circular coordinate ({why}); latent angle")
         if u is None:
             u, src = _latent_angle(z), "latent angle"
         else:
