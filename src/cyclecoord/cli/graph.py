@@ -66,18 +66,6 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "2, as the paper)",
     )
     p.add_argument(
-        "--no-carry",
-        action="store_true",
-        help="generation: keep the training frames' mean root step (the feet glide) instead of "
-        "moving the root as the feet on the ground carry it, and do not pin the feet",
-    )
-    p.add_argument(
-        "--no-lock",
-        action="store_true",
-        help="generation: do not pin the planted feet by leg IK (on by default where it adds "
-        "no pop)",
-    )
-    p.add_argument(
         "-k",
         "--k",
         type=positive_int,
@@ -120,13 +108,6 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         action="store_true",
         help="write nothing when the motion fails the plausibility checks",
     )
-    p.add_argument(
-        "--allow-contacts",
-        action="store_true",
-        help="write the motion even when its limbs pass through each other (bone contacts the "
-        "training takes never make); by default such a motion is refused and only the report "
-        "is written",
-    )
     p.add_argument("--no-topo", action="store_true", help="crossval: skip the bottleneck distances")
     p.add_argument(
         "--no-progress", action="store_true",
@@ -139,9 +120,33 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="crossval: also follow the field for this many times each left-out take, with "
         "freeze and slip columns (default 3; 0 skips it)",
     )
+    _feet_options(p)
     p.set_defaults(func=run)
     declare(p, inputs=_files_read, files=("-o", "--report"), folders={"--plot": r".*\.png"})
     return p
+
+
+def _feet_options(p: argparse.ArgumentParser) -> None:
+    """Generation's options for the feet and the limbs."""
+    p.add_argument(
+        "--no-carry",
+        action="store_true",
+        help="generation: keep the training frames' mean root step (the feet glide) instead of "
+        "moving the root as the feet on the ground carry it, and do not pin the feet",
+    )
+    p.add_argument(
+        "--no-lock",
+        action="store_true",
+        help="generation: do not pin the planted feet by leg IK (on by default where it adds "
+        "no pop)",
+    )
+    p.add_argument(
+        "--allow-contacts",
+        action="store_true",
+        help="write the motion even when its limbs pass through each other (bone contacts the "
+        "training takes never make); by default such a motion is refused and only the report "
+        "is written",
+    )
 
 
 def _dims(text: str):
