@@ -82,6 +82,7 @@ TESTS: dict[str, list[str]] = {
                  "windows.py")},
     Q + "contacts.py": [T + "quality/test_contacts.py"],
     Q + "cycle_quality.py": [T + "quality/test_reference.py", T + "quality/test_cycle_figures.py"],
+    Q + "generated.py": [T + "quality/test_generated.py"],
     Q + "legs.py": [T + "quality/test_legs.py", T + "quality/test_contacts.py"],
     Q + "metrics.py": [T + "quality/test_metrics.py", T + "quality/test_one_definition.py"],
     Q + "plausibility.py": [T + "quality/test_plausibility.py"],

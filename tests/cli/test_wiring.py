@@ -294,6 +294,13 @@ def test_render_options_reach_render(monkeypatch, files, tmp_path, option, keywo
     assert got[keyword] == value and plain[keyword] != value
 
 
+def test_render_no_progress_reaches_render(monkeypatch, files, tmp_path):
+    target, out = "cyclecoord.plot.figures.render", ["-o", tmp_path / "a.gif"]
+    assert reach(monkeypatch, target, "render", files.walk, *out).kwargs["progress"] is True
+    got = reach(monkeypatch, target, "render", files.walk, *out, "--no-progress").kwargs
+    assert got["progress"] is False
+
+
 def test_render_frames_and_side_by_side(monkeypatch, files, tmp_path):
     spy = reach(monkeypatch, "cyclecoord.plot.figures.render", "render", files.walk, "-o",
                 tmp_path / "a.gif", "--frames", "10:40", "--side-by-side", files.jog)
@@ -578,6 +585,40 @@ def test_graph_crossval_options_reach_cross_validate(monkeypatch, takes, option,
     assert got[keyword] == value and plain[keyword] != value
 
 
+@pytest.mark.parametrize("option, keywords", [
+    (("--no-carry",), {"carry": False, "lock": False}),
+    (("--no-lock",), {"carry": True, "lock": False}),
+], ids=_id)
+def test_graph_carry_and_lock_reach_the_synthesiser(monkeypatch, takes, option, keywords):
+    target = "cyclecoord.synthesis.graph.MotionGraphSynth"
+    plain = reach(monkeypatch, target, "graph", *takes).kwargs
+    got = reach(monkeypatch, target, "graph", *takes, *option).kwargs
+    assert {k: plain[k] for k in keywords} == {"carry": True, "lock": True}
+    assert {k: got[k] for k in keywords} == keywords
+
+
+def test_graph_horizon_and_no_progress_reach_cross_validate(monkeypatch, takes):
+    target = "cyclecoord.synthesis.graph.cross_validate"
+    plain = reach(monkeypatch, target, "graph", "crossval", *takes).kwargs
+    got = reach(monkeypatch, target, "graph", "crossval", *takes, "--horizon", "0",
+                "--no-progress").kwargs
+    assert (plain["horizon"], plain["progress"]) == (3, True)
+    assert (got["horizon"], got["progress"]) == (0, False)
+
+
+def test_graph_no_progress_reaches_the_loading_bar(monkeypatch, takes):
+    """graph's loading bar (drawn from four takes on) is off with --no-progress."""
+    import tqdm
+
+    bars = Spy(monkeypatch, "tqdm.tqdm", stop=False)
+    target = "cyclecoord.synthesis.graph.MotionGraphSynth"
+    four = takes + takes
+    reach(monkeypatch, target, "graph", *four)
+    reach(monkeypatch, target, "graph", *four, "--no-progress")
+    assert [kw["disable"] for _, kw in bars.calls] == [False, True]
+    assert tqdm.tqdm is bars  # the command reads the bar at run time (from tqdm import tqdm)
+
+
 def test_graph_start_target_and_frames_reach_the_walk(monkeypatch, takes, tmp_path):
     gen = reach(monkeypatch, "cyclecoord.synthesis.graph.MotionGraphSynth.generate", "graph",
                 *takes, "--frames", "77", "--start", f"{takes[1]}:5")
@@ -655,6 +696,16 @@ def test_latent_fit_options_reach_the_model(monkeypatch, takes, tmp_path):
     assert not (tmp_path / "m.npz").exists()
 
 
+def test_latent_fit_no_progress_reaches_fit(monkeypatch, takes, tmp_path):
+    def progress(*extra):
+        fit = Spy(monkeypatch, "cyclecoord.synthesis.latent.model.LatentModel.fit")
+        with pytest.raises(Reached):
+            main(["latent", "fit", takes[0], "-o", str(tmp_path / "m.npz"), *extra])
+        return fit.kwargs["progress"]
+
+    assert progress() is True and progress("--no-progress") is False
+
+
 def test_latent_fit_writes_the_model_and_the_report(takes, tmp_path, capsys):
     model, rep = tmp_path / "m.npz", tmp_path / "fit.json"
     assert main(["latent", "fit", takes[0], "-o", str(model), "--max-iter", "5",
@@ -673,6 +724,15 @@ def test_animate_no_check_reaches_run_script(monkeypatch, tmp_path):
         "check"] is True
     assert reach(monkeypatch, target, "animate", script, "-o", tmp_path / "a.bvh",
                  "--no-check").kwargs["check"] is False
+
+
+def test_animate_no_progress_reaches_run_script(monkeypatch, tmp_path):
+    script = tmp_path / "s.json"
+    script.write_text(json.dumps({"models": {}, "commands": []}))
+    target, out = "cyclecoord.synthesis.latent.script.run_script", ["-o", tmp_path / "a.bvh"]
+    assert reach(monkeypatch, target, "animate", script, *out).kwargs["progress"] is True
+    assert reach(monkeypatch, target, "animate", script, *out, "--no-progress").kwargs[
+        "progress"] is False
 
 
 def test_spy_sees_what_it_replaced(monkeypatch):

@@ -95,6 +95,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         "--step": RENDER,
         "--view": RENDER,
         "--follow": RENDER,
+        "--no-progress": W + "test_render_no_progress_reaches_render",
     },
     **{command: {
         **dict.fromkeys(("--as-cycle", "--extract", "--window", "--fps", "--max-scale",
@@ -141,16 +142,23 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         **dict.fromkeys(("--no-carry", "--no-lock", "--horizon", "--no-progress"),
                         W + "test_graph_feet_horizon_and_progress_options_reach_the_library"),
         "--no-topo": W + "test_graph_crossval_options_reach_cross_validate",
+        **dict.fromkeys(("--no-carry", "--no-lock"),
+                        W + "test_graph_carry_and_lock_reach_the_synthesiser"),
+        "--horizon": W + "test_graph_horizon_and_no_progress_reach_cross_validate",
+        "--no-progress": (W + "test_graph_horizon_and_no_progress_reach_cross_validate",
+                          W + "test_graph_no_progress_reaches_the_loading_bar"),
     },
     "latent fit": {
         **dict.fromkeys(("--dims", "--variance", "--step", "--max-iter"), LATENT),
         **dict.fromkeys(("-o", "--report"), W + "test_latent_fit_writes_the_model_and_the_report"),
+        "--no-progress": W + "test_latent_fit_no_progress_reaches_fit",
     },
     "animate": {
         **dict.fromkeys(("-o", "--report"), "tests/synthesis/test_latent_cli.py::"
                         "test_animate_writes_bvh_and_report_reproducibly"),
         "--no-check": W + "test_animate_no_check_reaches_run_script",
         "--feet": W + "test_animate_feet_reach_the_script",
+        "--no-progress": W + "test_animate_no_progress_reaches_run_script",
     },
 }
 

@@ -4,8 +4,8 @@ A generated pose sequence (a motion graph's path, a latent particle's) comes wit
 velocity taken from the training frames nearest it; the feet, made by the pose alone,
 do not agree with it and glide.  :func:`carry_by_feet` moves the root instead as the foot
 on the ground carries it, as the periodic pipeline's cycles do
-(:func:`~cyclecoord.periodic.root.planted_ground`, :func:`~cyclecoord.periodic.clip.
-anchor_to_feet`):
+(:func:`~cyclecoord.periodic.root.planted_ground`,
+:func:`~cyclecoord.periodic.clip.anchor_to_feet`):
 
 * contact is the height of each foot point above its own ground level, not its speed
   (:func:`~cyclecoord.quality.contacts.foot_contacts` with ``speed=None``): a gliding foot
