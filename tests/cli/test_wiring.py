@@ -647,20 +647,10 @@ def test_graph_strict_refuses_an_implausible_motion(monkeypatch, takes, tmp_path
     assert main(argv) == 0 and cc.load(out).n_frames == 40
 
 
-def test_graph_feet_horizon_and_progress_options_reach_the_library(monkeypatch, takes):
+def test_graph_generates_with_the_phase_aware_field_by_default(monkeypatch, takes):
     target = "cyclecoord.synthesis.graph.MotionGraphSynth"
-    plain = reach(monkeypatch, target, "graph", *takes).kwargs
-    assert plain["carry"] and plain["lock"] and plain["method"] == "delaunay+phase"
-    kw = reach(monkeypatch, target, "graph", *takes, "--no-lock").kwargs
-    assert kw["carry"] and not kw["lock"]
-    kw = reach(monkeypatch, target, "graph", *takes, "--no-carry").kwargs
-    assert not kw["carry"] and not kw["lock"]
-    cv = "cyclecoord.synthesis.graph.cross_validate"
-    plain = reach(monkeypatch, cv, "graph", "crossval", *takes).kwargs
-    kw = reach(monkeypatch, cv, "graph", "crossval", *takes, "--horizon", "2",
-               "--no-progress").kwargs
-    assert (plain["horizon"], plain["progress"]) == (3, True)
-    assert (kw["horizon"], kw["progress"]) == (2, False)
+    kw = reach(monkeypatch, target, "graph", *takes).kwargs
+    assert kw["method"] == "delaunay+phase" and kw["dims"] == "auto"
 
 
 def test_graph_refuses_limbs_through_each_other_unless_allowed(monkeypatch, takes, tmp_path):

@@ -139,8 +139,6 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
                         "tests/synthesis/test_graph_cli.py::test_generate_writes_motion_report_and_figures"),
         "--strict": W + "test_graph_strict_refuses_an_implausible_motion",
         "--allow-contacts": W + "test_graph_refuses_limbs_through_each_other_unless_allowed",
-        **dict.fromkeys(("--no-carry", "--no-lock", "--horizon", "--no-progress"),
-                        W + "test_graph_feet_horizon_and_progress_options_reach_the_library"),
         "--no-topo": W + "test_graph_crossval_options_reach_cross_validate",
         **dict.fromkeys(("--no-carry", "--no-lock"),
                         W + "test_graph_carry_and_lock_reach_the_synthesiser"),
