@@ -4,7 +4,8 @@ The paper's field stalls where a walk's trajectory folds over itself in the late
 frames going out and frames coming back share a neighbourhood and their velocities
 cancel (on set w1 the 2-D paths sat still for 80 frames while the root glided on).  Only
 this project has the remedy at hand: the periodic pipeline's circular coordinate
-(:func:`cyclecoord.extract`) gives every training frame a phase in the gait cycle, and
+(:func:`cyclecoord.extract`; its re-timed ``phase``, which advances at the capture's
+pace) gives every training frame a phase in the gait cycle, and
 two frames at one pose but opposite phases are far apart once the phase is part of the
 state.
 
@@ -42,9 +43,10 @@ __all__ = ["PhaseField", "TakePhases", "take_phases", "align_phases", "follow_ph
 
 #: Neighbours of the phase-aware field, the pull per frame towards their next states
 #: and the phase circle's radius against the latent points' RMS radius.  Chosen on set
-#: w1 (4 starts x 1,200 frames, dims auto) over k 4-16, pull 0.05-0.3 and weight 0.5-2:
-#: largest accel 0.54x the sources' p99, knee and hip ranges 0.92-0.93 of theirs; weight
-#: 1 or 2 gives 1.2-3.8x (the path leaves the poses to keep the phase), k under 8 up to 2.5x.
+#: w1 (4 starts x 1,200 frames, dims auto) over k 4-16, pull 0.05-0.3 and weight 0.5-2
+#: (with the circular coordinate: largest accel 0.54x the sources' p99, knee and hip
+#: ranges 0.92-0.93 of theirs; weight 1 or 2 gave 1.2-3.8x, k under 8 up to 2.5x); with
+#: the re-timed phase 0.75-0.76x and 0.94-0.97.
 K = 12
 PULL = 0.1
 WEIGHT = 0.5
@@ -87,6 +89,18 @@ def _latent_angle(z: np.ndarray) -> np.ndarray:
     return a if a[-1] >= a[0] else -a
 
 
+def _phase_of(result) -> np.ndarray:
+    """The pipeline's re-timed phase (advancing at the capture's pace); its circular
+    coordinate where there is none.  The coordinate itself can dwell: on a synthetic walk
+    it sat within 0.01 of a turn for 20 frames while the pose moved on, and a path
+    following it stalled there for 0.9 s."""
+    phase = getattr(result, "phase", None)
+    phase = np.asarray([] if phase is None else phase, dtype=float)
+    if np.isfinite(phase).sum() >= 3:
+        return phase
+    return np.asarray(result.coordinate, dtype=float)
+
+
 def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePhases:
     """Each take's gait phase from the periodic pipeline's circular coordinate.
 
@@ -101,7 +115,7 @@ def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePh
         for turns in (None, SHORT_TURNS):  # a short take: fewer turns than extract asks
             try:
                 kw = {} if turns is None else {"min_turns": turns, "steady": False}
-                u = _fill(np.asarray(extract(m, random_state=0, **kw).coordinate, dtype=float))
+                u = _fill(_phase_of(extract(m, random_state=0, **kw)))
             except CycleCoordError as exc:
                 why = str(exc)
                 continue
@@ -197,7 +211,8 @@ class PhaseField:
         med = float(np.median(rate))
         if not med > 0:
             raise ParameterError("the training takes' phases do not advance")
-        self.rate = np.maximum(rate, MIN_RATE * med)
+        self.min_rate = MIN_RATE * med
+        self.rate = np.maximum(rate, self.min_rate)
         self.unwrapped = phi
         self.phase = phi % 1.0
         z = graph.points
@@ -242,7 +257,7 @@ class PhaseField:
             a = 2 * np.pi * (self.phase[idx] + s * self.rate[idx])
             tp = np.arctan2(w @ np.sin(a), w @ np.cos(a)) / (2 * np.pi)
             np_ = np_ + self.pull * (((tp - np_ + 0.5) % 1.0) - 0.5)
-        return nx, np_, idx, w
+        return nx, max(np_, phase + s * self.min_rate), idx, w  # the phase always advances
 
 
 def follow_phase(
