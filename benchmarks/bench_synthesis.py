@@ -108,7 +108,7 @@ def generate(s: dict) -> dict:
             g, fit = _cpu(lambda t=threshold: ClassicMotionGraph(threshold=t).fit(takes))
             walk, cpu = _cpu(lambda g=g: g.walk(n, g.nearest_frame(takes[0], 0), seed=0))
         except CycleCoordError as exc:
-            out["classic graph"]["note"] += str(exc) + "; "
+            out["classic graph"]["note"] = str(exc)
             continue
         out["classic graph"] = {"motion": walk.motion, "fit_cpu": fit, "gen_cpu": cpu,
                                 "note": f"threshold {threshold:g} leg lengths, "

@@ -9,8 +9,8 @@
   motion that fits it best to the first (the paper's closed form), and the distance is
   the RMS of what is left over the window's points;
 * **transition points**: local minima of that distance over ``(a, b)`` (3 x 3
-  neighbourhood) under :data:`THRESHOLD` leg lengths, not between a frame and its own
-  neighbourhood of a take;
+  neighbourhood) under :data:`THRESHOLD` leg lengths, not between two frames of one take
+  within a window of each other;
 * **transitions**: ``W`` frames blending the window of ``a`` into the window of ``b``
   (the second aligned by the fitted rigid motion) with the paper's ease
   ``2 u**3 - 3 u**2 + 1``: joint angles interpolated linearly (unwrapped; the two poses
@@ -47,8 +47,6 @@ WINDOW = 1.0 / 3.0
 THRESHOLD = 0.06
 #: Chance per frame of taking a transition where one leaves (a random walk).
 JUMP = 0.05
-#: Frames of a take that transitions may not jump within (of the source frame).
-SELF_GAP_S = 0.5
 #: A replay cuts to a frame with at least this long (s) left of its take.
 REPLAY_LEFT_S = 1.0
 
@@ -168,7 +166,7 @@ class ClassicMotionGraph:
         ok = self.frame_ + self.w_ < np.bincount(self.take_)[self.take_]
         low = (d == minimum_filter(d, size=3, mode="nearest")) & (d <= limit)
         low &= ok[:, None] & ok[None, :]
-        gap = int(round(SELF_GAP_S * self.takes_[0].fps))
+        gap = self.w_  # a jump within its own window is no transition
         same = self.take_[:, None] == self.take_[None, :]
         near = np.abs(self.frame_[:, None] - self.frame_[None, :]) <= gap
         low &= ~(same & near)
