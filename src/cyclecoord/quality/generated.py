@@ -72,8 +72,8 @@ CONTACT_HEIGHT = 0.03
 FAST_CONTACT = 0.5
 #: Cadence search window, seconds.
 CYCLE_RANGE = (0.4, 2.5)
-#: The leg cycle is the first autocorrelation peak reaching this fraction of the highest.
-SUBHARMONIC = 0.9
+#: The leg cycle is the first autocorrelation peak at least this fraction of the highest.
+CYCLE_PEAK = 0.85
 
 
 # ------------------------------------------------------------------ geometry
@@ -207,14 +207,14 @@ def _cycle(signal: np.ndarray, fps: float) -> float:
     spec = np.fft.rfft(k, 2 * n)
     ac = np.fft.irfft(spec * np.conj(spec))[:n] / np.arange(n, 0, -1)
     ac = ac / ac[0]
-    seg = ac[lo:hi]
-    best = float(seg.max())
-    # the first peak nearly as high as the best: a steady gait correlates about as well
-    # two cycles on as one, and the second must not win (a 1,200-frame graph walk read
-    # 2.04x the captured cycle)
-    peak = (seg[1:-1] >= seg[:-2]) & (seg[1:-1] >= seg[2:]) & (seg[1:-1] >= SUBHARMONIC * best)
-    first = np.flatnonzero(peak)
-    return (lo + (int(first[0]) + 1 if first.size else int(np.argmax(seg)))) / fps
+    win = ac[lo:hi]
+    # the first local peak within CYCLE_PEAK of the highest: a clean capture's two cycles
+    # correlate as well as one (the synthetic walk of 1.1 s read 2.23 s by the highest)
+    top = float(win.max())
+    for k in range(1, win.size - 1):
+        if win[k] >= win[k - 1] and win[k] >= win[k + 1] and win[k] >= CYCLE_PEAK * top:
+            return (lo + k) / fps
+    return (lo + int(np.argmax(win))) / fps
 
 
 def _support(kin: _Kin, rig: _Rig) -> np.ndarray:
