@@ -364,6 +364,7 @@ class GeneratedQuality:
     source_root_speed: float
     held_frames: int = 0
     notes: list[str] = field(default_factory=list)
+    knee_p99: tuple[float, ...] = ()  # degrees of flexion per leg (the table)
 
     # ---- derived
     @property
@@ -481,6 +482,7 @@ class GeneratedQuality:
             "longest_freeze_s": f(self.longest_freeze_s),
             "held_frames": self.held_frames,
             "knee_range_deg": [f(x) for x in self.knee_range],
+            "knee_p99_deg": [f(x) for x in self.knee_p99],
             "hip_range_deg": [f(x) for x in self.hip_range],
             "knee_range_ratio": [f(x) for x in self.knee_ratio],
             "hip_range_ratio": [f(x) for x in self.hip_ratio],
@@ -590,6 +592,7 @@ def measure_generated(
         source_root_speed=ref.root_speed * m,
         held_frames=int(held.sum()),
         notes=notes,
+        knee_p99=tuple(float(x) for x in np.percentile(kin.knee, 99, axis=0)),
     )
 
 
