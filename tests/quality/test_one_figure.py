@@ -99,10 +99,21 @@ def test_without_a_skeleton_the_channels_are_measured(synthetic):
     assert s["space"] == "channels" and np.isfinite(s["loop_closure"])
 
 
-def test_bandai_walk_reads_the_same_in_bvh_npz_and_gltf(bvh_dir, tmp_path):
+def test_bandai_walk_reads_the_same_in_every_format(bvh_dir, tmp_path):
     """The issue's walk: extract read its loop closure 0.70 and blend, reading back the
-    BVH extract wrote, 1.30 (channels).  Now one value.  Its AMC is left out: an ASF
-    cannot say the Bandai rig's centimetres and adds connector bones under a static root
-    (see docs/guide/quality.rst)."""
+    BVH extract wrote, 1.30 (channels).  Now one value, also from its AMC: the ASF is
+    written in the rig extract read (static root folded into the hips, constant position
+    channels as offsets) with the Bandai rig's centimetres (``length 2.54``), the AMC
+    names its 30 fps, and a place of the body counts once in every format (an AMC read it
+    1.33 m -> 9.43 m tall, Z-up, jerk 11,073 m/s^3 against 144 before)."""
     res = cc.extract(cc.load(bvh_dir / "bandai" / "dataset-1_walk_normal_001.bvh"))
-    _assert_within(_table(res.cycle, _reported(res), tmp_path, (".bvh", ".npz", ".glb")))
+    _assert_within(_table(res.cycle, _reported(res), tmp_path))
+    path = tmp_path / "plain.amc"
+    cc.save(res.cycle, path)
+    back = cc.load(path)  # no fps given: the AMC's own comment says 30
+    assert back.fps == 30.0 and back.skeleton.length_unit == pytest.approx(2.54)
+    from cyclecoord.rig import describe_rig
+
+    info = describe_rig(back)
+    assert (info.units, info.up_axis) == ("asf", "Y")
+    assert info.height * info.metres_per_unit == pytest.approx(1.33, abs=0.01)

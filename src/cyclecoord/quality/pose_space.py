@@ -63,6 +63,23 @@ SPREAD_FLOOR = 1.0
 MAX_SPREAD_PROBES = 2_000
 
 
+def _distinct_points(skeleton, names: list[str]) -> list[int]:
+    """Indices of the forward-kinematics points that are not a parent's place again: a
+    joint or end site at zero offset from its parent always sits on it (a BVH ``Head``
+    end site of length 0; the zero-length bones an ASF adds where a BVH joint's children
+    start at different places), and counting it twice would weigh that place double in
+    every RMS figure, differently in each format."""
+    joints = {j.name: j for j in skeleton.joints}
+    scale = max([float(np.linalg.norm(j.offset)) for j in skeleton.joints] + [1e-300])
+    keep = []
+    for i, n in enumerate(names):
+        j = joints.get(n[:-4] if n.endswith("/end") else n)
+        off = None if j is None else (j.end_site if n.endswith("/end") else j.offset)
+        if i == 0 or off is None or np.linalg.norm(off) > 1e-9 * scale:
+            keep.append(i)
+    return keep
+
+
 def root_frame_points(motion: Motion, rig=None, names=None) -> np.ndarray:
     """Joint and end-site positions in the root's frame, plus the root's height.
 
@@ -80,10 +97,11 @@ def root_frame_points(motion: Motion, rig=None, names=None) -> np.ndarray:
 
     Returns
     -------
-    ndarray, shape (T, 3 * (J + E) + 1)
+    ndarray, shape (T, 3 * P + 1)
         Per frame: every point's position minus the travelling root's, turned by the
         inverse of the root's heading (skeleton length units), then the root's up (y)
-        coordinate.
+        coordinate.  Without ``names``, a point at zero offset from its parent (always on
+        it) is left out, so each place of the body counts once in every format.
     """
     from ..periodic.root import root_layout, root_rotations
     from ..rig import normalize_rig
@@ -95,6 +113,8 @@ def root_frame_points(motion: Motion, rig=None, names=None) -> np.ndarray:
     if names is not None:
         index = {n: i for i, n in enumerate(fk.names)}
         pos = pos[:, [0] + [index[n] for n in names if n != fk.names[0]], :]
+    elif motion.skeleton is not None:
+        pos = pos[:, _distinct_points(motion.skeleton, fk.names), :]
     layout = root_layout(motion)
     root = pos[:, :1, :]
     rel = pos - root
