@@ -24,6 +24,8 @@ why; the score is killed over the mutants not judged equivalent.
     python benchmarks/mutation.py --list                  # mutants per module
     python benchmarks/mutation.py --every 25 --jobs 2 --out mutation.json
     python benchmarks/mutation.py --report mutation.json  # score, survivors
+    python benchmarks/mutation.py --show ID               # one mutant's diff
+    python benchmarks/mutation.py --run ID [--tests T..]  # one mutant: killed or not
 
 Not part of the test suite: a sampled run takes an hour or more.
 """
@@ -248,12 +250,12 @@ class Worker:
         self.src = base / f"w{k}" / "src"
         shutil.copytree(SRC, self.src, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
 
-    def run(self, m: Mutant, timeout: float) -> dict:
+    def run(self, m: Mutant, timeout: float, tests: list[str] | None = None) -> dict:
         path = self.src / m.module
         original = path.read_text()
         try:
             path.write_text(mutate(original, m.index))
-            status, seconds, first = run_tests(self.src, TESTS[m.module], timeout)
+            status, seconds, first = run_tests(self.src, tests or TESTS[m.module], timeout)
         finally:
             path.write_text(original)
         killed = status != "passed"
@@ -319,14 +321,30 @@ def main(argv=None) -> int:
     ap.add_argument("--list", action="store_true", help="count the mutants and stop")
     ap.add_argument("--report", type=Path, default=None, help="print the score of a results file")
     ap.add_argument("--show", default=None, help="print the diff of one mutant id")
+    ap.add_argument("--run", default=None, help="run the tests of one mutant id (exit 0 if killed)")
+    ap.add_argument("--tests", nargs="+", default=None,
+                    help="with --run: these tests (pytest ids) instead of the module's own")
     args = ap.parse_args(argv)
     if args.report:
         report(json.loads(args.report.read_text())["results"])
         return 0
     modules = args.modules or sorted(TESTS)
     every = mutants(modules)
+    one = args.show or args.run
+    if one:
+        found = [m for m in every if m.id == one]
+        if not found:
+            sys.exit(f"no mutant {one!r} in the current source (see --list; ids carry line numbers)")
+        (m,) = found
+    if args.run:
+        base = Path(tempfile.mkdtemp(prefix="mutation-"))
+        try:
+            r = Worker(base, 0).run(m, timeout=3600, tests=args.tests)
+        finally:
+            shutil.rmtree(base, ignore_errors=True)
+        print(f"{'killed' if r['killed'] else 'SURVIVED'} {m.id} ({r['seconds']} s) {r['failure']}")
+        return 0 if r["killed"] else 1
     if args.show:
-        (m,) = [m for m in every if m.id == args.show]
         original = ast.unparse(ast.parse((SRC / m.module).read_text())).splitlines()
         changed = mutate((SRC / m.module).read_text(), m.index).splitlines()
         import difflib
