@@ -183,6 +183,17 @@ def _check_by_unique(edges, z, n):
     return len(np.unique(key)), len(np.unique(key[bad]))
 
 
+def test_rips_edges_known_answer_and_empty():
+    """Edges i < j within the scale, sorted, from points or a distance matrix; none at a
+    scale below every distance is still an (0, 2) integer array."""
+    x = np.array([[0.0, 0.0], [3.0, 0.0], [1.0, 0.0], [0.0, 1.5]])
+    d = np.linalg.norm(x[:, None] - x[None], axis=2)
+    for edges in (rips_edges(x, 2.0), rips_edges(x, 2.0, d)):
+        assert edges.dtype == np.int64 and edges.tolist() == [[0, 2], [0, 3], [1, 2], [2, 3]]
+    for edges in (rips_edges(x, 0.5), rips_edges(x, 0.5, d)):
+        assert edges.shape == (0, 2) and edges.dtype == np.int64
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_cocycle_check_counts_distinct_triangles_as_sorting_does(seed):
     from cyclecoord.periodic.coordinates import check_cocycle, rips_edges
