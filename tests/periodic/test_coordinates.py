@@ -134,6 +134,26 @@ def test_scale_outside_the_bar_is_refused():
         select_bar(bc, len(bc.h1))
 
 
+def test_select_bar_figures_on_a_known_barcode():
+    """Gap to the next-longest bar (the last bar has none: infinite), ratio, scale and
+    clearness on hand-made bars; deaths are capped at the threshold."""
+    from cyclecoord.periodic.barcode import Barcode
+
+    h1 = np.array([[1.0, np.inf], [1.0, 2.0], [0.5, 1.0]])  # persistence 4, 1, 0.5
+    bc = Barcode(h0=np.zeros((0, 2)), h1=h1, cocycles=[], threshold=5.0, prime=47, n_points=9)
+    figures = [(s.gap, s.ratio, s.scale, s.clear) for s in (select_bar(bc, k) for k in range(3))]
+    assert figures == [
+        (4.0, 5.0, pytest.approx(4.6), True),
+        (2.0, 2.0, pytest.approx(1.9), True),
+        (np.inf, 2.0, pytest.approx(0.95), True),
+    ]
+    # a bar shorter than 5 % of the threshold is not clear, however isolated
+    short = Barcode(h0=np.zeros((0, 2)), h1=np.array([[0.1, 0.3]]), cocycles=[], threshold=5.0,
+                    prime=47, n_points=9)
+    s = select_bar(short, 0)
+    assert (s.gap, s.ratio, s.clear) == (np.inf, pytest.approx(3.0), False)
+
+
 def test_noise_has_no_clear_bar():
     rng = np.random.default_rng(3)
     x = rng.standard_normal((200, 6))
