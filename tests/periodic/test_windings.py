@@ -160,6 +160,22 @@ def test_typical_amplitude_restores_what_averaging_flattens():
     assert np.argmax(out[:, 0]) == np.argmax(avg[:, 0])  # the shape is kept, only widened
 
 
+def test_typical_amplitude_windows_start_at_every_frame_for_short_cycles():
+    """A 4-frame cycle: P // 8 is 0, so a window of one period starts at every frame of the
+    phased run (not every other one); no running median (spike 1), so the known answer is
+    the median of the 6 windows' ranges 0, 0, 1, 2, 2, 2: 1.5, a gain of 1.5 on a cycle of
+    range 1, about its mean."""
+    from cyclecoord.periodic.clip import typical_amplitude
+
+    poses = np.array([0, 0, 0, 0, 0, 1, 2, 0, 0], float)[:, None]
+    phase = np.zeros(9)  # every frame phased; only finiteness is read
+    cycle = np.array([[0.0], [1.0], [0.0], [0.0]])
+    out = typical_amplitude(cycle, phase, poses, spike=1)
+    np.testing.assert_allclose(out[:, 0], 0.25 + 1.5 * (cycle[:, 0] - 0.25))
+    # a run shorter than the cycle gives no window: the cycle is returned as it is
+    np.testing.assert_array_equal(typical_amplitude(cycle, phase[:3], poses[:3], spike=1), cycle)
+
+
 def test_hold_weights_give_a_held_stretch_one_vote():
     from cyclecoord.periodic.registration import hold_weights
 
