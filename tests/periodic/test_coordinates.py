@@ -47,6 +47,14 @@ def test_good_primes(p):
     assert check_prime(p) == p
 
 
+def test_retry_primes_are_the_primes_from_47_to_97():
+    """The primes a failed lift is retried with: each a valid coefficient prime, in order."""
+    from cyclecoord.periodic.coordinates import RETRY_PRIMES
+
+    assert RETRY_PRIMES == tuple(p for p in range(47, 98) if all(p % d for d in range(2, p)))
+    assert all(check_prime(p) == p for p in RETRY_PRIMES)
+
+
 def test_circle_has_one_clear_bar_and_recovers_the_angle():
     x, phase = noisy_circle()
     est = CircularCoordinates().fit(x)
