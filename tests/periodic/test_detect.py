@@ -322,3 +322,53 @@ def test_motion_cycles_need_one_and_a_half_cycles(chain):
         m for m, (_, c) in sorted(longest.items()) if c >= fewest + 0.01
     ]
     assert len(motion_cycles(res, min_cycles=fewest)) == res.n_motions
+
+
+def test_class_period_turns_and_frames_per_turn():
+    """A coordinate advancing 1/40 of a turn per frame from 0.2: 5 turns over frames
+    0..200 and a period of 40 frames, from complete windings or, with under 0.75 excited
+    turns, from the whole segment."""
+    from cyclecoord.periodic.detection._segments import class_period
+
+    theta = np.mod(0.2 + np.arange(201) / 40.0, 1.0)
+    cyc, period = class_period(theta, np.ones(201, bool), 0, 201)
+    assert cyc == pytest.approx(5.0) and period == pytest.approx(40.0)
+    few = np.arange(201) < 30  # 29 excited steps: 0.725 turns
+    cyc, period = class_period(theta, few, 0, 201)
+    assert cyc == pytest.approx(5.0) and period == pytest.approx(200 / 5.0)
+
+
+def test_drop_unsteady_keeps_a_piece_exactly_min_run_long():
+    """No pause and no root: the segment is kept whole when it is exactly ``min_run``
+    frames long, dropped (labels -1) when ``min_run`` is one more."""
+    from cyclecoord.motion import Motion
+    from cyclecoord.periodic.detection._segments import drop_unsteady
+
+    T = 90
+    ang = 2 * np.pi * np.arange(T) / 30
+    joints = 30.0 * np.column_stack([np.sin(ang), np.cos(ang)])  # constant joint speed
+    motion = Motion(joints, [("a", "rx"), ("b", "rx")], fps=30.0)
+    seg = Segment(0, T, 0, (0,), 1.0, 2.0, 1.5, 3.0, 30.0)
+    labels, out = drop_unsteady(np.zeros(T, int), [seg], joints, motion, min_run=T)
+    assert out == [seg] and np.all(labels == 0)
+    labels, out = drop_unsteady(np.zeros(T, int), [seg], joints, motion, min_run=T + 1)
+    assert out == [] and np.all(labels == -1)
+
+
+def test_read_classes_min_consistency_is_inclusive():
+    """Every step of a clean ramp goes one way: its consistency is exactly 1, and
+    ``min_consistency=1`` (at least 1) keeps it."""
+    from types import SimpleNamespace
+
+    from cyclecoord.periodic.detection.classes import read_classes
+
+    theta = np.mod(np.arange(300) / 50.0, 1.0)  # 6 turns at 1/50 of a turn per frame
+
+    class Stub:
+        def with_coordinate_params(self, class_index):
+            return SimpleNamespace(fit_coordinate=lambda: None, coordinates_=theta,
+                                   selection_=SimpleNamespace(birth=1.0, death=3.0, scale=2.0))
+
+    (c,) = read_classes(Stub(), [0], window=11, min_speed=0.01, min_consistency=1.0,
+                        min_cycles=2.0, notes=[])
+    assert c.status == "kept" and c.mask.all() and np.all(c.consistency == 1.0)
