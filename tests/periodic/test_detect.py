@@ -372,3 +372,42 @@ def test_read_classes_min_consistency_is_inclusive():
     (c,) = read_classes(Stub(), [0], window=11, min_speed=0.01, min_consistency=1.0,
                         min_cycles=2.0, notes=[])
     assert c.status == "kept" and c.mask.all() and np.all(c.consistency == 1.0)
+
+
+def test_window_table_uses_every_frame_of_a_window_within_max_points():
+    from cyclecoord.periodic.detection import window_table
+    from cyclecoord.periodic.preprocess import Preprocessor
+
+    m = cc.datasets.make_periodic_capture(n_frames=300, period=100, random_state=0).motion
+    prep = Preprocessor(delay=30).fit_transform(m)
+    n = int(round(2.0 * m.fps))
+    for max_points, step in [(n, 1), (n - 1, 2), (n // 3, 3)]:
+        wins = window_table(prep.points, prep.poses, m.fps, lengths=(2.0,), max_points=max_points,
+                            progress=False)
+        assert wins and all(w.step == step and w.stop - w.start == n for w in wins)
+
+
+def test_three_windows_covering_exactly_min_cycles_make_a_motion():
+    """No window turns ``min_cycles`` times, but three alike ones together cover 18 frames
+    of a 20-frame period: 0.9 turns, exactly ``min_cycles``, which is enough."""
+    from cyclecoord.periodic.detection.result import WindowInfo
+    from cyclecoord.periodic.detection.windows import windowed_motions
+
+    ang = 2 * np.pi * np.arange(16) / 16
+    cycle = 10.0 * np.column_stack([np.cos(ang), np.sin(ang)])
+    poses = cycle[np.arange(18) % 16]  # every frame on the cycle
+
+    def win(a, b):
+        return WindowInfo(start=a, stop=b, step=1, birth=1.0, death=5.0, threshold=6.0, scale=4.0,
+                          clear=True, cycles=0.5, steadiness=1.0, period_frames=20.0,
+                          looping=True, cycle=cycle)
+
+    for min_cycles, motions in [(0.9, 1), (0.91, 0)]:
+        windows = [win(0, 8), win(5, 13), win(10, 18)]
+        labels, segments, n = windowed_motions(
+            windows, [], np.full(18, -1), 0, poses, window=3, min_cycles=min_cycles,
+            similarity=0.5, merge_overlap=0.5,
+        )
+        assert n == motions and len(segments) == motions
+        assert np.all(labels == (0 if motions else -1))
+        assert all(w.motion == (0 if motions else -1) for w in windows)
