@@ -114,10 +114,14 @@ class Mutant:
     line: int
     col: int
     operator: str
+    #: 2, 3... for the later mutants that would share an id (``a - b - c`` has two
+    #: subtractions at one column, ``1 <= n <= T`` two comparisons): their id ends ``#2``...
+    dup: int = 0
 
     @property
     def id(self) -> str:
-        return f"{self.module}:{self.line}:{self.col}:{self.operator}"
+        plain = f"{self.module}:{self.line}:{self.col}:{self.operator}"
+        return f"{plain}#{self.dup}" if self.dup else plain
 
 
 def _sites(tree: ast.AST) -> list[tuple[ast.AST, str, object]]:
@@ -215,8 +219,13 @@ def mutants(modules: list[str]) -> list[Mutant]:
     out = []
     for module in modules:
         tree = ast.parse((SRC / module).read_text())
+        seen: dict[str, int] = {}
         for i, (node, op, _) in enumerate(_sites(tree)):
-            out.append(Mutant(module, i, node.lineno, node.col_offset, op))
+            m = Mutant(module, i, node.lineno, node.col_offset, op)
+            seen[m.id] = seen.get(m.id, 0) + 1
+            if seen[m.id] > 1:
+                m.dup = seen[m.id]
+            out.append(m)
     return out
 
 
