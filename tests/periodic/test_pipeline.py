@@ -116,6 +116,7 @@ def test_report_has_the_documented_fields():
     # measured: pop 0.523, seam 0.518, nearest 0.847 (the warnings: pop 2, seam 1.5, stray 1)
     assert pq["pop"] <= at_most(0.523) and pq["seam"] <= at_most(0.518)
     assert pq["nearest_max"] <= min(1.0, at_most(0.847))
+    assert not any("some cycle poses" in w for w in res.warnings)  # no stray pose, no warning
     assert rep["loop_closure"] <= at_most(0.399)  # measured 0.399
     assert rep["jerk"]["cycle"] / rep["jerk"]["original"] <= at_most(0.0375)  # measured 0.0375
 
