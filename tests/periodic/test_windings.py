@@ -176,6 +176,29 @@ def test_typical_amplitude_windows_start_at_every_frame_for_short_cycles():
     np.testing.assert_array_equal(typical_amplitude(cycle, phase[:3], poses[:3], spike=1), cycle)
 
 
+def test_register_straightens_a_warped_phase_and_keeps_runs_too_short_to_align():
+    """Poses on a circle, one turn per 50 frames; the phase given is warped by up to 0.03
+    of a cycle.  Registration brings the long run back to the true phase (to a sample of
+    the 50-sample cycle: exactly, since the frames sit on the samples); a run of 2 frames
+    is left as it was."""
+    from cyclecoord.periodic.registration import register
+
+    t = np.arange(200)
+    true = t / 50.0
+    poses = np.column_stack([np.cos(2 * np.pi * true), np.sin(2 * np.pi * true)])
+    given = np.full(200, np.nan)
+    runs = [(0, 140), (150, 152)]
+    for a, b in runs:
+        given[a:b] = np.mod(true[a:b] + 0.03 * np.sin(2 * np.pi * t[a:b] / 37), 1.0)
+    out = register(given, poses, runs, n_samples=50, width=0.02)
+
+    err = np.abs(np.mod(out - true + 0.5, 1.0) - 0.5)
+    was = np.abs(np.mod(given - true + 0.5, 1.0) - 0.5)
+    assert was[:140].max() > 0.025 and err[:140].max() < 1e-12
+    np.testing.assert_array_equal(out[150:152], given[150:152])
+    assert np.all(np.isnan(out[140:150])) and np.all(np.isnan(out[152:]))
+
+
 def test_hold_weights_give_a_held_stretch_one_vote():
     from cyclecoord.periodic.registration import hold_weights
 
