@@ -199,6 +199,29 @@ def test_register_straightens_a_warped_phase_and_keeps_runs_too_short_to_align()
     assert np.all(np.isnan(out[140:150])) and np.all(np.isnan(out[152:]))
 
 
+def test_one_complete_winding_has_no_spread():
+    """From 0.99 to 2.015 turns at 1/40 a frame: level 0 alone is crossed twice, one
+    winding of 40 frames, and one length has no spread."""
+    w = complete_windings(0.99 + np.arange(42) / 40, [(0, 42)])
+    assert w.pooled.tolist() == [pytest.approx(40.0)]
+    assert w.period_frames == pytest.approx(40.0) and w.spread == 0.0
+
+
+def test_retime_from_a_single_pin_runs_at_one_cycle_a_period():
+    """A run that crosses its one anchor once: the phase is 0 there and advances one cycle
+    per period before and after (here the coordinate's own fraction)."""
+    from cyclecoord.periodic.windings import Windings
+
+    w = Windings(levels=np.array([0.0]), anchors=np.array([0]), reference=0,
+                 lengths=np.zeros(0), pooled=np.array([20.0]), period_frames=20.0,
+                 spread=0.0, turns=1.0, positions=np.array([0.0]))
+    u = np.full(14, np.nan)
+    u[2:12] = 0.7 + np.arange(10) / 20  # reaches 1.0 at frame 8
+    out = retime(u, [(2, 12)], w)
+    np.testing.assert_allclose(out[2:12], np.mod(u[2:12], 1.0), atol=1e-12)
+    assert out[8] == pytest.approx(0.0, abs=1e-12) and np.isnan(out[:2]).all() and np.isnan(out[12:]).all()
+
+
 def test_hold_weights_give_a_held_stretch_one_vote():
     from cyclecoord.periodic.registration import hold_weights
 
