@@ -352,3 +352,19 @@ def test_coverage_simulation_bounds_what_an_average_can_reach(capsys):
     assert table[(3, "smooth")] > 1.05 and table[(3, "noise")] < 0.95
     assert sim.main(["--takes", "1"]) == 0
     assert "repetitions" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("order", ["ZYX", "XYZ"])
+def test_root_orientation_of_single_turns(order):
+    """A turn about y alone is heading, about x alone pitch, about z alone roll, each
+    with its sign (right-handed, y up, z forward), whatever the Euler order."""
+    from cyclecoord.motion import Motion
+    from cyclecoord.quality.cycle_quality import root_orientation
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    dofs = ("tx", "ty", "tz") + tuple("r" + a.lower() for a in order)
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], dofs, order, end_site=[0, 1, 0]),))
+    rows = [{"ry": 30.0}, {"rx": 20.0}, {"rz": 20.0}, {"rz": -15.0}]
+    frames = np.array([[r.get(d, 0.0) for _, d in sk.channels] for r in rows])
+    hpr = root_orientation(Motion(frames, sk.channels, fps=30, skeleton=sk))
+    np.testing.assert_allclose(hpr, [[30, 0, 0], [0, 20, 0], [0, 0, 20], [0, 0, -15]], atol=1e-9)
