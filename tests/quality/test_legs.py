@@ -394,3 +394,19 @@ def test_hands_mostly_off_the_floor_stay_arms():
                for e in hands)
     legs = find_legs(dog, prancing)
     assert legs.method == "names" and [g.label for g in legs.legs] == ["left", "right"]
+
+
+@pytest.mark.parametrize("trotting", [False, True])
+def test_short_quadruped_pairs_legs_where_they_part_lowest(trotting):
+    """A body of 4 (legs of about 8): a front and a hind leg are alike enough from the
+    pelvis to pair, but the pairs are those whose chains part lowest in the tree (the
+    front legs at the chest, the hind legs at the pelvis)."""
+    names = quadruped_names("anonymous")
+    skel = quadruped_skeleton(names, body=4.0)
+    legs = find_legs(skel, trot(skel, names, body=4.0) if trotting else None)
+    assert legs.method == "geometry"
+    assert [(g.label, g.points) for g in legs.legs] == [
+        (label, (names[f"{k}_ankle"], names[f"{k}_toe"]))
+        for label, k in (("front left", "fl"), ("front right", "fr"), ("hind left", "hl"),
+                         ("hind right", "hr"))
+    ]
