@@ -136,6 +136,17 @@ def test_joint_range(walk):
     assert v.channel == ("ltibia", "rx") and v.frames == 1 and v.first_frame == 10
     assert v.excess == pytest.approx(7.0) and v.high == pytest.approx(top + 5.0)
     assert joint_range_violations(walk.with_frames(g), [walk], margin_deg=15.0) == []
+    # a second reference one turn up is brought onto the first's turn: the same range
+    found = joint_range_violations(walk.with_frames(g), [walk, walk.with_frames(f)], margin_deg=5.0)
+    assert len(found) == 1 and found[0].high == pytest.approx(top + 5.0)
+
+
+def test_bones_are_frozen(walk):
+    import dataclasses
+
+    bn = bones(walk)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        bn.names = []
 
 
 def test_bad_arguments(walk):
