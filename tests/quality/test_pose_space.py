@@ -42,3 +42,15 @@ def test_capture_copy_is_at_distance_zero(extracted):
     copy = res.motion.window((a, a + P))
     q = pose_quality(copy, res.motion, res.used_frames, res.period_frames)
     assert q.nearest_max == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_two_frame_run_has_one_capture_step():
+    """A run of two frames has one frame step: the first step of a longer run from there."""
+    from cyclecoord.quality.pose_space import _capture_steps
+    from cyclecoord.rig import describe_rig
+
+    m = cc.datasets.make_periodic_capture(kind="walk", n_frames=40, period=20, random_state=0).motion
+    rig = describe_rig(m)
+    two, three = _capture_steps(m, [(5, 7)], rig), _capture_steps(m, [(5, 8)], rig)
+    assert two.shape == (1,) and three.shape == (2,) and two[0] == three[0] > 0
+    assert _capture_steps(m, [(5, 6)], rig).size == 0  # one frame: no step
