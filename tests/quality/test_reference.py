@@ -77,6 +77,16 @@ def test_autocorrelation_period_finds_the_true_period(steady):
     assert np.isnan(autocorrelation_period(steady.motion, used_frames=[[0, 40]]))
 
 
+@pytest.mark.parametrize("period", [100.4, 37.3])
+def test_autocorrelation_period_to_a_fraction_of_a_frame(period):
+    """The parabola through the peak and its neighbours finds a period between whole
+    frames (measured errors 0.0011 and 0.0056 frames, noise-free; whole lags are 0.3-0.4
+    off)."""
+    m = cc.datasets.make_periodic_capture(n_frames=600, period=period, noise=0.0,
+                                          speed_variation=0.0, random_state=3).motion
+    assert abs(autocorrelation_period(m) - period) < 0.02
+
+
 def test_autocorrelation_period_of_noise_is_nan():
     rng = np.random.default_rng(0)
     m = _motion({"lfemur.rx": rng.normal(size=400), "ltibia.rx": rng.normal(size=400)}, fps=120.0)
