@@ -111,6 +111,31 @@ def test_arm_through_the_torso_is_flagged(walk):
     assert payload["clean"] is False and payload["joint_range_violations"]
 
 
+def test_a_reference_of_another_size_is_measured_at_the_motions_size(walk):
+    """The same walk built at a total bone length of 0.5 (other units) keeps its bones
+    as far apart, relative to its size: the arm through the torso is as new as against
+    the walk itself."""
+    from dataclasses import replace
+
+    from cyclecoord.skeleton import Skeleton
+
+    sk = walk.skeleton
+    k = 0.5 / sk.total_length()
+    small_sk = Skeleton(tuple(
+        replace(j, offset=j.offset * k, end_site=None if j.end_site is None else j.end_site * k)
+        for j in sk.joints), name=sk.name, length_unit=sk.length_unit,
+        source_format=sk.source_format)
+    f = np.array(walk.frames)
+    for c in walk.root_channels():
+        if walk.channels[c][1].startswith("t"):
+            f[:, c] *= k
+    small = cc.Motion(f, walk.channels, fps=walk.fps, skeleton=small_sk)
+    assert small_sk.total_length() == pytest.approx(0.5)
+    bad = arm_through_torso(walk)
+    want = check_plausibility(bad, [walk]).new_contact_frames
+    assert len(want) >= 30 and check_plausibility(bad, [small]).new_contact_frames == want
+
+
 def test_contacts_the_inputs_share_are_explained_not_new(walk):
     bad = arm_through_torso(walk)
     report = check_plausibility(bad, [walk, bad])
