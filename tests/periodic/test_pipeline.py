@@ -118,6 +118,7 @@ def test_report_has_the_documented_fields():
     # measured: pop 0.523, seam 0.518, nearest 0.847 (the warnings: pop 2, seam 1.5, stray 1)
     assert pq["pop"] <= at_most(0.523) and pq["seam"] <= at_most(0.518)
     assert pq["nearest_max"] <= min(1.0, at_most(0.847))
+    assert not any("some cycle poses" in w for w in res.warnings)  # no stray pose, no warning
     # the report's loop closure and jerk are pose_quality's (joint positions, one value)
     assert rep["loop_closure"] == pytest.approx(pq["seam"]) and pq["figures"]["jerk"] > 0
     assert rep["loop_closure"] <= at_most(0.518)  # measured 0.518
@@ -347,3 +348,21 @@ def test_a_take_of_several_motions_points_to_detect():
     assert any("cyclecoord detect" in w for w in res.warnings)
     # one steady motion alone does not get the note
     assert not any("cyclecoord detect" in w for w in cc.extract(cc.datasets.example_capture().motion).warnings)
+
+
+def test_configured_estimator_gives_its_parameters():
+    """extract(estimator=...) takes the estimator's parameters for the keywords left at
+    their defaults, refuses one given both ways, and refuses what is no estimator."""
+    from cyclecoord.periodic.coordinates import CircularCoordinates
+    from cyclecoord.periodic.results import EXTRACT_CONFIGURED_DEFAULTS, configured_keywords
+
+    given = dict(EXTRACT_CONFIGURED_DEFAULTS)
+    est = CircularCoordinates(prime=53, scale_fraction=0.7)
+    chosen = configured_keywords(None, None, est, given)
+    assert chosen["prime"] == 53 and chosen["scale_fraction"] == 0.7
+    assert set(chosen) == {"max_scale", "scale", "class_index", "prime", "scale_fraction",
+                           "temporal", "landmarks", "memory_limit"}
+    with pytest.raises(cc.ParameterError, match="give prime either as keyword"):
+        configured_keywords(None, None, est, {**given, "prime": 59})
+    with pytest.raises(cc.ParameterError, match="estimator must be a CircularCoordinates, got str"):
+        configured_keywords(None, None, "ripser", given)
