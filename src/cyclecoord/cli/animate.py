@@ -6,6 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
+from ._options import add_memory_option
 from ._outputs import Outputs, declare
 
 __all__ = ["add_parser", "run"]
@@ -27,6 +28,7 @@ def add_parser(subparsers) -> None:
         "--report", metavar="R.json", help="write a JSON report (commands, bridges, timing, checks)"
     )
     p.add_argument("--no-check", action="store_true", help="skip the plausibility checks")
+    add_memory_option(p)
     p.set_defaults(func=run)
     declare(p, inputs=_script_files, files=("-o", "--report"), derived=_skeleton_output)
 

@@ -6,6 +6,7 @@ import argparse
 
 from ._options import (
     EXIT_OK,
+    add_memory_option,
     add_units_option,
     check_output,
     export_units,
@@ -38,6 +39,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     c.add_argument("--frames", type=frame_range, metavar="A:B", help="only these frames")
     add_units_option(c)
+    add_memory_option(c)
     c.set_defaults(func=cmd_convert)
     declare(c, inputs=capture_inputs(), files=("-o",))
     return c

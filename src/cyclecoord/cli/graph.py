@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ..errors import ParameterError
 from ..io import input_files
-from ._options import EXIT_OK, check_output, positive_float, positive_int
+from ._options import EXIT_OK, add_memory_option, check_output, positive_float, positive_int
 from ._outputs import Outputs, declare
 from .report import clean, load_input, write_json
 
@@ -105,6 +105,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="write nothing when the motion fails the plausibility checks",
     )
     p.add_argument("--no-topo", action="store_true", help="crossval: skip the bottleneck distances")
+    add_memory_option(p)
     p.set_defaults(func=run)
     declare(p, inputs=_files_read, files=("-o", "--report"), folders={"--plot": r".*\.png"})
     return p

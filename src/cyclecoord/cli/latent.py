@@ -6,6 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
+from ._options import add_memory_option
 from ._outputs import Outputs, declare
 
 __all__ = ["add_parser", "parse_take", "run"]
@@ -66,6 +67,7 @@ def add_parser(subparsers) -> None:
     )
     f.add_argument("--max-iter", type=int, default=200, help="optimiser iterations (default 200)")
     f.add_argument("--report", metavar="R.json", help="also write the model's summary as JSON")
+    add_memory_option(f)
     f.set_defaults(func=run)
     declare(f, inputs=_take_files, files=("-o", "--report"))
     p.set_defaults(func=lambda args: _usage(p))

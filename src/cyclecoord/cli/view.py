@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..io import input_files
+from ._options import add_memory_option
 from ._outputs import Outputs, declare
 
 
@@ -51,6 +52,7 @@ def add_parser(subparsers) -> None:
         help="animate at most this many frames per second (default 30; more are skipped)",
     )
     p.add_argument("--no-contacts", action="store_true", help="do not mark planted feet")
+    add_memory_option(p)
     p.set_defaults(func=run)
     declare(
         p,
