@@ -57,6 +57,7 @@ from ._limits import (
     MAX_JOINTS,
     MAX_MAGNITUDE,
     MAX_NPZ_BYTES,
+    check_memory,
     check_writable,
     fps_problem,
     frames_problem,
@@ -202,16 +203,17 @@ class _Arrays:
     Every failure is a :class:`ParseError` naming the file and the key.
     """
 
-    def __init__(self, data: dict[str, np.ndarray], spath: str) -> None:
+    def __init__(self, data: dict[str, np.ndarray], spath: str, prefix: str = "") -> None:
         self.data = data
         self.spath = spath
+        self.prefix = prefix  # how the archive names the keys ("motion_" in a latent model)
 
     def error(self, key: str, message: str) -> ParseError:
-        return ParseError(f"array {key!r}: {message}", self.spath)
+        return ParseError(f"array {self.prefix + key!r}: {message}", self.spath)
 
     def get(self, key: str) -> np.ndarray:
         if key not in self.data:
-            raise ParseError(f"missing array {key!r}", self.spath)
+            raise ParseError(f"missing array {self.prefix + key!r}", self.spath)
         return self.data[key]
 
     def _one(self, key: str, kinds: str, what: str):
@@ -374,6 +376,7 @@ def _open_npz(p: Path, spath: str) -> dict[str, np.ndarray]:
                     "supported",
                     spath,
                 )
+            check_memory(size, f"the archive's arrays ({size:,} bytes unpacked)", spath)
             data = {}
             for k in npz.files:
                 try:
@@ -439,12 +442,17 @@ def read_npz(
     spath = str(p)
     if not p.is_file():
         raise ParseError("no such file" if not p.exists() else "not a file", spath)
-    arr = _Arrays(_open_npz(p, spath), spath)
-    data = arr.data
+    return npz_motion(_Arrays(_open_npz(p, spath), spath), skeleton, fps)
+
+
+def npz_motion(arr: _Arrays, skeleton=None, fps: float | None = None) -> Motion:
+    """The motion the arrays of ``arr`` describe (:func:`read_npz`'s layout), checked."""
+    data, spath = arr.data, arr.spath
     missing = [k for k in _MOTION_KEYS if k not in data]
     if missing:
         raise ParseError(
-            f"missing array {missing[0]!r} (an .npz motion needs {', '.join(_MOTION_KEYS)})",
+            f"missing array {arr.prefix + missing[0]!r} (an .npz motion needs "
+            f"{', '.join(arr.prefix + k for k in _MOTION_KEYS)})",
             spath,
         )
     if "format" in data and arr.text("format") != _NPZ_FORMAT:
@@ -494,8 +502,9 @@ def read_npz(
             metadata=metadata,
         )
     except ParameterError as exc:
-        raise ParseError(f"{exc} (arrays 'frames', 'channel_joints', 'channel_dofs')",
-                         spath) from None
+        keys = ("frames", "channel_joints", "channel_dofs")
+        names = ", ".join(repr(arr.prefix + k) for k in keys)
+        raise ParseError(f"{exc} (arrays {names})", spath) from None
 
 
 # ----------------------------------------------------------------------------- CSV

@@ -55,6 +55,14 @@ PLANT_SMOOTH = 0.07
 PLANT_ROUNDS = 2
 #: Longest blend, seconds.
 MAX_BLEND = 4.0
+#: Bytes of one edge of a networkx graph (its weight dict in both directions).
+_EDGE_BYTES = 400
+#: Bytes a synthesised frame takes until the motion is written, besides a training frame
+#: (latent point, pose, root motion, the motion's frames, forward kinematics of the
+#: checks) and per training frame (the kernel and root weights of the frame).
+_FRAME_BYTES = 8 * 16
+_FRAME_BYTES_PER_TRAINING_FRAME = 8 * 4
+
 #: Without a bridge, pairs within this factor of the closest distance are candidates
 #: (the one nearest the particle is taken).
 CLOSE_ENOUGH = 1.1
@@ -91,10 +99,14 @@ class CommandGraph:
     """Shortest paths over a model's training latent points (complete graph, cost ``d^p``)."""
 
     def __init__(self, model: LatentModel, power: float = 4.0) -> None:
+        from ...io._limits import check_memory
+
         self.model = model
         self.power = power
         X = model.X_
         n = X.shape[0]
+        # networkx keeps every edge of the complete graph as Python objects
+        check_memory(_EDGE_BYTES * n * (n - 1) / 2, f"the command graph of {n:,} latent points")
         i, j = np.triu_indices(n, 1)
         cost = np.sqrt(sqdist(X, X))[i, j] ** power
         self.graph = nx.Graph()
@@ -194,6 +206,24 @@ class Synthesizer:
         self.sim_cpu_seconds = 0.0
         self.clamped = {"values": 0, "max_deg": 0.0}
         self._ranges: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self._made = 0  # frames emitted so far
+        widest = max(m.X_.shape[0] for m in self.models.values())
+        channels = max(len(m.all_channels_) for m in self.models.values())
+        self.frame_bytes = _FRAME_BYTES * channels + _FRAME_BYTES_PER_TRAINING_FRAME * widest
+
+    def reserve(self, n: float, what: str = "") -> int:
+        """``n`` more frames as a whole number, or ParameterError when the script's frames
+        would pass :data:`~cyclecoord.io._limits.MAX_FRAMES` or the memory limit."""
+        from ...io._limits import MAX_FRAMES, check_memory
+
+        total = self._made + float(n)
+        if not np.isfinite(total) or total > MAX_FRAMES:
+            raise ParameterError(
+                f"{what or 'the script'} would make {total:.4g} frames in all at {self.fps:g} "
+                f"fps; at most {MAX_FRAMES:,} are supported"
+            )
+        check_memory(total * self.frame_bytes, f"{int(total):,} synthesised frames")
+        return int(n)
 
     def _range(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         if name not in self._ranges:
@@ -214,9 +244,18 @@ class Synthesizer:
         ``{"segment": s, "time": seconds}``."""
         name = name or self.current
         m = self.model(name)
+        q = m.X_.shape[1]
         if isinstance(spec, _Point):
             return np.asarray(spec, dtype=float)
-        q = m.X_.shape[1]
+        if isinstance(spec, (list, tuple)) and (
+            len(spec) != q or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) for v in spec
+            )
+        ):
+            raise ParameterError(
+                f"a latent target of {name!r} must be {q} numbers or a frame/segment, "
+                f"got {str(spec)[:80]}"
+            )
         if isinstance(spec, dict):
             unknown = sorted(set(spec) - {"frame", "segment", "time"})
             if unknown:
@@ -274,6 +313,7 @@ class Synthesizer:
         m = self._need_start("moving")
         params = self.params if radius is None else self.params.replace(radius=radius)
         t0, c0 = time.perf_counter(), time.process_time()
+        self.reserve(path.shape[0] - 1)
         X, V = simulate(m, path, self.x, self.v, self.fps, params, self.force, self.t)
         self._emit(self.current, X, m.pose(X), self._root(m, X))
         self.sim_seconds += time.perf_counter() - t0
@@ -295,6 +335,7 @@ class Synthesizer:
         if clip:
             angles = self._clip(name, angles)
         self.chunks.append(_Chunk(name, X, angles, root, self.command))
+        self._made += X.shape[0]
         self.t += X.shape[0] / self.fps
 
     @staticmethod
@@ -351,17 +392,25 @@ class Synthesizer:
             poly = self._graphs[self.current].path(self.x, goal)
         else:
             raise ParameterError(f"MOVE path must be 'line' or 'graph', got {path!r}")
-        if not (isinstance(speed, (int, float)) and speed > 0):
+        if not (
+            isinstance(speed, (int, float)) and not isinstance(speed, bool)
+            and np.isfinite(speed) and speed > 0
+        ):
             raise ParameterError(f"MOVE speed must be a positive number, got {speed!r}")
         length = float(np.linalg.norm(np.diff(poly, axis=0), axis=1).sum())
         if duration is None:
-            n = max(1, int(np.ceil(length / (m.speed_ * speed) * self.fps)))
+            with np.errstate(all="ignore"):
+                frames = np.ceil(length / (m.speed_ * speed) * self.fps)
         else:
-            if not (isinstance(duration, (int, float)) and duration > 0):
+            if not (
+                isinstance(duration, (int, float)) and not isinstance(duration, bool)
+                and np.isfinite(duration) and duration > 0
+            ):
                 raise ParameterError(
                     f"MOVE duration must be a positive number of seconds, got {duration!r}"
                 )
-            n = max(1, int(round(duration * self.fps)))
+            frames = round(duration * self.fps)
+        n = max(1, self.reserve(frames if np.isfinite(frames) else np.inf, "MOVE"))
         ramp = int(round(self.ease * self.fps))
         if ramp:
             n += ramp  # the ramps lose about half their length each
@@ -377,10 +426,19 @@ class Synthesizer:
     ) -> None:
         """IDLE within ``radius`` of one point (default: where the particle is) or several."""
         self._need_start("IDLE")
-        if not (isinstance(duration, (int, float)) and duration > 0):
+        if not (
+            isinstance(duration, (int, float)) and not isinstance(duration, bool)
+            and np.isfinite(duration) and duration > 0
+        ):
             raise ParameterError(
                 f"IDLE duration must be a positive number of seconds, got {duration!r}"
             )
+        if not (
+            isinstance(hover, (int, float)) and not isinstance(hover, bool)
+            and np.isfinite(hover) and hover > 0
+        ):
+            raise ParameterError(f"IDLE hover must be a positive number of seconds, got {hover!r}")
+        self.reserve(duration * self.fps, "IDLE")
         many = isinstance(at, list) and at and all(isinstance(a, (dict, list)) for a in at)
         points = (
             [self.target(a) for a in at]
@@ -502,7 +560,10 @@ class Synthesizer:
         src = self.current
         m2 = self.model(to)
         check_compatible(self.models[src], m2, f"TRANSITION from {src!r} to {to!r}: ")
-        if not (isinstance(blend, (int, float)) and not isinstance(blend, bool) and blend > 0):
+        if not (
+            isinstance(blend, (int, float)) and not isinstance(blend, bool)
+            and np.isfinite(blend) and blend > 0
+        ):
             raise ParameterError(
                 f"TRANSITION blend must be a positive number of seconds, got {blend!r}"
             )
@@ -532,6 +593,7 @@ class Synthesizer:
         self.move(_Point(x1), radius=small, speed=APPROACH_SPEED)
         asked = max(1, int(round(blend * self.fps)))
         n = min(max(asked, self.blend_frames(src, to, x1, x2)), int(MAX_BLEND * self.fps))
+        self.reserve(n + 1, "TRANSITION")
         still = np.repeat(x1[None, :], n + 1, axis=0)
         p1 = self.params.replace(radius=small)
         X1, _ = simulate(m1, still, self.x, self.v, self.fps, p1, self.force, self.t)
@@ -585,6 +647,12 @@ class Synthesizer:
             ) from None
         idx = np.flatnonzero(m.segments_ == s)
         length = m.times_[idx][-1]
+        for what, value in (("start", start), ("stop", stop)):
+            if value is not None and (
+                not isinstance(value, (int, float)) or isinstance(value, bool)
+                or not np.isfinite(value)
+            ):
+                raise ParameterError(f"PLAY {what} must be a number of seconds, got {value!r}")
         stop = length if stop is None else float(stop)
         if not 0 <= float(start) < stop <= length + 1e-9:
             raise ParameterError(
@@ -593,6 +661,7 @@ class Synthesizer:
             )
         first = idx[np.argmin(np.abs(m.times_[idx] - start))]
         self.move(_Point(m.X_[first]), radius=0.25 * self.params.radius)
+        self.reserve((stop - float(start)) * self.fps, "PLAY")
         t = np.arange(float(start), stop, 1.0 / self.fps)
         tt = m.times_[idx]
 
@@ -614,7 +683,7 @@ class Synthesizer:
     # ----------------------------------------------------------------- output
     @property
     def n_frames(self) -> int:
-        return sum(c.X.shape[0] for c in self.chunks)
+        return self._made
 
     def motion(self) -> Motion:
         """The frames so far as a motion on the first model's skeleton (root integrated)."""
