@@ -237,3 +237,16 @@ def test_usd_sparse_time_samples_are_interpolated(usda, walk):
     m = cc.load(usda)
     assert m.n_frames == 50_000 and np.isfinite(m.frames).all()
     np.testing.assert_allclose(m.frames[:19], walk.frames[:19], atol=1e-3)
+
+
+def test_usd_refusal_is_one_line_without_usd_core_warnings(usda, capfd):
+    # joints array cut to 3 entries: usd-core warns about every size that disagrees
+    text = usda.read_text()
+    a = text.index("uniform token[] joints = [") + len("uniform token[] joints = [")
+    b = text.index("]", a)
+    usda.write_text(text[:a] + ", ".join(text[a:b].split(", ")[:3]) + text[b:])
+    capfd.readouterr()
+    with pytest.raises(ParseError) as e:
+        cc.load(usda)
+    one_line(e, usda)
+    assert capfd.readouterr().err == ""

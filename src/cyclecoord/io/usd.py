@@ -19,8 +19,15 @@ original skeleton and channels are kept in the skeleton prim's ``customData`` so
 
 from __future__ import annotations
 
+import contextlib
+import functools
+import io
 import json
 import os
+import re
+import sys
+import tempfile
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -194,6 +201,15 @@ def write_usd(
             raise ParameterError(f"{p}: usd-core could not write the stage")
 
 
+def _why(exc: BaseException) -> str:
+    """The message of a usd-core error, without the C++ function, line and source file
+    it names first (``Error in 'pxrInternal_...::CrateFile::_ReadX' at line 3472 in file
+    .../crateFile.cpp : 'the message'``), on one line of at most 300 characters."""
+    why = " ".join(line.strip() for line in str(exc).splitlines() if line.strip())
+    why = re.sub(r"^Error in '[^']*' at line \d+ in file \S+ : ", "", why).strip("'")
+    return why if len(why) <= 300 else why[:297] + "..."
+
+
 #: Bytes per joint and frame while a stage is read (local matrices, translations,
 #: quaternions, rotation matrices, their copies for the joints, the Euler angles).
 _FRAME_JOINT_BYTES = 8 * 64
@@ -213,8 +229,7 @@ def _open(path: Path):
             cached.Reload(force=True)
         stage = Usd.Stage.Open(str(path))
     except Exception as exc:  # noqa: BLE001 - pxr raises Tf errors of its own types
-        why = next((line.strip() for line in str(exc).splitlines() if line.strip()), "")
-        raise ParseError(f"not a readable USD file ({why[:300]})", str(path)) from None
+        raise ParseError(f"not a readable USD file ({_why(exc)})", str(path)) from None
     skel_prim = next((p for p in stage.Traverse() if p.IsA(UsdSkel.Skeleton)), None)
     if skel_prim is None:
         raise ParseError("no UsdSkel Skeleton prim in the stage", str(path))
@@ -297,11 +312,24 @@ def _local_transforms(query, times: np.ndarray, path: Path) -> tuple[np.ndarray,
     if aq:
         anim = UsdSkel.Animation(aq.GetPrim())
         rot_attr = anim.GetRotationsAttr() if anim else None
+        kind = str(rot_attr.GetTypeName()) if rot_attr else ""
+        if rot_attr and kind not in ("quatf[]", "quath[]", "quatd[]"):
+            raise ParseError(
+                f"{anim.GetPath()}.rotations is of type {kind[:40]}, not an array of quaternions",
+                str(path),
+            )
         for t in keys if rot_attr else ():
             raw = rot_attr.Get(Usd.TimeCode(float(t)))
             if raw is None:
                 continue
-            q = np.array(raw, dtype=float).reshape(-1, 4)
+            try:
+                q = np.array(raw, dtype=float).reshape(-1, 4)
+            except (TypeError, ValueError):
+                raise ParseError(
+                    f"{anim.GetPath()}.rotations at time code {t:g}: not an array of "
+                    "quaternions",
+                    str(path),
+                ) from None
             bad = ~np.isfinite(q).all(axis=1)
             length = np.linalg.norm(np.where(np.isfinite(q), q, 0.0), axis=1)
             bad |= np.abs(length - 1.0) > 1e-3
@@ -354,6 +382,87 @@ def _local_transforms(query, times: np.ndarray, path: Path) -> tuple[np.ndarray,
     return tr, rots
 
 
+@contextlib.contextmanager
+def _held_stderr():
+    """Hold back what is written to standard error in the body, on the Python side and on
+    file descriptor 2 (usd-core's C++ code prints there directly: a failed ``madvise``,
+    a value it cannot convert).  Yields a list that gets the held text; the caller
+    decides whether to print it.  Only on the main thread (file descriptor 2 belongs to
+    the whole process); elsewhere nothing is held."""
+    held: list[str] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield held
+        return
+    with tempfile.TemporaryFile() as fh:
+        try:
+            sys.stderr.flush()
+            saved = os.dup(2)
+        except (OSError, ValueError, AttributeError):  # no usable descriptor 2
+            yield held
+            return
+        py_err = io.StringIO()
+        os.dup2(fh.fileno(), 2)
+        try:
+            with contextlib.redirect_stderr(py_err):
+                yield held
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            fh.seek(0)
+            held.append(py_err.getvalue() + fh.read().decode("utf-8", "replace"))
+
+
+def _refusing(func):
+    """``func(path)``, a reader, with what usd-core does on a damaged stage turned into one
+    ParseError naming the file: names it cannot give as text (invalid UTF-8 in a joint
+    path, a token or customData) and the errors it raises when a corrupt crate's values
+    are read (found then, not when the stage opens).  What usd-core prints meanwhile
+    (warnings on sizes that disagree or joints out of order, C++ messages) is not shown
+    with a refusal, whose one line says what was wrong; after a read that succeeds, or
+    an error of another kind, it is printed as usual."""
+
+    @functools.wraps(func)
+    def wrapper(path):
+        Tf = require_usd()[2]
+        trap = getattr(Tf, "DiagnosticTrap", None)  # usd-core 25.2 and later
+        refused = False
+        held: list[str] = []
+        try:
+            # the trap closes first: the warnings it reposts are held too
+            with _held_stderr() as held, (
+                trap() if trap is not None else contextlib.nullcontext()
+            ) as caught:
+                try:
+                    return func(path)
+                except ParseError:
+                    refused = True
+                    raise
+                except UnicodeDecodeError as exc:
+                    refused = True
+                    raise ParseError(
+                        f"holds a name or text that is not UTF-8 ({exc.reason} at byte "
+                        f"{exc.start})",
+                        str(path),
+                    ) from None
+                except Exception as exc:
+                    if not type(exc).__module__.startswith("pxr"):
+                        raise
+                    refused = True
+                    raise ParseError(
+                        f"not a readable USD file ({_why(exc)})", str(path)
+                    ) from None
+                finally:
+                    if caught is not None and refused:
+                        caught.Clear()
+        finally:
+            if not refused and held and held[0]:
+                sys.stderr.write(held[0])
+                sys.stderr.flush()
+
+    return wrapper
+
+
+@_refusing
 def usd_joint_positions(path: str | os.PathLike[str]) -> tuple[list[str], np.ndarray, float]:
     """Joint positions ``(T, J, 3)`` computed by usd-core (``ComputeJointSkelTransforms``).
 
@@ -410,6 +519,7 @@ def _custom_data(prim, path: Path) -> dict | None:
     return out
 
 
+@_refusing
 def read_usd(path: str | os.PathLike[str]) -> Motion:
     """Read the first UsdSkel skeleton of a stage and its animation as a :class:`Motion`.
 
