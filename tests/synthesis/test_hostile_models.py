@@ -178,3 +178,11 @@ def test_graph_refuses_what_it_cannot_make(takes, tmp_path, capsys, extra, words
     for w in words:
         assert w in err, err
     assert not out.exists()
+
+
+def test_a_duration_too_large_for_a_float(model, tmp_path, capsys):
+    # JSON integers have no limit; np.isfinite(10**30) raised a TypeError
+    for value in (10**30, 10**400):
+        script = _script(tmp_path, model, [{"command": "IDLE", "duration": value}])
+        assert main(["animate", str(script), "-o", str(tmp_path / "o.bvh")]) == 1
+        assert "commands[0] (IDLE)" in _error(capsys)

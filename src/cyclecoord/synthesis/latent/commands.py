@@ -15,6 +15,7 @@ segment as it was.  Root motion comes from the training frames nearest the parti
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -66,6 +67,15 @@ _FRAME_BYTES_PER_TRAINING_FRAME = 8 * 4
 #: Without a bridge, pairs within this factor of the closest distance are candidates
 #: (the one nearest the particle is taken).
 CLOSE_ENOUGH = 1.1
+
+
+def _isfinite(value: Any) -> bool:
+    """``math.isfinite`` of a JSON or Python number; False, not an error as from
+    ``np.isfinite``, for an integer too large for a float."""
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
 
 
 @dataclass(frozen=True)
@@ -183,7 +193,7 @@ class Synthesizer:
     def __post_init__(self) -> None:
         if not self.models:
             raise ParameterError("no models")
-        if not np.isfinite(self.fps) or self.fps <= 0:
+        if not _isfinite(self.fps) or self.fps <= 0:
             raise ParameterError(f"fps must be positive, got {self.fps}")
         if self.plant not in ("transitions", "all", "off"):
             raise ParameterError(
@@ -394,7 +404,7 @@ class Synthesizer:
             raise ParameterError(f"MOVE path must be 'line' or 'graph', got {path!r}")
         if not (
             isinstance(speed, (int, float)) and not isinstance(speed, bool)
-            and np.isfinite(speed) and speed > 0
+            and _isfinite(speed) and speed > 0
         ):
             raise ParameterError(f"MOVE speed must be a positive number, got {speed!r}")
         length = float(np.linalg.norm(np.diff(poly, axis=0), axis=1).sum())
@@ -404,7 +414,7 @@ class Synthesizer:
         else:
             if not (
                 isinstance(duration, (int, float)) and not isinstance(duration, bool)
-                and np.isfinite(duration) and duration > 0
+                and _isfinite(duration) and duration > 0
             ):
                 raise ParameterError(
                     f"MOVE duration must be a positive number of seconds, got {duration!r}"
@@ -428,14 +438,14 @@ class Synthesizer:
         self._need_start("IDLE")
         if not (
             isinstance(duration, (int, float)) and not isinstance(duration, bool)
-            and np.isfinite(duration) and duration > 0
+            and _isfinite(duration) and duration > 0
         ):
             raise ParameterError(
                 f"IDLE duration must be a positive number of seconds, got {duration!r}"
             )
         if not (
             isinstance(hover, (int, float)) and not isinstance(hover, bool)
-            and np.isfinite(hover) and hover > 0
+            and _isfinite(hover) and hover > 0
         ):
             raise ParameterError(f"IDLE hover must be a positive number of seconds, got {hover!r}")
         self.reserve(duration * self.fps, "IDLE")
@@ -562,7 +572,7 @@ class Synthesizer:
         check_compatible(self.models[src], m2, f"TRANSITION from {src!r} to {to!r}: ")
         if not (
             isinstance(blend, (int, float)) and not isinstance(blend, bool)
-            and np.isfinite(blend) and blend > 0
+            and _isfinite(blend) and blend > 0
         ):
             raise ParameterError(
                 f"TRANSITION blend must be a positive number of seconds, got {blend!r}"
@@ -650,7 +660,7 @@ class Synthesizer:
         for what, value in (("start", start), ("stop", stop)):
             if value is not None and (
                 not isinstance(value, (int, float)) or isinstance(value, bool)
-                or not np.isfinite(value)
+                or not _isfinite(value)
             ):
                 raise ParameterError(f"PLAY {what} must be a number of seconds, got {value!r}")
         stop = length if stop is None else float(stop)

@@ -30,11 +30,10 @@ import time
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 
 from ...errors import CycleCoordError, ParameterError, ParseError
 from ...quality.contacts import skating_report
-from .commands import Synthesizer
+from .commands import Synthesizer, _isfinite
 from .model import LatentModel
 from .particle import ParticleParams
 
@@ -110,7 +109,7 @@ def _number(p: Path, where: str, value: Any, low: float, high: float, what: str)
     if (
         not isinstance(value, (int, float))
         or isinstance(value, bool)
-        or not np.isfinite(value)
+        or not _isfinite(value)
         or not low < value <= high
     ):
         raise _fail(p, where, f"{what} must be a number in ({low:g}, {high:g}], got {value!r}")
@@ -204,7 +203,7 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
     if (
         not isinstance(fps, (int, float))
         or isinstance(fps, bool)
-        or not np.isfinite(fps)
+        or not _isfinite(fps)
         or not MIN_FPS <= fps <= MAX_FPS
     ):
         raise _fail(p, "fps", f"must be a number of frames a second in {MIN_FPS:g}..{MAX_FPS:g}, "
