@@ -186,3 +186,13 @@ def test_a_duration_too_large_for_a_float(model, tmp_path, capsys):
         script = _script(tmp_path, model, [{"command": "IDLE", "duration": value}])
         assert main(["animate", str(script), "-o", str(tmp_path / "o.bvh")]) == 1
         assert "commands[0] (IDLE)" in _error(capsys)
+
+
+def test_a_model_of_a_motion_that_never_moves(tmp_path, capsys):
+    first = cc.datasets.example_capture().motion[:1]
+    still = first.with_frames(np.repeat(first.frames, 30, axis=0))
+    cc.save(still, tmp_path / "still.bvh")
+    args = ["latent", "fit", str(tmp_path / "still.bvh"), "-o", str(tmp_path / "m.npz")]
+    assert main(args + ["--step", "1", "--max-iter", "5"]) == 1
+    assert "no joint angle changes" in _error(capsys)
+    assert not (tmp_path / "m.npz").exists()

@@ -199,6 +199,11 @@ class LatentModel:
         self.weights_ = influence_weights(angles, self.channels_, self.skeleton_)
         Z = (angles - self.mean_) * self.weights_
         _, S, Vt = np.linalg.svd(Z, full_matrices=False)
+        if not S.size or not S[0] > 1e-12:  # nothing to learn (and a log of zero variance)
+            raise ParameterError(
+                f"segments {self.segment_names_}: no joint angle changes over the training "
+                "frames; a model needs motion"
+            )
         ratio = np.cumsum(S**2) / max((S**2).sum(), 1e-300)
         d_pca = int(np.searchsorted(ratio, self.variance - 1e-12) + 1)
         d_pca = max(d_pca, int(self.n_components) + 1)
