@@ -56,11 +56,15 @@ Columns (per file):
 * **step/p99** -- the cycle's largest frame step, its seam (last to first frame) included,
   over the 99th percentile of the capture's steps.
 * **near max**, **near med** -- each cycle pose's distance to its nearest captured pose,
-  largest and median, over the capture's **spread**: the median, over captured frames, of
-  the distance to the nearest captured pose at least a quarter period away in time (how
-  far one cycle's pose lies from the same pose in another cycle; the period is the
-  strike period, or the autocorrelation's when no strikes were found).  At most 1 means
-  the cycle pose is as close to the capture as the capture's own cycles are to each other.
+  largest and median, over the capture's **spread**: the 90th percentile, over captured
+  frames, of the distance to the nearest captured pose at least half a period away in
+  time (how far one cycle's pose lies from the same pose in another cycle; the period is
+  the strike period, or the autocorrelation's when no strikes were found).  At most 1
+  means the cycle pose is as close to the capture as nine in ten captured poses are to
+  another cycle (the median was tried first: on a take of two or three strides, half the
+  captured poses are themselves farther than it from every other stride).  This is the
+  definition of ``cyclecoord.quality.pose_space``, computed here with this file's own
+  forward kinematics and search.
 * **seam** -- the cycle's last-to-first step over the median of its own steps.
 * **jerk/cut** -- mean jerk (third difference, cyclic, RMS over points, units/s^3) of the
   cycle over the best loop cut's; the **best loop cut** (:func:`loop_cut`, the rule of
@@ -774,7 +778,7 @@ def measure_cycle(cap: Capture, cycle_frames: np.ndarray, cycle_fps: float,
                   period: float) -> dict[str, Any]:
     """Quality of a cycle (channel values in the rig's order) against the capture's
     steady frames, all in root-frame FK positions; ``period`` (frames) sets the quarter
-    period of the spread and the loop cut's length."""
+    period of the spread's exclusion and the loop cut's length."""
     a, b = cap.steady
     x = cap.poses[a:b]
     posed = forward_kinematics(cap.rig, cycle_frames)
@@ -782,7 +786,7 @@ def measure_cycle(cap: Capture, cycle_frames: np.ndarray, cycle_fps: float,
     cap_steps = steps(x)
     p99 = float(np.percentile(cap_steps, 99))
     cyc_steps = steps(y, cyclic=True)
-    spread = float(np.nanmedian(nearest_distances(x, x, exclude_within=period / 4)))
+    spread = float(np.nanpercentile(nearest_distances(x, x, exclude_within=period / 2), 90))
     near = nearest_distances(y, x)
     out: dict[str, Any] = {
         "cycle_frames": int(len(y)),
@@ -1079,8 +1083,8 @@ def format_report(report: dict) -> str:
     lines += ["", _table(FIGURE_HEADERS, figure_rows(report)), "",
               "period/ac/strike: frames; ac%, str%: ours against the rotation autocorrelation /",
               "foot strikes; step/p99: cycle's largest step (seam included) over the capture's",
-              "p99 step; near max/med: cycle pose to nearest captured pose over the spread (median",
-              "distance of captured poses to their nearest pose >= a quarter period away); seam:",
+              "p99 step; near max/med: cycle pose to nearest captured pose over the spread (p90",
+              "distance of captured poses to their nearest pose >= half a period away); seam:",
               "last-to-first step over the cycle's median step; jerk/cut, legs/cut: against the",
               "best loop cut (legs: smallest p1-p99 range ratio of hip/knee/ankle flexion). All",
               "in root-frame joint positions from this benchmark's own FK, steady frames only.",

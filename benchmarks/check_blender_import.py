@@ -61,7 +61,7 @@ def main() -> int:
     import numpy as np
 
     import cyclecoord as cc
-    from cyclecoord.io.gltf import default_scale
+    from cyclecoord.rig import metres_per_unit
 
     motion = cc.load(args.capture)
     with tempfile.TemporaryDirectory() as tmp:
@@ -82,7 +82,7 @@ def main() -> int:
         pos = data["pos"]
         version = str(data["version"])
     fk = motion.positions()
-    scale = default_scale(motion.skeleton)
+    scale = metres_per_unit(motion)  # what the export scaled by
     fk_names = [n[:-4] + "/end" if n.endswith("_end") else n for n in names]
     cols = [fk.names.index(n) for n in fk_names]
     blender_as_gltf = np.stack([pos[..., 0], pos[..., 2], -pos[..., 1]], axis=-1) / scale

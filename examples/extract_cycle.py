@@ -1,4 +1,7 @@
-"""Extract the typical cycle of a capture and save it as a loopable BVH clip.
+"""Extract the typical cycle of a capture and save it as a loopable BVH clip
+=========================================================================
+
+A command-line script (the gallery shows it; it is run by the tests)::
 
     python examples/extract_cycle.py                      # built-in synthetic walk
     python examples/extract_cycle.py 69_01.amc --frames 200:450 --max-scale 50 -o walk_cycle.bvh

@@ -1,4 +1,7 @@
-"""Print the phase of every frame of a periodic capture as CSV (frame, phase, cycle).
+"""Print the phase of every frame of a periodic capture as CSV (frame, phase, cycle)
+=================================================================================
+
+A command-line script (the gallery shows it; it is run by the tests)::
 
     python examples/phase_per_frame.py                    # built-in synthetic walk
     python examples/phase_per_frame.py 69_01.amc --frames 200:450 --max-scale 50 -o phase.csv

@@ -1,4 +1,7 @@
-"""Render a capture next to its extracted typical cycle as a stick-figure GIF.
+"""Render a capture next to its extracted typical cycle as a stick-figure GIF
+==========================================================================
+
+A command-line script (the gallery shows it; it is run by the tests)::
 
     python examples/render_comparison.py                  # built-in synthetic walk
     python examples/render_comparison.py 69_01.amc --frames 200:450 --max-scale 50 -o walk.gif

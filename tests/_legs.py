@@ -26,11 +26,14 @@ def legs_skeleton(
     return Skeleton(tuple(joints), name="legs")
 
 
-def make_motion(skel, T=120, fps=60.0, root_speed=0.0, lift_left=None):
+def make_motion(skel, T=120, fps=60.0, root_speed=0.0, lift_left=None, bob=(0.0, 0.0)):
+    """Standing legs; ``root_speed`` slides them forward, ``lift_left`` lifts the left foot
+    on those frames, ``bob=(amplitude, hz)`` moves the whole body up and down."""
     channels = skel.channels
     frames = np.zeros((T, len(channels)))
     col = {c: i for i, c in enumerate(channels)}
-    frames[:, col[("root", "ty")]] = 10.0
+    amplitude, hz = bob
+    frames[:, col[("root", "ty")]] = 10.0 + amplitude * np.sin(2 * np.pi * hz * np.arange(T) / fps)
     frames[:, col[("root", "tz")]] = root_speed * np.arange(T) / fps
     if lift_left is not None:
         frames[lift_left, col[(skel.names[1], "rx")]] = -40.0  # swing the left thigh forward

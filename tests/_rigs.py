@@ -5,7 +5,6 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-import pytest
 from scipy.spatial.transform import Rotation
 
 import cyclecoord as cc
@@ -13,6 +12,7 @@ from cyclecoord.conventions import to_bvh_convention
 from cyclecoord.motion import Motion
 from cyclecoord.rig import CMU_UNIT, Z_TO_Y
 from cyclecoord.skeleton import Joint, Skeleton
+from _skips import need_data
 
 BVH = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "bvh"
 BANDAI = sorted((BVH / "bandai").glob("*.bvh")) if (BVH / "bandai").is_dir() else []
@@ -20,14 +20,12 @@ XSENS = BVH / "xsens" / "S02-Trial-Walk-1.bvh"
 
 
 def shared(path: Path) -> Motion:
-    if not path.is_file():
-        pytest.skip(f"shared capture not found at {path} (../shared/data beside the checkout)")
+    need_data(path)
     return cc.load(path)
 
 
 def bandai(k: int = 0) -> Motion:
-    if not BANDAI:
-        pytest.skip(f"shared Bandai captures not found under {BVH / 'bandai'}")
+    need_data(BVH / "bandai")
     return cc.load(BANDAI[k])
 
 

@@ -109,3 +109,54 @@ def test_the_notebook_line_and_its_extra():
     assert re.search(r'^notebooks = \[[^]]*"nbconvert', pyproject, flags=re.MULTILINE)
     for ignored in ("/out/", "/walk_cycle.bvh", "/walk_report.json"):
         assert ignored in (ROOT / ".gitignore").read_text().splitlines()
+
+
+# ---------------------------------------------------------------- issue 25: no drift
+#: Every ``python`` block of the README and the test that runs it: the Library blocks run
+#: here on stand-ins (test_every_library_line_runs_as_written), the motion-graph block on
+#: the shared subject-35 walks (below).
+PYTHON_SECTIONS = {"Library": 2, "Motion graph": 1}
+
+
+def test_every_python_block_is_run_by_a_test():
+    assert len(blocks("python")) == sum(PYTHON_SECTIONS.values())
+    for section, n in PYTHON_SECTIONS.items():
+        assert len(blocks("python", section)) == n, section
+
+
+def test_the_motion_graph_block_runs_as_written(cmu_dir, tmp_path, monkeypatch):
+    for n in ("16", "07", "08", "13"):
+        (tmp_path / f"35_{n}.amc").symlink_to(cmu_dir / "35" / f"35_{n}.amc")
+    (tmp_path / "35.asf").symlink_to(cmu_dir / "35" / "35.asf")
+    monkeypatch.chdir(tmp_path)
+    (code,) = blocks("python", "Motion graph")
+    namespace: dict = {}
+    exec(compile(code, "README.md", "exec"), namespace)  # noqa: S102 - the README's own lines
+    assert namespace["gen"].motion.n_frames == 450
+    assert (tmp_path / "walk.bvh").is_file()
+
+
+def test_the_latent_script_shown_is_the_example_file():
+    import json
+
+    (shown,) = blocks("json", "Latent-space synthesis: models, scripts, `animate`")
+    example = json.loads((ROOT / "examples" / "latent_script.json").read_text())
+    assert json.loads(shown) == example
+
+
+def test_no_figure_without_a_named_run():
+    """Test counts and suite times drift with every commit: the README gives none."""
+    assert not re.search(r"\b\d[\d,]* tests\b", README)
+    assert not re.search(r"suite[^.]*\b\d+ min\b", README)
+
+
+def test_the_docs_build_line_and_its_extra():
+    line = next(ln for ln in README.splitlines() if ln.startswith("sphinx-build"))
+    assert line == "sphinx-build -W --keep-going -b html docs docs/_build/html"
+    assert 'pip install -e ".[docs]"' in README
+    tomllib = pytest.importorskip("tomllib", reason="tomllib is Python 3.11+")
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    for extra in ("docs", "test"):  # the test suite builds the docs, so CI has the tools
+        names = {re.split(r"[<>=\[ ]", d)[0] for d in extras[extra]}
+        assert {"sphinx", "numpydoc", "sphinx-gallery", "pydata-sphinx-theme"} <= names, extra
+    assert "/docs/_build/" in (ROOT / ".gitignore").read_text().splitlines()

@@ -30,6 +30,7 @@ __all__ = [
     "to_bvh_convention",
     "local_rotations",
     "continuous_euler",
+    "continuous_channels",
     "check_order",
     "wrap_degrees",
     "in_conventions_of",
@@ -361,6 +362,52 @@ def _match_branches(motion: Motion, target: Motion) -> Motion:
             frames[:, cols] = best
             changed = True
     return motion.with_frames(frames) if changed else motion
+
+
+#: A frame-to-frame step in an Euler channel over this (degrees) is a wrap or a flip.
+JUMP_DEGREES = 90.0
+
+
+def continuous_channels(motion: Motion) -> Motion:
+    """``motion`` with each joint's Euler channels continuous over frames.
+
+    Joints with three rotation channels whose values jump by more than
+    :data:`JUMP_DEGREES` between two frames (a wrap past +-180, a flip to the other
+    Tait-Bryan solution) are rewritten with :func:`continuous_euler`, starting from the
+    first frame's own solution: the same rotations, numbers that never jump.  Other joints
+    keep their values exactly (a motion without jumps is returned as it is).
+
+    Parameters
+    ----------
+    motion : Motion
+        With a skeleton (without one, the motion is returned unchanged).
+
+    Returns
+    -------
+    Motion
+    """
+    sk = motion.skeleton
+    if sk is None or motion.n_frames < 2:
+        return motion
+    frames = None
+    for j in sk.joints:
+        order = j.rotation_order
+        if len(order) != 3:
+            continue
+        cols = [motion.channels.index((j.name, "r" + a.lower()))
+                if (j.name, "r" + a.lower()) in motion.channels else -1 for a in order]
+        if min(cols) < 0:
+            continue
+        vals = motion.frames[:, cols]
+        if np.abs(np.diff(vals, axis=0)).max() <= JUMP_DEGREES:
+            continue
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message=".*[Gg]imbal.*")
+            mats = Rotation.from_euler(order, vals, degrees=True).as_matrix()
+        if frames is None:
+            frames = np.array(motion.frames, dtype=float)
+        frames[:, cols] = continuous_euler(mats[:, None], order, vals[0])[:, 0]
+    return motion if frames is None else motion.with_frames(frames)
 
 
 def in_conventions_of(motion: Motion, template: Motion) -> Motion:

@@ -8,7 +8,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from .errors import ParameterError
-from .skeleton import DOF_NAMES, Skeleton
+from .skeleton import DOF_NAMES, Skeleton, forward_kinematics
 
 __all__ = ["Motion", "DEFAULT_FPS"]
 
@@ -224,8 +224,6 @@ class Motion:
     def positions(self):
         """Forward kinematics: world positions of every joint (see
         :func:`cyclecoord.skeleton.forward_kinematics`)."""
-        from .skeleton import forward_kinematics
-
         return forward_kinematics(self)
 
     def root_channels(self) -> list[int]:

@@ -1,6 +1,6 @@
 """JSON reports: strict JSON writing and the partial report of a run with nothing periodic.
 
-Shared by the command line (:mod:`cyclecoord.cli`) and :mod:`cyclecoord.batch`; it imports
+Shared by the command line (``cyclecoord.cli``) and :mod:`cyclecoord.batch`; it imports
 neither, so neither imports the other for it.
 """
 

@@ -331,6 +331,41 @@ def _body_points(motion: Motion, frames: np.ndarray, skip_root: bool) -> np.ndar
     return pos[:, 1:] if skip_root else pos
 
 
+def _ends_at_bottom(motion: Motion, frames: np.ndarray) -> np.ndarray:
+    """Per axis, the median over ``frames`` of how many chain ends (end sites and joints
+    without children) lie within a tenth of the body's extent of its lowest point, ``(3,)``.
+    Along the up axis the feet are those ends; along a horizontal axis one end (a tail,
+    a hand, a snout) usually leads alone."""
+    fk = forward_kinematics(motion[frames])
+    par = fk.parents
+    ends = np.setdiff1d(np.arange(len(par)), par[par >= 0])
+    pos = fk.positions
+    low = pos.min(axis=1, keepdims=True)
+    reach = 0.1 * np.ptp(pos, axis=1, keepdims=True)
+    near = (pos[:, ends] - low <= reach).sum(axis=1)
+    return np.median(near, axis=0)
+
+
+def _up_of(motion: Motion, frames: np.ndarray, extents: np.ndarray, static: bool) -> str:
+    """Y or Z, the up axis of a capture.
+
+    A body at least twice as tall as it is deep or long: the axis of its larger extent (a
+    biped).  Otherwise (a dog, whose body can be longer than it is tall) the axis along
+    which more chain ends reach the bottom (the feet stand on the floor), then the axis the
+    body travels less along, then the larger extent."""
+    y, z = float(extents[1]), float(extents[2])
+    if max(y, z) >= 2.0 * min(y, z):
+        return "Z" if z > y else "Y"
+    at_bottom = _ends_at_bottom(motion, frames)
+    if at_bottom[1] != at_bottom[2]:
+        return "Z" if at_bottom[2] > at_bottom[1] else "Y"
+    root = forward_kinematics(motion[frames]).positions[:, 1 if static else 0]
+    travel = np.ptp(root, axis=0)
+    if max(travel[1], travel[2]) > max(y, z):
+        return "Y" if travel[2] > travel[1] else "Z"
+    return "Z" if z > y else "Y"
+
+
 def _first_step_ratio(motion: Motion, skip_root: bool) -> tuple[float, float]:
     """Largest point move frame 0 -> 1, and its ratio to the largest later move (200 frames)."""
     T = motion.n_frames
@@ -376,7 +411,10 @@ def describe_rig(motion: Motion, units: Units = "auto") -> RigInfo:
     standing or walking pose.  It is where the skeleton's points reach: a rig whose head
     ends at the skull's base (Bandai: the ``Head`` end site has zero offset) measures some
     20 cm shorter than the performer.  The up axis is whichever of y and z that median
-    extent is larger along.  The first frame is a reference pose when its largest joint
+    extent is larger along when it is at least twice the other (a biped); for a body as
+    long as it is tall (a dog) it is the axis along which more chain ends reach the
+    bottom (the feet), then the one the body travels less along (see ``_up_of``).
+    The first frame is a reference pose when its largest joint
     move to the second frame exceeds 5 times the largest move between the next 200 frames
     and 2 % of the height.  Only ratios of lengths are used, so the findings do not
     depend on the unit.
@@ -387,14 +425,14 @@ def describe_rig(motion: Motion, units: Units = "auto") -> RigInfo:
     T = motion.n_frames
     pos = _body_points(motion, _sample(T, 400), static)
     extents = np.median(np.ptp(pos, axis=1), axis=0)
-    up = "Z" if extents[2] > extents[1] else "Y"
+    up = _up_of(motion, _sample(T, 400), extents, static)
     height = float(extents[AXIS_INDEX[up.lower()]])
     step0, ratio = _first_step_ratio(motion, static)
     reference = bool(np.isfinite(ratio) and ratio > 5.0 and step0 > 0.02 * height)
     if reference:  # measure the body without the reference pose
         pos = _body_points(motion, 1 + _sample(T - 1, 400), static)
         extents = np.median(np.ptp(pos, axis=1), axis=0)
-        up = "Z" if extents[2] > extents[1] else "Y"
+        up = _up_of(motion, 1 + _sample(T - 1, 400), extents, static)
         height = float(extents[AXIS_INDEX[up.lower()]])
 
     given = parse_units(units)
@@ -825,7 +863,7 @@ def normalize_rig(
             p = t0 + np.einsum("ab,tb->ta", R0, trans[:, 1])
         else:
             R, p = rots[:, 0], trans[:, 0]
-        for d in [d for d in new_root.dofs]:
+        for d in new_root.dofs:
             columns.pop((new_root.name, d), None)
         if rotates:
             R = np.einsum("ab,tbc->tac", up, R)
@@ -842,7 +880,7 @@ def normalize_rig(
             columns[(new_root.name, d)] = (
                 p[:, AXIS_INDEX[d[1]]] if d.startswith("t") else angles.get(d, np.zeros(T))
             )
-        joints[0] = replace_joint(joints[0], dofs=dofs, rotation_order=order)
+        joints[0] = _replace_joint(joints[0], dofs=dofs, rotation_order=order)
 
     analysis_skel = Skeleton(
         joints=tuple(joints),
@@ -877,7 +915,7 @@ def normalize_rig(
     return out, adapter
 
 
-def replace_joint(joint: Joint, **changes) -> Joint:
+def _replace_joint(joint: Joint, **changes) -> Joint:
     """A copy of ``joint`` with some fields changed (re-validated)."""
     fields = {
         "name": joint.name,

@@ -24,14 +24,24 @@ in degrees.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Sequence
+from typing import Protocol, Sequence
 
 import numpy as np
 
 from .errors import ParameterError
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .motion import Motion
+
+class Posable(Protocol):
+    """What :func:`forward_kinematics` reads of a capture: a
+    :class:`~cyclecoord.motion.Motion` has it.
+
+    The skeleton module does not import :mod:`cyclecoord.motion` (which imports this one):
+    the dependency goes one way, from the capture to its skeleton.
+    """
+
+    frames: np.ndarray
+    channels: Sequence[tuple[str, str]]
+    skeleton: "Skeleton | None"
 
 __all__ = [
     "Joint",
@@ -253,7 +263,7 @@ def rotation_matrices(values: np.ndarray, order: str) -> np.ndarray:
 
 
 def forward_kinematics(
-    motion: "Motion", skeleton: Skeleton | None = None
+    motion: Posable, skeleton: Skeleton | None = None
 ) -> JointPositions:
     """World positions of every joint for every frame.
 

@@ -76,7 +76,7 @@ def test_extract_bandwidth_option(tmp_path, capsys):
     assert code == 0, err
     assert "(cross-validated)" in out
     chosen = json.loads(rep.read_text())["bandwidth_frames"]
-    assert chosen > 0 and f"kernel width {chosen:.3g} frames" in out
+    assert chosen > 0 and f"kernel width {chosen:.3g} frame" in out  # "1 frame", "2.5 frames"
     code, out, err = run(capsys, "extract", "example", "--bandwidth", "3.5", "--report", rep)
     assert code == 0 and json.loads(rep.read_text())["bandwidth_frames"] == 3.5
     with pytest.raises(SystemExit):

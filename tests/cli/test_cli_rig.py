@@ -63,3 +63,23 @@ def test_feet_prints_the_rig_first(capsys):
     assert code == 0, err
     assert text.splitlines()[0].startswith("BVH rig: Hips travels, 25 joints")
     assert "mm (1.7" in text.splitlines()[0]
+
+
+def test_feet_on_a_z_up_rig(walk_69_01, tmp_path, capsys):
+    """Contacts measured along the rig's own up axis: the same on 69_01 and on it turned Z-up."""
+    import cyclecoord as cc
+    from cyclecoord.conventions import to_bvh_convention
+    from cyclecoord.rig import Z_TO_Y
+    from _rigs import turn_root
+
+    y_up = to_bvh_convention(walk_69_01[200:450], "ZXY")
+    texts = []
+    for name, m in (("y.bvh", y_up), ("z.bvh", turn_root(y_up, Z_TO_Y.T))):
+        cc.save(m, tmp_path / name)
+        code, text, err = run(capsys, "feet", tmp_path / name)
+        assert code == 0, err
+        texts.append(text.splitlines())
+    assert "Z-up" in texts[1][0] and "Y-up" in texts[0][0]
+    first = next(i for i, line in enumerate(texts[1]) if "planted" in line)
+    assert "planted   0.0%" not in texts[1][first]
+    assert texts[0][2:] == texts[1][2:]  # feet found, contacts and skating alike

@@ -187,7 +187,7 @@ def _commands():
 
 #: Options that take a value and say they write, but name no file.
 NOT_OUTPUTS = {("batch", "--cycles"): "the cycles' format",
-               **{(c, "--units"): "the length unit written" for c in ("convert", "feet")}}
+               **{(c, "--units"): "the length unit written" for c in ("convert", "feet", "extract")}}
 
 
 def test_every_command_declares_what_it_reads_and_writes():

@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 import cyclecoord as cc
+from _measured import at_most
 from cyclecoord import batch
 from cyclecoord.batch import SUMMARY_COLUMNS, find_captures, run_batch
 from cyclecoord.errors import ParameterError
@@ -114,12 +115,14 @@ def test_statuses_summary_and_reports(first, folder):
         assert row["cycles"] == report["cycles"]
         # the period is the median complete winding (the capture's speed wobbles by up to 30%)
         assert float(r["period_frames"]) == pytest.approx(report["period_frames"], rel=1e-4)
-        assert float(r["period_frames"]) == pytest.approx(PERIOD, rel=0.2)
+        # measured 10.1-13.6 % from 120 (the capture's cadence wobbles by up to 30 %)
+        assert abs(float(r["period_frames"]) / PERIOD - 1) <= at_most(0.136)
         assert float(r["period_seconds"]) == pytest.approx(float(r["period_frames"]) / 120.0, rel=1e-4)
         assert int(r["frames"]) == N_FRAMES and int(r["dims"]) == report["dims"] > 0
         assert 0 < float(r["birth"]) < float(r["scale"]) < float(r["death"])  # "inf" parses too
         assert float(r["birth"]) == pytest.approx(report["selected"]["birth"], rel=1e-5)
-        assert 0 < float(r["jerk_ratio"]) < 1  # the typical cycle is smoother than the noisy capture
+        # the typical cycle is smoother than the noisy capture: measured 0.050-0.055 of its jerk
+        assert 0 < float(r["jerk_ratio"]) <= at_most(0.055)
         assert float(r["jerk_ratio"]) == pytest.approx(report["jerk"]["cycle"] / report["jerk"]["original"], rel=1e-5)
         assert float(r["loop_closure"]) == pytest.approx(report["loop_closure"], rel=1e-5)
         assert float(r["seconds"]) >= 0
@@ -215,7 +218,8 @@ def test_two_processes_give_the_same_numbers(first, folder, tmp_path):
 
 
 def test_dask_local_cluster_gives_the_same_summary(first, folder, tmp_path):
-    distributed = pytest.importorskip("distributed", reason="dask[distributed] not installed (extra 'dask')")
+    import distributed  # dask[distributed] is in the 'test' extra
+
     summary, _, before = first
     with distributed.LocalCluster(
         processes=False, n_workers=1, threads_per_worker=1, dashboard_address=None
@@ -345,8 +349,6 @@ def test_cycles_in_the_formats_extract_writes(tmp_path):
     cycle = cc.load(out / "a.cycle.npz")
     want = cycle.positions()
     for fmt in ("glb", "gltf", "usda", "csv"):
-        if fmt == "usda":
-            pytest.importorskip("pxr")
         s = run_batch(src, out, extract_options=opts, write_cycles=fmt, progress=False)
         assert s.processed == ["a.bvh", "bare.npz"]  # the format is part of the options
         assert s.row("a.bvh")["cycle_file"] == f"a.cycle.{fmt}"

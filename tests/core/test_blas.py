@@ -1,9 +1,8 @@
 """The pipeline runs its linear algebra on one BLAS thread and restores the setting."""
 
 import numpy as np
-import pytest
 
-threadpoolctl = pytest.importorskip("threadpoolctl")
+import threadpoolctl
 
 import cyclecoord as cc
 from cyclecoord._blas import one_blas_thread

@@ -77,3 +77,23 @@ def test_bad_motions():
         cc.Motion(np.zeros((3, 1)), [("a", "rx")], fps=0)
     with pytest.raises(cc.ParameterError, match="skeleton"):
         cc.Motion(np.zeros((3, 1)), [("a", "rx")]).positions()
+
+
+def test_skeleton_does_not_import_motion():
+    """Issue 25: motion and skeleton imported each other (skeleton for its type hints);
+    the dependency now goes one way, from the capture to its skeleton."""
+    import ast
+    from pathlib import Path
+
+    import cyclecoord.skeleton as skeleton_module
+
+    tree = ast.parse(Path(skeleton_module.__file__).read_text())
+    imported = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            imported.add(("." * node.level) + (node.module or ""))
+        elif isinstance(node, ast.Import):
+            imported.update(a.name for a in node.names)
+    assert not {".motion", "cyclecoord.motion"} & imported, imported
+    m = cc.datasets.example_capture().motion
+    assert m.positions().positions.shape[0] == m.n_frames  # Motion.positions still works

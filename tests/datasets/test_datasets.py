@@ -10,6 +10,7 @@ import pytest
 from cyclecoord import datasets as ds
 from cyclecoord.errors import ParameterError
 from cyclecoord.motion import Motion
+from _skips import need_data
 
 SHARED = Path(__file__).resolve().parents[2].parent / "shared" / "data"
 
@@ -108,8 +109,7 @@ def test_channels_are_cmu_amc_order():
 
 def test_channel_order_matches_real_amc():
     amc = SHARED / "cmu" / "69" / "69_01.amc"
-    if not amc.exists():
-        pytest.skip(f"CMU data not found at {amc} (../shared/data beside the checkout)")
+    need_data(amc)
     names, counts, in_frame = [], [], False
     for line in amc.read_text().splitlines():
         words = line.split()
@@ -275,7 +275,8 @@ def test_walk_looks_like_a_walk():
 @pytest.mark.parametrize("kind", ds.KINDS)
 def test_each_kind_traces_one_clear_loop(kind):
     """One cycle is a loop in angle space (not the same path out and back), so H1 shows it."""
-    ripser = pytest.importorskip("ripser").ripser
+    from ripser import ripser
+
     cap = ds.make_periodic_capture(n_frames=100, period=100.0, noise=0.0, speed_variation=0.0,
                                    kind=kind, random_state=0)
     dgm = ripser(cap.clean.frames[:, angle_cols(cap.clean)], maxdim=1)["dgms"][1]

@@ -14,6 +14,7 @@ from cyclecoord.errors import ParameterError, ParseError
 from cyclecoord.io.asfamc import read_amc, read_asf, write_amc, write_asf
 from cyclecoord.motion import Motion
 from cyclecoord.skeleton import Joint, Skeleton, forward_kinematics
+from _skips import need_data
 
 DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data"
 CMU = DATA / "cmu"
@@ -27,9 +28,7 @@ CMU_TRIALS = {
 
 
 def need_cmu() -> Path:
-    if not CMU.is_dir():
-        pytest.skip(f"CMU captures not found at {CMU} (../shared/data beside the checkout)")
-    return CMU
+    return need_data(CMU)
 
 
 # --------------------------------------------------------------------- synthetic data

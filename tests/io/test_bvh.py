@@ -178,9 +178,10 @@ def test_forward_kinematics_of_a_chain(tmp_path):
 
 # ------------------------------------------------------------------------- writing
 def test_round_trip_exact(tmp_path):
+    """continuous=False writes the numbers as given (the sample's frames jump by 180)."""
     m = read_bvh(write_text(tmp_path, SAMPLE))
     out = tmp_path / "out.bvh"
-    write_bvh(m, out)
+    write_bvh(m, out, continuous=False)
     m2 = read_bvh(out)
     assert m2.skeleton.names == m.skeleton.names
     assert m2.fps == m.fps
@@ -199,7 +200,7 @@ def test_round_trip_exact(tmp_path):
     np.testing.assert_array_equal(m2.select(extra).frames, 0.0)
     np.testing.assert_allclose(m2.positions().positions, m.positions().positions, atol=1e-6)
     # and once more: a BVH-convention file written by us reads back unchanged
-    write_bvh(m2, tmp_path / "again.bvh")
+    write_bvh(m2, tmp_path / "again.bvh", continuous=False)
     m3 = read_bvh(tmp_path / "again.bvh")
     assert m3.channels == m2.channels
     np.testing.assert_allclose(m3.frames, m2.frames, atol=1e-6)
@@ -229,7 +230,7 @@ def test_writer_maps_columns_by_name(tmp_path):
     rng = np.random.default_rng(0)
     perm = rng.permutation(m.n_channels)
     shuffled = m.select([m.channels[k] for k in perm])
-    write_bvh(shuffled, tmp_path / "s.bvh")
+    write_bvh(shuffled, tmp_path / "s.bvh", continuous=False)
     m2 = read_bvh(tmp_path / "s.bvh")
     np.testing.assert_allclose(m2.select(m.channels).frames, m.frames, atol=1e-6)
 
@@ -239,7 +240,7 @@ def test_random_values_round_trip_and_forced_order(tmp_path):
     rng = np.random.default_rng(1)
     vals = rng.uniform(-170, 170, size=(40, m.n_channels))
     m = m.with_frames(vals)
-    write_bvh(m, tmp_path / "r.bvh")
+    write_bvh(m, tmp_path / "r.bvh", continuous=False)
     back = read_bvh(tmp_path / "r.bvh")
     np.testing.assert_allclose(back.select(m.channels).frames, vals, atol=1e-6)
     # forcing one order re-expresses joints with other orders; positions unchanged
@@ -437,3 +438,24 @@ def test_mangled_files_parse_or_raise_parse_error(text):
         assert isinstance(m, Motion)
         assert m.frames.shape == (m.n_frames, len(m.skeleton.channels))
         assert np.isfinite(m.frames).all()
+
+
+def test_written_euler_channels_never_jump(tmp_path):
+    """A capture whose Euler numbers wrap and flip is written with continuous channels that
+    pose the same body (issue 23: no written file flips)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "periodic"))
+    from test_rotations import scrambled
+
+    import cyclecoord as cc
+    from cyclecoord.conventions import to_bvh_convention
+
+    m = scrambled(to_bvh_convention(cc.datasets.example_capture().motion[:120], "ZXY"))
+    joints = np.setdiff1d(np.arange(m.n_channels), np.asarray(m.root_channels()))
+    assert np.abs(np.diff(m.frames[:, joints], axis=0)).max() > 100
+    cc.save(m, tmp_path / "w.bvh")
+    back = cc.load(tmp_path / "w.bvh")
+    assert np.abs(np.diff(back.frames[:, joints], axis=0)).max() < 20
+    np.testing.assert_allclose(back.positions().positions, m.positions().positions, atol=1e-4)

@@ -14,6 +14,7 @@ from cyclecoord.io import convert, default_asf_path, load, save
 from cyclecoord.motion import Motion
 from cyclecoord.conventions import continuous_euler, to_bvh_convention
 from cyclecoord.skeleton import Joint, Skeleton, forward_kinematics
+from _skips import data_reason
 
 DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data"
 CMU69 = DATA / "cmu" / "69"
@@ -199,20 +200,8 @@ def test_default_asf_path():
     assert default_asf_path("dir/69_01.amc") == Path("dir/69.asf")
 
 
-def _asfamc_available() -> bool:
-    try:
-        import cyclecoord.io.asfamc  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
-needs_asfamc = pytest.mark.skipif(
-    not _asfamc_available(), reason="cyclecoord.io.asfamc (ASF/AMC reader) not written yet"
-)
 needs_data = pytest.mark.skipif(
-    not (CMU69 / "69_01.amc").is_file(),
-    reason=f"CMU capture 69_01 not found under {CMU69} (../shared/data beside the checkout)",
+    not (CMU69 / "69_01.amc").is_file(), reason=data_reason(CMU69 / "69_01.amc")
 )
 
 
@@ -229,7 +218,6 @@ def _compare_fk(a: Motion, b: Motion, tol: float, same_points: bool = True) -> f
     return err
 
 
-@needs_asfamc
 def test_save_amc_writes_asf_beside(tmp_path):
     m = asf_like_motion(seed=2, T=10)
     save(m, tmp_path / "out.amc")
@@ -250,7 +238,6 @@ def test_save_amc_writes_asf_beside(tmp_path):
     _compare_fk(other, back3, 1e-6 * m.skeleton.total_length(), same_points=False)
 
 
-@needs_asfamc
 @needs_data
 def test_cmu_amc_to_bvh_and_back(tmp_path):
     amc = load(CMU69 / "69_01.amc")
@@ -272,7 +259,6 @@ def test_cmu_amc_to_bvh_and_back(tmp_path):
     assert not missing
 
 
-@needs_asfamc
 @needs_data
 def test_amc_to_amc_keeps_source_skeleton(tmp_path):
     shutil.copy(CMU69 / "69.asf", tmp_path / "69.asf")

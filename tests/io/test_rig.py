@@ -248,3 +248,30 @@ def test_restore_refuses_other_channels():
     _, adapter = normalize_rig(m)
     with pytest.raises(ParameterError, match="analysis rig"):
         adapter.restore(m)
+
+
+def _dog_turned(rot: np.ndarray) -> Motion:
+    """The synthetic trot (a dog longer than it is tall) with its root premultiplied by ``rot``."""
+    from _walkers import quadruped_names, quadruped_skeleton, trot
+
+    names = quadruped_names()
+    m = trot(quadruped_skeleton(names), names, n_frames=120)
+    root = m.skeleton.joints[0]
+    order = root.rotation_order
+    r = [m.channel_index(root.name, "r" + a.lower()) for a in order]
+    t = [m.channel_index(root.name, d) for d in ("tx", "ty", "tz")]
+    frames = np.array(m.frames)
+    turned = Rotation.from_matrix(rot) * Rotation.from_euler(order, frames[:, r], degrees=True)
+    frames[:, r] = np.unwrap(turned.as_euler(order, degrees=True), period=360, axis=0)
+    frames[:, t] = frames[:, t] @ rot.T
+    return m.with_frames(frames)
+
+
+def test_up_axis_of_a_dog_longer_than_tall():
+    """A trotting dog is 14.5 long and 10 tall: its feet at the bottom, not its length, say
+    which way is up, in a Y-up and in a Z-up world (it read Z-up in a Y-up world before)."""
+    dog = _dog_turned(np.eye(3))
+    extents = describe_rig(dog).extents
+    assert extents[2] > extents[1]  # longer than tall: the extent alone would say Z
+    assert describe_rig(dog).up_axis == "Y"
+    assert describe_rig(_dog_turned(Z_TO_Y.T)).up_axis == "Z"

@@ -71,7 +71,6 @@ def test_z_up_glb_is_y_up(tmp_path):
 
 
 def test_usd_metres_per_unit_and_up_axis(tmp_path):
-    pytest.importorskip("pxr", reason="usd-core (the optional 'usd' extra) is not installed")
     from pxr import Usd, UsdGeom
 
     out = tmp_path / "cm.usda"

@@ -7,8 +7,6 @@ import cyclecoord as cc
 from cyclecoord.errors import ParameterError, ParseError
 from cyclecoord.motion import Motion
 
-pytest.importorskip("pxr", reason="usd-core (the optional 'usd' extra) is not installed")
-
 from cyclecoord.io.usd import read_usd, usd_joint_positions, write_usd
 
 

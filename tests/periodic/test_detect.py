@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 
 import cyclecoord as cc
+from _measured import at_most, frame
+from _skips import need_data
 from cyclecoord.cli import main
 from cyclecoord.quality.metrics import distance_to_cycle
 from cyclecoord.periodic.detection import (
@@ -19,24 +21,35 @@ from cyclecoord.periodic.detection import (
 )
 
 
+#: Measured on each chain (tests/_measured.py RUN): the fraction of frames mislabelled, the
+#: largest boundary error (frames), the largest period error of a segment or cycle against
+#: its kind's true period, and the largest loop closure and step (over the capture's p99)
+#: of the cycles.  Floors: half a percent of the frames, 5 frames, one frame of period.
+CHAINS = {
+    0: (0.0022, 4, 0.0244, 0.560, 1.016),
+    1: (0.0061, 11, 0.0400, 0.370, 0.851),
+    2: (0.0, 0, 0.0109, 0.743, 0.844),
+}
+
+
 @pytest.fixture(scope="module", params=[(("walk", "jumping_jack", "arm_circles"), 0), (("walk", "jog", "squat"), 1), (("squat", "arm_circles", "jog"), 2)])
 def chain(request):
     kinds, seed = request.param
     cap = cc.datasets.make_motion_chain(kinds=kinds, random_state=seed)
-    return cap, detect(cap.motion)
+    return cap, detect(cap.motion), CHAINS[seed]
 
 
 def test_chain_motions_are_found_and_segmented(chain):
-    cap, res = chain
+    cap, res, (mislabelled, boundary, period_err, _, _) = chain
     acc, match = best_match_accuracy(res.labels, cap.labels)
-    assert acc >= 0.90
+    assert 1 - acc <= at_most(mislabelled, 0.005)
     assert res.n_motions == 3 and sorted(match.values()) == [0, 1, 2]
-    assert max(boundary_errors(res.segments, cap.boundaries, cap.motion.n_frames)) <= 30
+    assert max(boundary_errors(res.segments, cap.boundaries, cap.motion.n_frames)) <= at_most(boundary, 5)
     # every segment counts its cycles like the truth: segment length / true period
     periods = dict(zip([k for _, _, k in cap.boundaries], cap.motion.metadata["periods"]))
     for sg in res.segments:
-        kind = cap.boundaries[match[sg.motion]][2]
-        assert sg.period_frames == pytest.approx(periods[kind], rel=0.25)
+        true = periods[cap.boundaries[match[sg.motion]][2]]
+        assert abs(sg.period_frames / true - 1) <= at_most(period_err, frame(true))
 
 
 def _closest_cycle(frames, cycles):
@@ -46,7 +59,7 @@ def _closest_cycle(frames, cycles):
 
 
 def test_motion_cycles_follow_the_detected_classes(chain):
-    cap, res = chain
+    cap, res, (_, _, period_err, closure, step) = chain
     _, match = best_match_accuracy(res.labels, cap.labels)
     periods = dict(zip([k for _, _, k in cap.boundaries], cap.motion.metadata["periods"]))
     cycles = motion_cycles(res)
@@ -55,10 +68,10 @@ def test_motion_cycles_follow_the_detected_classes(chain):
         kind = cap.boundaries[match[c.motion]][2]
         assert c.phase_from.startswith("class")
         assert c.cycle.n_frames == round(c.period_frames)
-        assert c.period_frames == pytest.approx(periods[kind], rel=0.25)
-        assert c.loop_closure <= 1.5
+        assert abs(c.period_frames / periods[kind] - 1) <= at_most(period_err, frame(periods[kind]))
+        assert c.loop_closure <= at_most(closure)
         # no pop: the largest step is measured (positive) and under the warning's threshold
-        assert 0 < c.largest_step < 2.0
+        assert 0 < c.largest_step <= min(2.0, at_most(step))
         assert c.cycle.channels == cap.motion.channels and c.cycle.fps == cap.motion.fps
         # the motion's own frames are nearer its cycle than any other motion's cycle
         a, b, _ = cap.boundaries[match[c.motion]]
@@ -66,7 +79,7 @@ def test_motion_cycles_follow_the_detected_classes(chain):
 
 
 def test_report_and_labels(chain):
-    cap, res = chain
+    cap, res, _ = chain
     rep = res.to_report()
     assert len(rep["labels"]) == cap.motion.n_frames
     assert set(rep["labels"]) <= {-1, 0, 1, 2}
@@ -164,10 +177,12 @@ def test_windows_find_a_small_motion_the_global_barcode_misses():
         res = detect(m, method=method, progress=False)
         acc, match = best_match_accuracy(res.labels, cap.labels)
         assert res.n_motions == 2 and sorted(match.values()) == [0, 1], method
-        assert acc >= 0.9, method
-        assert max(boundary_errors(res.segments, cap.boundaries, m.n_frames)) <= 30, method
+        # measured with either method: no frame mislabelled, boundaries exact, the jog's
+        # period 1.25 % from its 80 frames
+        assert 1 - acc <= at_most(0.0, 0.005), method
+        assert max(boundary_errors(res.segments, cap.boundaries, m.n_frames)) <= at_most(0, 5), method
         jog = [s for s in res.segments if match.get(s.motion) == 1]
-        assert jog and all(s.period_frames == pytest.approx(80, rel=0.25) for s in jog)
+        assert jog and all(abs(s.period_frames / 80 - 1) <= at_most(0.0125, frame(80)) for s in jog)
         assert any(w.looping and w.motion >= 0 for w in res.windows)
     # under auto the jog has no global class: its typical cycle takes its phase from time
     # over the segment's period, and the jog's frames are nearer it than the squat's cycle
@@ -176,13 +191,15 @@ def test_windows_find_a_small_motion_the_global_barcode_misses():
     jog_cycle = next(c for c in cycles if c.motion == jog_id)
     assert jog_cycle.phase_from == "time"
     assert jog_cycle.cycle.n_frames == round(jog_cycle.period_frames)
-    assert jog_cycle.period_frames == pytest.approx(80, rel=0.25) and jog_cycle.loop_closure <= 1.5
+    # measured: period 1.25 % from 80 frames, loop closure 0.334
+    assert abs(jog_cycle.period_frames / 80 - 1) <= at_most(0.0125, frame(80))
+    assert jog_cycle.loop_closure <= at_most(0.334)
     a, b, _ = cap.boundaries[1]
     assert _closest_cycle(m.frames[a:b], cycles) == jog_id
 
 
 def test_windowed_report_and_parameters(chain):
-    cap, res = chain
+    cap, res, _ = chain
     assert res.method == "auto" and res.windows
     rep = json.loads(json.dumps(res.to_report()))  # JSON-serialisable as it is
     assert rep["method"] == "auto" and len(rep["windows"]) == len(res.windows)
@@ -227,8 +244,8 @@ def test_window_table_loops_only_where_periodic():
     loops, none = found
     assert none == []
     assert len(loops) >= 10
-    for w in loops:  # 2.4 or 4.8 cycles of a 100-frame period
-        assert w.period_frames == pytest.approx(100, rel=0.25)
+    for w in loops:  # 2.4 or 4.8 cycles of a 100-frame period; measured within 14.4 %
+        assert abs(w.period_frames / 100 - 1) <= at_most(0.144)
 
 
 def test_cli_detect_method(tmp_path):
@@ -245,8 +262,7 @@ def test_13_29_windows_find_the_slow_exercises(cmu_dir):
     import csv
 
     path = cmu_dir.parent / "labels" / "13_29.csv"
-    if not path.is_file():
-        pytest.skip(f"labels not found at {path}")
+    need_data(path)
     m = cc.load(cmu_dir / "13" / "13_29.amc")
     with open(path, newline="") as fh:
         spans = [(int(r["start_frame"]), int(r["stop_frame"]), r["activity"]) for r in csv.DictReader(fh)]
@@ -256,16 +272,22 @@ def test_13_29_windows_find_the_slow_exercises(cmu_dir):
     old, _ = best_match_accuracy(detect(m, method="global", progress=False).labels, truth)
     res = detect(m, progress=False)
     acc, match = best_match_accuracy(res.labels, truth)
-    assert acc >= 0.80 and acc > old + 0.3  # the issue's target; global alone gets 28%
+    # measured: 92.9 % of the frames labelled right (the issue's target was 80 %), global
+    # alone 28.2 %
+    assert 1 - acc <= at_most(1 - 0.929) and acc > old + 0.3
     names = {spans[t][2] for t in match.values()}
     assert {"JumpJack", "Twist", "ArmCircle", "ToeTouchOneHand", "KneeRaise", "Squat"} <= names
     # each segment's period against the autocorrelation of its exercise's labelled frames
     # (ArmCircle's labelled frames show no clear repetition to compare with)
     truth_period = {"JumpJack": 134, "Twist": 424, "ToeTouchOneHand": 496, "KneeRaise": 335, "Squat": 375}
+    # measured errors: 0.77 %, 0.47 %, 1.21 %, 0.60 %, 0.53 %
+    measured = {"JumpJack": 0.0077, "Twist": 0.0047, "ToeTouchOneHand": 0.0121, "KneeRaise": 0.0060,
+                "Squat": 0.0053}
     for s in res.segments:
         name = spans[match[s.motion]][2]
         if name in truth_period:
-            assert s.period_frames == pytest.approx(truth_period[name], rel=0.2), (name, s)
+            true = truth_period[name]
+            assert abs(s.period_frames / true - 1) <= at_most(measured[name], frame(true)), (name, s)
     # the twist and the one-handed toe touch hold about one repetition each (under 1.5
     # cycles, as extract finds too): they are segmented, but get no typical cycle
     got = {spans[match[c.motion]][2] for c in motion_cycles(res)}
@@ -290,7 +312,7 @@ def test_autocorrelation_period_refines_a_window_length_guess():
 def test_motion_cycles_need_one_and_a_half_cycles(chain):
     """The rule extract applies (min_turns): a motion of one repetition and a part gets no
     cycle; the CLI says which and why."""
-    _, res = chain
+    _, res, _ = chain
     longest = {}
     for sg in res.segments:
         if sg.stop - sg.start > longest.get(sg.motion, (0, 0))[0]:

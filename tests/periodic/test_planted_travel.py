@@ -6,6 +6,7 @@ import pytest
 import cyclecoord as cc
 import cyclecoord.periodic.clip as clip_module
 from cyclecoord.quality.contacts import foot_skating
+from _measured import at_most
 
 
 @pytest.fixture(scope="module")
@@ -20,7 +21,8 @@ def test_planted_feet_do_not_slide_in_the_cycle(window, monkeypatch):
     take = foot_skating(window)
     ours, before = foot_skating(anchored), foot_skating(mean_steps)
     # measured 2026-11-25: 1.14 units/s (24 % of frames) against 2.35 (62 %) with the mean
-    # ground step and the take's own 2.13 (55 %)
+    # ground step and the take's own 2.13 (55 %); at tests/_measured.py RUN 1.13 (25 %)
+    assert ours.mean_speed <= at_most(1.13) and ours.skating_fraction <= at_most(0.25)
     assert ours.mean_speed < 0.6 * before.mean_speed
     assert ours.mean_speed < take.mean_speed
     assert ours.skating_fraction < 0.5 * before.skating_fraction

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-ripser = pytest.importorskip("ripser")
+import ripser
 
 from cyclecoord.periodic._rips import rips_cohomology, sparse_rips_cohomology
 from cyclecoord.periodic.barcode import temporal_distance_matrix

@@ -79,6 +79,20 @@ def test_phase_average_recovers_a_periodic_signal():
         phase_average(ph, vals, 50, 0.0)
 
 
+@pytest.mark.parametrize("width", [0.02, 0.05])
+def test_phase_average_is_a_gaussian_of_the_stated_width(width):
+    """Known answer: a Gaussian of standard deviation s (in phase) multiplies harmonic k of
+    a periodic signal by exp(-2 pi^2 s^2 k^2); a kernel narrower or wider than stated
+    (exp(-(d / s)^2) is s / sqrt(2)) changes that attenuation by 5-35 %."""
+    ph = (np.arange(4000) + 0.5) / 4000  # dense and even: the sum is the integral
+    k = np.arange(1, 5)
+    vals = np.cos(2 * np.pi * np.outer(ph, k))
+    grid = np.arange(64) / 64
+    out = phase_average(ph, vals, 64, width)
+    want = np.cos(2 * np.pi * np.outer(grid, k)) * np.exp(-2 * np.pi**2 * width**2 * k**2)
+    np.testing.assert_allclose(out, want, atol=1.5e-4)  # measured 1.1e-4: the kernel ends at 4 widths
+
+
 def test_edge_taper_fades_each_run_in_and_out():
     mask = np.zeros(40, dtype=bool)
     mask[2:30] = True

@@ -21,7 +21,8 @@ from cyclecoord.plot import figures as plot  # noqa: E402
 from cyclecoord.errors import NoPeriodicMotionError, ParameterError  # noqa: E402
 from cyclecoord.quality.metrics import jerk  # noqa: E402
 
-Image = pytest.importorskip("PIL.Image", reason="image checks need Pillow (ships with matplotlib)")
+from PIL import Image  # noqa: E402  (Pillow ships with matplotlib)
+from _skips import need_program  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
@@ -271,12 +272,9 @@ def test_channels_selection_and_errors(result):
 
 def test_partial_result_is_refused(capture, tmp_path):
     motion = cc.datasets.make_random_walk_capture(n_frames=120, random_state=1).motion
-    try:
+    with pytest.raises(NoPeriodicMotionError) as refused:  # seeded: this walk has no loop
         cc.extract(motion)
-    except NoPeriodicMotionError as exc:
-        partial = exc.result
-    else:  # pragma: no cover - the random walk should have no clear loop
-        pytest.skip("the random walk happened to give a periodic result")
+    partial = refused.value.result
     plot.plot_barcode(partial.barcode)  # the barcode is still drawable
     for fn in (plot.plot_pca, plot.plot_density, plot.plot_channels):
         with pytest.raises(ParameterError, match="no periodic motion"):
@@ -409,6 +407,64 @@ def test_render_is_atomic(capture, tmp_path, monkeypatch):
     assert os.listdir(tmp_path) == ["keep.gif"]
 
 
+def _gif_delays_read_back(path: Path) -> list[int]:
+    from PIL import Image
+
+    with Image.open(path) as im:
+        out = []
+        for i in range(im.n_frames):
+            im.seek(i)
+            out.append(im.info["duration"])
+    return out
+
+
+def test_gif_plays_at_the_motion_rate(capture, tmp_path):
+    """Issue 25: a 63-frame 30 fps GIF played 10 % fast (30 ms a frame); the delays,
+    whole centiseconds, now alternate 3 and 4 cs and sum to the motion's duration."""
+    from cyclecoord.plot.animation import gif_delays
+
+    m = capture.motion
+    m30 = m.with_frames(m.frames[::4][:63], fps=30.0)
+    out = plot.render(m30, tmp_path / "walk30.gif", dpi=30, size=2)
+    delays = _gif_delays_read_back(out)
+    assert sum(delays) == 2100  # 63 frames / 30 fps = 2.1 s
+    assert set(delays) <= {30, 40}
+    # every frame starts within half a centisecond of its time
+    starts = np.cumsum([0] + delays[:-1])
+    assert np.abs(starts - np.arange(len(delays)) * 1000 / 30).max() <= 5 + 1e-9
+    # 120 fps drawn every 4th frame plays in real time too
+    out = plot.render(m[:120], tmp_path / "walk120.gif", dpi=30, size=2)
+    assert sum(_gif_delays_read_back(out)) == 1000
+    assert gif_delays(4, 25) == [40, 40, 40, 40]
+    assert gif_delays(3, 100) == [20, 20, 20]  # GIF's fastest is 50 fps
+
+
+def test_mp4_rate_is_passed_as_an_exact_fraction():
+    from cyclecoord.plot.animation import _rate_fraction
+
+    assert str(_rate_fraction(30.0)) == "30"
+    assert str(_rate_fraction(30000 / 1001)) == "30000/1001"
+    assert str(_rate_fraction(120 / 7)) == "120/7"
+
+
+def test_mp4_keeps_the_rate_exactly(capture, tmp_path):
+    import shutil
+
+    from matplotlib import animation
+
+    if not animation.FFMpegWriter.isAvailable() or shutil.which("ffprobe") is None:
+        pytest.skip("ffmpeg/ffprobe are not installed; the MP4 rate cannot be read back here")
+    m = capture.motion
+    m = m.with_frames(m.frames[::4][:63], fps=30000 / 1001)
+    out = plot.render(m, tmp_path / "ntsc.mp4", dpi=30, size=2)
+    probe = subprocess.run(
+        ["ffprobe", "-v", "error", "-select_streams", "v:0", "-show_entries",
+         "stream=avg_frame_rate,nb_frames", "-of", "default=nw=1", str(out)],
+        capture_output=True, text=True, check=True,
+    ).stdout
+    assert "avg_frame_rate=30000/1001" in probe and "nb_frames=63" in probe
+
+
 def test_render_mp4_needs_ffmpeg(capture, tmp_path, monkeypatch):
     from matplotlib import animation
 
@@ -419,10 +475,7 @@ def test_render_mp4_needs_ffmpeg(capture, tmp_path, monkeypatch):
 
 
 def test_render_mp4_when_ffmpeg_is_there(capture, tmp_path):
-    from matplotlib import animation
-
-    if not animation.FFMpegWriter.isAvailable():
-        pytest.skip("ffmpeg is not installed; .mp4 output cannot be tested here")
+    need_program("ffmpeg")
     out = plot.render(capture.motion[:40], tmp_path / "a.mp4", step=4, dpi=40)
     data = out.read_bytes()
     assert len(data) > 1000 and data[4:8] == b"ftyp"
@@ -482,7 +535,7 @@ def test_examples_run_on_the_builtin_capture(script, args, outputs, tmp_path):
         assert (tmp_path / name).stat().st_size > 100
     if script == "extract_cycle.py":
         back = cc.load(tmp_path / "cycle.bvh")
-        assert 100 <= back.n_frames <= 140  # one period of the 120-frame synthetic walk
+        assert back.n_frames == 120  # one period of the synthetic walk: measured 119.6 frames
     if script == "phase_per_frame.py":
         rows = (tmp_path / "phase.csv").read_text().splitlines()
         assert rows[0] == "frame,phase,cycle" and len(rows) == 481

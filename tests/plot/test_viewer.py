@@ -10,6 +10,7 @@ from cyclecoord.cli.main import main
 from cyclecoord.errors import ParameterError
 from cyclecoord.motion import Motion
 from cyclecoord.plot.viewer import skeleton_figure, write_viewer
+from _skips import need_program
 
 
 @pytest.fixture(scope="module")
@@ -110,12 +111,9 @@ Plotly.animate(gd, ['30'], {frame: {duration: 0, redraw: true}, mode: 'immediate
 def test_page_in_headless_chromium(walk, tmp_path):
     """Chromium (Debian's, when installed) draws the page offline: frame 30 puts the bones
     where forward kinematics does, and the Play button moves the animation on."""
-    import shutil
     import subprocess
 
-    browser = shutil.which("chromium") or shutil.which("chromium-browser")
-    if browser is None:
-        pytest.skip("no chromium on PATH (apt-get install chromium)")
+    browser = need_program("chromium")
     page = write_viewer(skeleton_figure(walk, max_fps=120), tmp_path / "probe.html", _PROBE)
     cmd = [
         browser,

@@ -326,11 +326,15 @@ def test_cross_validate_report_keys(walks):
         assert cv.median[m]["error_f_deg"] < cv.baselines["standing_still"]["median"]["error_f_deg"]
     assert set(cv.baselines) == {"standing_still", "nearest_take"}
     assert {"nodes", "edges", "weak_components", "strong_components"} <= set(cv.graph)
-    assert "paper w1: delaunay" in cv.table()
+    # the synthetic takes are none of the paper's sets: no paper row (w1's was printed for any)
+    assert "paper w1: delaunay" not in cv.table() and "no paper row" in cv.table()
 
 
 def test_synth_generates_a_playable_walk(walks):
-    synth = MotionGraphSynth(dims=2, step_scale=2.0).fit(walks)
+    # the root as the training frames' mean step (carry=False): the synthetic walker's own
+    # feet glide (support foot 2.08 m/s on the take itself), so carried by them it would
+    # travel a third as far
+    synth = MotionGraphSynth(dims=2, step_scale=2.0, carry=False).fit(walks)
     gen = synth.generate(120, walks[0], 10)
     m = gen.motion
     assert m.n_frames == 120 and m.channels == walks[0].channels
@@ -353,3 +357,29 @@ def test_target_path_keeps_to_the_data_with_squared_costs():
     # along the takes' direction of travel (anticlockwise), not back against it
     ang = np.unwrap(np.arctan2(p.points[:, 1], p.points[:, 0]))
     assert np.all(np.diff(ang) > -0.05) and ang[-1] - ang[0] == pytest.approx(np.pi, abs=0.2)
+
+
+def test_crossval_prints_the_papers_row_for_its_set_and_a_longer_horizon(walks):
+    from cyclecoord.synthesis.graph import PAPER, paper_set
+
+    long_take = cc.datasets.make_periodic_capture(kind="walk", n_frames=460, random_state=0).motion
+    lengths = lambda ns: [long_take[:n] for n in ns]  # noqa: E731
+    assert paper_set(lengths((167, 167, 175, 160))) == "r1"
+    assert paper_set(lengths((443, 360, 455, 454))) == "w1"
+    assert paper_set(lengths((100, 120, 130))) is None
+    assert PAPER["r1"]["delaunay"] == {"error_a": 0.749, "error_f": 0.038}
+    assert PAPER["r1"]["knn"] == {"error_a": 0.099, "error_f": 0.044}
+    cv = cross_validate(walks, methods=("delaunay", "knn"), dims=2, topo=False, horizon=3)
+    assert "no paper row" in cv.table() and "paper w1" not in cv.table()
+    cv.parameters["paper_set"] = "r1"
+    table = cv.table()
+    rows = {line[:26].strip(): line[26:].split()[:2] for line in table.splitlines()}
+    assert rows["paper r1: delaunay"] == ["0.749", "0.038"]
+    assert rows["paper r1: knn"] == ["0.099", "0.044"]
+    long = cv.long_table()
+    assert "3x the left-out take" in long and "freeze s" in long and "slip m/s" in long
+    assert set(cv.long) == {"delaunay", "knn"}
+    fold = cv.folds[0]["long"]
+    assert fold["frames"] == 3 * walks[0].n_frames
+    assert {"longest_freeze_s", "support_slip", "error_f_deg"} <= set(fold)
+    assert cv.to_report()["long_horizon"] == cv.long

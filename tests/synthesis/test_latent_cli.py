@@ -177,3 +177,25 @@ def test_fit_rejects_bad_takes(workdir, capsys):
     assert main(["latent", "fit", f"{workdir / 'walk.bvh'}:5", "-o", str(workdir / "x.npz")]) == 1
     assert "PATH:A:B" in capsys.readouterr().err
     assert not (workdir / "x.npz").exists()
+
+
+def test_animate_feet_option_and_script_key(workdir, capsys):
+    """``--feet`` (or the script's "feet") names the planted feet and the report's skating."""
+    s = _script(workdir, "feet.json")
+    rep = workdir / "feet_report.json"
+    code = main(["animate", str(s), "-o", str(workdir / "feet.bvh"), "--no-check",
+                 "--feet", "lfoot:ltoes,rfoot:rtoes", "--report", str(rep)])
+    assert code == 0
+    per_foot = json.loads(rep.read_text())["foot_skating"]["per_foot"]
+    assert set(per_foot) == {"lfoot", "ltoes", "rfoot", "rtoes"}
+    s = _script(workdir, "feet_key.json", feet=["ltoes", "rtoes"])
+    code = main(["animate", str(s), "-o", str(workdir / "feet2.bvh"), "--no-check",
+                 "--report", str(rep)])
+    assert code == 0
+    assert set(json.loads(rep.read_text())["foot_skating"]["per_foot"]) == {"ltoes", "rtoes"}
+    for bad in (["--feet", "lfoot,rfot"], []):
+        script = s if bad else _script(workdir, "feet_bad.json", feet=["lfoot", "nosuch"])
+        out = workdir / "feet_bad.bvh"
+        assert main(["animate", str(script), "-o", str(out), *bad]) == 1
+        err = capsys.readouterr().err
+        assert "feet: no joint" in err and "nearest" in err and not out.exists()

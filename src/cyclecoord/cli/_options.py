@@ -11,6 +11,16 @@ from ..errors import ParameterError
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_NO_PERIODIC = 0, 1, 2, 3
 
+#: Every format cyclecoord reads and writes, as the help texts list them.
+FORMATS = "ASF/AMC, BVH, NPZ, CSV, glTF (.glb/.gltf) and USD (.usda/.usdc/.usd)"
+
+#: Help of the INPUT argument of the commands that read one capture.
+INPUT_HELP = (
+    "capture to read: .amc (its .asf found beside it), .bvh, .npz, .csv, .glb/.gltf or "
+    ".usda/.usdc/.usd, or 'example' (example:jog, example:chain, example:take, ...) for a "
+    "built-in synthetic capture"
+)
+
 
 def frame_range(text: str) -> tuple[int | None, int | None]:
     """Parse ``A:B`` (0-based, half-open; either side may be empty)."""
@@ -333,6 +343,40 @@ def cycle_options(args: argparse.Namespace) -> dict:
         "bandwidth": args.bandwidth,
         "cycle_start": args.cycle_start,
     }
+
+
+#: Help of ``--feet``, the same on every command that finds foot contacts.
+FEET_HELP = (
+    "foot joints: LEFT,RIGHT (four names for a quadruped), each a joint or ANKLE:TOE for both "
+    "points of a leg, e.g. Foot_L,Foot_R or lfoot:ltoes,rfoot:rtoes (default: found by joint "
+    "name on the common rigs, else as the lowest ends of two leg chains)"
+)
+
+
+def add_feet_option(g) -> None:
+    """``--feet LEFT,RIGHT`` on a parser or group."""
+    g.add_argument("--feet", metavar="LEFT,RIGHT", help=FEET_HELP)
+
+
+def feet_option(args: argparse.Namespace, motion) -> tuple[str, ...] | None:
+    """The foot points ``--feet`` names, checked on ``motion``'s skeleton (None: not given).
+
+    Raises
+    ------
+    ParameterError
+        A name that is not a joint (with the nearest names), or a motion without a
+        skeleton.
+    """
+    from ..quality.legs import resolve_feet
+
+    spec = getattr(args, "feet", None)
+    if not spec:
+        return None
+    if motion.skeleton is None:
+        raise ParameterError(
+            f"--feet: {motion.source or 'the input'} has no skeleton (forward kinematics)"
+        )
+    return resolve_feet(motion.skeleton, spec)
 
 
 def check_output(path: str | None, what: str = "output") -> None:

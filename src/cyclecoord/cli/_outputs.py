@@ -33,7 +33,8 @@ from ..io import StagedOutputs, input_files, refuse_clobber
 
 __all__ = ["OUTPUT_FLAGS", "Outputs", "Paths", "capture_inputs", "check_paths", "declare"]
 
-#: Option names that always write something; a command that has one must declare it.
+#: Option names that write what they name (when they take a value: blend's --extract is a
+#: switch); a command that has one must declare it.
 OUTPUT_FLAGS = ("-o", "--output", "--report", "--plot", "--save-model", "--extract")
 
 Inputs = Callable[[argparse.Namespace], Iterable[Any]]

@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ._options import add_memory_option
+from ._options import add_feet_option, add_memory_option
 from ._outputs import Outputs, declare
 
 __all__ = ["add_parser", "run"]
@@ -22,12 +22,21 @@ def add_parser(subparsers) -> None:
             "the script fails."
         ),
     )
-    p.add_argument("script", metavar="SCRIPT.json")
-    p.add_argument("-o", "--output", required=True, metavar="OUT.bvh")
+    p.add_argument(
+        "script", metavar="SCRIPT.json",
+        help="the script: models by name, start, commands (see examples/latent_script.json)",
+    )
+    p.add_argument(
+        "-o", "--output", required=True, metavar="OUT.bvh",
+        help="the synthesised motion; its suffix chooses the format (.bvh, .amc, .npz, .csv, "
+        ".glb/.gltf, .usda/.usdc/.usd)",
+    )
     p.add_argument(
         "--report", metavar="R.json", help="write a JSON report (commands, bridges, timing, checks)"
     )
     p.add_argument("--no-check", action="store_true", help="skip the plausibility checks")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar over the commands")
+    add_feet_option(p)
     add_memory_option(p)
     p.set_defaults(func=run)
     declare(p, inputs=_script_files, files=("-o", "--report"), derived=_skeleton_output)
@@ -55,7 +64,9 @@ def run(args: argparse.Namespace) -> int:
     for target in [out] + ([Path(args.report)] if args.report else []):
         if not (target.parent if str(target.parent) else Path(".")).is_dir():
             raise ParameterError(f"{target}: folder {target.parent} does not exist")
-    motion, report = run_script(script, check=not args.no_check, progress=True)
+    motion, report = run_script(
+        script, check=not args.no_check, progress=not args.no_progress, feet=args.feet or None
+    )
     # every output moves into place at the end, so a failure or Ctrl-C leaves none
     with Outputs() as staged:
         skeleton = [asf for _option, asf in _skeleton_output(args)]
@@ -63,6 +74,8 @@ def run(args: argparse.Namespace) -> int:
         if args.report:
             with atomic_write(staged.file(args.report)) as fh:
                 json.dump(report, fh, indent=2, default=float)
+    for line in report.get("motion_quality_lines", []):
+        print(line)
     t = report["timing"]
     fps = t["frames_per_second"]
     cpu = t.get("frames_per_cpu_second")
@@ -88,8 +101,8 @@ def run(args: argparse.Namespace) -> int:
                 f"{kind} (pose distance {ev['bridge_distance']:.3g}, blend {ev['blend_frames']} "
                 "frames)"
             )
-    if report.get("foot_skating"):
-        print(f"foot skating: {report['foot_skating']['skating_fraction']:.0%} of frames")
+    for note in report.get("notes", []):
+        print(note)
     if "plausibility" in report:
         pl = report["plausibility"]
         print("plausibility: " + ("clean" if pl["clean"] else "; ".join(pl["notes"])))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from ._options import EXIT_OK, add_selection_options
+from ._options import INPUT_HELP, EXIT_OK, add_selection_options
 from ._outputs import capture_inputs, declare
 from .report import clean, load_input, summary_barcode
 
@@ -16,7 +16,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="print the H0/H1 barcode of a capture",
         description="Vietoris-Rips persistent cohomology barcode (H0, H1) of the prepared poses.",
     )
-    b.add_argument("input", metavar="INPUT")
+    b.add_argument("input", metavar="INPUT", help=INPUT_HELP)
     add_selection_options(b)
     b.add_argument(
         "--json",

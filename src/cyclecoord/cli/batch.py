@@ -5,7 +5,14 @@ from __future__ import annotations
 import argparse
 
 from ..batch import CYCLE_FORMATS
-from ._options import EXIT_ERROR, EXIT_OK, add_cycle_options, add_selection_options, cycle_options
+from ._options import (
+    EXIT_ERROR,
+    EXIT_OK,
+    add_cycle_options,
+    add_feet_option,
+    add_selection_options,
+    cycle_options,
+)
 from ._outputs import declare
 
 
@@ -66,7 +73,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         ba, "what to analyse and how (the same for every capture)", per_file=False
     )
     g.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (0)")
-    add_cycle_options(ba.add_argument_group("the cycle (the same for every capture)"))
+    cyc = ba.add_argument_group("the cycle (the same for every capture)")
+    add_cycle_options(cyc)
+    add_feet_option(cyc)
     ba.set_defaults(func=cmd_batch)
     declare(
         ba,
@@ -84,12 +93,14 @@ def cmd_batch(args: argparse.Namespace) -> int:
     options = dict(
         pca=args.pca,
         normalize=args.normalize,
+        rotations=args.rotations,
         temporal=args.temporal,
         prime=args.prime,
         max_scale=args.max_scale,
         landmarks=args.landmarks,
         random_state=args.seed,
         **({} if args.memory_limit is None else {"memory_limit": args.memory_limit}),
+        **({} if not args.feet else {"feet": args.feet}),
         **cycle_options(args),
     )
     summary = run_batch(

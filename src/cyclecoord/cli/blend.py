@@ -10,7 +10,9 @@ from ..io import input_files
 from ._options import (
     EXIT_NO_PERIODIC,
     EXIT_OK,
+    add_feet_option,
     check_output,
+    feet_option,
     frame_range,
     positive_float,
     positive_int,
@@ -124,6 +126,7 @@ def add_input_options(q: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--seed", type=int, default=0, metavar="S", help="random seed for extraction (0)"
     )
+    add_feet_option(g)
     m = q.add_argument_group("matching and checks")
     m.add_argument(
         "--allow-reverse",
@@ -208,6 +211,9 @@ def _load_cycles(args: argparse.Namespace) -> list:
     ):
         motion = load_input(path, None, fps)
         options = {"random_state": args.seed}
+        feet = feet_option(args, motion)
+        if feet is not None:
+            options["feet"] = feet
         if max_scale is not None:
             options["max_scale"] = max_scale
         if scale is not None:
@@ -239,8 +245,12 @@ def finish(
     what: str,
     problem: str | None = None,
     out: Outputs | None = None,
+    quality: dict | None = None,
 ) -> int:
     """Print the plausibility verdict, honour --strict, write the motion and the report.
+
+    ``quality`` (the measure of generated motion, :func:`~cyclecoord.quality.generated.
+    lead_lines`; printed by the command first) leads the report as ``motion_quality``.
 
     The outputs go through ``out`` (the command's staged outputs; a new one when None) and
     move into place together; with --strict and a failed check the report (and what was
@@ -250,7 +260,9 @@ def finish(
 
     if out is None:
         with Outputs() as own:
-            return finish(args, motion, payload, report, what, problem, own)
+            return finish(args, motion, payload, report, what, problem, own, quality)
+    if quality is not None:
+        payload = {"motion_quality": quality, **payload}
     print(report.summary())
     payload["plausibility"] = report.to_dict()
     refused = args.strict and (not report.clean or problem is not None)
@@ -291,6 +303,7 @@ def cmd_blend(args: argparse.Namespace) -> int:
         align_heading=not args.no_heading,
         up=args.up,
     )
+    quality = _lead(out, cycles, args.feet)
     info = out.metadata["blend"]
     for i, al in enumerate(info["alignments"][1:], start=1):
         rev = ", reversed" if al["reversed"] else ""
@@ -305,13 +318,11 @@ def cmd_blend(args: argparse.Namespace) -> int:
         f"blend {', '.join(f'{w:g}' for w in info['weights'])}: {out.n_frames} frames "
         f"({s['seconds']:.3f} s; inputs "
         + ", ".join(f"{v['frames']}" for v in summaries)
-        + f"), loop closure {s['loop_closure']:.2f}, jerk {s['jerk']:.4g} (inputs "
-        + ", ".join(f"{v['jerk']:.4g}" for v in summaries)
-        + ")"
+        + f"), loop closure {s['loop_closure']:.2f}, {_jerk_words(s, summaries)}"
     )
     for note in info["notes"]:
         print(f"note: {note}")
-    skating, inputs_skating = _skating(out, cycles, "blend")
+    skating, inputs_skating = _skating(out, cycles, "blend", args.feet)
     report = check_plausibility(out, cycles, margin_deg=args.margin)
     payload = {
         "inputs": [
@@ -324,16 +335,43 @@ def cmd_blend(args: argparse.Namespace) -> int:
         "foot_skating": skating,
         "blend": info,
     }
-    return finish(args, out, payload, report, "blend")
+    return finish(args, out, payload, report, "blend", quality=quality)
 
 
-def _skating(motion, inputs: list, what: str) -> tuple[dict | None, list]:
+def _jerk_words(out: dict, inputs: list[dict]) -> str:
+    """The blend's jerk against its inputs': a ratio, then the figures with an SI prefix
+    (mean jerk norm of the channels, degrees / s³ for joint angles)."""
+    import math
+
+    from .._words import si
+
+    mean = sum(v["jerk"] for v in inputs) / max(len(inputs), 1)
+    if not (math.isfinite(mean) and mean > 0 and math.isfinite(out["jerk"])):
+        return "jerk not measured (fewer than 7 frames)"
+    ratio = f"{out['jerk'] / mean:.2f}x the inputs' mean"
+    figures = ", ".join(si(v["jerk"], "deg/s³") for v in inputs)
+    return f"jerk {ratio} ({si(out['jerk'], 'deg/s³')}; inputs {figures})"
+
+
+def _lead(motion, sources: list, feet: str | None = None) -> dict | None:
+    """Print the measure of generated motion against ``sources`` (the console's first
+    lines) and return its report dict (None when it cannot be measured)."""
+    from ..quality.generated import lead_lines
+
+    quality, lines = lead_lines(motion, sources, feet=feet or None)
+    for line in lines:
+        print(line)
+    return quality
+
+
+def _skating(motion, inputs: list, what: str, feet: str | None = None) -> tuple[dict | None, list]:
     """Foot skating of the result and of each input cycle (``skating_report`` dicts, None
-    where not measurable), and one console line for them."""
+    where not measurable), and one console line for them; ``feet`` is ``--feet``'s text
+    (None: found on each)."""
     from ..quality.contacts import skating_report, skating_line
 
-    result = skating_report(motion)
-    per_input = [skating_report(c) for c in inputs]
+    result = skating_report(motion, feet=feet)
+    per_input = [skating_report(c, feet=feet) for c in inputs]
     line = skating_line(result, what)
     if any(r is not None for r in per_input):
         line += (
@@ -367,6 +405,7 @@ def cmd_transition(args: argparse.Namespace) -> int:
         align_heading=not args.no_heading,
         up=args.up,
     )
+    quality = _lead(clip, [a, b], args.feet)
     info = clip.metadata["transition"]
     al = info["alignment"]
     cont = info["continuity"]
@@ -382,7 +421,7 @@ def cmd_transition(args: argparse.Namespace) -> int:
     )
     for note in info["notes"]:
         print(f"note: {note}")
-    skating, inputs_skating = _skating(clip, [a, b], "transition")
+    skating, inputs_skating = _skating(clip, [a, b], "transition", args.feet)
     report = check_plausibility(clip, [a, b], margin_deg=args.margin)
     meta = {k: v for k, v in info.items() if k not in ("weight", "phase")}
     payload = {
@@ -399,4 +438,4 @@ def cmd_transition(args: argparse.Namespace) -> int:
     problem = None
     if cont["max_ratio"] > cont["limit"]:
         problem = f"has a step {cont['max_ratio']:.2f}x the typical step (limit {cont['limit']:g})"
-    return finish(args, clip, payload, report, "transition", problem)
+    return finish(args, clip, payload, report, "transition", problem, quality=quality)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 
 from ._options import (
+    FORMATS,
+    INPUT_HELP,
     EXIT_OK,
     add_memory_option,
     add_units_option,
@@ -21,10 +23,10 @@ from .report import load_input
 def add_parser(subparsers) -> argparse.ArgumentParser:
     c = subparsers.add_parser(
         "convert",
-        help="convert between ASF/AMC, BVH, NPZ, CSV, glTF and USD",
-        description="Convert a capture between formats, chosen by the file suffixes.",
+        help=f"convert between {FORMATS}",
+        description=f"Convert a capture between formats, chosen by the file suffixes: {FORMATS}.",
     )
-    c.add_argument("input", metavar="INPUT")
+    c.add_argument("input", metavar="INPUT", help=INPUT_HELP)
     c.add_argument(
         "-o",
         "--output",

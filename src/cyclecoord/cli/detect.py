@@ -8,14 +8,19 @@ from pathlib import Path
 
 from ..errors import NoPeriodicMotionError, ParameterError
 from ..io import input_files
+from .._words import plural
 from ._options import (
+    INPUT_HELP,
     EXIT_NO_PERIODIC,
     EXIT_OK,
+    add_feet_option,
     add_selection_options,
     bandwidth,
     check_output,
+    feet_option,
     named,
     positive_int,
+    rig_line,
 )
 from ._outputs import Outputs, declare
 from .report import clean, load_input, summary_barcode, write_json
@@ -37,7 +42,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
             "report. Exit code 3 when nothing is found."
         ),
     )
-    d.add_argument("input", metavar="INPUT")
+    d.add_argument("input", metavar="INPUT", help=INPUT_HELP)
     add_selection_options(d)
     d.add_argument(
         "--classes",
@@ -97,6 +102,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default="slowest",
         help="begin each cycle at its slowest pose (default) or at phase 0",
     )
+    add_feet_option(dc)
     d.add_argument(
         "--extract-format",
         default="bvh",
@@ -130,6 +136,10 @@ def cmd_detect(args: argparse.Namespace) -> int:
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder (--plot takes a folder)")
     motion = load_input(args.input, args.skeleton, args.fps)
+    if args.extract:  # a wrong --feet name fails before the detection runs
+        feet_option(args, motion)
+    if motion.skeleton is not None:
+        print(f"rig: {rig_line(motion, args)}")
     with Outputs() as out:  # every output moves into place at the end, or none does
         return _detect(args, motion, out)
 
@@ -138,6 +148,7 @@ def _detect(args: argparse.Namespace, motion, out: Outputs) -> int:
     from ..periodic.detection import detect, motion_cycles
 
     code = EXIT_OK
+    feet = feet_option(args, motion) if args.extract else None
     try:
         res = detect(
             motion,
@@ -173,7 +184,7 @@ def _detect(args: argparse.Namespace, motion, out: Outputs) -> int:
         print(
             f"; {len(res.windows)} windows, {sum(w.looping for w in res.windows)} looping", end=""
         )
-    print(f": {res.n_motions} motion(s)")
+    print(f": {plural(res.n_motions, 'motion')}")
     for sg in res.segments:
         print(
             f"  motion {sg.motion}: frames {m.start_frame + sg.start}-{m.start_frame + sg.stop} "
@@ -194,6 +205,7 @@ def _detect(args: argparse.Namespace, motion, out: Outputs) -> int:
             cycle_start=args.cycle_start,
             timing=args.timing,
             travel=args.travel,
+            feet=feet,
         )
         have = {mc.motion for mc in cycles}
         for mid in range(res.n_motions):
@@ -223,7 +235,7 @@ def _detect(args: argparse.Namespace, motion, out: Outputs) -> int:
                     "99th-percentile step in one frame (its repetitions disagree there); look "
                     "at it, and try --bandwidth 2"
                 )
-            skating = skating_report(mc.cycle)
+            skating = skating_report(mc.cycle, feet=feet)
             print("  " + skating_line(skating))
             extracted.append(
                 {

@@ -11,13 +11,18 @@ import numpy as np
 from ..errors import NoPeriodicMotionError, ParameterError
 from ..io import input_files
 from ._options import (
+    INPUT_HELP,
     EXIT_NO_PERIODIC,
     EXIT_OK,
     add_cycle_options,
+    add_feet_option,
     add_selection_options,
+    add_units_option,
+    export_units,
     check_output,
     cycle_options,
     delay,
+    feet_option,
     named,
     positive_float,
     positive_int,
@@ -39,8 +44,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
             "report is still written."
         ),
     )
-    e.add_argument("input", metavar="INPUT")
-    add_selection_options(e)
+    e.add_argument("input", metavar="INPUT", help=INPUT_HELP)
+    add_units_option(add_selection_options(e))
     g = e.add_argument_group("class, scale and cycle")
     g.add_argument(
         "--scale",
@@ -92,7 +97,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="delay embedding in seconds so out-and-back motions (squats, jumping jacks) form "
         "loops; auto (default): none, and 0.25 s when the poses alone show no periodic motion",
     )
-    add_cycle_options(e.add_argument_group("the cycle"))
+    cyc = e.add_argument_group("the cycle")
+    add_cycle_options(cyc)
+    add_feet_option(cyc)
     e.add_argument(
         "-v",
         "--verbose",
@@ -160,38 +167,50 @@ def cmd_extract(args: argparse.Namespace) -> int:
 
 def _extract(args: argparse.Namespace, motion, out: Outputs) -> int:
     from ..periodic.pipeline import extract
+    from ..periodic.suggest import MAX_FRAMES as SUGGEST_MAX_FRAMES, what_would_help
 
     report_payload = None
     code = EXIT_OK
+    feet = feet_option(args, motion)
+    options = dict(
+        frames=args.frames,
+        pca=args.pca,
+        normalize=args.normalize,
+        rotations=args.rotations,
+        temporal=args.temporal,
+        delay=args.delay,
+        difference_root=not args.no_root_diff,
+        prime=args.prime,
+        max_scale=args.max_scale,
+        scale=args.scale,
+        class_index=args.class_index,
+        n_samples=args.samples,
+        n_neighbors=args.neighbors,
+        weighting=args.weighting,
+        sampling=args.sampling,
+        landmarks=args.landmarks,
+        memory_limit=args.memory_limit,
+        random_state=args.seed,
+        feet=feet,
+        **cycle_options(args),
+    )
     try:
-        res = extract(
-            motion,
-            frames=args.frames,
-            pca=args.pca,
-            normalize=args.normalize,
-            rotations=args.rotations,
-            temporal=args.temporal,
-            delay=args.delay,
-            difference_root=not args.no_root_diff,
-            prime=args.prime,
-            max_scale=args.max_scale,
-            scale=args.scale,
-            class_index=args.class_index,
-            n_samples=args.samples,
-            n_neighbors=args.neighbors,
-            weighting=args.weighting,
-            sampling=args.sampling,
-            landmarks=args.landmarks,
-            memory_limit=args.memory_limit,
-            random_state=args.seed,
-            **cycle_options(args),
-        )
+        res = extract(motion, **options)
     except NoPeriodicMotionError as exc:
         partial = exc.result
         print(f"cyclecoord: {named(args.input, exc)}", file=sys.stderr)
+        helps = what_would_help(motion, options)
+        if helps:
+            print("would help here (tried): " + "; ".join(h.text() for h in helps),
+                  file=sys.stderr)
+        elif motion.n_frames <= SUGGEST_MAX_FRAMES:
+            print("tried --rotations rotvec, --no-steady, --pca 3 and --normalize: none finds a "
+                  "clean cycle here; look at the barcode (--plot) or pick frames (--frames)",
+                  file=sys.stderr)
         if partial is not None:
             print(summary_barcode(partial.barcode))
             report_payload = partial_report(exc)
+            report_payload["suggestions"] = [h.to_dict() for h in helps]
             if args.plot:
                 _save_plots(partial, args.plot, out)
         code = EXIT_NO_PERIODIC
@@ -200,11 +219,10 @@ def _extract(args: argparse.Namespace, motion, out: Outputs) -> int:
             print(line)
         cycle, locked = res.cycle, None
         if args.lock_feet:
-            cycle, locked = _lock(res.cycle)
-            print(locked.summary() if locked is not None else
-                  "feet: not locked: the cycle has no skeleton with recognisable feet")
+            cycle, locked, why = _lock(res.cycle, feet)
+            print(locked.summary() if locked is not None else f"feet: not locked: {why}")
         if args.output:
-            out.save(cycle, args.output)
+            out.save(cycle, args.output, **export_units(args, args.output))
         if args.save_model:
             res.model.save(out.file(args.save_model))
             out.wrote(args.save_model)
@@ -287,7 +305,7 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
     width = ""
     if res.parameters.get("bandwidth") is not None:
         chosen = " (cross-validated)" if res.typical.bandwidth_selection is not None else ""
-        width = f"; kernel width {res.typical.bandwidth:.3g} frames{chosen}"
+        width = f"; kernel width {_frames(res.typical.bandwidth)}{chosen}"
     lines.append(
         f"cycle: {res.cycle.n_frames} frames ({res.cycle.n_frames / fps:.3f} s), {seam} "
         f"(last-to-first step {closure:.2f} median steps), {smooth} (jerk ratio "
@@ -301,7 +319,7 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
             "in_place": "removed, and the cycle stays in place (--travel in_place)",
         }[travel]
         lines.append(f"heading: turns {res.heading_per_cycle:+.1f} degrees per cycle ({kept})")
-    feet = _feet_line(res.cycle)
+    feet = _feet_line(res.cycle, res.parameters.get("feet"))
     if feet:
         lines.append(feet)
     for w in res.warnings:
@@ -323,7 +341,7 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
     )
     lines.append(
         f"frames to cycle: median distance {res.distance['median']:.3g} (median frame step "
-        f"{res.distance['median_frame_step']:.3g}); kernel width {res.typical.bandwidth:.3g} frames"
+        f"{res.distance['median_frame_step']:.3g}); kernel width {_frames(res.typical.bandwidth)}"
     )
     lines.append(
         f"largest cycle step {res.distance['largest_cycle_step']:.3g} (capture's 99th "
@@ -340,29 +358,40 @@ def describe_extraction(res, name: str, verbose: bool = False) -> list[str]:
     return lines
 
 
-def _lock(cycle):
-    """The cycle with its planted feet pinned over the loop, or ``(cycle, None)`` when it
-    has no skeleton with feet."""
+def _lock(cycle, feet=None):
+    """The cycle with its planted feet pinned over the loop: ``(motion, result, None)``,
+    or ``(cycle, None, why)`` when it has no skeleton or no feet are found (named ``feet``
+    that are not joints raise)."""
     from ..errors import ParameterError
     from ..synthesis.footlock import lock_feet
 
     if cycle.skeleton is None:
-        return cycle, None
+        return cycle, None, "the cycle has no skeleton"
+    if feet is not None:
+        result = lock_feet(cycle, cyclic=True, feet=tuple(feet))
+        return result.motion, result, None
     try:
         result = lock_feet(cycle, cyclic=True)
-    except ParameterError:
-        return cycle, None
-    return result.motion, result
+    except ParameterError as exc:
+        return cycle, None, str(exc)
+    return result.motion, result, None
 
 
-def _feet_line(cycle) -> str | None:
-    """One line on the cycle's planted feet (the report's ``foot_skating``), or None."""
-    from ..quality.contacts import skating_report
+def _feet_line(cycle, feet=None) -> str | None:
+    """One line on the cycle's planted feet (the report's ``foot_skating``), or on why
+    they are not measured; None without a skeleton."""
+    from ..errors import ParameterError
+    from ..quality.contacts import foot_contacts, skating_report
 
     if cycle is None or cycle.skeleton is None:
         return None
-    sk = skating_report(cycle)
+    feet = None if feet is None else tuple(feet)
+    sk = skating_report(cycle, feet=feet)
     if sk is None:
+        try:
+            foot_contacts(cycle, feet=feet)
+        except ParameterError as exc:
+            return f"feet: not measured: {exc}"
         return None
     return (
         f"feet: planted feet slide {sk['mean_speed_leg_lengths_per_s']:.2f} leg lengths/s on "
@@ -405,3 +434,8 @@ def _save_plots(result, folder: str, out: Outputs) -> None:
 
     for path in save_figures(result, out.folder(folder)):
         out.wrote(Path(folder) / path.name)
+
+
+def _frames(n: float) -> str:
+    """``"1 frame"``, ``"2.5 frames"``: a kernel width in words."""
+    return f"{n:.3g} frame" + ("" if float(f"{n:.3g}") == 1 else "s")

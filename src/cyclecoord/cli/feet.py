@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ._options import add_memory_option, add_units_option, export_units, rig_line
+from ._options import add_feet_option, add_memory_option, add_units_option, export_units, rig_line
 from ._outputs import Outputs, capture_inputs, declare
 
 
@@ -15,7 +15,8 @@ def add_parser(subparsers) -> None:
         "feet",
         help="foot contacts and foot skating; --lock pins planted feet (small leg IK)",
         description=(
-            "Find when each foot point (ankle and toe of each leg) is planted, from forward "
+            "Find when each foot point (ankle and toe of each leg; four legs on a quadruped) is "
+            "planted, from forward "
             "kinematics with thresholds scaled to the leg length and a floor estimated from "
             "the motion, and measure foot skating: the horizontal speed of planted feet and "
             "the frames on which a planted foot moves faster than --skate-speed. With --lock "
@@ -26,6 +27,7 @@ def add_parser(subparsers) -> None:
         epilog=(
             "examples:\n"
             "  cyclecoord feet 69_01.amc --frames 200:450\n"
+            "  cyclecoord feet walk.bvh --feet Foot_L:Toes_L,Foot_R:Toes_R\n"
             "  cyclecoord feet cycle.bvh --cycle --lock -o cycle_locked.glb --report feet.json"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -57,6 +59,7 @@ def add_parser(subparsers) -> None:
         metavar="V",
         help="a planted foot faster than V leg lengths/s skates (0.1)",
     )
+    add_feet_option(p)
     p.add_argument("--lock", action="store_true", help="pin planted feet (needs -o)")
     p.add_argument(
         "--cycle",
@@ -71,8 +74,9 @@ def add_parser(subparsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
-    from ..quality.contacts import contact_runs, foot_contacts, foot_skating
-    from ._options import check_output
+    from ..quality.contacts import contact_runs, contact_skeleton, foot_contacts, foot_skating
+    from ..quality.legs import find_legs, legs_of_feet
+    from ._options import check_output, feet_option
     from .report import load_input, write_json
     from .view import frame_window
 
@@ -82,22 +86,36 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.report, "report")
     motion = load_input(args.input, args.skeleton, args.fps).window(frame_window(args.frames))
     print(rig_line(motion, args))
-    options = {"height": args.height, "speed": args.speed}
+    from ..rig import describe_rig
+
+    up = describe_rig(motion).up_axis.lower() if motion.skeleton is not None else "y"
+    skeleton = contact_skeleton(motion)
+    given = feet_option(args, motion)
+    legs = (
+        find_legs(skeleton, motion, up=up)
+        if given is None
+        else legs_of_feet(skeleton, given, motion, up=up)
+    )
+    options = {"height": args.height, "speed": args.speed, "up": up, "feet": legs.feet}
     contacts = foot_contacts(motion, **options)
     skating = foot_skating(motion, contacts, skate_speed=args.skate_speed)
     print(
         f"{Path(args.input).name}: {motion.n_frames} frames, leg length "
         f"{contacts.leg_length:.3g} units, floor at {contacts.floor:.3g}"
     )
+    print(legs.describe() if given is None else legs.describe().replace("by given", "given"))
+    width = max(12, *(len(f) for f in contacts.feet))
     for i, f in enumerate(contacts.feet):
         runs = contact_runs(contacts.planted[:, i])
         shown = ", ".join(f"{a}:{b}" for a, b in runs[:6]) + (" ..." if len(runs) > 6 else "")
-        print(f"  {f:>12}: planted {100 * contacts.planted[:, i].mean():5.1f}% ({shown})")
+        print(f"  {f:>{width}}: planted {100 * contacts.planted[:, i].mean():5.1f}% ({shown})")
     print(skating.summary())
     payload = {
         "input": args.input,
         "frames": motion.n_frames,
         "feet": list(contacts.feet),
+        "legs": {leg.label: list(leg.points) for leg in legs.legs},
+        "feet_found_by": legs.method,
         "floor": contacts.floor,
         "leg_length": contacts.leg_length,
         "contacts": {f: contact_runs(contacts.planted[:, i]) for i, f in enumerate(contacts.feet)},

@@ -57,9 +57,23 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--dims",
-        type=positive_int,
-        default=2,
-        help="latent PCA dimensions (default 2, as the paper)",
+        type=_dims,
+        default=None,
+        help="latent PCA dimensions, or 'auto': the fewest explaining 85 %% of the joint-angle "
+        "variance (generation default auto, so strides keep their amplitude; crossval default "
+        "2, as the paper)",
+    )
+    p.add_argument(
+        "--no-carry",
+        action="store_true",
+        help="generation: keep the training frames' mean root step (the feet glide) instead of "
+        "moving the root as the feet on the ground carry it, and do not pin the feet",
+    )
+    p.add_argument(
+        "--no-lock",
+        action="store_true",
+        help="generation: do not pin the planted feet by leg IK (on by default where it adds "
+        "no pop)",
     )
     p.add_argument(
         "-k",
@@ -105,10 +119,26 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="write nothing when the motion fails the plausibility checks",
     )
     p.add_argument("--no-topo", action="store_true", help="crossval: skip the bottleneck distances")
+    p.add_argument(
+        "--no-progress", action="store_true",
+        help="no progress bars (loading the takes, crossval's folds)",
+    )
+    p.add_argument(
+        "--horizon",
+        type=int,
+        default=3,
+        help="crossval: also follow the field for this many times each left-out take, with "
+        "freeze and slip columns (default 3; 0 skips it)",
+    )
     add_memory_option(p)
     p.set_defaults(func=run)
     declare(p, inputs=_files_read, files=("-o", "--report"), folders={"--plot": r".*\.png"})
     return p
+
+
+def _dims(text: str):
+    """``--dims``: a whole number >= 1 or ``auto``."""
+    return "auto" if text == "auto" else positive_int(text)
 
 
 def _files_read(args: argparse.Namespace) -> list[Path]:
@@ -127,16 +157,41 @@ def _take_spec(text: str) -> tuple[str, int]:
 
 
 def _find(path: str, inputs: list[str], motions: list):
-    """The motion of ``path``: a training take when it names one, else loaded."""
-    for name, m in zip(inputs, motions):
-        if (
-            Path(name).exists()
-            and Path(path).exists()
-            and Path(name).resolve() == Path(path).resolve()
-            or name == path
-        ):
-            return m
+    """The motion ``--start``/``--target`` names: a training take when it names one, else
+    the file loaded.
+
+    Paths are matched as files: the same file named two ways (``35_16.amc``,
+    ``./data/35_16.amc``, an absolute path or a link) is the same take; a name that is
+    not a file here but is the name (or the trailing path) of one training take is that
+    take, and of two is an error naming both.
+    """
+    given = Path(path)
+    if given.is_file():
+        for name, m in zip(inputs, motions):
+            if Path(name).is_file() and _same_file(Path(name), given):
+                return m
+        return load_input(path)
+    parts = given.parts
+    matches = [
+        (name, m)
+        for name, m in zip(inputs, motions)
+        if parts and Path(name).parts[-len(parts):] == parts
+    ]
+    if len(matches) > 1:
+        raise ParameterError(
+            f"{path}: names more than one training take ({', '.join(n for n, _ in matches)}); "
+            "give the path of the one you mean"
+        )
+    if matches:
+        return matches[0][1]
     return load_input(path)
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.samefile(b)
+    except OSError:
+        return a.resolve() == b.resolve()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -150,7 +205,9 @@ def run(args: argparse.Namespace) -> int:
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder")
     motions = [
-        load_input(p) for p in tqdm(inputs, desc="loading", unit="take", disable=len(inputs) < 4)
+        load_input(p)
+        for p in tqdm(inputs, desc="loading", unit="take",
+                      disable=len(inputs) < 4 or args.no_progress)
     ]
     with Outputs() as out:  # every output moves into place at the end, or none does
         if crossval:
@@ -166,12 +223,13 @@ def _crossval(args: argparse.Namespace, motions: list, out: Outputs) -> int:
     cv = cross_validate(
         motions,
         methods=methods,
-        dims=args.dims,
+        dims=2 if args.dims in (None, "auto") else args.dims,
         k=args.k,
         integrator=args.integrator,
         step_scale=args.step_scale or 1.0,
         topo=not args.no_topo,
-        progress=True,
+        progress=not args.no_progress,
+        horizon=args.horizon,
     )
     print(cv.table())
     outside = sum(f["outside_hull_steps"] for f in cv.folds)
@@ -180,6 +238,15 @@ def _crossval(args: argparse.Namespace, motions: list, out: Outputs) -> int:
         "pos (RMS joint distance, skeleton units); topo: bottleneck of H1 barcodes; "
         f"{outside} steps outside the hull"
     )
+    if cv.long:
+        print()
+        print(cv.long_table())
+        print(
+            f"longer horizon: the field followed for {args.horizon}x each left-out take; "
+            "freeze: longest stretch (s) under 10 % of the training takes' median pose speed "
+            "(folds fz: folds with one over 0.2 s); slip: support-foot speed (m/s; x the "
+            "training takes'), root carried by the feet, no foot locking"
+        )
     if args.report:
         write_json(out.file(args.report), clean(cv.to_report()))
         out.wrote(args.report)
@@ -203,10 +270,12 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         )
     synth = MotionGraphSynth(
         method=method,
-        dims=args.dims,
+        dims=args.dims or "auto",
         k=args.k,
         integrator=args.integrator,
         step_scale=args.step_scale or 2.0,
+        carry=not args.no_carry,
+        lock=not (args.no_lock or args.no_carry),
     ).fit(motions)
     path, frame = _take_spec(args.start) if args.start else (inputs[0], 0)
     start = _find(path, inputs, motions)
@@ -217,6 +286,9 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         )
     else:
         gen = synth.generate(args.frames, start, frame)
+    from .blend import _lead
+
+    quality = _lead(gen.motion, motions)
     conn = synth.graph_.connectivity()
     print(
         f"{synth.graph_.method} graph ({synth.field_.name} field) over {conn['nodes']} frames of "
@@ -232,16 +304,18 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         )
     ev = synth.space_.explained_variance_ratio_
     print(
-        f"latent space: {args.dims} PCA dims explain {100 * ev.sum():.1f} % "
+        f"latent space: {synth.dims_} PCA dims explain {100 * ev.sum():.1f} % "
         "of the joint-angle variance"
     )
     print(
         f"generated {gen.motion.n_frames} frames from {gen.start['take']}:{gen.start['frame']} "
         f"({gen.path.kind}; {gen.path.outside_hull_steps} steps outside the hull)"
     )
+    for note in gen.notes:
+        print(note)
     payload = {
         "method": method,
-        "dims": args.dims,
+        "dims": synth.dims_,
         "k": args.k,
         "integrator": args.integrator,
         "step_scale": synth.step_scale,
@@ -254,9 +328,16 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
             key: conn[key] for key in ("nodes", "edges", "weak_components", "strong_components")
         },
         "connectivity": conn,
-        "root": "weighted mean of the root steps, turns, heights and tilts of the training "
-        "frames weighing on "
-        "each generated point (the field's neighbourhood), integrated from the start frame's root",
+        "notes": gen.notes,
+        "root": "turns, heights and tilts: weighted mean over the training frames weighing on "
+        "each generated point (the field's neighbourhood), integrated from the start frame's "
+        "root; ground travel "
+        + (
+            "as the lowest foot points carry the body (quality.generated's support foot), "
+            "raised where a foot would go under the training takes' floor"
+            if synth.carry and synth.floor_ is not None
+            else "the weighted mean of the training frames' root steps"
+        ),
     }
     if args.plot:
         from ..plot.graph import save_graph_figures
@@ -264,4 +345,4 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         for p in save_graph_figures(synth, gen, out.folder(args.plot)):
             out.wrote(Path(args.plot) / p.name)
     report = check_plausibility(gen.motion, motions)
-    return finish(args, gen.motion, payload, report, "generated motion", out=out)
+    return finish(args, gen.motion, payload, report, "generated motion", out=out, quality=quality)

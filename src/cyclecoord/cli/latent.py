@@ -50,8 +50,16 @@ def add_parser(subparsers) -> None:
             "13_29.amc:0:456=JumpJack. All segments need the same channels."
         ),
     )
-    f.add_argument("takes", nargs="+", metavar="TAKE[:A:B][=NAME]")
-    f.add_argument("-o", "--output", required=True, metavar="MODEL.npz")
+    f.add_argument(
+        "takes", nargs="+", metavar="TAKE[:A:B][=NAME]",
+        help="training segments: a capture, optionally frames A..B-1 of it, optionally named "
+        "(e.g. 13_29.amc:0:456=JumpJack; the name is what scripts call the segment)",
+    )
+    f.add_argument(
+        "-o", "--output", required=True, metavar="MODEL.npz",
+        help="the model file to write (.npz: the model with its training frames and skeleton, "
+        "read by 'cyclecoord animate' scripts)",
+    )
     f.add_argument("--dims", type=int, default=3, help="latent dimensions (default 3)")
     f.add_argument(
         "--variance",
@@ -67,6 +75,8 @@ def add_parser(subparsers) -> None:
     )
     f.add_argument("--max-iter", type=int, default=200, help="optimiser iterations (default 200)")
     f.add_argument("--report", metavar="R.json", help="also write the model's summary as JSON")
+    f.add_argument("--no-progress", action="store_true",
+                   help="no progress bar over the GPLVM's optimisation")
     add_memory_option(f)
     f.set_defaults(func=run)
     declare(f, inputs=_take_files, files=("-o", "--report"))
@@ -100,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
     from .. import load
     from ..errors import ParameterError
     from ..io import atomic_write
+    from .._words import plural
     from ..synthesis.latent.model import LatentModel
 
     if args.dims < 1:
@@ -135,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
     w0 = time.perf_counter()
     model = LatentModel(
         n_components=args.dims, variance=args.variance, gplvm={"max_iter": args.max_iter}
-    ).fit(segments, names)
+    ).fit(segments, names, progress=not args.no_progress)
     summary = model.describe() | {
         "fit_cpu_s": time.process_time() - t0,
         "fit_wall_s": time.perf_counter() - w0,
@@ -147,9 +158,9 @@ def run(args: argparse.Namespace) -> int:
             with atomic_write(staged.file(args.report)) as fh:
                 json.dump(summary, fh, indent=2)
     print(
-        f"{out}: {summary['frames']} frames in {len(names)} segments, {summary['pca_components']} "
-        "PCA "
-        f"components ({summary['explained_variance']:.0%}), {args.dims}-D latent, fitted in "
+        f"{out}: {summary['frames']} frames in {plural(len(names), 'segment')}, "
+        f"{plural(summary['pca_components'], 'PCA component')} "
+        f"({summary['explained_variance']:.0%}), {args.dims}-D latent, fitted in "
         f"{summary['fit_wall_s']:.1f} s ({summary['fit_cpu_s']:.1f} s CPU)"
     )
     return 0

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 
 from ..errors import CycleCoordError
 from ..io._limits import memory_limit
-from ._options import EXIT_ERROR, EXIT_NO_PERIODIC, EXIT_OK, EXIT_USAGE, named
+from ._options import FORMATS, EXIT_ERROR, EXIT_NO_PERIODIC, EXIT_OK, EXIT_USAGE, named
 from ._outputs import check_paths
 
 __all__ = [
@@ -56,9 +56,10 @@ def build_parser() -> argparse.ArgumentParser:
         prog="cyclecoord",
         description=(
             "Find, parameterise and reuse periodic motion in motion capture with persistent "
-            "cohomology. INPUT is an .amc (skeleton found beside it), .bvh, .npz or .csv file, or "
-            "'example' for the built-in synthetic walk (example:jog, example:chain, example:take, "
-            "...)."
+            "cohomology. INPUT is an .amc (skeleton found beside it), .bvh, .npz, .csv, glTF "
+            "(.glb/.gltf) or USD (.usda/.usdc/.usd) file, or 'example' for the built-in synthetic "
+            "walk (example:jog, example:chain, example:take, ...). Motions are written as "
+            f"{FORMATS}, chosen by the output's suffix."
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog=(

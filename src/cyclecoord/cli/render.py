@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..errors import ParameterError
 from ..io import input_files
-from ._options import EXIT_OK, frame_range, positive_float, positive_int
+from ._options import INPUT_HELP, EXIT_OK, frame_range, positive_float, positive_int
 from ._outputs import Outputs, declare
 from .report import load_input
 
@@ -23,7 +23,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
             "shorter one loops."
         ),
     )
-    r.add_argument("input", metavar="INPUT")
+    r.add_argument("input", metavar="INPUT", help=INPUT_HELP)
     r.add_argument(
         "-o", "--output", required=True, metavar="OUT", help="animation file, .gif or .mp4"
     )
@@ -67,6 +67,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=None,
         help="keep the figure centred and move the floor (default: only when it travels far)",
     )
+    r.add_argument("--no-progress", action="store_true", help="no progress bar over the frames")
     r.set_defaults(func=cmd_render)
     declare(
         r,
@@ -93,7 +94,7 @@ def cmd_render(args: argparse.Namespace) -> int:
     other = load_input(args.side_by_side, None, None) if args.side_by_side else None
     with Outputs() as staged:
         render(motion, staged.file(out), other=other, view=args.view, step=args.step,
-               follow=args.follow)
+               follow=args.follow, progress=not args.no_progress)
     what = f"{motion.n_frames} frames" + (
         f" beside {other.n_frames} frames of {args.side_by_side}" if other else ""
     )

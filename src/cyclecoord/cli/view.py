@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..io import input_files
-from ._options import add_memory_option
+from ._options import add_feet_option, add_memory_option
 from ._outputs import Outputs, declare
 
 
@@ -52,6 +52,7 @@ def add_parser(subparsers) -> None:
         help="animate at most this many frames per second (default 30; more are skipped)",
     )
     p.add_argument("--no-contacts", action="store_true", help="do not mark planted feet")
+    add_feet_option(p)
     add_memory_option(p)
     p.set_defaults(func=run)
     declare(
@@ -79,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..plot.viewer import ViewerInput, skeleton_figure, write_viewer
     from ..quality.contacts import foot_skating
+    from ._options import feet_option
     from .report import load_input
 
     out = Path(args.output)
@@ -89,13 +91,15 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"{out}: folder {folder} does not exist")
     items = []
     m = load_input(args.input, args.skeleton, args.fps).window(frame_window(args.frames))
-    items.append(ViewerInput(m, Path(args.input).name, args.cycle))
+    items.append(ViewerInput(m, Path(args.input).name, args.cycle, feet_option(args, m)))
     if args.side_by_side:
         o = load_input(args.side_by_side).window(frame_window(args.other_frames))
-        items.append(ViewerInput(o, Path(args.side_by_side).name, args.other_cycle))
+        items.append(
+            ViewerInput(o, Path(args.side_by_side).name, args.other_cycle, feet_option(args, o))
+        )
     for it in items:
         try:
-            print(f"{it.label}: {foot_skating(it.motion).summary()}")
+            print(f"{it.label}: {foot_skating(it.motion, feet=it.feet).summary()}")
         except ParameterError as exc:
             print(f"{it.label}: foot skating not measured ({exc})")
     fig = skeleton_figure(items, contacts=not args.no_contacts, max_fps=args.max_fps)

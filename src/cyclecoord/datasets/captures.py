@@ -144,8 +144,8 @@ def make_periodic_capture(
         Relative amplitude of the phase-speed wobble, ``0 <= speed_variation < 1`` (0 gives
         a constant speed: frame ``t`` has phase exactly ``t / period``).
     kind : str
-        One of :data:`KINDS`: ``"walk"``, ``"jog"`` (faster, larger, flight phases, bent
-        elbows), ``"jumping_jack"``, ``"arm_circles"``, ``"squat"``.
+        One of :data:`cyclecoord.datasets.KINDS`: ``"walk"``, ``"jog"`` (faster, larger, flight
+        phases, bent elbows), ``"jumping_jack"``, ``"arm_circles"``, ``"squat"``.
     fps : float
         Frame rate stored in the motion.
     random_state : int, numpy Generator or None
@@ -212,7 +212,8 @@ def make_motion_chain(
     Parameters
     ----------
     kinds : sequence of str
-        Motions in order, each one of :data:`KINDS` (a single string is one segment).
+        Motions in order, each one of :data:`cyclecoord.datasets.KINDS` (a single string is one
+        segment).
     segment_frames : int or sequence of int
         Frames per segment (>= 2), one number for all or one per segment.
     periods : sequence of float, optional

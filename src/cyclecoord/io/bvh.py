@@ -623,6 +623,7 @@ def write_bvh(
     motion: Motion,
     path: str | os.PathLike[str],
     rotation_order: str | None = None,
+    continuous: bool = True,
 ) -> None:
     """Write a motion as a BVH file.
 
@@ -630,8 +631,10 @@ def write_bvh(
     Zposition`` plus three rotation channels, every other joint ``CHANNELS 3`` rotation
     channels (six if it has translation dofs); leaves with an end site get ``End Site``
     blocks.  Rotation channels a joint lacks are written as 0, position channels it lacks
-    as its offset component, so forward kinematics is unchanged.  Values are written with
-    8 decimals.
+    as its offset component, so forward kinematics is unchanged.  Euler channels that wrap
+    or flip between frames are written continuous (the same rotations; each frame on the
+    solution nearest the previous one: :func:`cyclecoord.conventions.continuous_channels`).
+    Values are written with 8 decimals.
 
     Parameters
     ----------
@@ -646,6 +649,9 @@ def write_bvh(
         Force one intrinsic order (a permutation of ``"XYZ"``, e.g. ``"ZXY"``) for every
         joint.  By default a BVH-convention skeleton keeps each joint's own order and
         other skeletons are converted to ``"ZXY"``.
+    continuous : bool, default True
+        Rewrite Euler channels that wrap or flip between frames on the solution nearest
+        the previous frame (same rotations); False writes the values exactly as given.
 
     Raises
     ------
@@ -672,6 +678,10 @@ def write_bvh(
         motion = to_bvh_convention(motion, rotation_order=forced or "ZXY")
         orders = _bvh_ready_orders(motion.skeleton, forced)
         assert orders is not None
+    from ..conventions import continuous_channels
+
+    if continuous:
+        motion = continuous_channels(motion)  # no written file flips or wraps between frames
     skel = motion.skeleton
     assert skel is not None
     safe_names = _bvh_names([j.name for j in skel.joints])

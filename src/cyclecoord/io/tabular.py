@@ -2,34 +2,34 @@
 
 NPZ layout (every entry a plain array, so ``np.load(path, allow_pickle=False)`` works):
 
-==========================  ===============  =============================================
-key                         shape / dtype    meaning
-==========================  ===============  =============================================
-``format``                  () str           ``"cyclecoord-motion"``
-``version``                 () int           layout version, currently 1
-``frames``                  (T, D) float     channel values
-``channel_joints``          (D,) str         joint of each column
-``channel_dofs``            (D,) str         dof of each column
-``fps``                     () float         frames per second
-``start_frame``             () int           index of frame 0 in the original capture
-``source``                  (0,) or (1,) str the source string, empty array for ``None``
-``metadata_json``           () str           JSON of the JSON-serialisable metadata
-``has_skeleton``            () bool          whether the ``skeleton_*``/``joint_*`` follow
-``skeleton_name``           () str           :attr:`Skeleton.name`
-``skeleton_length_unit``    () float         :attr:`Skeleton.length_unit`
-``skeleton_source_format``  () str           :attr:`Skeleton.source_format`
-``joint_names``             (J,) str         joint names
-``joint_parents``           (J,) int         parent indices (``-1`` for the root)
-``joint_offsets``           (J, 3) float     offsets
-``joint_dofs``              (J,) str         dofs joined by spaces (``"tx ty tz rz rx ry"``)
-``joint_rotation_orders``   (J,) str         e.g. ``"ZXY"``, ``""`` for none
-``joint_axes``              (J, 3, 3) float  rest-frame rotations
-``joint_end_sites``         (J, 3) float     end sites, NaN rows where there is none
-``joint_has_end_site``      (J,) bool        which joints have an end site
-``limit_joints``            (L,) int         joint index of each limit
-``limit_dofs``              (L,) str         dof of each limit
-``limit_ranges``            (L, 2) float     ``(low, high)`` of each limit
-==========================  ===============  =============================================
+==========================  =================  =============================================
+key                         shape / dtype      meaning
+==========================  =================  =============================================
+``format``                  () str             ``"cyclecoord-motion"``
+``version``                 () int             layout version, currently 1
+``frames``                  (T, D) float       channel values
+``channel_joints``          (D,) str           joint of each column
+``channel_dofs``            (D,) str           dof of each column
+``fps``                     () float           frames per second
+``start_frame``             () int             index of frame 0 in the original capture
+``source``                  (0,) or (1,) str   the source string, empty array for ``None``
+``metadata_json``           () str             JSON of the JSON-serialisable metadata
+``has_skeleton``            () bool            whether the ``skeleton_*``/``joint_*`` follow
+``skeleton_name``           () str             :attr:`Skeleton.name`
+``skeleton_length_unit``    () float           :attr:`Skeleton.length_unit`
+``skeleton_source_format``  () str             :attr:`Skeleton.source_format`
+``joint_names``             (J,) str           joint names
+``joint_parents``           (J,) int           parent indices (``-1`` for the root)
+``joint_offsets``           (J, 3) float       offsets
+``joint_dofs``              (J,) str           dofs joined by spaces (``"tx ty tz rz rx ry"``)
+``joint_rotation_orders``   (J,) str           e.g. ``"ZXY"``, ``""`` for none
+``joint_axes``              (J, 3, 3) float    rest-frame rotations
+``joint_end_sites``         (J, 3) float       end sites, NaN rows where there is none
+``joint_has_end_site``      (J,) bool          which joints have an end site
+``limit_joints``            (L,) int           joint index of each limit
+``limit_dofs``              (L,) str           dof of each limit
+``limit_ranges``            (L, 2) float       ``(low, high)`` of each limit
+==========================  =================  =============================================
 
 CSV layout: an optional leading comment line ``# fps=120`` (also ``start_frame=N``), a
 header row naming the channels ``joint.dof``, then one row of values per frame.  Lines

@@ -51,7 +51,7 @@ def require_usd():
 
     Ctrl-C is held back while they load and raised once they have: usd-core catches a
     ``KeyboardInterrupt`` raised while it post-processes its modules, prints it as a
-    warning and goes on (see :mod:`cyclecoord._signals`).
+    warning and goes on (see ``cyclecoord._signals``).
     """
     from .._signals import deferred_interrupt
 

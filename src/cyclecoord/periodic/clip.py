@@ -201,29 +201,38 @@ def typical_amplitude(
 
 
 def planted_weights(
-    motion: Motion, rows: np.ndarray, phase: np.ndarray, n_out: int, width: float
+    motion: Motion,
+    rows: np.ndarray,
+    phase: np.ndarray,
+    n_out: int,
+    width: float,
+    feet: tuple[str, ...] | None = None,
 ) -> tuple[tuple[str, ...], np.ndarray] | None:
     """How often each foot point is planted at each phase of the cycle, over the capture.
 
     Contacts (:func:`~cyclecoord.quality.contacts.foot_contacts`) are found on the
     capture's frames ``rows[0] .. rows[-1]`` and averaged at ``n_out`` phases with the
     cycle's kernel, so a point planted in every repetition at some phase weighs 1 there.
+    The foot points are ``feet`` when given, else found on the capture
+    (:func:`~cyclecoord.quality.legs.find_legs`: by name on the common rigs, else by
+    geometry).
 
     Returns
     -------
     (feet, weights) or None
         The foot point names and an array of shape ``(n_out, len(feet))`` in ``[0, 1]``;
-        None without a skeleton or recognisable feet.
+        None without a skeleton, or without ``feet`` and no feet found.
     """
     from ..quality.contacts import find_feet, foot_contacts
 
     if motion.skeleton is None or rows.size < 2:
         return None
-    try:
-        feet = find_feet(motion.skeleton)
-    except ParameterError:
-        return None
     lo, hi = int(rows[0]), int(rows[-1]) + 1
+    if feet is None:
+        try:
+            feet = find_feet(motion.skeleton, motion[lo:hi])
+        except ParameterError:
+            return None
     contacts = foot_contacts(motion[lo:hi], feet)
     planted = contacts.planted[rows - lo].astype(float)
     return feet, phase_average(phase, planted, n_out, width)
@@ -275,6 +284,7 @@ def capture_cycle(
     register_iter: int = 2,
     amplitude: str = "typical",
     metadata: dict | None = None,
+    feet: tuple[str, ...] | None = None,
 ) -> tuple[TypicalCycle, Motion, float]:
     """The typical cycle averaged in a phase that advances at the capture's pace.
 
@@ -309,6 +319,8 @@ def capture_cycle(
         differ.
     metadata : dict, optional
         Stored on the returned clip.
+    feet : tuple of str, optional
+        Foot points whose contacts carry the root (:func:`planted_weights`; default found).
 
     Returns
     -------
@@ -389,7 +401,7 @@ def capture_cycle(
     clip = motion.with_frames(cyc, start_frame=0, source=f"cycle of {motion.source or 'capture'}",
                               metadata=dict(metadata or {}))
     if feats is not None and travel != "in_place":
-        planted = planted_weights(motion, rows, ph, P, width / float(period))
+        planted = planted_weights(motion, rows, ph, P, width / float(period), feet)
         if planted is not None:
             feet, weights = planted
             cyc[:, [layout.column("tx"), layout.column("tz")]] = anchor_to_feet(

@@ -172,11 +172,11 @@ class PeriodicDensity(ParamsMixin):
     ----------
     n_components_ : int
         Number of mixture components used.
-    weights_ : ndarray, shape (n_components_,)
+    weights_ : ndarray, shape (``n_components_``,)
         Mixture weights (sum to 1).
-    means_ : ndarray, shape (n_components_,)
+    means_ : ndarray, shape (``n_components_``,)
         Component means wrapped into ``[0, 1)``.
-    stds_ : ndarray, shape (n_components_,)
+    stds_ : ndarray, shape (``n_components_``,)
         Component standard deviations (phase units).
     converged_ : bool
         Whether EM reached its tolerance within ``max_iter`` iterations.

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numbers
 import time
+from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -98,6 +99,7 @@ def extract(
     timing: str = "capture",
     travel: str = "keep",
     min_turns: float = MIN_TURNS,
+    feet: Sequence[str] | str | None = None,
     cycle: CycleOptions | None = None,
     preprocessor: Preprocessor | None = None,
     estimator: CircularCoordinates | None = None,
@@ -190,6 +192,12 @@ def extract(
         (heading change per cycle removed) or stay in place.
     min_turns : float, default 1.5
         Fewer turns of the coordinate over the steady frames is no periodic motion.
+    feet : sequence of str, or str, optional
+        Foot point joint names (ankle then toe of each leg, e.g. ``("Foot_L", "Toes_L",
+        "Foot_R", "Toes_R")``, or the command line's ``"Foot_L:Toes_L,Foot_R:Toes_R"``)
+        whose contacts carry the cycle's root and whose skating the report gives; default
+        :func:`~cyclecoord.quality.legs.find_legs` (names of the common rigs, else the
+        geometry).
     cycle : CycleOptions, optional
         The cycle's options as one object (timing, travel, bandwidth, cycle_start,
         n_samples, n_neighbors, weighting, sampling, min_turns), instead of keywords.
@@ -245,10 +253,15 @@ def extract(
                 res = extract(motion, frames=frames, delay=AUTO_DELAY, **options)
             except NoPeriodicMotionError:
                 raise first from None
+            # what the poses alone showed: the refusal's reason, without the file it names
+            # and without its advice (the delay was what helped)
+            reason = getattr(first.result, "reason", None) or str(first)
+            seen = reason.removeprefix("no periodic motion found: ").split("; ")[0]
             res.warnings.insert(
                 0,
-                f"read with a {AUTO_DELAY:g} s delay embedding: the poses alone show no "
-                "periodic motion (an out-and-back movement, such as a squat)",
+                f"read with a {AUTO_DELAY:g} s delay embedding (each pose joined by the pose "
+                f"{AUTO_DELAY:g} s later), because the poses alone showed no periodic motion: "
+                f"{seen}",
             )
             return res
     opts = _check_options(
@@ -273,6 +286,12 @@ def extract(
         random_state=random_state,
     )
     bandwidth = opts["bandwidth"]
+    if feet is not None:
+        from ..quality.legs import feet_names
+
+        if motion.skeleton is None:
+            raise ParameterError("feet= needs a motion with a skeleton")
+        feet = feet_names(motion.skeleton, feet)
     params = dict(
         frames=None if frames is None else list(frames), pca=pca, normalize=normalize,
         temporal=temporal, delay=delay, difference_root=difference_root, root=root, prime=prime,
@@ -282,6 +301,7 @@ def extract(
         sampling=sampling, n_components=n_components, cycle_start=cycle_start,
         landmarks=landmarks, memory_limit=memory_limit, random_state=random_state, steady=steady,
         timing=timing, travel=travel, min_turns=min_turns,
+        feet=None if feet is None else list(feet),
     )
     motion = motion.window(frames)
     if motion.n_frames < 2 * n_neighbors or motion.n_frames < 10:
@@ -305,6 +325,7 @@ def extract(
         n_components=n_components, n_samples=n_samples, n_neighbors=n_neighbors,
         weighting=weighting, sampling=sampling, bandwidth=bandwidth, random_state=random_state,
         cycle_start=cycle_start, timing=timing, travel=travel, min_turns=min_turns,
+        feet=feet,
     )
     if adapter is not None:
         # the cycle in the capture's own rig (static root, position channels, up axis)
@@ -497,6 +518,7 @@ def _make_cycle(motion, prepared, prep, theta, rows, u, runs, wind, period, dens
             cycle_start=o["cycle_start"],
             travel=o["travel"],
             k=o["n_neighbors"],
+            feet=o["feet"],
             metadata=meta,
         )
     return typ, cycle_motion, phase, heading_change

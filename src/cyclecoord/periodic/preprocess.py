@@ -189,7 +189,7 @@ class Preprocessor:
     ----------
     root_columns_ : ndarray of int
         Root channels that were differenced.
-    root_rotation_mask_ : ndarray of bool, shape (len(root_columns_),)
+    root_rotation_mask_ : ndarray of bool, shape (``len(root_columns_)``,)
         Which of them are rotations (differenced as angles, wrapped into [-180, 180)).
     mean_ : ndarray, shape (D,)
         Channel means of the prepared poses (used by PCA).

@@ -116,6 +116,10 @@ class PartialExtraction:
     estimator: CircularCoordinates | None = None
     preprocessor: Preprocessor | None = None
 
+    def __repr__(self) -> str:  # one line, not the arrays it holds
+        bars = "no barcode" if self.barcode is None else f"{len(self.barcode.h1)} H1 bars"
+        return f"PartialExtraction({self.motion!r}, {bars}, reason={self.reason!r})"
+
 
 @dataclass
 class ExtractionResult:
@@ -210,6 +214,12 @@ class ExtractionResult:
     rig: Any = None
     rig_changes: list = field(default_factory=list)
 
+    def __repr__(self) -> str:  # one line, not the arrays it holds
+        return (
+            f"ExtractionResult({self.motion!r}, period {self.period_frames:.1f} frames, "
+            f"{self.cycles:.2f} cycles over frames {self.used_frames})"
+        )
+
     def _rig_dict(self) -> dict | None:
         if self.rig is None:
             return None
@@ -262,7 +272,7 @@ class ExtractionResult:
             "bandwidth_frames": float(self.typical.bandwidth)
             if np.isfinite(self.typical.bandwidth)
             else None,
-            "foot_skating": _cycle_skating(self.cycle),
+            "foot_skating": _cycle_skating(self.cycle, self.parameters.get("feet")),
             "distance_to_cycle": self.distance,
             "pose_quality": None if self.pose_quality is None else self.pose_quality.to_dict(),
             "rig": self._rig_dict(),
@@ -283,11 +293,14 @@ class ExtractionResult:
         }
 
 
-def _cycle_skating(cycle: Motion) -> dict | None:
-    """Foot skating of the cycle (:func:`~cyclecoord.quality.contacts.skating_report`)."""
+def _cycle_skating(cycle: Motion, feet=None) -> dict | None:
+    """Foot skating of the cycle (:func:`~cyclecoord.quality.contacts.skating_report`) on
+    ``feet`` (None: found)."""
     from ..quality.contacts import skating_report
 
-    return skating_report(cycle) if cycle is not None and cycle.skeleton is not None else None
+    if cycle is None or cycle.skeleton is None:
+        return None
+    return skating_report(cycle, feet=None if feet is None else tuple(feet))
 
 
 def _nullable(values: np.ndarray | None) -> list | None:

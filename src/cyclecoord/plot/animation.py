@@ -22,7 +22,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from ..motion import Motion
 
-__all__ = ["render"]
+__all__ = ["gif_delays", "render"]
 
 
 # ------------------------------------------------------------------- render
@@ -148,6 +148,7 @@ def render(
     dpi: float = 80,
     size: float = 4.0,
     max_frames: int = 2000,
+    progress: bool = False,
 ) -> Path:
     """Animate a capture as a stick figure (forward kinematics) and write a GIF or MP4.
 
@@ -162,7 +163,10 @@ def render(
         file is rendered beside the target under a temporary name and renamed, so a
         failed render leaves nothing behind.
     fps : float, optional
-        Playback rate of the animation; default real time (``motion.fps / step``).
+        Playback rate of the animation; default real time (``motion.fps / step``).  A
+        GIF's frame delays are whole centiseconds: they alternate so that they average
+        to this rate (:func:`gif_delays`; at most 50 fps, the fastest GIF browsers
+        play).  An MP4 keeps the rate exactly.
     other : Motion, optional
         A second capture drawn side by side (e.g. the extracted cycle next to the
         original).  The animation lasts as long as the longer one; the shorter one loops,
@@ -187,6 +191,8 @@ def render(
         pixels tall).
     max_frames : int, default 2000
         Upper bound on drawn frames when ``step`` is automatic.
+    progress : bool, default False
+        A tqdm bar on stderr over the drawn frames (shown after 1 s).
 
     Returns
     -------
@@ -253,7 +259,7 @@ def render(
                 dots.set_data(q[:, 0], q[:, 1])
             text.set_text(f"{tr.title}  frame {tr.start_frame + int(frames_used[k][i])}")
 
-    _write_frames(fig, out, suffix, play_fps, dpi, len(times), draw_frame)
+    _write_frames(fig, out, suffix, play_fps, dpi, len(times), draw_frame, progress)
     return out
 
 
@@ -455,24 +461,28 @@ def _panel_2d(fig, k: int, n_panels: int, tr: _Track, st: _Stage) -> tuple:
 
 
 def _write_frames(fig, out: Path, suffix: str, play_fps: float, dpi: float, n: int,
-                  draw_frame) -> None:
+                  draw_frame, progress: bool = False) -> None:
     """Draw the ``n`` frames one by one into a GIF or MP4 written atomically at ``out``."""
     import matplotlib as mpl
     from matplotlib import animation as anim
+    from tqdm import tqdm
 
     from ..io import atomic_path
 
     if suffix == ".gif":
-        writer = anim.PillowWriter(fps=play_fps)
+        writer = _gif_writer(anim.PillowWriter)(fps=play_fps)
     else:
+        # ffmpeg reads the rate as text: a fraction keeps 30000/1001 or 120/7 exact, where
+        # str(float) would hand it 17 digits to round
         writer = anim.FFMpegWriter(
-            fps=play_fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"]
+            fps=_rate_fraction(play_fps), codec="libx264", extra_args=["-pix_fmt", "yuv420p"]
         )
     with atomic_path(out, suffix=f".tmp{suffix}") as tmp, mpl.rc_context({"savefig.bbox": None}):
         # (a 'tight' bbox would change the frame size)
         writer.setup(fig, str(tmp), dpi)
         try:
-            for i in range(n):
+            for i in tqdm(range(n), desc="drawing", unit="frame", disable=not progress,
+                          delay=1.0, leave=False):
                 draw_frame(i)
                 writer.grab_frame()
         except BaseException:
@@ -482,6 +492,66 @@ def _write_frames(fig, out: Path, suffix: str, play_fps: float, dpi: float, n: i
                 writer.finish()
             raise
         writer.finish()
+
+
+def gif_delays(n: int, fps: float) -> list[int]:
+    """Per-frame delays in milliseconds, whole centiseconds, that average to ``1 / fps``.
+
+    A GIF stores each frame's delay in centiseconds, so 30 fps cannot be one delay: 3 cs
+    plays 10 % fast, 4 cs 17 % slow.  Frame ``k`` is shown from ``round(100 k / fps)`` cs,
+    so the delays alternate (3, 4, 3, 3, 4, 3, ... at 30 fps) and frame ``k`` is never
+    more than half a centisecond from its time.  Browsers show a delay under 2 cs as
+    10 cs, so a GIF cannot play faster than 50 frames per second: a delay is at least
+    2 cs (a rate above 50 fps is played at 50; write an MP4 for those).
+
+    Parameters
+    ----------
+    n : int
+        Number of frames.
+    fps : float
+        Playback rate in frames per second.
+
+    Returns
+    -------
+    list of int
+        ``n`` delays in milliseconds, each a multiple of 10.
+
+    Examples
+    --------
+    >>> gif_delays(6, 30)
+    [30, 40, 30, 30, 40, 30]
+    >>> sum(gif_delays(63, 30))  # 63 frames at 30 fps: 2.1 s
+    2100
+    """
+    if not np.isfinite(fps) or fps <= 0:
+        raise ParameterError(f"fps must be a positive number, got {fps!r}")
+    rate = min(float(fps), 50.0)
+    ends = np.round(np.arange(1, n + 1) * 100.0 / rate + 1e-9).astype(int)
+    cs = np.diff(ends, prepend=0)
+    return [int(10 * max(2, c)) for c in cs]
+
+
+def _rate_fraction(fps: float):
+    """``fps`` as a fraction with a denominator of at most 1001 (30000/1001, 120/7)."""
+    from fractions import Fraction
+
+    return Fraction(float(fps)).limit_denominator(1001)
+
+
+def _gif_writer(base):
+    """matplotlib's PillowWriter, saving with :func:`gif_delays` instead of one delay.
+
+    matplotlib saves every frame with ``int(1000 / fps)`` ms, which the GIF stores as
+    whole centiseconds (33 ms -> 3 cs): a 30 fps motion played 10 % fast.
+    """
+
+    class GifWriter(base):
+        def finish(self):
+            frames = self._frames
+            frames[0].save(self.outfile, save_all=True, append_images=frames[1:],
+                           duration=gif_delays(len(frames), self.fps), loop=0)
+
+    return GifWriter
 
 
 def _grid_spacing(body: float) -> float:

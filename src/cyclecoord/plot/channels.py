@@ -124,9 +124,10 @@ def plot_channels(
     ``result.phase``), so the curves stay in step over repetitions of different lengths;
     frames without a phase, and results timed by the coordinate, play the cycle at its
     own constant rate from the phase of the clip's first frame (paper Fig. 6).  The right panel is
-    the jerk as the console and the report give it (:func:`cyclecoord.quality.metrics.
-    jerk_summary`: third derivative by 4th-order finite differences of every prepared
-    channel, root as per-frame steps, norm over channels; the cycle looped so its seam
+    the jerk as the console and the report give it
+    (:func:`~cyclecoord.quality.metrics.jerk_summary`: third derivative by 4th-order finite
+    differences of every prepared channel, root as per-frame steps, norm over channels; the cycle
+    looped so its seam
     counts), per frame over one period of each; the title gives the means over the whole
     clip and the whole cycle, ``result.jerk``.
 

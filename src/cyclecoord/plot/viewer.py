@@ -48,11 +48,15 @@ class ViewerInput:
     cycle : bool
         Whether the motion is a loop (phase ``k / T``, seam between the last frame and
         the first); it then repeats when a longer motion plays beside it.
+    feet : tuple of str, optional
+        Foot points whose contacts are marked (default found:
+        :func:`~cyclecoord.quality.legs.find_legs`).
     """
 
     motion: Motion
     label: str
     cycle: bool = False
+    feet: tuple[str, ...] | None = None
 
 
 def _to_plot(p: np.ndarray) -> np.ndarray:
@@ -93,7 +97,7 @@ def _prepare(item: ViewerInput, offset: float, contacts: bool, center: bool):
         from ..quality.contacts import foot_contacts
 
         try:
-            c = foot_contacts(m)
+            c = foot_contacts(m, feet=item.feet)
         except ParameterError:
             c = None
         if c is not None:

@@ -5,6 +5,10 @@ level it rests at on the floor and barely moves horizontally.  Both thresholds a
 to the skeleton (its leg length), so the same defaults serve CMU's ASF units (about
 5.6 cm), BVH centimetres or metres.
 
+The foot points come from :func:`~cyclecoord.quality.legs.find_legs` (joint names of the
+common rigs, else the skeleton's geometry): two legs, or four on a quadruped, each with its
+ankle and toe point.  Given foot points are grouped into legs by the hierarchy.
+
 The floor is not assumed at height 0 (CMU root heights are not): :func:`foot_contacts`
 estimates it as a low quantile of the lowest foot point over the motion, and each foot
 point's own contact level (an ankle rests higher than a toe) as a low quantile of that
@@ -17,14 +21,15 @@ and the fraction of frames on which a planted foot moves faster than a small thr
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Motion
+from ..joint_names import classify_skeleton
 from ..skeleton import Skeleton
+from .legs import Legs, find_feet, find_legs, legs_of_feet
 
 __all__ = [
     "FootContacts",
@@ -66,7 +71,7 @@ class FootContacts:
         Joint names of the foot points, e.g. ``("lfoot", "ltoes", "rfoot", "rtoes")``
         (ankle then toe of each leg).
     sides : tuple of str
-        ``"left"`` or ``"right"`` per foot point.
+        ``"left"`` or ``"right"`` per foot point (``"?"`` when unknown).
     planted : ndarray of bool, shape (T, F)
         Whether each foot point is planted on each frame.
     height : ndarray, shape (T, F)
@@ -86,6 +91,9 @@ class FootContacts:
         Frame rate of the motion.
     up : int
         Index of the up axis (1 for y).
+    legs : tuple of str
+        Leg label per foot point: ``"left"``/``"right"``, or ``"front left"`` ...
+        ``"hind right"`` on a quadruped (empty: the sides are the legs).
     """
 
     feet: tuple[str, ...]
@@ -100,14 +108,26 @@ class FootContacts:
     speed_threshold: float
     fps: float
     up: int = 1
+    legs: tuple[str, ...] = ()
 
     @property
     def n_frames(self) -> int:
         return int(self.planted.shape[0])
 
+    @property
+    def leg_labels(self) -> tuple[str, ...]:
+        """Leg label per foot point (the sides when no legs were recorded)."""
+        return self.legs if self.legs else self.sides
+
     def side_planted(self, side: str) -> np.ndarray:
-        """Frames ``(T,)`` on which any point of the ``"left"`` or ``"right"`` foot is planted."""
-        cols = [i for i, s in enumerate(self.sides) if s == side]
+        """Frames ``(T,)`` on which any point of a side or a leg is planted.
+
+        ``side`` is ``"left"`` or ``"right"`` (every leg on that side: both left legs of
+        a quadruped) or a leg label such as ``"front left"``.
+        """
+        cols = [
+            i for i, (s, g) in enumerate(zip(self.sides, self.leg_labels)) if side in (s, g)
+        ]
         if not cols:
             raise ParameterError(f"no {side} foot among {self.feet}")
         return self.planted[:, cols].any(axis=1)
@@ -193,70 +213,10 @@ def _summary_line(speed: float, speed_legs: float, frames: int, fraction: float)
 
 
 # ---------------------------------------------------------------- skeleton help
-def _normalise(name: str) -> str:
-    name = name.rsplit(":", 1)[-1]  # "mixamorig:LeftFoot" -> "LeftFoot"
-    return re.sub(r"[^a-z0-9]", "", name.lower())
-
-
-def _side_and_kind(name: str) -> tuple[str, str] | None:
-    """``(side, kind)`` for a foot-like joint name, kind ``"ankle"`` or ``"toe"``."""
-    n = _normalise(name)
-    if n.endswith("end") or "nub" in n:
-        return None
-    for side, prefixes in (("left", ("left", "l")), ("right", ("right", "r"))):
-        for pre in prefixes:
-            if n.startswith(pre):
-                rest = n[len(pre) :]
-                break
-        else:
-            continue
-        if rest in ("foot", "ankle", "heel"):
-            return side, "ankle"
-        if rest in ("toe", "toes", "toebase", "ball", "toe0", "toe1"):
-            return side, "toe"
-    return None
-
-
-def find_feet(skeleton: Skeleton) -> tuple[str, ...]:
-    """Foot point joint names of a skeleton: ankle then toe of the left, then right leg.
-
-    Recognises CMU ASF names (``lfoot``, ``ltoes``, ...) and the usual BVH ones
-    (``LeftFoot``, ``LeftToeBase``, ``RightAnkle``, ``mixamorig:LeftToe`` ...).
-
-    Raises
-    ------
-    ParameterError
-        If no ankle or toe joint is found for either leg.
-    """
-    found: dict[tuple[str, str], str] = {}
-    for j in skeleton.joints:
-        sk = _side_and_kind(j.name)
-        if sk is not None and sk not in found:
-            found[sk] = j.name
-    feet = [found[(s, k)] for s in ("left", "right") for k in ("ankle", "toe") if (s, k) in found]
-    sides = {s for s, _ in found}
-    if sides != {"left", "right"}:
-        raise ParameterError(
-            f"skeleton {skeleton.name or '(unnamed)'}: no foot joints found for both legs "
-            "(expected names like lfoot/ltoes or LeftFoot/LeftToeBase); pass feet= explicitly"
-        )
-    return tuple(feet)
-
-
-def _side_of(name: str) -> str:
-    sk = _side_and_kind(name)
-    if sk is not None:
-        return sk[0]
-    n = _normalise(name)
-    if n.startswith(("left", "l")):
-        return "left"
-    if n.startswith(("right", "r")):
-        return "right"
-    return "?"
-
-
 def _ankle_of(skeleton: Skeleton, feet: tuple[str, ...], foot: str) -> int:
-    """Index of the highest foot point on ``foot``'s chain (the ankle), foot itself if alone."""
+    """Index of the ankle of ``foot``'s leg: the highest foot point on its chain, or its
+    parent when that point is a toe (named so, or its bone under half its parent's): a
+    leg given by its toe alone."""
     idx = skeleton.index(foot)
     members = {skeleton.index(f) for f in feet}
     ankle = idx
@@ -265,14 +225,22 @@ def _ankle_of(skeleton: Skeleton, feet: tuple[str, ...], foot: str) -> int:
         if p in members:
             ankle = p
         p = skeleton.joints[p].parent
+    parent = skeleton.joints[ankle].parent
+    if parent > 0:
+        role = classify_skeleton(skeleton).get(skeleton.joints[ankle].name)
+        bone = np.linalg.norm(skeleton.joints[ankle].offset)
+        if (role is not None and role.role == "toe") or bone < 0.5 * np.linalg.norm(
+            skeleton.joints[parent].offset
+        ):
+            ankle = parent
     return ankle
 
 
 def leg_length(skeleton: Skeleton, feet: tuple[str, ...] | None = None) -> float:
     """Mean hip-to-ankle length (thigh plus shin bone) over the legs, in length units.
 
-    The ankle is the highest foot point of each leg; its offset is the shin and its
-    parent's offset the thigh.
+    The ankle is the highest foot point of each leg (two legs or four); its offset is
+    the shin and its parent's offset the thigh.
     """
     feet = find_feet(skeleton) if feet is None else tuple(feet)
     ankles = sorted({_ankle_of(skeleton, feet, f) for f in feet})
@@ -356,7 +324,7 @@ def foot_contacts(
     feet: tuple[str, ...] | list[str] | None = None,
     *,
     height: float = DEFAULT_HEIGHT,
-    speed: float = DEFAULT_SPEED,
+    speed: float | None = DEFAULT_SPEED,
     min_duration: float = DEFAULT_MIN_DURATION,
     up: str = "y",
     floor: float | None = None,
@@ -368,14 +336,18 @@ def foot_contacts(
     motion : Motion
         Any motion with a skeleton.
     feet : sequence of str, optional
-        Foot joint names; default :func:`find_feet` (``lfoot ltoes rfoot rtoes`` on a
-        CMU skeleton).
+        Foot joint names; default :func:`~cyclecoord.quality.legs.find_legs` on this
+        motion (``lfoot ltoes rfoot rtoes`` on a CMU skeleton, ``Foot_L Toes_L Foot_R
+        Toes_R`` on Bandai's, four legs on a quadruped).  Given names are grouped into
+        legs by the hierarchy (points on one chain make one leg).
     height : float
         Height band above a point's contact level, as a fraction of the leg length
         (0.05: about 4 cm on an adult).
-    speed : float
+    speed : float or None
         Horizontal speed limit of a planted point, in leg lengths per second (0.5:
-        about 0.4 m/s).
+        about 0.4 m/s).  None: contact from height alone, not gated by speed (what
+        :mod:`cyclecoord.quality.generated` judges generated motion by: a foot that
+        glides along the floor is on the floor, and its speed is the slip).
     min_duration : float
         Contacts shorter than this (seconds) are dropped and gaps shorter than this
         closed.
@@ -397,22 +369,19 @@ def foot_contacts(
     skel = contact_skeleton(motion)
     if up not in _UP:
         raise ParameterError(f"up axis must be one of x, y, z, got {up!r}")
-    for label, value in (("height", height), ("speed", speed)):
+    gates = (("height", height),) if speed is None else (("height", height), ("speed", speed))
+    for label, value in gates:
         if not (np.isfinite(value) and value > 0):
             raise ParameterError(f"{label} threshold must be a positive number, got {value!r}")
     if not (np.isfinite(min_duration) and min_duration >= 0):
         raise ParameterError(f"min_duration must be >= 0 seconds, got {min_duration!r}")
-    feet = find_feet(skel) if feet is None else tuple(feet)
-    if not feet:
-        raise ParameterError("feet must name at least one joint")
-    for f in feet:
-        if f not in skel.names:
-            raise ParameterError(
-                f"no joint {f!r} in the skeleton (joints: {', '.join(skel.names)})"
-            )
+    legs: Legs = (
+        find_legs(skel, motion, up=up) if feet is None else legs_of_feet(skel, feet, motion, up=up)
+    )
+    feet = legs.feet
     axis = _UP[up]
     horiz = [k for k in range(3) if k != axis]
-    legs = leg_length(skel, feet)
+    scale = leg_length(skel, feet)
 
     pos = motion.positions()
     cols = [pos.names.index(f) for f in feet]
@@ -428,31 +397,32 @@ def foot_contacts(
     else:
         floor_level = float(floor)
     level = np.quantile(y, _LOW_QUANTILE, axis=0)
-    level = np.clip(level, floor_level, floor_level + _MAX_LEVEL * legs)
+    level = np.clip(level, floor_level, floor_level + _MAX_LEVEL * scale)
     rel = y - level
 
     xz = pos.positions[:, cols][:, :, horiz]
     vel = np.gradient(xz, axis=0) * motion.fps
     spd = np.linalg.norm(vel, axis=2)
 
-    h_thr = height * legs
-    v_thr = speed * legs
+    h_thr = height * scale
+    v_thr = np.inf if speed is None else speed * scale
     planted = (rel < h_thr) & (spd < v_thr)
     min_frames = round(min_duration * motion.fps)
     planted = np.stack([_clean(planted[:, i], min_frames) for i in range(len(feet))], axis=1)
     return FootContacts(
         feet=feet,
-        sides=tuple(_side_of(f) for f in feet),
+        sides=legs.sides,
         planted=planted,
         height=rel,
         speed=spd,
         floor=floor_level,
         contact_level=level,
-        leg_length=legs,
+        leg_length=scale,
         height_threshold=h_thr,
         speed_threshold=v_thr,
         fps=motion.fps,
         up=axis,
+        legs=legs.labels,
     )
 
 

@@ -41,15 +41,24 @@ MAX_POP = 2.0
 MAX_SEAM = 1.5
 #: Captured frames compared against (a long take is sampled evenly down to this).
 MAX_REFERENCE_FRAMES = 20_000
+#: Captured poses (evenly spaced) whose nearest other repetition gives the spread.
+MAX_SPREAD_PROBES = 2_000
 
 
-def root_frame_points(motion: Motion) -> np.ndarray:
+def root_frame_points(motion: Motion, rig=None, names=None) -> np.ndarray:
     """Joint and end-site positions in the root's frame, plus the root's height.
 
     Parameters
     ----------
     motion : Motion
         With a skeleton.
+    rig : RigInfo, optional
+        How to read the rig (:func:`cyclecoord.rig.describe_rig`), so that a cycle is read
+        as the capture it came from; default: described afresh.
+    names : sequence of str, optional
+        Only these points, in this order (forward-kinematics names, end sites
+        ``"<joint>/end"``): a cycle read back from a format that lays out its skeleton
+        otherwise (ASF bones against BVH joints) is compared point for point.
 
     Returns
     -------
@@ -62,8 +71,12 @@ def root_frame_points(motion: Motion) -> np.ndarray:
     from ..rig import normalize_rig
 
     if motion.skeleton is not None:
-        motion, _ = normalize_rig(motion)  # the travelling joint is the root
-    pos = np.asarray(motion.positions().positions, dtype=float)  # (T, N, 3)
+        motion, _ = normalize_rig(motion, rig, drop_reference=False)  # travelling joint first
+    fk = motion.positions()
+    pos = np.asarray(fk.positions, dtype=float)  # (T, N, 3)
+    if names is not None:
+        index = {n: i for i, n in enumerate(fk.names)}
+        pos = pos[:, [0] + [index[n] for n in names if n != fk.names[0]], :]
     layout = root_layout(motion)
     root = pos[:, :1, :]
     rel = pos - root
@@ -142,15 +155,38 @@ class PoseQuality:
         return {k: (None if not np.isfinite(v) else float(v)) for k, v in asdict(self).items()}
 
 
-def _runs_points(capture: Motion, runs: list[tuple[int, int]]) -> list[np.ndarray]:
+def _point_names(motion: Motion, rig) -> list[str]:
+    from ..rig import normalize_rig
+
+    one = motion.with_frames(motion.frames[:1])
+    return list(normalize_rig(one, rig, drop_reference=False)[0].positions().names)
+
+
+def _runs_points(capture: Motion, runs: list[tuple[int, int]], rig, names=None
+                 ) -> list[np.ndarray]:
     total = sum(b - a for a, b in runs)
     every = max(1, int(np.ceil(total / MAX_REFERENCE_FRAMES)))
     out = []
     for a, b in runs:
         if b - a >= 2:
-            # whole runs, sampled evenly on long takes (steps then span ``every`` frames)
-            out.append(root_frame_points(capture.window((a, b)))[::every])
+            # whole runs, sampled evenly on long takes before forward kinematics
+            part = capture.with_frames(capture.frames[a:b:every])
+            out.append(root_frame_points(part, rig, names))
     return out
+
+
+def _capture_steps(capture: Motion, runs: list[tuple[int, int]], rig, names=None
+                   ) -> np.ndarray:
+    """Frame steps of the capture: every run whole, or on a long take the middle
+    :data:`MAX_REFERENCE_FRAMES` frames of its longest run."""
+    if sum(b - a for a, b in runs) <= MAX_REFERENCE_FRAMES:
+        parts = [root_frame_points(capture.window((a, b)), rig, names)
+                 for a, b in runs if b - a >= 2]
+        return np.concatenate([_steps(p) for p in parts]) if parts else np.zeros(0)
+    a, b = max(runs, key=lambda r: r[1] - r[0])
+    mid = (a + b) // 2
+    lo, hi = max(a, mid - MAX_REFERENCE_FRAMES // 2), min(b, mid + MAX_REFERENCE_FRAMES // 2)
+    return _steps(root_frame_points(capture.window((lo, hi)), rig, names))
 
 
 def pose_quality(
@@ -177,15 +213,24 @@ def pose_quality(
     """
     if cycle.skeleton is None or capture.skeleton is None or cycle.n_frames < 3:
         return None
-    parts = _runs_points(capture, runs)
+    from ..rig import describe_rig
+
+    rig = describe_rig(capture)
+    names = None
+    cap_names = _point_names(capture, rig)
+    cyc_names = _point_names(cycle, rig)
+    if cap_names != cyc_names:  # another layout of the same body: the points both have
+        names = [n for n in cap_names if n in set(cyc_names)]
+        if cap_names[0] != cyc_names[0] or len(names) < 3:
+            return None
+    parts = _runs_points(capture, runs, rig, names)
     if not parts:
         return None
     every = max(1, int(np.ceil(sum(b - a for a, b in runs) / MAX_REFERENCE_FRAMES)))
-    cyc = root_frame_points(cycle)
+    cyc = root_frame_points(cycle, rig, names)
     csteps = _steps(cyc, cyclic=True)
     seam = float(csteps[-1] / np.median(csteps)) if np.median(csteps) > 0 else float("nan")
-    cap_steps = np.concatenate([_steps(p) for p in parts if len(p) > 1]) if every == 1 else \
-        _steps(root_frame_points(capture.window(max(runs, key=lambda r: r[1] - r[0]))))
+    cap_steps = _capture_steps(capture, runs, rig, names)
     p99 = float(np.percentile(cap_steps, 99)) if cap_steps.size else float("nan")
     pop = float(csteps.max() / p99) if p99 > 0 else float("nan")
     pts = np.concatenate(parts)
@@ -193,13 +238,15 @@ def pose_quality(
         np.arange(a, b)[::every][: len(p)] for (a, b), p in zip(
             [r for r in runs if r[1] - r[0] >= 2], parts)
     ])
-    tree = cKDTree(pts)
-    near, _ = tree.query(cyc)
+    rms = 1.0 / np.sqrt(max(1, pts.shape[1] // 3))  # distances as RMS point distances
+    tree = cKDTree(pts * rms)
+    near, _ = tree.query(cyc * rms)
     # spread: each captured pose's nearest pose in another repetition
     half = max(1.0, 0.5 * float(period))
     k = int(min(len(pts), max(8, 4 * np.ceil(period / every))))
-    d, idx = tree.query(pts, k=k)
-    far = np.abs(frame_of[idx] - frame_of[:, None]) >= half
+    probe = np.unique(np.linspace(0, len(pts) - 1, min(len(pts), MAX_SPREAD_PROBES)).astype(int))
+    d, idx = tree.query(pts[probe] * rms, k=k)
+    far = np.abs(frame_of[idx] - frame_of[probe][:, None]) >= half
     d = np.where(far, d, np.inf)
     best = d.min(axis=1)
     best = best[np.isfinite(best)]

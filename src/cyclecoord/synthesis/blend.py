@@ -10,8 +10,12 @@ in different conventions (an AMC capture, a BVH cycle) are re-expressed in one
 reference skeleton's size, every cycle is turned about the vertical axis so that it faces
 the same way (otherwise a walk heading north and a jog heading east would have their
 velocities cancel, and a CMU root facing east sits at the gimbal lock of its Euler
-angles), and joint angles are moved by multiples of 360 degrees to lie within 180 degrees
-of the reference's, so that 179 and -179 do not average to 0.
+angles), and joint rotations are blended as rotations: each joint's rotation becomes its rotation
+vector about the joint's mean over all the cycles
+(:mod:`cyclecoord.periodic.rotations`), the weighted sum is taken there (a weighted mean
+of the rotations, exact to second order in their spread) and turned back into Euler
+channels that are continuous over frames, so 179 and -179 do not average to 0 and an
+Euler flip in one input changes nothing.
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ from .align import (
     rotate_heading,
 )
 from ..conventions import bvh_ready, common_channels, wrap_degrees
+from ..periodic.rotations import fit_rotation_map
 from .curve import (
     CycleCurve,
     angle_columns,
@@ -193,6 +198,7 @@ class _Prepared:
     turned: bool
     up: int
     base: Motion  # the reference in the common channels, not turned
+    rotations: Any = None  # RotationMap: joints blended as rotation vectors about a mean
 
 
 def _skeleton_size(m: Motion) -> float | None:
@@ -272,6 +278,18 @@ def _common_frame(
                 "cycles not turned to a common heading: a cycle spins round (no mean heading)"
             )
 
+    # joint rotations are blended as rotations: rotation vectors about each joint's mean
+    # over all the cycles (a weighted sum of them is a weighted mean of rotations to second
+    # order, and a wrap or Euler flip in one input changes nothing); the root keeps its own
+    # treatment (heading turned, travel per loop)
+    rotations = fit_rotation_map(
+        fixed[0].with_frames(np.vstack([m.frames for m in fixed])),
+        exclude=np.asarray(root_columns(fixed[0]), dtype=int),
+    )
+    if rotations.columns.size:
+        fixed = [m.with_frames(rotations.to_vectors(m.frames)) for m in fixed]
+    else:
+        rotations = None
     curves = [_curve_of_extended(m) for m in fixed]
     ref_curve = curves[0]
     pose = np.array(
@@ -304,6 +322,7 @@ def _common_frame(
         turned=turned,
         up=u,
         base=ref[:-1],
+        rotations=rotations,
     )
 
 
@@ -326,7 +345,10 @@ def _curve_of_extended(extended: Motion) -> CycleCurve:
 
 
 def _turn_back(frames: np.ndarray, prep: _Prepared, original: Motion) -> np.ndarray:
-    """Frames from the common heading back to the reference's, root Euler near the original's."""
+    """Frames from the common heading back to the reference's, root Euler near the original's;
+    joint rotation vectors back to Euler channels, continuous and near the original's."""
+    if prep.rotations is not None:
+        frames = prep.rotations.to_channels(frames, near=original.frames[0])
     if not prep.turned or prep.reference_heading == 0.0:
         return frames
     m = prep.reference.with_frames(frames)

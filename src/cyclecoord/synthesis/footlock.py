@@ -430,8 +430,9 @@ def _lock_once(
     frames = np.array(motion.frames, dtype=float)
     scale = contacts.leg_length
     worst = 0.0
-    for side in sorted(set(contacts.sides)):
-        cols = [i for i, s in enumerate(contacts.sides) if s == side]
+    labels = contacts.leg_labels
+    for leg in sorted(set(labels)):
+        cols = [i for i, g in enumerate(labels) if g == leg]
         pts = [skel.index(contacts.feet[i]) for i in cols]
         depth = {p: 0 for p in pts}
         for p in pts:
@@ -544,8 +545,8 @@ def lock_feet(
     motion : Motion
         A motion with a skeleton (CMU ASF, BVH, ...).
     contacts : FootContacts, optional
-        Contacts to lock; found with :func:`foot_contacts` (and ``contact_options``)
-        when not given.
+        Contacts to lock; found with :func:`foot_contacts` (and ``contact_options``,
+        ``feet=`` among them to name the foot points) when not given.
     blend : float
         Seconds over which a foot eases into and out of each lock.
     cyclic : bool
@@ -569,8 +570,11 @@ def lock_feet(
         raise ParameterError(f"blend must be >= 0 seconds, got {blend!r}")
     if isinstance(passes, bool) or not isinstance(passes, (int, np.integer)) or passes < 1:
         raise ParameterError(f"passes must be a whole number >= 1, got {passes!r}")
+    feet = contact_options.pop("feet", None)
     if contacts is None:
-        contacts = foot_contacts(motion, **contact_options)
+        contacts = foot_contacts(motion, feet=feet, **contact_options)
+    elif feet is not None:
+        raise ParameterError("pass either contacts or feet, not both")
     else:
         contact_skeleton(motion)
     if contacts.n_frames != motion.n_frames:
@@ -581,7 +585,11 @@ def lock_feet(
     if not contact_options:  # find contacts afresh with the thresholds of the given ones
         contact_options = {
             "height": contacts.height_threshold / contacts.leg_length,
-            "speed": contacts.speed_threshold / contacts.leg_length,
+            "speed": (
+                contacts.speed_threshold / contacts.leg_length
+                if np.isfinite(contacts.speed_threshold)
+                else None
+            ),
             "up": "xyz"[contacts.up],
         }
     out, worst = _lock_once(motion, contacts, nb, cyclic)

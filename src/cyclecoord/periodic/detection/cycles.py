@@ -78,6 +78,7 @@ def motion_cycles(
     travel: str = "keep",
     min_cycles: float = 1.5,
     cycle: CycleOptions | None = None,
+    feet: tuple[str, ...] | None = None,
 ) -> list[MotionCycle]:
     """A typical cycle for every motion :func:`detect` found, with the phase it found.
 
@@ -85,8 +86,9 @@ def motion_cycles(
     global H1 class, that class's circular coordinate on the frames it excites inside
     the segment (the class the motion was detected by, so the cycle has the segment's
     period); for a motion found by the windows alone, time over the segment's period
-    (:func:`autocorrelation_period`), which is accurate for the one to three cycles such
-    segments hold.  The typical cycle is then built as :func:`cyclecoord.extract` builds
+    (:func:`~cyclecoord.periodic.detection.windows.autocorrelation_period`), which is accurate for
+    the one to three cycles such segments hold.  The typical cycle is then built as
+    :func:`cyclecoord.extract` builds
     it: by default (``timing="capture"``) in a phase re-timed to the capture's pace
     between the coordinate's crossings and aligned by time warping
     (:func:`~cyclecoord.periodic.clip.capture_cycle`), slowest pose first, root tilt
@@ -109,6 +111,9 @@ def motion_cycles(
         A motion whose longest segment holds fewer cycles gets no cycle: one repetition
         and a part is no typical cycle (the rule :func:`cyclecoord.extract` applies with
         ``min_turns``; 13_29's twist holds 1.4).
+    feet : tuple of str, optional
+        Foot points whose contacts carry each cycle's root (default found, as
+        :func:`cyclecoord.extract` finds them).
 
     Returns
     -------
@@ -132,7 +137,7 @@ def motion_cycles(
             result, n_samples=chosen["n_samples"], n_neighbors=chosen["n_neighbors"],
             bandwidth=chosen["bandwidth"], cycle_start=chosen["cycle_start"],
             random_state=random_state, timing=chosen["timing"], travel=chosen["travel"],
-            min_cycles=chosen["min_turns"],
+            min_cycles=chosen["min_turns"], feet=feet,
         )
     if not isinstance(result, DetectionResult):
         raise ParameterError(
@@ -191,6 +196,7 @@ def motion_cycles(
                 travel=travel,
                 k=n_neighbors,
                 metadata=meta,
+                feet=feet,
             )
         else:
             density = PeriodicDensity(random_state=random_state).fit(theta)
@@ -201,6 +207,8 @@ def motion_cycles(
             typ, clip = loop_cycle(
                 typ, motion, prepared, prep, cycle_start=cycle_start, rows=rows, metadata=meta
             )
+        if result.rig_adapter is not None:
+            clip = result.rig_adapter.restore(clip)  # in the capture's own rig
         out.append(MotionCycle(
             motion=mid, start=a, stop=b, phase_from=source, n_frames_used=int(rows.size),
             period_frames=period, cycle=clip, loop_closure=float(loop_closure(typ.frames)),

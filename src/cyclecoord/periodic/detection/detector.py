@@ -42,6 +42,7 @@ def detect(
     temporal: bool = False,
     difference_root: bool = True,
     rotations: str = "auto",
+    rig: bool = True,
     prime: int = DEFAULT_PRIME,
     max_scale: float | None = None,
     delay: float | tuple | None = 0.25,
@@ -75,7 +76,9 @@ def detect(
     frames : (start, stop), optional
         0-based half-open frame range to analyse.
     pca, normalize, temporal, difference_root, rotations, prime, max_scale, landmarks
-        As for :func:`cyclecoord.extract`; so is ``memory_limit``.
+        As for :func:`cyclecoord.extract`; so are ``memory_limit`` and ``rig`` (the
+        capture's rig read first: ``result.motion`` is the analysed motion, and the cycles
+        of :func:`motion_cycles` are written back in the capture's own rig).
     delay : float, sequence of float, or None, default 0.25
         Delay embedding in seconds (each pose joined by the poses this long before), so
         that out-and-back movements (squats, jumping jacks, knee raises) form loops.
@@ -165,7 +168,7 @@ def detect(
     params = dict(
         frames=None if frames is None else list(frames), pca=pca, normalize=normalize,
         temporal=temporal, difference_root=difference_root, prime=prime, max_scale=max_scale,
-        rotations=rotations, landmarks=landmarks, delay=delay, n_classes=n_classes,
+        rotations=rotations, rig=rig, landmarks=landmarks, delay=delay, n_classes=n_classes,
         max_classes=max_classes,
         min_persistence=min_persistence, scale_fraction=scale_fraction, window=window,
         max_period=max_period, min_consistency=min_consistency, min_cycles=min_cycles,
@@ -174,35 +177,26 @@ def detect(
         window_cycles=window_cycles, window_steadiness=window_steadiness, similarity=similarity,
     )
     motion = motion.window(frames)
+    adapter = None
+    if rig and motion.skeleton is not None:
+        from ...rig import normalize_rig
+
+        motion, adapter = normalize_rig(motion)
+        if adapter.identity:
+            adapter = None
     T = motion.n_frames
     if T < 20:
         raise ParameterError(f"{T} frames are too few to look for periodic motion")
     timings: dict[str, float] = {}
     notes: list[str] = []
 
-    t0 = time.perf_counter()
-    lag = (
-        [int(round(d * motion.fps)) for d in np.atleast_1d(delay) if d]
-        if delay is not None
-        else None
+    prepared, est, barcode = _barcode_of(
+        motion, timings, notes,
+        preprocess=dict(difference_root=difference_root, normalize=normalize, pca=pca,
+                        delay=delay, rotations=rotations),
+        estimate=dict(max_scale=max_scale, prime=prime, scale_fraction=scale_fraction,
+                      temporal=temporal, landmarks=landmarks, memory_limit=memory_limit),
     )
-    lag = lag or None
-    prepared = Preprocessor(
-        difference_root=difference_root, normalize=normalize, pca=pca, delay=lag,
-        rotations=rotations,
-    ).fit_transform(motion)
-    timings["prepare"] = time.perf_counter() - t0
-
-    est = CircularCoordinates(
-        max_scale=max_scale, prime=prime, scale_fraction=scale_fraction, temporal=temporal,
-        landmarks=landmarks, refine_birth=False,
-        **({} if memory_limit is None else {"memory_limit": memory_limit}),
-    )
-    t0 = time.perf_counter()
-    barcode = est.fit_barcode(prepared.points)
-    timings["barcode"] = time.perf_counter() - t0
-    if est.landmarks_ is not None:
-        notes.append(f"barcode on {len(est.landmarks_)} landmarks: {est.landmark_reason_}")
 
     # 1-4. candidate classes, their coordinates, excitation and validation
     cand = candidate_classes(barcode, n_classes, max_classes, min_persistence)
@@ -223,24 +217,12 @@ def detect(
     # 6-8. windowed stage
     windows: list[WindowInfo] = []
     if method != "global":
-        keep_cols = np.setdiff1d(np.arange(prepared.poses.shape[1]), prepared.root_columns)
-        poses = prepared.poses[:, keep_cols] if keep_cols.size else prepared.poses
-        t0 = time.perf_counter()
-        windows = window_table(
-            prepared.points, poses, fps, window_lengths, window_stride, int(window_points), prime,
-            scale_fraction, window_cycles, window_steadiness, progress,
+        windows, labels, segments, n_motions = _windowed_stage(
+            prepared, fps, method, kept, labels, n_motions, timings,
+            table=(window_lengths, window_stride, int(window_points), prime, scale_fraction,
+                   window_cycles, window_steadiness, progress),
+            grouping=(w, min_cycles, similarity, merge_overlap),
         )
-        timings["windows"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        n_global = n_motions if method == "auto" else 0
-        if method == "windows":
-            for c in kept:
-                c.motion = -1
-        labels, segments, n_motions = windowed_motions(
-            windows, kept if n_global else [], labels, n_global, poses, w, min_cycles, similarity,
-            merge_overlap,
-        )
-        timings["segments"] += time.perf_counter() - t0
     t0 = time.perf_counter()
     joint_cols = np.setdiff1d(np.arange(prepared.poses.shape[1]), prepared.root_columns)
     labels, segments = drop_unsteady(
@@ -252,18 +234,85 @@ def detect(
     result = DetectionResult(
         motion=motion, barcode=barcode, classes=classes, segments=segments, labels=labels,
         n_motions=n_motions, timings=timings, parameters=params, warnings=notes, estimator=est,
-        windows=windows, method=method,
+        windows=windows, method=method, rig_adapter=adapter,
     )
     if not segments:
+        raise _nothing_found(result, len(cand), min_cycles)
+    return result
+
+
+def _barcode_of(
+    motion: Motion, timings: dict, notes: list, preprocess: dict, estimate: dict
+) -> tuple[Any, CircularCoordinates, Any]:
+    """Steps 0-1 of :func:`detect`: the prepared capture (``delay`` in seconds), the
+    estimator and the barcode of the whole capture, timed into ``timings``."""
+    t0 = time.perf_counter()
+    delay = preprocess.pop("delay")
+    lag = (
+        [int(round(d * motion.fps)) for d in np.atleast_1d(delay) if d]
+        if delay is not None
+        else None
+    )
+    prepared = Preprocessor(delay=lag or None, **preprocess).fit_transform(motion)
+    timings["prepare"] = time.perf_counter() - t0
+
+    memory_limit = estimate.pop("memory_limit")
+    est = CircularCoordinates(
+        refine_birth=False, **estimate,
+        **({} if memory_limit is None else {"memory_limit": memory_limit}),
+    )
+    t0 = time.perf_counter()
+    barcode = est.fit_barcode(prepared.points)
+    timings["barcode"] = time.perf_counter() - t0
+    if est.landmarks_ is not None:
+        notes.append(f"barcode on {len(est.landmarks_)} landmarks: {est.landmark_reason_}")
+    return prepared, est, barcode
+
+
+def _windowed_stage(
+    prepared, fps: float, method: str, kept: list, labels: np.ndarray, n_motions: int,
+    timings: dict, table: tuple, grouping: tuple,
+) -> tuple[list[WindowInfo], np.ndarray, list, int]:
+    """Steps 6-8 of :func:`detect`: the sliding windows' barcodes (``table``: lengths,
+    stride, points, prime, scale fraction, cycles, steadiness, progress) and the motions
+    grouped from them (``grouping``: smoothing window, min cycles, similarity, merge
+    overlap), joined to the global motions when ``method`` is ``"auto"``."""
+    w, min_cycles, similarity, merge_overlap = grouping
+    keep_cols = np.setdiff1d(np.arange(prepared.poses.shape[1]), prepared.root_columns)
+    poses = prepared.poses[:, keep_cols] if keep_cols.size else prepared.poses
+    t0 = time.perf_counter()
+    lengths, stride, points, prime, scale_fraction, cycles, steadiness, progress = table
+    windows = window_table(
+        prepared.points, poses, fps, lengths, stride, points, prime, scale_fraction, cycles,
+        steadiness, progress,
+    )
+    timings["windows"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    n_global = n_motions if method == "auto" else 0
+    if method == "windows":
+        for c in kept:
+            c.motion = -1
+    labels, segments, n_motions = windowed_motions(
+        windows, kept if n_global else [], labels, n_global, poses, w, min_cycles, similarity,
+        merge_overlap,
+    )
+    timings["segments"] += time.perf_counter() - t0
+    return windows, labels, segments, n_motions
+
+
+def _nothing_found(result: DetectionResult, n_candidates: int, min_cycles: float):
+    """The error :func:`detect` raises when no segment stands (``result`` attached)."""
+    windows = result.windows
+    local = ""
+    if result.method != "global":
         looping = sum(wi.looping for wi in windows)
         local = (f"; {len(windows)} window(s), {looping} looping, no group of them holds "
-                 f"{min_cycles:g} cycles" if method != "global" else "")
-        raise NoPeriodicMotionError(
-            f"no periodic motion found: {len(cand)} candidate H1 class(es), none completes "
-            f"{min_cycles:g} steady cycles anywhere in the capture" + local,
-            result=result,
-        )
-    return result
+                 f"{min_cycles:g} cycles")
+    return NoPeriodicMotionError(
+        f"no periodic motion found: {n_candidates} candidate H1 class(es), none completes "
+        f"{min_cycles:g} steady cycles anywhere in the capture" + local,
+        result=result,
+    )
 
 
 #: detect's defaults for the settings a Preprocessor or CircularCoordinates can carry.

@@ -177,6 +177,9 @@ class DetectionResult:
         only: each class's coordinate is in ``classes``).
     windows : list of WindowInfo
         Every window of the windowed stage (empty with ``method="global"``).
+    rig_adapter : RigAdapter or None
+        How the capture's rig was read (:func:`cyclecoord.rig.normalize_rig`); None when
+        it was analysed as it is.
     method : str
         The method that ran (``"auto"``, ``"global"`` or ``"windows"``).
     """
@@ -193,6 +196,7 @@ class DetectionResult:
     estimator: CircularCoordinates | None = None
     windows: list = field(default_factory=list)
     method: str = "global"
+    rig_adapter: Any = None
 
     def to_report(self) -> dict[str, Any]:
         bc = self.barcode.to_dict()

@@ -14,11 +14,14 @@ root trajectory (:class:`MotionGraphSynth`) and the paper's leave-one-out table
 from .build import METHODS, MotionGraph, build_graph, training_vectors
 from .crossval import (
     DEFAULT_METHODS,
+    HORIZON,
+    PAPER,
     PAPER_W1,
     CrossValidation,
     bottleneck,
     cross_validate,
     h1_diagram,
+    paper_set,
     path_errors,
 )
 from .field import FIELD_OPTIONS, VectorField, parse_variant
@@ -30,7 +33,10 @@ __all__ = [
     "DEFAULT_METHODS",
     "FIELD_OPTIONS",
     "METHODS",
+    "HORIZON",
+    "PAPER",
     "PAPER_W1",
+    "paper_set",
     "CrossValidation",
     "Generation",
     "GraphPath",

@@ -56,6 +56,10 @@ __all__ = [
     "CrossValidation",
     "cross_validate",
     "PAPER_W1",
+    "PAPER",
+    "PAPER_LENGTHS",
+    "HORIZON",
+    "paper_set",
     "ERROR_KEYS",
     "DEFAULT_METHODS",
 ]
@@ -65,6 +69,44 @@ PAPER_W1 = {
     "delaunay": {"error_a": 0.023, "error_f": 0.02},
     "knn": {"error_a": 0.022, "error_f": 0.057},
 }
+#: The paper's Table II, every set (w1, w2 walks; r1, r2 runs; k-NN with k = 16).
+PAPER = {
+    "w1": PAPER_W1,
+    "w2": {
+        "delaunay": {"error_a": 0.073, "error_f": 0.043},
+        "knn": {"error_a": 0.105, "error_f": 0.114},
+    },
+    "r1": {
+        "delaunay": {"error_a": 0.749, "error_f": 0.038},
+        "knn": {"error_a": 0.099, "error_f": 0.044},
+    },
+    "r2": {
+        "delaunay": {"error_a": 0.068, "error_f": 0.067},
+        "knn": {"error_a": 0.118, "error_f": 0.024},
+    },
+}
+#: The paper's Table I: each set's take lengths in frames.
+PAPER_LENGTHS = {
+    "w1": (443, 360, 455, 454),
+    "w2": (347, 520, 269, 282),
+    "r1": (167, 167, 175, 160),
+    "r2": (258, 139, 200, 163),
+}
+#: The longer horizon: the field followed for this many times the left-out take.
+HORIZON = 3
+
+
+def paper_set(motions: Sequence[Motion]) -> str | None:
+    """The paper's set whose take lengths (Table I) these takes have (within 2 frames,
+    in any order), else None."""
+    have = sorted(m.n_frames for m in motions)
+    for name, lengths in PAPER_LENGTHS.items():
+        want = sorted(lengths)
+        if len(have) == len(want) and all(abs(a - b) <= 2 for a, b in zip(have, want)):
+            return name
+    return None
+
+
 #: The paper's two, our fix of the Delaunay field (see :mod:`.field`) and k-Delaunay.
 DEFAULT_METHODS = ("delaunay", "delaunay+ring+agree", "knn", "union")
 #: Latent coordinates the H1 barcodes are computed in.
@@ -189,6 +231,7 @@ class CrossValidation:
     paths: dict = field(default_factory=dict)
     fold_graphs: list = field(default_factory=list)
     parameters: dict = field(default_factory=dict)
+    long: dict = field(default_factory=dict)
 
     def to_report(self) -> dict[str, Any]:
         return {
@@ -199,6 +242,9 @@ class CrossValidation:
             "fold_graphs": self.fold_graphs,
             "parameters": self.parameters,
             "paper_w1": PAPER_W1,
+            "paper_set": self.parameters.get("paper_set"),
+            "paper": PAPER.get(self.parameters.get("paper_set") or "", None),
+            "long_horizon": self.long,
         }
 
     def table(self, paper: bool = True) -> str:
@@ -228,9 +274,39 @@ class CrossValidation:
             lines.append(row(m, vals))
         for b, res in self.baselines.items():
             lines.append(row(f"baseline: {b.replace('_', ' ')}", res["median"]))
-        if paper:
-            for m, vals in PAPER_W1.items():
-                lines.append(row(f"paper w1: {m}", vals))
+        which = self.parameters.get("paper_set")
+        if paper and which:
+            for m, vals in PAPER[which].items():
+                lines.append(row(f"paper {which}: {m}", vals))
+        elif paper:
+            lines.append(
+                "(no paper row: these takes' lengths are not one of the paper's sets "
+                + ", ".join(PAPER_LENGTHS)
+                + ")"
+            )
+        return "\n".join(lines)
+
+    def long_table(self) -> str:
+        """The longer horizon: errors over :data:`HORIZON` times the left-out take, the
+        longest freeze and the support-foot slip (quality.generated; root carried by the
+        feet as ``cyclecoord graph`` writes it, no foot locking), medians over the folds."""
+        if not self.long:
+            return ""
+        h = self.parameters.get("horizon", HORIZON)
+        cols = [
+            ("error_a_deg", "A deg", "{:.2f}"),
+            ("error_f_deg", "F deg", "{:.2f}"),
+            ("longest_freeze_s", "freeze s", "{:.2f}"),
+            ("freeze_folds", "folds fz", "{:.0f}"),
+            ("support_slip", "slip m/s", "{:.2f}"),
+            ("slip_ratio", "slip x", "{:.1f}"),
+        ]
+        head = f"{str(h) + 'x the left-out take':<26}" + "".join(f"{c[1]:>9}" for c in cols)
+        lines = [head, "-" * len(head)]
+        for m, vals in self.long.items():
+            lines.append(
+                f"{m:<26}" + "".join(f"{_cell(vals.get(k), fmt):>9}" for k, _, fmt in cols)
+            )
         return "\n".join(lines)
 
 
@@ -293,6 +369,7 @@ def cross_validate(
     step_scale: float = 1.0,
     topo: bool = True,
     progress: bool = False,
+    horizon: int = HORIZON,
 ) -> CrossValidation:
     """Leave-one-take-out cross-validation (the paper's Table II, with baselines).
 
@@ -312,6 +389,10 @@ def cross_validate(
         Compute the bottleneck distances (about half the time).
     progress : bool
         Show a tqdm bar over the folds.
+    horizon : int, default 3
+        Also follow the field for this many times the left-out take and measure the
+        motion (:mod:`cyclecoord.quality.generated`: longest freeze, support-foot slip,
+        root carried by the feet) with the angle errors over that length; 0 skips it.
 
     Returns
     -------
@@ -353,6 +434,18 @@ def cross_validate(
             row = {"held_out": names[i], "method": method}
             row.update(ev.errors(path.points, space.inverse_transform(path.points)))
             row["outside_hull_steps"] = path.outside_hull_steps
+            if horizon and horizon > 1:
+                row["long"] = _long_row(
+                    ev,
+                    space,
+                    train,
+                    takes[i],
+                    field_,
+                    start,
+                    n * int(horizon),
+                    integrator,
+                    step_scale,
+                )
             folds.append(row)
             paths[(names[i], method)] = path
             fold_graphs.append(
@@ -376,6 +469,21 @@ def cross_validate(
         for key, row in _baseline_rows(ev, space, train, train_names, n).items():
             base[key].append({"held_out": names[i], **row})
     median = {m: _median([r for r in folds if r["method"] == m]) for m in methods}
+    long = {}
+    if horizon and horizon > 1:
+        for m in methods:
+            rows = [r["long"] for r in folds if r["method"] == m and "long" in r]
+            long[m] = {
+                k: _nanmedian([r.get(k) for r in rows])
+                for k in (
+                    "error_a_deg",
+                    "error_f_deg",
+                    "longest_freeze_s",
+                    "support_slip",
+                    "slip_ratio",
+                )
+            }
+            long[m]["freeze_folds"] = float(sum(1 for r in rows if r.get("freezes")))
     baselines = {b: {"folds": rows, "median": _median(rows)} for b, rows in base.items()}
     graph = _graph_summary(takes, methods, dims, k, names)
     params = {
@@ -386,6 +494,8 @@ def cross_validate(
         "step_scale": step_scale,
         "takes": names,
         "frames": [m.n_frames for m in takes],
+        "paper_set": paper_set(takes),
+        "horizon": int(horizon or 0),
         "units": {
             "error_a/error_f": "latent distance / longest side of the training points' box",
             "*_deg": "RMS over the joint-angle channels, degrees",
@@ -401,4 +511,42 @@ def cross_validate(
         paths=paths,
         fold_graphs=fold_graphs,
         parameters=params,
+        long=long,
     )
+
+
+def _cell(value, fmt: str) -> str:
+    return fmt.format(value) if value is not None and np.isfinite(value) else "-"
+
+
+def _nanmedian(vals: list) -> float:
+    a = np.array([np.nan if v is None else v for v in vals], dtype=float)
+    return float(np.median(a[np.isfinite(a)])) if np.isfinite(a).any() else float("nan")
+
+
+def _long_row(ev, space, train, take, field_, start, n, integrator, step_scale) -> dict:
+    """Errors over ``n`` frames of the field from the take's start, and the measure of the
+    motion made of them (root carried by the feet)."""
+    from ...errors import CycleCoordError
+    from ...quality.generated import measure_generated
+    from ..carry import carry_by_feet
+    from .paths import root_trajectory
+
+    path = follow_field(field_, start, n, integrator, step_scale)
+    errs = ev.errors(path.points, space.inverse_transform(path.points))
+    row = {k: errs[k] for k in ("error_a_deg", "error_f_deg") if k in errs}
+    row["frames"] = n
+    try:
+        root = root_trajectory(train, path, take, 0)
+        motion = carry_by_feet(space.motion(path.points, train[0], root))
+        q = measure_generated(motion, train)
+    except CycleCoordError as exc:
+        row["not_measured"] = str(exc)
+        return row
+    row.update(
+        longest_freeze_s=q.longest_freeze_s,
+        freezes=[list(f) for f in q.freezes],
+        support_slip=q.support_slip,
+        slip_ratio=q.slip_ratio,
+    )
+    return row

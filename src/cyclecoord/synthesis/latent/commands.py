@@ -168,16 +168,28 @@ class Synthesizer:
     clamp : bool, default True
         Clip joint angles to the training range of the model(s) making each frame (the
         count and largest clip are kept in ``clamped``).
-    plant : {"transitions", "all", "off"}, default "transitions"
-        Where :meth:`motion` moves the root as the planted feet carry it (blend windows
-        and :data:`PLANT_MARGIN` around them, everywhere, or nowhere).
-    lock : bool, default False
+    plant : {"all", "transitions", "off"}, default "all"
+        Where :meth:`motion` moves the root as the planted feet carry it.  ``"all"``:
+        everywhere, by :func:`~cyclecoord.synthesis.carry.carry_by_feet` (contact from
+        height, not speed, the lowest foot carrying the body; IDLE stands after 0.5 s; no
+        foot under the training frames' floor), then, with ``lock``, the planted feet
+        pinned where that makes no pop
+        (:func:`~cyclecoord.synthesis.carry.lock_where_clean`, limit 1.5x the models'
+        99th percentile of joint acceleration; the ``notes`` attribute says where not).
+        ``"transitions"``: the blend windows and
+        :data:`PLANT_MARGIN` around them only, with the speed-gated contacts of before
+        (the feet elsewhere glide with the training frames' root velocity); ``"off"``.
+    lock : bool, default True
         Also pin the planted feet in those spans by a leg IK
         (:func:`~cyclecoord.synthesis.footlock.lock_feet`).  On the shared-data models'
         56 transitions it leaves planted feet sliding on 11 % of the blend windows'
         frames instead of 54 %, but the locks' easing makes joints accelerate up to 3.1x
         the training 99th percentile (4 of 56 blend windows over 1.5x, 8 of 56 whole
         transitions), so it is off.
+    feet : tuple of str, optional
+        Foot point joint names the planting and locking use (default
+        :func:`~cyclecoord.quality.legs.find_legs` on the motion: names of the common
+        rigs, else its geometry).
     """
 
     models: dict[str, LatentModel]
@@ -187,8 +199,9 @@ class Synthesizer:
     bridge_threshold: float | None = None
     clamp: bool = True
     ease: float = 0.25
-    plant: str = "transitions"
-    lock: bool = False
+    plant: str = "all"
+    lock: bool = True
+    feet: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
         if not self.models:
@@ -215,6 +228,8 @@ class Synthesizer:
         self.sim_seconds = 0.0
         self.sim_cpu_seconds = 0.0
         self.clamped = {"values": 0, "max_deg": 0.0}
+        self.held: list[tuple[int, int]] = []  # frame ranges of IDLE commands
+        self.notes: list[str] = []
         self._ranges: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._made = 0  # frames emitted so far
         widest = max(m.X_.shape[0] for m in self.models.values())
@@ -456,6 +471,14 @@ class Synthesizer:
             else [self.target(at) if at is not None else self.x.copy()]
         )
         end = self.t + duration
+        first = self.n_frames
+        try:
+            self._idle(points, end, radius, hover)
+        finally:
+            self.held.append((first, self.n_frames))
+
+    def _idle(self, points, end: float, radius, hover: float) -> None:
+        duration = end - self.t
         while self.t < end - 0.5 / self.fps:
             p = points[int(self.rng.integers(len(points)))] if len(points) > 1 else points[0]
             m = self.models[self.current]
@@ -563,7 +586,7 @@ class Synthesizer:
         true, the default: possibly through other models, one hop each) or directly:
         a hop without a bridge crosses at its closest pair of poses.  The blend lasts
         ``blend`` seconds or longer when the two poses are far apart
-        (:meth:`blend_frames`).  Each hop is reported in :attr:`events` with its route,
+        (:meth:`blend_frames`).  Each hop is reported in ``self.events`` with its route,
         pose distance and blend length.
         """
         self._need_start("TRANSITION")
@@ -782,16 +805,22 @@ class Synthesizer:
         from ...periodic.root import planted_ground, root_layout
         from ...quality.contacts import find_feet, foot_contacts
 
+        if self.plant == "all":
+            return self._carry(motion)
         share = self.plant_spans(motion.n_frames)[:, None]
         mask = share[:, 0] > 0
         layout = root_layout(motion)
         if not mask.any() or layout is None or motion.n_frames < 3:
             return motion
-        try:
-            feet = find_feet(motion.skeleton)
+        if self.feet is not None:  # named feet: a wrong name is an error, not skipped
+            feet = self.feet
             found = foot_contacts(motion, feet).planted
-        except CycleCoordError:
-            return motion
+        else:
+            try:
+                feet = find_feet(motion.skeleton, motion)
+                found = foot_contacts(motion, feet).planted
+            except CycleCoordError:
+                return motion
         cols = [layout.column("tx"), layout.column("tz")]
         own = np.diff(motion.frames[:, cols], axis=0)
         frames = motion.frames.copy()
@@ -820,6 +849,49 @@ class Synthesizer:
         if not contacts.planted.any():
             return out
         return lock_feet(out, contacts, blend=LOCK_BLEND, passes=1).motion
+
+    def hold_mask(self, n_frames: int) -> np.ndarray:
+        """(T,) frames an IDLE command made."""
+        hold = np.zeros(n_frames, dtype=bool)
+        for a, b in self.held:
+            hold[a:b] = True
+        return hold
+
+    def _carry(self, motion: Motion) -> Motion:
+        """``plant="all"``: the root carried by the feet everywhere, IDLE standing, no
+        foot under the floor, the feet pinned where that makes no pop."""
+        from ...errors import CycleCoordError
+        from ...quality.contacts import foot_contacts
+        from ..carry import carry_by_feet, channel_bounds, lock_where_clean
+
+        used = sorted({c.model for c in self.chunks})
+        try:
+            floor = float(
+                np.median(
+                    [foot_contacts(self.models[k].training_motion(), self.feet).floor for k in used]
+                )
+            )
+        except CycleCoordError:
+            floor = None
+        out = carry_by_feet(
+            motion,
+            self.feet,
+            floor=floor,
+            hold=self.hold_mask(motion.n_frames),
+            smooth=PLANT_SMOOTH,
+        )
+        self.notes.append(
+            "root: carried by the feet on the ground"
+            + ("" if floor is None else " (no foot under the training frames' floor)")
+            + ("; IDLE stands after 0.5 s" if self.held else "")
+        )
+        if self.lock:
+            limit = 1.5 * max(self._acc99(k) for k in used)
+            bounds = channel_bounds([self.models[k].training_motion() for k in used])
+            locked = lock_where_clean(out, limit, self.feet, bounds=bounds)
+            self.notes.append(locked.line)
+            out = locked.motion
+        return out
 
     def segments(self) -> list[dict[str, Any]]:
         """Which frames each command made and in which model."""

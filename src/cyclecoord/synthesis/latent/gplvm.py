@@ -1,7 +1,7 @@
 """The GPLVM of Bailey et al. (Eq. 4-7): RBF + white kernel, dynamics and connectivity priors.
 
 The negative log posterior of latent points ``X`` (N, q) and kernel hyperparameters
-given data ``Y`` (N, d) is
+given data ``Y`` (N, d) is::
 
     D/2 log|K| + 1/2 tr(K^-1 Y Y^T)                      (Eq. 4, RBF + white kernel, Eq. 5)
   + 1/2 tr(X^T K_t^-1 X)                                 (dynamics prior, Eq. 6)
@@ -268,8 +268,15 @@ class GPLVM:
         )
 
     @one_blas_thread
-    def fit(self, Y: np.ndarray, segments: Sequence[int], times: Sequence[float]) -> GPLVM:
-        """Fit to ``Y`` (N, d), centred PCA coordinates, with each frame's segment and time (s)."""
+    def fit(
+        self, Y: np.ndarray, segments: Sequence[int], times: Sequence[float], *,
+        progress: bool = False,
+    ) -> GPLVM:
+        """Fit to ``Y`` (N, d), centred PCA coordinates, with each frame's segment and time (s).
+
+        ``progress`` shows a tqdm bar on stderr over the optimiser's iterations (at most
+        ``max_iter``; shown after 1 s).
+        """
         Y = np.asarray(Y, dtype=float)
         seg = np.asarray(segments, dtype=int)
         t = np.asarray(times, dtype=float)
@@ -294,15 +301,20 @@ class GPLVM:
             (np.log(1e-3), np.log(1e3)),
             (np.log(1e-4 * s0), np.log(s0)),
         ]
-        res = optimize.minimize(
-            objective,
-            theta0,
-            args=(st, q),
-            jac=True,
-            method="L-BFGS-B",
-            bounds=bounds,
-            options={"maxiter": int(self.max_iter)},
-        )
+        from tqdm import tqdm
+
+        with tqdm(total=int(self.max_iter), desc="fitting the GPLVM", unit="iteration",
+                  disable=not progress, delay=1.0, leave=False) as bar:
+            res = optimize.minimize(
+                objective,
+                theta0,
+                args=(st, q),
+                jac=True,
+                method="L-BFGS-B",
+                bounds=bounds,
+                options={"maxiter": int(self.max_iter)},
+                callback=lambda *_: bar.update(1),
+            )
         theta = res.x
         self.X_ = theta[: n * q].reshape(n, q).copy()
         s, l2, w = np.exp(theta[n * q :])

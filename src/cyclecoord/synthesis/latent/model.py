@@ -142,7 +142,10 @@ class LatentModel:
         self.random_state = random_state
 
     # ------------------------------------------------------------------ fitting
-    def fit(self, motions: Sequence[Motion], names: Sequence[str] | None = None) -> LatentModel:
+    def fit(
+        self, motions: Sequence[Motion], names: Sequence[str] | None = None, *,
+        progress: bool = False,
+    ) -> LatentModel:
         """Fit to training segments (each a contiguous capture; same channels and rate).
 
         Parameters
@@ -152,6 +155,8 @@ class LatentModel:
             channel is modelled.
         names : sequence of str, optional
             One name per segment (default ``"segment0"``, ...).
+        progress : bool, default False
+            A tqdm bar on stderr over the GPLVM's optimisation (shown after 1 s).
         """
         if not motions:
             raise ParameterError("a latent model needs at least one training segment")
@@ -213,7 +218,7 @@ class LatentModel:
         self.Y_ = Z @ self.components_
         self.gp_ = GPLVM(
             n_components=self.n_components, random_state=self.random_state, **(self.gplvm or {})
-        ).fit(self.Y_, self.segments_, self.times_)
+        ).fit(self.Y_, self.segments_, self.times_, progress=progress)
         self._precompute()
         return self
 
@@ -314,6 +319,12 @@ class LatentModel:
             "white_variance": self.gp_.noise_,
             "latent_speed_per_s": self.speed_,
         }
+
+    def training_motion(self) -> Motion:
+        """The training frames as one motion (segments end to end)."""
+        return Motion(
+            frames=self.frames_, channels=self.all_channels_, fps=self.fps_, skeleton=self.skeleton_
+        )
 
     # --------------------------------------------------------------- storage
     def save(self, path: str | os.PathLike[str]) -> None:

@@ -8,7 +8,7 @@ A script is a JSON object::
       "start": {"model": "jumpjack", "at": {"frame": 0}},
       "particle": {"radius": 0.15, "random": 6},
       "bridge_threshold": null,
-      "plant": "transitions", "lock_feet": false,
+      "plant": "all", "lock_feet": true,
       "commands": [
         {"command": "IDLE", "duration": 1.5},
         {"command": "MOVE", "to": {"segment": "JumpJack", "time": 2.0}, "path": "graph"},
@@ -30,6 +30,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 
 from ...errors import CycleCoordError, ParameterError, ParseError
 from ...quality.contacts import skating_report
@@ -48,6 +49,7 @@ TOP_KEYS = {
     "bridge_threshold",
     "plant",
     "lock_feet",
+    "feet",
     "commands",
 }
 #: Each command's allowed keys (besides "command").
@@ -269,10 +271,15 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
         from ...io._limits import MAX_MAGNITUDE
 
         _number(p, "bridge_threshold", thr, 0.0, MAX_MAGNITUDE, "the threshold (skeleton units)")
-    if spec.get("plant", "transitions") not in ("transitions", "all", "off"):
+    if spec.get("plant", "all") not in ("transitions", "all", "off"):
         raise _fail(p, "plant", f"must be transitions, all or off, got {spec['plant']!r}")
-    if not isinstance(spec.get("lock_feet", False), bool):
+    if not isinstance(spec.get("lock_feet", True), bool):
         raise _fail(p, "lock_feet", f"must be true or false, got {spec['lock_feet']!r}")
+    feet = spec.get("feet")
+    if feet is not None and (
+        not isinstance(feet, list) or not feet or not all(isinstance(f, str) for f in feet)
+    ):
+        raise _fail(p, "feet", f"must be a list of joint names, got {feet!r}")
     for i, c in enumerate(commands):
         where = f"commands[{i}]"
         if not isinstance(c, dict) or not isinstance(c.get("command"), str):
@@ -295,7 +302,43 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
     return spec, models
 
 
-def run_script(path: str | Path, check: bool = True, progress: bool = False):
+def training_takes(models: dict[str, LatentModel], names=None) -> list:
+    """The training segments of ``models`` (all, or those in ``names``) as motions."""
+    from ...motion import Motion
+
+    out = []
+    for k in sorted(models if names is None else names):
+        m = models[k]
+        for seg in np.unique(m.segments_):
+            rows = np.flatnonzero(m.segments_ == seg)
+            if rows.size >= 3:
+                out.append(
+                    Motion(
+                        frames=m.frames_[rows],
+                        channels=m.all_channels_,
+                        fps=m.fps_,
+                        skeleton=m.skeleton_,
+                    )
+                )
+    return out
+
+
+def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None, list[str]]:
+    """The measure of generated motion (:mod:`cyclecoord.quality.generated`) against the
+    training segments of the models the script used, IDLE frames counted as asked holds."""
+    from ...quality.generated import lead_lines
+
+    hold = syn.hold_mask(motion.n_frames)
+    sources = training_takes(syn.models, {c.model for c in syn.chunks})
+    return lead_lines(motion, sources, feet=feet, hold=hold)
+
+
+def run_script(
+    path: str | Path,
+    check: bool = True,
+    progress: bool = False,
+    feet: str | tuple[str, ...] | None = None,
+):
     """Run a script: the synthesised :class:`~cyclecoord.motion.Motion` and a report dict.
 
     Parameters
@@ -306,9 +349,23 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
         new limb contacts) for the report.
     progress : bool
         A tqdm bar over the commands.
+    feet : str or tuple of str, optional
+        Foot points for planting, locking and the skating figures: joint names, or the
+        command line's ``"LEFT,RIGHT"`` text (:func:`~cyclecoord.quality.legs.feet_names`);
+        default the script's ``"feet"`` list, else found.
     """
+    from ...quality.legs import feet_names
+
     p = Path(path)
     spec, models = load_script(p)
+    if feet is None and spec.get("feet") is not None:
+        feet = tuple(spec["feet"])
+    if feet is not None:
+        skeleton = models[spec.get("start", {"model": next(iter(models))})["model"]].skeleton_
+        try:
+            feet = feet_names(skeleton, feet)
+        except ParameterError as exc:
+            raise _fail(p, "feet", str(exc)) from None
     params = ParticleParams().replace(**(spec.get("particle") or {}))
     syn = Synthesizer(
         models,
@@ -316,8 +373,9 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
         seed=int(spec.get("seed", 0)),
         params=params,
         bridge_threshold=spec.get("bridge_threshold"),
-        plant=spec.get("plant", "transitions"),
-        lock=spec.get("lock_feet", False),
+        plant=spec.get("plant", "all"),
+        lock=spec.get("lock_feet", True),
+        feet=feet,
     )
     start = spec.get("start", {"model": next(iter(models))})
     t0 = time.perf_counter()
@@ -349,7 +407,11 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
             raise _fail(p, f"commands[{i}] ({c['command']})", str(exc)) from None
     total = time.perf_counter() - t0
     motion = syn.motion()
+    quality, quality_lines = script_quality(syn, motion, commands, feet)
     report: dict[str, Any] = {
+        "motion_quality": quality,
+        "motion_quality_lines": quality_lines,
+        "notes": list(syn.notes),
         "script": str(p),
         "fps": syn.fps,
         "seed": syn.seed,
@@ -360,7 +422,7 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
         "commands": syn.segments(),
         "transitions": syn.events,
         "clamped_to_training_range": syn.clamped,
-        "foot_skating": skating_report(motion),
+        "foot_skating": skating_report(motion, feet=feet),
         "bridges": {f"{a}->{b}": br.to_dict() for (a, b), br in syn.bridges_found().items()},
         "timing": {
             "total_s": total,
@@ -374,7 +436,7 @@ def run_script(path: str | Path, check: bool = True, progress: bool = False):
     }
     sizes = {round(m.skeleton_.total_length(), 6) for m in models.values()}
     if len(sizes) > 1:
-        report["notes"] = [
+        report["notes"] += [
             "the models' skeletons have the same joints but different bone lengths; "
             f"the output uses {syn.chunks[0].model!r}'s"
         ]

@@ -1,0 +1,606 @@
+"""One measure of generated motion, judged against the captures it came from.
+
+:func:`measure_generated` answers what an animator asks of a generated motion (a motion
+graph's path, a latent script, a blend or a transition), each figure beside the same
+figure of the source captures (resampled to the motion's rate):
+
+* **feet**: contact from the height of each foot point above its own ground level, *not*
+  gated by speed (:func:`~cyclecoord.quality.contacts.foot_contacts` with ``speed=None``;
+  a foot gliding along the floor is on it), the median speed of feet in contact and the
+  frames on which one moves faster than the old speed-gated test allowed, and the
+  **support-foot slip**: the horizontal speed of the lowest foot point on each frame
+  (central differences), median over frames, in m/s and leg lengths/s.  A planted walk
+  scores about 0.09 m/s, a capture's run about 0.6; a motion whose feet glide scores the
+  body's speed;
+* **ground penetration**: how far the lowest foot point goes under the sources' floor;
+* **freezes**: runs longer than :data:`FREEZE_SECONDS` whose pose speed (RMS joint speed
+  relative to the root, heading removed) is under :data:`FREEZE_FRACTION` of the sources'
+  median, outside the frames where a hold was asked (``hold``);
+* **stride amplitude**: knee and hip flexion p1-p99 ranges per leg against the sources'
+  median (over takes and legs);
+* **cadence**: the leg cycle (peak of the knee angle's autocorrelation between 0.4 and
+  2.5 s) against the sources' cycle at the same root speed (interpolated between the
+  takes' median root speeds);
+* **pops**: the largest pose step and the largest joint acceleration relative to the
+  root (heading removed) against the sources' 99th percentiles;
+* **root speed**: median horizontal root speed over 0.5 s windows against the sources'.
+
+The figures follow the definitions of an independent checker's (its own forward
+kinematics); ``tests/quality/test_generated.py`` compares them on a graph output and on a
+captured take.  Distances are in metres from the sources' skeleton unit
+(:func:`~cyclecoord.rig.metres_per_unit`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..motion import Motion
+from .contacts import contact_runs, foot_contacts, leg_length
+from .legs import Legs, find_legs, legs_of_feet
+
+__all__ = [
+    "GeneratedQuality",
+    "SourceFigures",
+    "source_figures",
+    "measure_generated",
+    "FREEZE_FRACTION",
+    "FREEZE_SECONDS",
+]
+
+#: A frame is frozen when its pose speed is under this fraction of the sources' median.
+FREEZE_FRACTION = 0.1
+#: A freeze lasts longer than this, in seconds.
+FREEZE_SECONDS = 0.2
+#: Support-foot slip up to this multiple of the sources' is "planted" (the issue's target).
+PLANTED_RATIO = 1.5
+#: Above this multiple the feet "glide" (between the two they "slip").
+GLIDING_RATIO = 4.0
+#: Window of the root speed, seconds.
+ROOT_WINDOW = 0.5
+#: A foot point deeper than this (metres) under the floor counts as under it.
+PENETRATION_M = 0.02
+#: Height band (leg lengths) above a foot point's ground level that counts as contact: 0.03
+#: (about 2.5 cm) keeps heel strike and toe-off, whose feet still move, mostly out of it
+#: (in-contact median speed on 35_07: 0.12 m/s at 0.03, 0.15 at 0.05).
+CONTACT_HEIGHT = 0.03
+#: In-contact speed (leg lengths/s) the old, speed-gated contact test stopped at.
+FAST_CONTACT = 0.5
+#: Cadence search window, seconds.
+CYCLE_RANGE = (0.4, 2.5)
+
+
+# ------------------------------------------------------------------ geometry
+@dataclass(frozen=True)
+class _Rig:
+    """Joint indices the measure needs, found once per skeleton."""
+
+    legs: Legs
+    feet: tuple[str, ...]
+    foot_cols: list[int]
+    hips: list[int]
+    knees: list[int]
+    ankles: list[int]
+    trunk: int | None
+    leg_length: float
+
+
+def _rig(motion: Motion, feet: Sequence[str] | None) -> _Rig:
+    skel = motion.skeleton
+    if skel is None:
+        raise ParameterError("the measure of generated motion needs a skeleton")
+    legs = find_legs(skel, motion) if feet is None else legs_of_feet(skel, tuple(feet), motion)
+    names = list(skel.names)
+    hips, knees, ankles = [], [], []
+    for leg in legs.legs[:2] if len(legs.legs) > 2 else legs.legs:
+        ankle = names.index(leg.points[0])
+        knee = skel.joints[ankle].parent
+        hip = skel.joints[knee].parent if knee > 0 else -1
+        if knee <= 0 or hip < 0:
+            raise ParameterError(f"leg {leg.label}: no knee and hip above {leg.points[0]}")
+        hips.append(hip)
+        knees.append(knee)
+        ankles.append(ankle)
+    from ..joint_names import classify_skeleton
+
+    roles = classify_skeleton(skel)
+    spine = [i for i, n in enumerate(names) if getattr(roles.get(n), "role", None) == "spine"]
+    trunk = spine[1] if len(spine) > 1 else (spine[0] if spine else None)
+    return _Rig(
+        legs=legs,
+        feet=legs.feet,
+        foot_cols=[names.index(f) for f in legs.feet],
+        hips=hips,
+        knees=knees,
+        ankles=ankles,
+        trunk=trunk,
+        leg_length=leg_length(skel, legs.feet),
+    )
+
+
+def _angle(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    nu = np.linalg.norm(u, axis=-1)
+    nv = np.linalg.norm(v, axis=-1)
+    c = np.einsum("...k,...k->...", u, v) / np.maximum(nu * nv, 1e-12)
+    return np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
+
+
+@dataclass
+class _Kin:
+    """Positions and the derived per-frame signals of one motion."""
+
+    fps: float
+    pos: np.ndarray  # (T, J, 3) every joint and end site
+    local: np.ndarray  # root-relative, heading removed
+    knee: np.ndarray  # (T, L) flexion, degrees (0 straight)
+    hip: np.ndarray  # (T, L) thigh against the trunk line, degrees
+    names: list = field(default_factory=list)
+    parents: list = field(default_factory=list)
+
+    @property
+    def n(self) -> int:
+        return int(self.pos.shape[0])
+
+    def pose_speed(self) -> np.ndarray:
+        """(T-1,) RMS joint speed relative to the root, heading removed (units/s)."""
+        d = np.diff(self.local, axis=0)
+        return np.sqrt((d**2).sum(-1).mean(-1)) * self.fps
+
+    def accel(self) -> np.ndarray:
+        """(T-2,) largest joint acceleration relative to the root (units/s^2)."""
+        a = np.diff(self.local, 2, axis=0) * self.fps**2
+        return np.linalg.norm(a, axis=-1).max(-1)
+
+    def root_speed(self) -> np.ndarray:
+        """Horizontal root speed over :data:`ROOT_WINDOW` windows (units/s)."""
+        r = self.pos[:, 0, :][:, [0, 2]]
+        k = max(1, int(round(ROOT_WINDOW * self.fps)))
+        if r.shape[0] <= k:
+            k = max(1, r.shape[0] - 1)
+        return np.linalg.norm(r[k:] - r[:-k], axis=-1) * self.fps / k
+
+    def cycle(self) -> float:
+        """Leg cycle in seconds (NaN when too short or aperiodic)."""
+        return _cycle(self.knee[:, 0], self.fps)
+
+
+def _kin(motion: Motion, rig: _Rig) -> _Kin:
+    fk = motion.positions()
+    pos = fk.positions
+    lr = pos[:, rig.hips[0]] - pos[:, rig.hips[-1]]
+    h = np.arctan2(lr[:, 2], lr[:, 0])
+    c, s = np.cos(h), np.sin(h)
+    rel = pos - pos[:, :1, :]
+    x, z = rel[..., 0], rel[..., 2]
+    local = np.stack(
+        [c[:, None] * x + s[:, None] * z, rel[..., 1], -s[:, None] * x + c[:, None] * z], -1
+    )
+    thigh = pos[:, rig.knees] - pos[:, rig.hips]
+    shin = pos[:, rig.ankles] - pos[:, rig.knees]
+    if rig.trunk is not None:
+        up = (pos[:, rig.trunk] - pos[:, 0])[:, None, :]
+    else:
+        up = np.broadcast_to(np.array([0.0, 1.0, 0.0]), thigh.shape)
+    return _Kin(
+        fps=float(motion.fps),
+        pos=pos,
+        local=local,
+        knee=_angle(thigh, shin),
+        hip=_angle(thigh, -up),
+        names=list(fk.names),
+        parents=[int(p) for p in fk.parents],
+    )
+
+
+def _cycle(signal: np.ndarray, fps: float) -> float:
+    k = np.asarray(signal, dtype=float) - np.mean(signal)
+    n = k.size
+    lo, hi = int(CYCLE_RANGE[0] * fps), min(int(CYCLE_RANGE[1] * fps), n // 2)
+    if hi <= lo or not np.any(k):
+        return float("nan")
+    spec = np.fft.rfft(k, 2 * n)
+    ac = np.fft.irfft(spec * np.conj(spec))[:n] / np.arange(n, 0, -1)
+    ac = ac / ac[0]
+    return (lo + int(np.argmax(ac[lo:hi]))) / fps
+
+
+def _support(kin: _Kin, rig: _Rig) -> np.ndarray:
+    """(T-2,) horizontal speed (units/s) of the lowest foot point, central differences."""
+    p = kin.pos[:, rig.foot_cols]
+    low = p[1:-1, :, 1].argmin(axis=1)
+    v = np.linalg.norm(p[2:, :, :][:, :, [0, 2]] - p[:-2, :, :][:, :, [0, 2]], axis=-1)
+    return v[np.arange(v.shape[0]), low] * kin.fps / 2.0
+
+
+def _ranges(a: np.ndarray) -> np.ndarray:
+    lo, hi = np.percentile(a, [1, 99], axis=0)
+    return hi - lo
+
+
+def _resampled(source: Motion, fps: float) -> Motion:
+    k = int(round(source.fps / fps))
+    if k > 1 and abs(source.fps / k - fps) < 0.05 * fps:
+        return source.with_frames(source.frames[::k], fps=source.fps / k)
+    return source
+
+
+# ------------------------------------------------------------------ sources
+@dataclass(frozen=True)
+class SourceFigures:
+    """The sources' figures a generated motion is compared with (at one frame rate)."""
+
+    fps: float
+    metres: float  # metres per unit
+    leg_length: float  # units
+    floor: float  # units
+    pose_speed_median: float  # units/s
+    step_p99: float  # units/s (pose speed)
+    accel_p99: float  # units/s^2
+    support_slip: float  # units/s, median
+    knee_range: float  # degrees, median over takes and legs
+    hip_range: float
+    take_speed: np.ndarray  # (S,) median root speed per take, units/s
+    take_cycle: np.ndarray  # (S,) leg cycle per take, s
+    penetration: float  # fraction of frames deeper than PENETRATION_M under the floor
+    contact_slide: float  # units/s, median speed of foot points in contact
+
+    @property
+    def root_speed(self) -> float:
+        return float(np.median(self.take_speed))
+
+    def cycle_at(self, speed: float) -> float:
+        ok = np.isfinite(self.take_cycle)
+        if not ok.any():
+            return float("nan")
+        s, c = self.take_speed[ok], self.take_cycle[ok]
+        order = np.argsort(s)
+        return float(np.interp(speed, s[order], c[order]))
+
+
+def source_figures(
+    sources: Sequence[Motion], fps: float, feet: Sequence[str] | None = None
+) -> SourceFigures:
+    """The figures of the source captures, resampled to ``fps`` (a whole-number step)."""
+    from ..rig import metres_per_unit
+
+    if not sources:
+        raise ParameterError("the measure of generated motion needs the source captures")
+    srcs = [_resampled(s, fps) for s in sources]
+    rig = _rig(srcs[0], feet)
+    kins = [_kin(s, rig) for s in srcs]
+    floors = [foot_contacts(s, rig.feet).floor for s in srcs]
+    floor = float(np.median(floors))
+    speeds = np.array([float(np.median(k.root_speed())) for k in kins])
+    cycles = np.array([k.cycle() for k in kins])
+    ps = np.concatenate([k.pose_speed() for k in kins])
+    lowest = np.concatenate([_lowest(k, rig) for k in kins])
+    metres = metres_per_unit(sources[0])
+    return SourceFigures(
+        fps=float(fps),
+        metres=metres,
+        leg_length=rig.leg_length,
+        floor=floor,
+        pose_speed_median=float(np.median(ps)),
+        step_p99=float(np.percentile(ps, 99)),
+        accel_p99=float(np.percentile(np.concatenate([k.accel() for k in kins]), 99)),
+        support_slip=float(np.median(np.concatenate([_support(k, rig) for k in kins]))),
+        knee_range=float(np.median(np.concatenate([_ranges(k.knee) for k in kins]))),
+        hip_range=float(np.median(np.concatenate([_ranges(k.hip) for k in kins]))),
+        take_speed=speeds,
+        take_cycle=cycles,
+        penetration=float(np.mean(floor - lowest > PENETRATION_M / metres)),
+        contact_slide=float(
+            np.median(np.concatenate([_contact_speeds(s, rig, floor)[0] for s in srcs]))
+        ),
+    )
+
+
+def _contact_speeds(motion: Motion, rig: _Rig, floor: float):
+    """Speeds (units/s) of foot points in contact (height only), the contacts and the
+    fraction of frames on which one in contact is faster than :data:`FAST_CONTACT`."""
+    c = foot_contacts(motion, rig.feet, speed=None, height=CONTACT_HEIGHT, floor=floor)
+    spd = c.speed[c.planted]
+    fast = (c.planted & (c.speed > FAST_CONTACT * c.leg_length)).any(axis=1).mean()
+    return (spd if spd.size else np.zeros(1)), c, float(fast)
+
+
+def _lowest(kin: _Kin, rig: _Rig) -> np.ndarray:
+    """(T,) height of the lowest foot point (the end sites below them included)."""
+    cols = list(rig.foot_cols) + [
+        i for i, p in enumerate(kin.parents) if kin.names[i].endswith("/end") and p in rig.foot_cols
+    ]
+    return kin.pos[:, cols, 1].min(axis=1)
+
+
+# ------------------------------------------------------------------ result
+@dataclass(frozen=True)
+class GeneratedQuality:
+    """The measure of a generated motion against its sources (:func:`measure_generated`).
+
+    Lengths in metres, speeds in m/s (and leg lengths/s), ratios against the sources'
+    figure at the motion's frame rate.
+    """
+
+    frames: int
+    fps: float
+    feet: tuple[str, ...]
+    leg_length_m: float
+    support_slip: float
+    support_slip_legs: float
+    source_support_slip: float
+    contact_fraction: dict[str, float]
+    contact_slide: float
+    source_contact_slide: float
+    sliding_fraction: float
+    penetration_m: float
+    penetration_fraction: float
+    source_penetration_fraction: float
+    freezes: list[tuple[int, int]]
+    longest_freeze_s: float
+    knee_range: tuple[float, ...]
+    hip_range: tuple[float, ...]
+    source_knee_range: float
+    source_hip_range: float
+    cycle_s: float
+    source_cycle_s: float
+    largest_step: float
+    largest_step_frame: int
+    largest_accel: float
+    largest_accel_frame: int
+    root_speed: float
+    source_root_speed: float
+    held_frames: int = 0
+    notes: list[str] = field(default_factory=list)
+
+    # ---- derived
+    @property
+    def slip_ratio(self) -> float:
+        return self.support_slip / max(self.source_support_slip, 1e-9)
+
+    @property
+    def feet_word(self) -> str:
+        """``"planted"`` (slip within 1.5x the sources'), ``"slipping"`` or ``"gliding"``
+        (over 4x: the feet slide with the body)."""
+        r = self.slip_ratio
+        return (
+            "planted" if r <= PLANTED_RATIO else ("slipping" if r <= GLIDING_RATIO else "gliding")
+        )
+
+    @property
+    def knee_ratio(self) -> tuple[float, ...]:
+        return tuple(k / self.source_knee_range for k in self.knee_range)
+
+    @property
+    def hip_ratio(self) -> tuple[float, ...]:
+        return tuple(k / self.source_hip_range for k in self.hip_range)
+
+    @property
+    def cadence_ratio(self) -> float:
+        return self.cycle_s / self.source_cycle_s
+
+    @property
+    def root_ratio(self) -> float:
+        return self.root_speed / max(self.source_root_speed, 1e-9)
+
+    def headline(self) -> str:
+        """The first line of a report: feet, freezes, strides, pops, speed."""
+        knees = "/".join(f"{r:.2f}" for r in self.knee_ratio)
+        return (
+            f"generated motion: feet {self.feet_word} (support foot {self.support_slip:.2f} m/s, "
+            f"sources {self.source_support_slip:.2f}); longest freeze "
+            f"{self.longest_freeze_s:.2f} s; knee range {knees} of the sources'; largest accel "
+            f"{self.largest_accel:.2f}x the sources' p99; root {self.root_speed:.2f} m/s "
+            f"(sources {self.source_root_speed:.2f})"
+        )
+
+    def summary(self) -> list[str]:
+        """Console lines, the headline first."""
+        lines = [self.headline()]
+        lines.append(
+            f"  feet: support-foot slip {self.support_slip:.2f} m/s "
+            f"({self.support_slip_legs:.2f} leg lengths/s, {self.slip_ratio:.1f}x the sources'); "
+            f"in contact (height only) "
+            + ", ".join(f"{k} {100 * v:.0f}%" for k, v in self.contact_fraction.items())
+            + f"; a foot in contact moves {self.contact_slide:.2f} m/s (median; sources "
+            f"{self.source_contact_slide:.2f}), faster than {FAST_CONTACT} leg lengths/s on "
+            f"{100 * self.sliding_fraction:.0f}% of frames"
+        )
+        lines.append(
+            f"  floor: lowest foot {100 * self.penetration_m:.1f} cm under the sources' floor, "
+            f"{100 * self.penetration_fraction:.0f}% of frames over "
+            f"{100 * PENETRATION_M:.0f} cm under "
+            f"(sources {100 * self.source_penetration_fraction:.0f}%)"
+        )
+        if self.freezes:
+            spans = ", ".join(f"{a}-{b}" for a, b in self.freezes[:4])
+            more = f" and {len(self.freezes) - 4} more" if len(self.freezes) > 4 else ""
+            lines.append(
+                f"  freezes: {len(self.freezes)} (pose speed under {FREEZE_FRACTION:.0%} of the "
+                f"sources' median over {FREEZE_SECONDS} s): frames {spans}{more}"
+                + (f"; {self.held_frames} held frames asked for" if self.held_frames else "")
+            )
+        else:
+            lines.append(
+                "  freezes: none"
+                + (f" ({self.held_frames} held frames asked for)" if self.held_frames else "")
+            )
+        hips = "/".join(f"{r:.2f}" for r in self.hip_ratio)
+        knees = "/".join(f"{r:.2f}" for r in self.knee_ratio)
+        lines.append(
+            f"  strides: knee range {knees}, hip range {hips} of the sources' "
+            f"({self.source_knee_range:.0f} / {self.source_hip_range:.0f} deg); leg cycle "
+            f"{self.cycle_s:.2f} s against the sources' {self.source_cycle_s:.2f} s at this "
+            f"root speed ({self.cadence_ratio:.2f}x)"
+        )
+        lines.append(
+            f"  pops: largest pose step {self.largest_step:.2f}x (frame "
+            f"{self.largest_step_frame}), largest accel {self.largest_accel:.2f}x (frame "
+            f"{self.largest_accel_frame}) the sources' p99; root speed {self.root_speed:.2f} "
+            f"m/s, {self.root_ratio:.2f}x the sources'"
+        )
+        lines.extend(f"  {n}" for n in self.notes)
+        return lines
+
+    def to_dict(self) -> dict:
+        """JSON-ready figures."""
+
+        def f(x: float) -> float | None:
+            return float(x) if np.isfinite(x) else None
+
+        return {
+            "frames": self.frames,
+            "fps": self.fps,
+            "feet": list(self.feet),
+            "feet_verdict": self.feet_word,
+            "leg_length_m": f(self.leg_length_m),
+            "support_slip_m_per_s": f(self.support_slip),
+            "support_slip_leg_lengths_per_s": f(self.support_slip_legs),
+            "sources_support_slip_m_per_s": f(self.source_support_slip),
+            "support_slip_ratio": f(self.slip_ratio),
+            "contact_fraction": {k: float(v) for k, v in self.contact_fraction.items()},
+            "contact_slide_m_per_s": f(self.contact_slide),
+            "sources_contact_slide_m_per_s": f(self.source_contact_slide),
+            "fast_contact_fraction": f(self.sliding_fraction),
+            "penetration_m": f(self.penetration_m),
+            "penetration_fraction": f(self.penetration_fraction),
+            "sources_penetration_fraction": f(self.source_penetration_fraction),
+            "freezes": [list(r) for r in self.freezes],
+            "longest_freeze_s": f(self.longest_freeze_s),
+            "held_frames": self.held_frames,
+            "knee_range_deg": [f(x) for x in self.knee_range],
+            "hip_range_deg": [f(x) for x in self.hip_range],
+            "knee_range_ratio": [f(x) for x in self.knee_ratio],
+            "hip_range_ratio": [f(x) for x in self.hip_ratio],
+            "sources_knee_range_deg": f(self.source_knee_range),
+            "sources_hip_range_deg": f(self.source_hip_range),
+            "cycle_s": f(self.cycle_s),
+            "sources_cycle_s": f(self.source_cycle_s),
+            "cadence_ratio": f(self.cadence_ratio),
+            "largest_step_ratio": f(self.largest_step),
+            "largest_step_frame": self.largest_step_frame,
+            "largest_accel_ratio": f(self.largest_accel),
+            "largest_accel_frame": self.largest_accel_frame,
+            "root_speed_m_per_s": f(self.root_speed),
+            "sources_root_speed_m_per_s": f(self.source_root_speed),
+            "root_speed_ratio": f(self.root_ratio),
+            "notes": list(self.notes),
+        }
+
+
+def measure_generated(
+    motion: Motion,
+    sources: Sequence[Motion] | None = None,
+    *,
+    feet: Sequence[str] | None = None,
+    hold: np.ndarray | None = None,
+    reference: SourceFigures | None = None,
+) -> GeneratedQuality:
+    """Measure a generated motion against the captures it came from.
+
+    Parameters
+    ----------
+    motion : Motion
+        The generated motion (any rig with two legs; a quadruped's first two legs).
+    sources : sequence of Motion
+        The source captures (training takes, the cycles' captures); resampled to the
+        motion's rate by a whole-number step.
+    feet : sequence of str, optional
+        Foot points; default found (:func:`~cyclecoord.quality.legs.find_legs`).
+    hold : ndarray of bool, shape (T,), optional
+        Frames where a hold was asked (IDLE): slow frames there are not freezes.
+    reference : SourceFigures, optional
+        The sources' figures already computed (then ``sources`` may be None).
+
+    Returns
+    -------
+    GeneratedQuality
+    """
+    if motion.n_frames < 3:
+        raise ParameterError(f"the measure needs at least 3 frames, got {motion.n_frames}")
+    ref = reference if reference is not None else source_figures(sources or [], motion.fps, feet)
+    rig = _rig(motion, feet)
+    kin = _kin(motion, rig)
+    m = ref.metres
+    legs = rig.leg_length
+    # feet: contact from height alone, at the sources' floor
+    spd, contacts, fast = _contact_speeds(motion, rig, ref.floor)
+    support = _support(kin, rig)
+    slip = float(np.median(support))
+    lowest = _lowest(kin, rig)
+    depth = ref.floor - lowest
+    # freezes
+    slow = kin.pose_speed() < FREEZE_FRACTION * ref.pose_speed_median
+    slow = np.r_[slow, slow[-1:]]  # a step's flag on its first frame; the last frame copies
+    held = np.zeros(kin.n, dtype=bool) if hold is None else np.asarray(hold, dtype=bool)
+    if held.shape != (kin.n,):
+        raise ParameterError(f"hold must have one flag per frame ({kin.n}), got {held.shape}")
+    min_len = FREEZE_SECONDS * kin.fps
+    freezes = [(a, b) for a, b in contact_runs(slow & ~held) if b - a > min_len]
+    runs = contact_runs(slow & ~held)
+    longest = max((b - a for a, b in runs), default=0) / kin.fps
+    # pops
+    ps = kin.pose_speed()
+    acc = kin.accel()
+    rs = float(np.median(kin.root_speed()))
+    cycle = kin.cycle()
+    notes = []
+    if motion.fps != ref.fps:
+        notes.append(f"sources measured at {ref.fps:g} fps, the motion at {motion.fps:g}")
+    return GeneratedQuality(
+        frames=kin.n,
+        fps=kin.fps,
+        feet=rig.feet,
+        leg_length_m=legs * m,
+        support_slip=slip * m,
+        support_slip_legs=slip / legs,
+        source_support_slip=ref.support_slip * m,
+        contact_fraction={f: float(contacts.planted[:, i].mean()) for i, f in enumerate(rig.feet)},
+        contact_slide=float(np.median(spd)) * m,
+        source_contact_slide=ref.contact_slide * m,
+        sliding_fraction=fast,
+        penetration_m=max(float(depth.max()), 0.0) * m,
+        penetration_fraction=float(np.mean(depth > PENETRATION_M / m)),
+        source_penetration_fraction=ref.penetration,
+        freezes=freezes,
+        longest_freeze_s=float(longest),
+        knee_range=tuple(float(x) for x in _ranges(kin.knee)),
+        hip_range=tuple(float(x) for x in _ranges(kin.hip)),
+        source_knee_range=ref.knee_range,
+        source_hip_range=ref.hip_range,
+        cycle_s=cycle,
+        source_cycle_s=ref.cycle_at(rs),
+        largest_step=float(ps.max() / ref.step_p99),
+        largest_step_frame=int(ps.argmax()),
+        largest_accel=float(acc.max() / ref.accel_p99),
+        largest_accel_frame=int(acc.argmax()) + 1,
+        root_speed=rs * m,
+        source_root_speed=ref.root_speed * m,
+        held_frames=int(held.sum()),
+        notes=notes,
+    )
+
+
+def lead_lines(
+    motion: Motion,
+    sources: Sequence[Motion],
+    *,
+    feet: Sequence[str] | str | None = None,
+    hold: np.ndarray | None = None,
+    reference: SourceFigures | None = None,
+) -> tuple[dict | None, list[str]]:
+    """The measure as a report dict and the console lines that lead a command's output;
+    ``(None, [why])`` when it cannot be measured (no skeleton, no legs found)."""
+    from ..errors import CycleCoordError
+    from .legs import resolve_feet
+
+    try:
+        if isinstance(feet, str):
+            feet = resolve_feet(motion.skeleton, feet)
+        q = measure_generated(motion, sources, feet=feet, hold=hold, reference=reference)
+    except CycleCoordError as exc:
+        return None, [f"generated motion: not measured ({exc})"]
+    return q.to_dict(), q.summary()

@@ -1,0 +1,284 @@
+"""Feet that carry the body: the root's ground track of a generated motion from its feet.
+
+A generated pose sequence (a motion graph's path, a latent particle's) comes with a root
+velocity taken from the training frames nearest it; the feet, made by the pose alone,
+do not agree with it and glide.  :func:`carry_by_feet` moves the root instead as the foot
+on the ground carries it, as the periodic pipeline's cycles do
+(:func:`~cyclecoord.periodic.root.planted_ground`,
+:func:`~cyclecoord.periodic.clip.anchor_to_feet`):
+
+* contact is the height of each foot point above its own ground level, not its speed
+  (:func:`~cyclecoord.quality.contacts.foot_contacts` with ``speed=None``): a gliding foot
+  is on the ground and must stop gliding.  Height is unchanged by the ground track, so one
+  search serves;
+* among the points in contact the lowest carry the body (weights fall off over
+  :data:`LOWNESS` leg lengths above the lowest point), so a stride flattened by the latent
+  space does not let the swinging foot drag the root back;
+* where no point is in contact (a run's flight) the root keeps its own step;
+* frames of an asked hold (``hold``) stand: their ground steps fade to 0 over
+  :data:`STAND_AFTER` seconds;
+* no foot below the floor: the root is raised, smoothly, where the lowest foot point
+  (toe end sites included) would go under ``floor``.
+
+:func:`lock_where_clean` then pins the planted feet by a leg IK
+(:func:`~cyclecoord.synthesis.footlock.lock_feet`) where it makes no joint accelerate past
+the limit, and says where it could not.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..errors import CycleCoordError
+from ..motion import Motion
+
+__all__ = [
+    "carry_by_feet",
+    "channel_bounds",
+    "lock_where_clean",
+    "LockOutcome",
+    "LOWNESS",
+    "STAND_AFTER",
+]
+
+#: Height (leg lengths) over the lowest foot point at which a point's share of carrying
+#: the body falls to 1/e (and over the contact band at which the feet's share does).
+LOWNESS = 0.01
+#: Height band (leg lengths) above a point's ground level that counts as contact.
+CONTACT_BAND = 0.05
+#: An asked hold stands still after this many seconds.
+STAND_AFTER = 0.5
+#: Gaussian width (s) of the smoothing of the carried track's steps.
+SMOOTH = 0.0
+
+
+def _lowest_points(motion: Motion, feet: tuple[str, ...]) -> np.ndarray:
+    pos = motion.positions()
+    cols = [pos.names.index(f) for f in feet]
+    cols += [
+        i for i, n in enumerate(pos.names) if n.endswith("/end") and int(pos.parents[i]) in cols
+    ]
+    return pos.positions[:, cols, 1].min(axis=1)
+
+
+def carry_by_feet(
+    motion: Motion,
+    feet: tuple[str, ...] | None = None,
+    *,
+    floor: float | None = None,
+    hold: np.ndarray | None = None,
+    share: np.ndarray | None = None,
+    smooth: float = SMOOTH,
+) -> Motion:
+    """The motion with its root's ground track carried by the feet on the ground.
+
+    Parameters
+    ----------
+    motion : Motion
+        A generated motion with a skeleton and a 6-channel root (else returned as is).
+    feet : tuple of str, optional
+        Foot points (default found, :func:`~cyclecoord.quality.legs.find_legs`).
+    floor : float, optional
+        Floor height (length units, e.g. the training takes' contact floor): no foot
+        point goes under it.  None: the motion's own estimate, and nothing is raised.
+    hold : ndarray of bool, shape (T,), optional
+        Frames where a hold was asked: the root stands after :data:`STAND_AFTER` s.
+    share : ndarray, shape (T - 1,), optional
+        How much of each ground step the feet carry (default 1 everywhere).
+    smooth : float
+        Gaussian width (s) of the smoothing of the carried steps.
+
+    Returns
+    -------
+    Motion
+        Same channels; only the root's translation changes.
+    """
+    from scipy.ndimage import gaussian_filter1d, maximum_filter1d
+
+    from ..periodic.root import planted_ground, root_layout
+    from ..quality.contacts import foot_contacts
+    from ..quality.legs import find_feet
+
+    layout = root_layout(motion)
+    if layout is None or motion.skeleton is None or motion.n_frames < 3:
+        return motion
+    try:
+        feet = find_feet(motion.skeleton, motion) if feet is None else tuple(feet)
+        contacts = foot_contacts(motion, feet, speed=None, height=CONTACT_BAND, floor=floor)
+    except CycleCoordError:
+        return motion
+    # the lowest points carry the body (what the support foot is); a point's share falls
+    # off with its height over the lowest, and all shares with the lowest point's height
+    # over its own ground level once it leaves the contact band (a run's flight)
+    y = contacts.height + contacts.contact_level  # absolute heights
+    above = (y - y.min(axis=1, keepdims=True)) / contacts.leg_length
+    share_low = np.exp(-above / LOWNESS)
+    share_low /= share_low.sum(axis=1, keepdims=True)
+    rel = contacts.height / contacts.leg_length
+    lowest = rel[np.arange(rel.shape[0]), y.argmin(axis=1)]
+    grounded = np.exp(-np.maximum(lowest - CONTACT_BAND, 0.0) / LOWNESS)
+    weights = share_low * grounded[:, None]
+    cols = [layout.column("tx"), layout.column("tz")]
+    own = np.diff(motion.frames[:, cols], axis=0)
+    steps = np.diff(planted_ground(motion, layout, feet, weights), axis=0)
+    if smooth > 0:
+        steps = gaussian_filter1d(steps, smooth * motion.fps, axis=0, mode="nearest")
+    w = np.ones(len(steps)) if share is None else np.clip(np.asarray(share, float), 0, 1)
+    steps = w[:, None] * steps + (1.0 - w[:, None]) * own
+    if hold is not None:
+        steps = steps * _moving(np.asarray(hold, bool), motion.fps)[:, None]
+    frames = motion.frames.copy()
+    frames[:, cols] = motion.frames[0, cols] + np.vstack([[0.0, 0.0], np.cumsum(steps, 0)])
+    out = motion.with_frames(frames)
+    if floor is not None:
+        depth = np.maximum(floor - _lowest_points(out, feet), 0.0)
+        if depth.any():
+            k = max(1, int(round(0.1 * motion.fps)))
+            lift = gaussian_filter1d(maximum_filter1d(depth, 2 * k + 1), k / 2.0, mode="nearest")
+            lift = np.maximum(lift, depth)
+            ty = layout.column("ty")
+            frames[:, ty] += lift / _translation_scale(out, ty)
+            out = motion.with_frames(frames)
+    return out
+
+
+def _translation_scale(motion: Motion, col: int) -> float:
+    """World units per unit of a root translation channel (1 on ASF and BVH; measured)."""
+    moved = motion.frames[:1].copy()
+    moved[0, col] += 1.0
+    probe = motion.with_frames(np.vstack([motion.frames[:1], moved])).positions().positions
+    d = float(np.linalg.norm(probe[1, 0] - probe[0, 0]))
+    return d if d > 1e-9 else 1.0
+
+
+def _moving(hold: np.ndarray, fps: float) -> np.ndarray:
+    """(T-1,) factor on each ground step: 1 outside holds, easing to 0 over
+    :data:`STAND_AFTER` s into each hold (and back to 1 as it ends)."""
+    from ..quality.contacts import contact_runs
+
+    factor = np.ones(hold.size)
+    n = max(1, int(round(STAND_AFTER * fps)))
+    for a, b in contact_runs(hold):
+        u = np.clip((np.arange(a, b) - a) / n, 0.0, 1.0)
+        factor[a:b] = 1.0 - u * u * (3.0 - 2.0 * u)
+    return 0.5 * (factor[1:] + factor[:-1])
+
+
+@dataclass(frozen=True)
+class LockOutcome:
+    """What :func:`lock_where_clean` did."""
+
+    motion: Motion
+    locked: int  # contacts pinned
+    skipped: list[tuple[int, int]]  # frame ranges of contacts left unlocked (a pop)
+    line: str
+
+
+def lock_where_clean(
+    motion: Motion,
+    limit: float,
+    feet: tuple[str, ...] | None = None,
+    *,
+    min_duration: float = 0.2,
+    blend: float = 0.1,
+    bounds: tuple[np.ndarray, np.ndarray] | None = None,
+) -> LockOutcome:
+    """Pin the planted feet (leg IK) except where the pin makes a pop.
+
+    Contacts (:func:`~cyclecoord.quality.contacts.foot_contacts`, low and slow: on a
+    carried motion the support foot) of at least ``min_duration`` s are pinned.  After
+    locking, a contact around which the largest joint acceleration (relative to the root)
+    exceeds both ``limit`` (length units/s^2, e.g. 1.5x the sources' 99th percentile)
+    and what it was before is unlocked and the rest locked again; so is one where a
+    channel leaves ``bounds`` (per-channel low and high values, e.g. the training takes'
+    range widened by :data:`RANGE_MARGIN` degrees) that it kept before.
+    """
+    from ..quality.contacts import contact_runs, foot_contacts
+    from ..quality.legs import find_feet
+    from .footlock import lock_feet
+
+    try:
+        feet = find_feet(motion.skeleton, motion) if feet is None else tuple(feet)
+        contacts = foot_contacts(motion, feet, min_duration=min_duration)
+    except CycleCoordError as exc:
+        return LockOutcome(motion, 0, [], f"foot locking: not done ({exc})")
+    planted = contacts.planted.copy()
+    for i in range(planted.shape[1]):  # short touches toggle and make the legs jitter
+        for a, b in contact_runs(planted[:, i]):
+            if b - a < min_duration * motion.fps:
+                planted[a:b, i] = False
+    if not planted.any():
+        return LockOutcome(motion, 0, [], "foot locking: no contact long enough to pin")
+    before = _accel(motion)
+    outside_before = _outside(motion.frames, bounds)
+    skipped: list[tuple[int, int]] = []
+    result = None
+    for _ in range(3):
+        if not planted.any():
+            break
+        trial = lock_feet(motion, replace(contacts, planted=planted), blend=blend, passes=1)
+        after = _accel(trial.motion)
+        bad = (after > limit) & (after > before * 1.05)
+        bad |= _outside(trial.motion.frames, bounds) & ~outside_before
+        bad = np.flatnonzero(bad)
+        if not bad.size:
+            result = trial
+            break
+        pad = int(round(blend * motion.fps)) + 2
+        dropped = False
+        for i in range(planted.shape[1]):
+            for a, b in contact_runs(planted[:, i]):
+                if ((bad >= a - pad) & (bad < b + pad)).any():  # a pop or out of range
+                    planted[a:b, i] = False
+                    skipped.append((a, b))
+                    dropped = True
+        if not dropped:  # the pops are not at a pin
+            result = trial
+            break
+    spans = sorted(set(skipped))
+    where = ", ".join(f"{a}-{b}" for a, b in spans[:6]) + (" ..." if len(spans) > 6 else "")
+    if result is None:
+        return LockOutcome(
+            motion,
+            0,
+            spans,
+            "foot locking: not done (pinning made joints accelerate past "
+            f"{limit:.3g} units/s^2 or leave the training range"
+            + (f" at frames {where})" if spans else ")"),
+        )
+    n_locked = sum(len(contact_runs(planted[:, i])) for i in range(planted.shape[1]))
+    line = f"foot locking: {n_locked} contacts pinned"
+    if spans:
+        line += f"; not at frames {where} (pinning there made a pop or left the training range)"
+    return LockOutcome(result.motion, n_locked, spans, line)
+
+
+#: Degrees a pinned leg's channels may go beyond the training range (as the plausibility
+#: check allows).
+RANGE_MARGIN = 5.0
+
+
+def channel_bounds(takes, margin: float = RANGE_MARGIN) -> tuple[np.ndarray, np.ndarray]:
+    """Per-channel range of the takes' frames widened by ``margin`` (root channels free)."""
+    frames = np.concatenate([m.frames for m in takes])
+    lo, hi = frames.min(axis=0) - margin, frames.max(axis=0) + margin
+    for c in takes[0].root_channels():
+        lo[c], hi[c] = -np.inf, np.inf
+    return lo, hi
+
+
+def _outside(frames: np.ndarray, bounds) -> np.ndarray:
+    if bounds is None:
+        return np.zeros(frames.shape[0], dtype=bool)
+    lo, hi = bounds
+    return ((frames < lo) | (frames > hi)).any(axis=1)
+
+
+def _accel(motion: Motion) -> np.ndarray:
+    """(T,) largest joint acceleration relative to the root, per frame (length units/s^2)."""
+    p = motion.positions().positions
+    rel = p - p[:, :1]
+    a = np.linalg.norm(np.diff(rel, 2, axis=0), axis=-1).max(-1) * motion.fps**2
+    return np.r_[a[:1], a, a[-1:]]

@@ -1,0 +1,377 @@
+"""Feet and named joints on any rig (issue 23 part 3): the naming table, the geometric
+fallback, quadrupeds, ``--feet`` parsing and every shared rig's feet found without options."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.errors import ParameterError
+from cyclecoord.joint_names import (
+    RIG_NAMINGS,
+    JointRole,
+    classify_joint,
+    classify_skeleton,
+    is_ignored_name,
+    name_words,
+)
+from cyclecoord.motion import Motion
+from cyclecoord.quality.contacts import find_feet, foot_contacts, foot_skating, leg_length
+from cyclecoord.quality.legs import find_legs, legs_of_feet, resolve_feet
+from cyclecoord.skeleton import Joint, Skeleton
+from cyclecoord.synthesis.footlock import lock_feet
+from _walkers import (  # tests/ is on the path (rootdir conftest)
+    biped_names,
+    biped_skeleton,
+    biped_walk,
+    quadruped_names,
+    quadruped_skeleton,
+    trot,
+)
+
+
+# ------------------------------------------------------------------ the naming table
+def convention_skeleton(rig) -> Skeleton:
+    """A minimal standing skeleton in a rig's naming convention: trunk up, legs down
+    (toes forward, +z), arms out sideways; left at +x."""
+    joints: list[Joint] = []
+    index: dict[str, int] = {}
+
+    def add(name, parent, offset, end=None):
+        index[name] = len(joints)
+        joints.append(Joint(name, -1 if parent is None else index[parent], offset,
+                            end_site=end))
+
+    prev = None
+    for name, _ in rig.trunk:
+        add(name, prev, [0, 0, 0] if prev is None else [0, 2.0, 0])
+        prev = name
+    # legs hang from the pelvis (or the first trunk joint when the root is a ground joint)
+    pelvis = next(n for n, r in rig.trunk if r == "pelvis") if any(
+        r == "pelvis" for _, r in rig.trunk) else rig.trunk[0][0]
+    for side, x in (("left", 1.0), ("right", -1.0)):
+        names = rig.names(side, "leg")
+        parent = pelvis
+        for k, name in enumerate(names):
+            role = rig.roles("leg")[k]
+            offset = {"pelvis": [x * 0.5, -0.5, 0], "hip": [x * 0.5, -0.5, 0],
+                      "knee": [0, -4.0, 0], "ankle": [0, -4.0, 0], "toe": [0, -0.5, 1.0]}[role]
+            add(name, parent, offset, end=[0, 0, 0.5] if role == "toe" else None)
+            parent = name
+        parent = rig.arm_parent
+        for name in rig.names(side, "arm"):
+            add(name, parent, [x * 1.5, 0, 0])
+            parent = name
+    return Skeleton(tuple(joints), name=rig.key)
+
+
+@pytest.mark.parametrize("rig", RIG_NAMINGS, ids=lambda r: r.key)
+def test_every_convention_classifies_its_joints(rig):
+    skel = convention_skeleton(rig)
+    roles = classify_skeleton(skel)
+    for name, role in rig.trunk:
+        got = roles.get(name)
+        assert (got.role if got else "") == role, name
+        assert got is None or got.side is None, name
+    for side in ("left", "right"):
+        for part in ("leg", "arm"):
+            for name, role in zip(rig.names(side, part), rig.roles(part)):
+                assert roles.get(name) == JointRole(role, side), (name, roles.get(name))
+
+
+@pytest.mark.parametrize("rig", RIG_NAMINGS, ids=lambda r: r.key)
+def test_every_convention_finds_its_feet(rig):
+    skel = convention_skeleton(rig)
+    legs = find_legs(skel)
+    assert legs.method == "names"
+    left, right = rig.names("left", "leg"), rig.names("right", "leg")
+    assert legs.feet == (left[-2], left[-1], right[-2], right[-1])
+    assert legs.sides == ("left", "left", "right", "right")
+    assert leg_length(skel) == pytest.approx(8.0)
+    # the same skeleton with its names taken away: the geometry gives the same joints
+    anon = anonymous(skel)
+    legs = find_legs(anon[0])
+    back = {v: k for k, v in anon[1].items()}
+    assert tuple(back[f] for f in legs.feet) == (left[-2], left[-1], right[-2], right[-1])
+    assert legs.method == "geometry"
+
+
+def anonymous(skel: Skeleton, motion: Motion | None = None):
+    """``skel`` (and ``motion``) with joints renamed j0, j1, ...; returns the renaming too."""
+    new = {n: f"j{i}" for i, n in enumerate(skel.names)}
+    anon = Skeleton(tuple(replace(j, name=new[j.name]) for j in skel.joints), name="anon")
+    if motion is None:
+        return anon, new
+    m = Motion(motion.frames, tuple((new[a], d) for a, d in motion.channels), fps=motion.fps,
+               skeleton=anon)
+    return anon, new, m
+
+
+@pytest.mark.parametrize(
+    "name, expected",
+    [
+        ("lfoot", JointRole("ankle", "left")),
+        ("rtoes", JointRole("toe", "right")),
+        ("lhipjoint", JointRole("pelvis", "left")),
+        ("mixamorig:RightToeBase", JointRole("toe", "right")),
+        ("mixamorig1:LeftUpLeg", JointRole("hip", "left")),
+        ("Character1_LeftFoot", JointRole("ankle", "left")),
+        ("Foot_L", JointRole("ankle", "left")),
+        ("foot.R", JointRole("ankle", "right")),
+        ("ball_r", JointRole("toe", "right")),
+        ("calf_l", JointRole("knee", "left")),
+        ("L_Ankle", JointRole("ankle", "left")),
+        ("left_knee", JointRole("knee", "left")),
+        ("RightAnkle", JointRole("ankle", "right")),
+        ("Bip01 R Toe0", JointRole("toe", "right")),
+        ("DEF-thigh.L", JointRole("hip", "left")),
+        ("LEFTFOOT", None),  # one word in capitals: no side can be read off
+        ("LeftFrontLeg", JointRole("knee", "left", "front")),
+        ("RightHindFoot", JointRole("ankle", "right", "hind")),
+        ("FrontLeftFoot", JointRole("ankle", "left", "front")),
+        ("BackRightToe", JointRole("toe", "right", "hind")),
+        ("LowerBack", JointRole("spine")),
+        ("LeftForeArm", JointRole("elbow", "left")),
+        ("LeftHandIndex1", JointRole("fingers", "left")),
+        ("T12", JointRole("spine")),
+        ("Hips", JointRole("pelvis")),
+        ("j12", None),
+        ("LeftToe_End", None),
+        ("calf_twist_01_l", None),
+        ("ik_foot_l", None),
+        ("Prop1", None),
+        ("Foot", None),  # a foot needs a side
+    ],
+)
+def test_classify_joint(name, expected):
+    assert classify_joint(name) == expected
+
+
+def test_name_words_and_ignored():
+    assert name_words("mixamorig:LeftToeBase") == ["left", "toe", "base"]
+    assert name_words("LHipJoint") == ["l", "hip", "joint"]
+    assert name_words("Bip01 L Toe0") == ["bip", "01", "l", "toe", "0"]
+    assert is_ignored_name("HeadTop_End") and is_ignored_name("Prop2")
+    assert not is_ignored_name("LeftToeBase")
+
+
+def test_twist_and_ik_bones_are_not_feet():
+    """The Unreal mannequin's ik_foot_l under the root and twist bones are left out."""
+    rig = next(r for r in RIG_NAMINGS if r.key == "unreal")
+    skel = convention_skeleton(rig)
+    extra = (
+        Joint("ik_foot_root", 0, [0, 0, 0]),
+        Joint("ik_foot_l", len(skel.joints), [1, 0, 0]),
+        Joint("calf_twist_01_l", skel.index("calf_l"), [0, -2, 0]),
+    )
+    skel = Skeleton(skel.joints + extra)
+    assert find_feet(skel) == ("foot_l", "ball_l", "foot_r", "ball_r")
+
+
+# ------------------------------------------------------------------ geometric fallback
+@pytest.mark.parametrize("heading", [0.0, 90.0, 200.0])
+def test_geometry_finds_legs_and_sides_ignoring_arms_and_prop(heading):
+    """Joints named j0..j21 (a long prop in the right hand reaching below the knee): the
+    legs and their sides come from the walk, whichever way it heads."""
+    names = biped_names()
+    skel = biped_skeleton(names)
+    motion = biped_walk(skel, names, heading_deg=heading)
+    legs = find_legs(skel, motion)
+    assert legs.method == "geometry"
+    assert legs.feet == (names["l_ankle"], names["l_toe"], names["r_ankle"], names["r_toe"])
+    assert legs.sides == ("left", "left", "right", "right")
+    c = foot_contacts(motion)
+    assert c.feet == legs.feet
+    assert 0.4 < c.side_planted("left").mean() < 0.8
+    assert foot_skating(motion, c).skating_frames == 0
+
+
+def test_geometry_in_the_rest_pose_and_right_leg_first():
+    """Without a motion the rest pose decides; sides come from where the toes point, not
+    from the order of the hierarchy."""
+    names = biped_names()
+    skel = biped_skeleton(names)
+    legs = find_legs(skel)
+    assert legs.feet == (names["l_ankle"], names["l_toe"], names["r_ankle"], names["r_toe"])
+    # mirror: the toes point to -z, so the joint at +x is now the right leg
+    flipped = Skeleton(tuple(
+        replace(j, offset=j.offset * [1, 1, -1],
+                end_site=None if j.end_site is None else j.end_site * [1, 1, -1])
+        for j in skel.joints))
+    legs = find_legs(flipped)
+    assert legs.feet == (names["r_ankle"], names["r_toe"], names["l_ankle"], names["l_toe"])
+
+
+def test_geometry_ankle_without_toe_joint():
+    """A leg ending at the ankle (its end site the toe) gives the ankle alone."""
+    joints = [Joint("j0", -1, [0, 0, 0], ("tx", "ty", "tz"), "")]
+    for x in (1.0, -1.0):
+        base = len(joints)
+        joints += [Joint(f"j{base}", 0, [x, 0, 0]), Joint(f"j{base + 1}", base, [0, -4, 0]),
+                   Joint(f"j{base + 2}", base + 1, [0, -4, 0], end_site=[0, -0.5, 1.0])]
+    joints.append(Joint("j7", 0, [0, 5, 0], end_site=[0, 1, 0]))
+    legs = find_legs(Skeleton(tuple(joints)))
+    assert legs.feet == ("j3", "j6")
+    assert legs.sides == ("left", "right")
+
+
+def test_no_feet_message_lists_candidates_and_the_option():
+    arm = Skeleton((Joint("j0", -1, [0, 0, 0]), Joint("j1", 0, [1, 0, 0]),
+                    Joint("j2", 1, [1, 0, 0])))
+    with pytest.raises(ParameterError) as err:
+        find_legs(arm)
+    text = str(err.value)
+    assert "--feet LEFT,RIGHT" in text and "j2" in text and "foot joints" in text
+
+
+# ------------------------------------------------------------------ quadrupeds
+@pytest.mark.parametrize("style", ["anonymous", "dog", "front_first", "human"])
+def test_quadruped_trot_four_feet(style):
+    names = quadruped_names(style)
+    skel = quadruped_skeleton(names)
+    motion = trot(skel, names)
+    legs = find_legs(skel, motion)
+    expected = {
+        "front left": "fl", "front right": "fr", "hind left": "hl", "hind right": "hr",
+    }
+    assert [g.label for g in legs.legs] == list(expected)
+    for g in legs.legs:
+        key = expected[g.label]
+        assert g.points == (names[f"{key}_ankle"], names[f"{key}_toe"]), g
+    assert legs.method == {"anonymous": "geometry", "human": "names and geometry"}.get(
+        style, "names")
+    c = foot_contacts(motion)
+    assert c.feet == legs.feet
+    assert c.leg_length == pytest.approx(8.0)
+    fl, fr = c.side_planted("front left"), c.side_planted("front right")
+    hl, hr = c.side_planted("hind left"), c.side_planted("hind right")
+    # a trot: diagonal legs planted together, the two front legs in turn
+    assert (fl == hr).mean() > 0.95 and (fr == hl).mean() > 0.95
+    assert (fl & ~fr).any() and (fr & ~fl).any()
+    # "left" covers both left legs
+    assert np.array_equal(c.side_planted("left"), fl | hl)
+    assert foot_skating(motion, c).skating_frames == 0
+
+
+def test_quadruped_rest_pose_and_given_feet():
+    names = quadruped_names("anonymous")
+    skel = quadruped_skeleton(names)
+    assert [g.label for g in find_legs(skel).legs] == [
+        "front left", "front right", "hind left", "hind right"]
+    motion = trot(skel, names)
+    given = (names["hr_ankle"], names["fl_toe"], names["hl_ankle"], names["fr_ankle"])
+    legs = legs_of_feet(skel, given, motion)
+    assert [g.label for g in legs.legs] == ["hind right", "front left", "hind left",
+                                            "front right"]
+
+
+def test_lock_feet_on_a_quadruped():
+    """Foot locking solves each of the four legs on its own."""
+    names = quadruped_names("dog")
+    skel = quadruped_skeleton(names)
+    motion = trot(skel, names)
+    frames = motion.frames.copy()
+    col = motion.channel_index(names["pelvis"], "tx")
+    frames[:, col] += 0.05 * np.arange(motion.n_frames)  # drift sideways: feet skate
+    sliding = motion.with_frames(frames)
+    result = lock_feet(sliding)
+    assert result.before.skating_frames > 0
+    assert result.after.skating_frames < 0.2 * result.before.skating_frames
+    assert set(result.contacts.legs) == {"front left", "front right", "hind left",
+                                         "hind right"}
+
+
+# ------------------------------------------------------------------ --feet
+def test_resolve_feet_forms_and_errors():
+    rig = next(r for r in RIG_NAMINGS if r.key == "mixamo")
+    skel = convention_skeleton(rig)
+    assert resolve_feet(skel, "mixamorig:LeftFoot,mixamorig:RightFoot") == (
+        "mixamorig:LeftFoot", "mixamorig:RightFoot")
+    assert resolve_feet(
+        skel, "mixamorig:LeftFoot:mixamorig:LeftToeBase,mixamorig:RightFoot:mixamorig:RightToeBase"
+    ) == ("mixamorig:LeftFoot", "mixamorig:LeftToeBase", "mixamorig:RightFoot",
+          "mixamorig:RightToeBase")
+    with pytest.raises(ParameterError, match="nearest: mixamorig:LeftFoot"):
+        resolve_feet(skel, "mixamorig:LeftFot,mixamorig:RightFoot")
+    with pytest.raises(ParameterError, match="two .* or four"):
+        resolve_feet(skel, "mixamorig:LeftFoot")
+    with pytest.raises(ParameterError, match="not below"):
+        resolve_feet(skel, "mixamorig:LeftToeBase:mixamorig:LeftFoot,mixamorig:RightFoot")
+    cmu = convention_skeleton(RIG_NAMINGS[0])
+    assert resolve_feet(cmu, "lfoot:ltoes, rfoot:rtoes") == ("lfoot", "ltoes", "rfoot", "rtoes")
+    with pytest.raises(ParameterError, match=r"no joint 'lfot'.*nearest: lfoot"):
+        resolve_feet(cmu, "lfot,rfoot")
+
+
+def test_given_feet_get_sides_from_geometry():
+    names = biped_names()
+    skel = biped_skeleton(names)
+    motion = biped_walk(skel, names, heading_deg=45)
+    c = foot_contacts(motion, feet=(names["r_toe"], names["l_toe"]))
+    assert c.sides == ("right", "left")
+    # toes alone: the leg is measured from the ankle above them
+    assert leg_length(skel, (names["r_toe"], names["l_toe"])) == pytest.approx(8.0)
+
+
+# ------------------------------------------------------------------ shared captures
+SHARED = {
+    "bandai/dataset-1_walk_normal_001.bvh": ("Foot_L", "Toes_L", "Foot_R", "Toes_R"),
+    "bandai/dataset-1_walk-back_sad_001.bvh": ("Foot_L", "Toes_L", "Foot_R", "Toes_R"),
+    "bandai/dataset-1_run_happy_001.bvh": ("Foot_L", "Toes_L", "Foot_R", "Toes_R"),
+    "bandai/dataset-2_walk-turn-left_normal_011.bvh": ("Foot_L", "Toes_L", "Foot_R", "Toes_R"),
+    "bandai/dataset-2_walk-turn-right_normal_029.bvh": ("Foot_L", "Toes_L", "Foot_R",
+                                                        "Toes_R"),
+    "xsens/S02-Trial-Walk-1.bvh": ("LeftAnkle", "LeftToe", "RightAnkle", "RightToe"),
+}
+
+
+@pytest.mark.parametrize("path", sorted(SHARED))
+def test_shared_bvh_feet_by_name_and_by_geometry(bvh_dir, path):
+    motion = cc.load(bvh_dir / path)
+    assert find_feet(motion.skeleton, motion) == SHARED[path]
+    c = foot_contacts(motion)
+    assert c.feet == SHARED[path] and c.sides == ("left", "left", "right", "right")
+    assert c.planted.mean() > 0.1
+    # names taken away: the motion's geometry finds the same joints and sides (the Xsens
+    # prop under the right wrist is not a foot)
+    _, new, anon = anonymous(motion.skeleton, motion)
+    legs = find_legs(anon.skeleton, anon)
+    assert legs.feet == tuple(new[f] for f in SHARED[path])
+    assert legs.sides == ("left", "left", "right", "right")
+
+
+@pytest.mark.parametrize("subject, take", [("69", "69_01"), ("143", "143_01"),
+                                           ("01", "01_09"), ("35", "35_07")])
+def test_shared_cmu_feet_by_name_and_by_geometry(cmu_dir, subject, take):
+    motion = cc.load(cmu_dir / subject / f"{take}.amc")
+    assert find_feet(motion.skeleton, motion) == ("lfoot", "ltoes", "rfoot", "rtoes")
+    _, new, anon = anonymous(motion.skeleton, motion)
+    assert find_feet(anon.skeleton, anon) == tuple(
+        new[f] for f in ("lfoot", "ltoes", "rfoot", "rtoes"))
+
+
+def test_person_on_all_fours_keeps_two_legs():
+    """A rig named like a person whose hands reach the floor in the take (crawling) keeps
+    two legs when its rest pose holds the arms up: only a rig that stands on four in its
+    rest pose (a dog named like a person) gets front legs from the geometry."""
+    names = quadruped_names("human")
+    dog = quadruped_skeleton(names)
+    arms = {names[f"{leg}_{p}"] for leg in ("fl", "fr") for p in ("knee", "ankle", "toe")}
+    # the same body with the arms raised in the rest pose (bones pointing up and back) ...
+    raised = Skeleton(tuple(
+        replace(j, offset=j.offset * [1, -1, -1],
+                end_site=None if j.end_site is None else j.end_site * [1, -1, -1])
+        if j.name in arms else j
+        for j in dog.joints))
+    motion = trot(dog, names)
+    frames = motion.frames.copy()
+    for leg in ("fl", "fr"):  # ... turned down at the shoulder: the same crawl
+        frames[:, motion.channel_index(names[f"{leg}_hip"], "rx")] += 180.0
+    crawl = Motion(frames, motion.channels, fps=motion.fps, skeleton=raised)
+    np.testing.assert_allclose(crawl.positions().positions, motion.positions().positions,
+                               atol=1e-9)
+    assert find_legs(dog, motion).method == "names and geometry"
+    legs = find_legs(raised, crawl)
+    assert legs.method == "names" and legs.feet == ("LeftFoot", "LeftToeBase", "RightFoot",
+                                                    "RightToeBase")
