@@ -250,3 +250,14 @@ def test_usd_refusal_is_one_line_without_usd_core_warnings(usda, capfd):
         cc.load(usda)
     one_line(e, usda)
     assert capfd.readouterr().err == ""
+
+
+def test_usd_animation_arrays_that_disagree_with_its_joints(usda):
+    # usd-core ignores such an animation (a warning and the rest pose): a motion that never
+    # moved was read, and latent fit ended in a KeyError on it
+    text = usda.read_text()
+    key = "uniform token[] joints = ["
+    a = text.index(key, text.index("def SkelAnimation")) + len(key)
+    first = text[a : text.index(",", a)]
+    usda.write_text(text[:a] + first + ", " + text[a:])
+    _refused(usda, "Animation.translations at time code 0", "for the animation's")

@@ -291,6 +291,36 @@ def _slerp(qa: np.ndarray, qb: np.ndarray, u: np.ndarray) -> np.ndarray:
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
+def _check_component_sizes(anim, keys: np.ndarray, path: Path) -> None:
+    """One translation, rotation and scale per joint of the animation at every time code
+    read: usd-core ignores an animation whose arrays disagree with its joints (a warning,
+    then the rest pose), which would read as a motion that never moves."""
+    from pxr import Usd
+
+    joints = anim.GetJointsAttr().Get()
+    n = len(joints) if joints is not None else 0
+    for name in ("translations", "rotations", "scales"):
+        attr = anim.GetPrim().GetAttribute(name)
+        if not attr or not attr.HasAuthoredValue():
+            continue
+        for t in keys:
+            value = attr.Get(Usd.TimeCode(float(t)))
+            if value is None:
+                continue
+            try:
+                got = len(value)
+            except TypeError:
+                raise ParseError(
+                    f"{anim.GetPath()}.{name} at time code {t:g}: not an array", str(path)
+                ) from None
+            if got != n:
+                raise ParseError(
+                    f"{anim.GetPath()}.{name} at time code {t:g}: {got} values for the "
+                    f"animation's {n} joints",
+                    str(path),
+                )
+
+
 def _local_transforms(query, times: np.ndarray, path: Path) -> tuple[np.ndarray, np.ndarray]:
     """Local translations ``(T, J, 3)`` and rotations ``(T, J, 3, 3)`` of every joint at the
     integer time codes ``times``.
@@ -311,6 +341,8 @@ def _local_transforms(query, times: np.ndarray, path: Path) -> tuple[np.ndarray,
     keys = np.unique(np.array([lo, hi] + [t for t in samples if lo <= t <= hi and np.isfinite(t)]))
     if aq:
         anim = UsdSkel.Animation(aq.GetPrim())
+        if anim:
+            _check_component_sizes(anim, keys, path)
         rot_attr = anim.GetRotationsAttr() if anim else None
         kind = str(rot_attr.GetTypeName()) if rot_attr else ""
         if rot_attr and kind not in ("quatf[]", "quath[]", "quatd[]"):
