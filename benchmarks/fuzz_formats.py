@@ -695,7 +695,8 @@ def run_case(case: Case, work: Path) -> dict:
     else:
         rec["cls"] = "ok"
     for name, h in digest.items():
-        if hashlib.sha256((d / name).read_bytes()).hexdigest() != h:
+        f = d / name
+        if not f.is_file() or hashlib.sha256(f.read_bytes()).hexdigest() != h:
             rec["cls"] = "input_modified"
             rec["file"] = name
     rec["t"] = round(time.perf_counter() - t0, 3)
@@ -706,8 +707,9 @@ def _worker(conn, wid: int, out: Path, fmt: str, memory: int) -> None:
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
-    work = out / "work" / f"w{wid}"
-    seeds = make_seeds(out / "seeds" / f"w{wid}")
+    # folders of this format and worker: runs of other formats may share ``out``
+    work = out / "work" / f"{fmt}-w{wid}"
+    seeds = make_seeds(out / "seeds" / f"{fmt}-w{wid}")
     while True:
         msg = conn.recv()
         if msg is None:
@@ -783,7 +785,7 @@ def run(fmt: str, start: int, n: int, workers: int = 2, timeout: float = 60.0,
                 if s.conn in ready:
                     try:
                         rec = s.conn.recv()
-                    except EOFError:  # the worker died
+                    except (EOFError, OSError):  # the worker died
                         rec = {"fmt": fmt, "id": s.case, "cls": "crash",
                                "exitcode": s.proc.exitcode}
                         s.kill()
