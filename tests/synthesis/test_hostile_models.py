@@ -196,3 +196,13 @@ def test_a_model_of_a_motion_that_never_moves(tmp_path, capsys):
     assert main(args + ["--step", "1", "--max-iter", "5"]) == 1
     assert "no joint angle changes" in _error(capsys)
     assert not (tmp_path / "m.npz").exists()
+
+
+def test_a_particle_that_diverges_is_refused_at_once(model, tmp_path, capsys):
+    # a random force of 2e9 over 4096 s: the integration overflowed within frames, then
+    # made 122,880 frames of NaN for over a minute
+    script = _script(tmp_path, model, [{"command": "IDLE", "duration": 4096}],
+                     particle={"random": 2e9})
+    assert main(["animate", str(script), "-o", str(tmp_path / "o.bvh"), "--no-check"]) == 1
+    err = _error(capsys)
+    assert "commands[0] (IDLE)" in err and "left finite values" in err
