@@ -59,7 +59,9 @@ Columns (per file):
   largest and median, over the capture's **spread**: the 90th percentile, over captured
   frames, of the distance to the nearest captured pose at least half a period away in
   time (how far one cycle's pose lies from the same pose in another cycle; the period is
-  the strike period, or the autocorrelation's when no strikes were found).  At most 1
+  the strike period, or the autocorrelation's when no strikes were found), and at least
+  the capture's median frame step (repetitions closer than that are as close as the
+  sampling shows: a keyframed loop played over has a spread of 0).  At most 1
   means the cycle pose is as close to the capture as nine in ten captured poses are to
   another cycle (the median was tried first: on a take of two or three strides, half the
   captured poses are themselves farther than it from every other stride).  This is the
@@ -787,6 +789,7 @@ def measure_cycle(cap: Capture, cycle_frames: np.ndarray, cycle_fps: float,
     p99 = float(np.percentile(cap_steps, 99))
     cyc_steps = steps(y, cyclic=True)
     spread = float(np.nanpercentile(nearest_distances(x, x, exclude_within=period / 2), 90))
+    spread = max(spread, float(np.median(cap_steps)))  # no finer than the sampling
     near = nearest_distances(y, x)
     out: dict[str, Any] = {
         "cycle_frames": int(len(y)),

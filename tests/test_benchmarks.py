@@ -453,3 +453,23 @@ def test_detect_bench_real_labels_match_capture():
     need_data(path)
     spans = detect_bench.load_activity_labels(path, 4592)
     assert len(spans) == 6 and spans[0] == (0, 456, "JumpJack") and spans[-1][1] == 4584
+
+
+# ===================================================== benchmarks/bench_synthesis.py
+def test_synthesis_bench_prints_every_method_on_synthetic_walks(tmp_path, capsys):
+    """Without the shared data the table runs on synthetic walks: every method and the
+    captures get a row, ours its ratios against each baseline (never speed)."""
+    spec = importlib.util.spec_from_file_location(
+        "bench_synthesis", BENCH.parent / "bench_synthesis.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["bench_synthesis"] = module
+    spec.loader.exec_module(module)
+    out = tmp_path / "s.json"
+    assert module.main(["--data", str(tmp_path / "none"), "--frames", "240", "--no-limbs",
+                        "--json", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "synthetic walks" in text
+    for label in (*module.METHODS, "captures (4)", "vs classic graph", "vs nearest-take replay"):
+        assert label in text
+    figures = json.loads(out.read_text())["sets"][0]["figures"]
+    assert not figures["graph (ours)"]["freezes"]

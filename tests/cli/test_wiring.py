@@ -647,6 +647,27 @@ def test_graph_strict_refuses_an_implausible_motion(monkeypatch, takes, tmp_path
     assert main(argv) == 0 and cc.load(out).n_frames == 40
 
 
+def test_graph_generates_with_the_phase_aware_field_by_default(monkeypatch, takes):
+    target = "cyclecoord.synthesis.graph.MotionGraphSynth"
+    kw = reach(monkeypatch, target, "graph", *takes).kwargs
+    assert kw["method"] == "delaunay+phase" and kw["dims"] == "auto"
+
+
+def test_graph_refuses_limbs_through_each_other_unless_allowed(monkeypatch, takes, tmp_path):
+    """A generated motion with new limb contacts is refused (report written, no motion)
+    without --strict; --allow-contacts writes it."""
+    bad = SimpleNamespace(clean=False, new_contact_frames=[7, 8, 9],
+                          summary=lambda: "plausibility: new limb contacts in 3 frames",
+                          to_dict=lambda: {"clean": False})
+    monkeypatch.setattr("cyclecoord.quality.plausibility.check_plausibility",
+                        lambda *a, **k: bad)
+    out, rep = tmp_path / "g.bvh", tmp_path / "g.json"
+    argv = ["graph", *takes, "--frames", "40", "-o", str(out), "--report", str(rep)]
+    assert main(argv) == 1 and not out.exists()
+    assert "limbs passing through" in json.loads(rep.read_text())["refused"]
+    assert main(argv + ["--allow-contacts"]) == 0 and cc.load(out).n_frames == 40
+
+
 # ---------------------------------------------------------------------- latent fit, animate
 def test_latent_fit_options_reach_the_model(monkeypatch, takes, tmp_path):
     def run(*extra):  # a method's spy goes in before its class's

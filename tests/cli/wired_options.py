@@ -143,6 +143,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         **dict.fromkeys(("-o", "--report", "--plot"),
                         "tests/synthesis/test_graph_cli.py::test_generate_writes_motion_report_and_figures"),
         "--strict": W + "test_graph_strict_refuses_an_implausible_motion",
+        "--allow-contacts": W + "test_graph_refuses_limbs_through_each_other_unless_allowed",
         "--no-topo": W + "test_graph_crossval_options_reach_cross_validate",
         **dict.fromkeys(("--no-carry", "--no-lock"),
                         W + "test_graph_carry_and_lock_reach_the_synthesiser"),

@@ -292,3 +292,21 @@ def test_full_birth_follows_the_selected_class_on_joined_walks(cmu_dir):
     # landmarks are born later: 1.098x with rotation vectors (3.826 against 3.484), 1.1x+ in Euler
     assert lm.selection.birth > 1.05 * full.selection.birth
     assert lm.selection.full_birth == pytest.approx(full.selection.birth, rel=1e-5)
+
+
+def test_a_capture_that_loops_exactly_gets_one_landmark_per_pose():
+    """30 poses played over 400 frames (a keyframed clip looped): the greedy choice stops
+    at the 30 distinct poses instead of repeating them (repeated landmarks tied the
+    coordinate's least squares in knots: it turned 0.01 times over 13 strides)."""
+    from cyclecoord.periodic.landmarks import greedy_landmarks
+
+    t = np.arange(400) % 30 * (2 * np.pi / 30)
+    x = np.column_stack([np.cos(t), np.sin(t), 0.3 * np.cos(2 * t)]) * 20.0 + 100.0
+    idx, radius = greedy_landmarks(x, 150)
+    assert len(idx) == 30 and radius == 0.0
+    assert len(np.unique(x[idx].round(9), axis=0)) == 30
+    d = np.linalg.norm(x[:, None] - x[None], axis=2)
+    idx_d, radius_d = greedy_landmarks(d, 150, distance_matrix=True)
+    assert len(idx_d) == 30 and radius_d == 0.0
+    idx, _ = greedy_landmarks(x + np.random.default_rng(0).normal(0, 1e-3, x.shape), 150)
+    assert len(idx) == 150  # poses that differ are all candidates

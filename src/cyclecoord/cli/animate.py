@@ -88,7 +88,14 @@ def run(args: argparse.Namespace) -> int:
         f"{len(report['transitions'])} transitions{speed}"
     )
     for ev in report["transitions"]:
-        if ev["route"][1:] != ev["transition"][1:] or not ev["under_threshold"]:
+        if ev.get("in_step"):
+            a, b = ev["transition"]
+            print(
+                f"commands[{ev['command']}] TRANSITION {a} -> {b} in step at gait phase "
+                f"{ev['phase']:.2f} (pose distance {ev['bridge_distance']:.3g}, blend "
+                f"{ev['blend_frames']} frames)"
+            )
+        elif ev["route"][1:] != ev["transition"][1:] or not ev["under_threshold"]:
             a, b = ev["transition"]
             kind = (
                 "over a bridge"

@@ -52,8 +52,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=None,
         help="delaunay, knn or union, the Delaunay ones optionally with +ring (the simplices "
         "adjacent to the containing one) and +agree (neighbours weighted by agreement with the "
-        "path's heading), e.g. delaunay+ring+agree (generation; default delaunay, the paper's); "
-        "crossval takes a comma list (default delaunay,delaunay+ring+agree,knn,union)",
+        "path's heading), e.g. delaunay+ring+agree; any of them with +phase: the phase-aware "
+        "field that follows the gait's circular coordinate and never stalls (generation "
+        "default delaunay+phase; 'delaunay' is the paper's field); crossval takes a comma list "
+        "(default delaunay,delaunay+ring+agree,knn,union)",
     )
     p.add_argument(
         "--dims",
@@ -62,18 +64,6 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="latent PCA dimensions, or 'auto': the fewest explaining 85 %% of the joint-angle "
         "variance (generation default auto, so strides keep their amplitude; crossval default "
         "2, as the paper)",
-    )
-    p.add_argument(
-        "--no-carry",
-        action="store_true",
-        help="generation: keep the training frames' mean root step (the feet glide) instead of "
-        "moving the root as the feet on the ground carry it, and do not pin the feet",
-    )
-    p.add_argument(
-        "--no-lock",
-        action="store_true",
-        help="generation: do not pin the planted feet by leg IK (on by default where it adds "
-        "no pop)",
     )
     p.add_argument(
         "-k",
@@ -130,10 +120,34 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="crossval: also follow the field for this many times each left-out take, with "
         "freeze and slip columns (default 3; 0 skips it)",
     )
+    _feet_options(p)
     add_memory_option(p)
     p.set_defaults(func=run)
     declare(p, inputs=_files_read, files=("-o", "--report"), folders={"--plot": r".*\.png"})
     return p
+
+
+def _feet_options(p: argparse.ArgumentParser) -> None:
+    """Generation's options for the feet and the limbs."""
+    p.add_argument(
+        "--no-carry",
+        action="store_true",
+        help="generation: keep the training frames' mean root step (the feet glide) instead of "
+        "moving the root as the feet on the ground carry it, and do not pin the feet",
+    )
+    p.add_argument(
+        "--no-lock",
+        action="store_true",
+        help="generation: do not pin the planted feet by leg IK (on by default where it adds "
+        "no pop)",
+    )
+    p.add_argument(
+        "--allow-contacts",
+        action="store_true",
+        help="write the motion even when its limbs pass through each other (bone contacts the "
+        "training takes never make); by default such a motion is refused and only the report "
+        "is written",
+    )
 
 
 def _dims(text: str):
@@ -263,7 +277,7 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
     from ..synthesis.graph import MotionGraphSynth
     from .blend import finish
 
-    method = args.method or "delaunay"
+    method = args.method or "delaunay+phase"
     if "," in method:
         raise ParameterError(
             f"--method {method}: generation uses one method (a list is for 'graph crossval')"
@@ -311,7 +325,7 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         f"generated {gen.motion.n_frames} frames from {gen.start['take']}:{gen.start['frame']} "
         f"({gen.path.kind}; {gen.path.outside_hull_steps} steps outside the hull)"
     )
-    for note in gen.notes:
+    for note in synth.phase_notes_ + gen.notes:
         print(note)
     payload = {
         "method": method,
@@ -345,4 +359,27 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         for p in save_graph_figures(synth, gen, out.folder(args.plot)):
             out.wrote(Path(args.plot) / p.name)
     report = check_plausibility(gen.motion, motions)
+    crossing = [int(f) for f in getattr(report, "new_contact_frames", None) or []]
+    if crossing and not args.allow_contacts:
+        return _refuse_crossing(args, gen.motion, payload, report, crossing, out, quality)
     return finish(args, gen.motion, payload, report, "generated motion", out=out, quality=quality)
+
+
+def _refuse_crossing(args, motion, payload, report, frames, out, quality) -> int:
+    """Write the report, not a motion whose limbs pass through each other."""
+    from ..errors import ImplausibleMotionError
+    from .blend import finish
+
+    where = f"frames {frames[0]}-{frames[-1]}" if len(frames) > 1 else f"frame {frames[0]}"
+    why = (
+        f"generated motion has limbs passing through each other in {len(frames)} frames "
+        f"({where}); nothing written (--allow-contacts writes it anyway; another --start or "
+        "--method may avoid it)"
+    )
+    payload = {**payload, "refused": why}
+    try:
+        finish(argparse.Namespace(**{**vars(args), "strict": True}), motion, payload, report,
+               "generated motion", out=out, quality=quality)
+    except ImplausibleMotionError:
+        raise ImplausibleMotionError(why) from None
+    raise ImplausibleMotionError(why)  # pragma: no cover (finish refuses an unclean report)

@@ -193,8 +193,10 @@ def greedy_landmarks(
 
     Returns
     -------
-    indices : ndarray of int, shape (n,)
-        Landmarks in the order chosen.
+    indices : ndarray of int, shape (n,) or fewer
+        Landmarks in the order chosen; fewer than ``n`` when every point repeats one of
+        them (a capture that loops exactly, e.g. a keyframed clip played several times:
+        repeated landmarks tied the coordinate's least squares in knots).
     covering_radius : float
         Largest distance from any point to its nearest landmark (ripser's ``r_cover``).
     """
@@ -209,6 +211,8 @@ def greedy_landmarks(
     if not 0 <= start < T:
         raise ParameterError(f"start must index a point (0..{T - 1}), got {start}")
     sq = None if distance_matrix else np.einsum("ij,ij->i", x, x)
+    # a point this near a landmark repeats it (the product form's rounding for points)
+    same = 1e-9 * float(np.abs(x).max()) if distance_matrix else 1e-12 * float(sq.max())
     idx = np.empty(int(n), dtype=np.int64)
     nearest = np.full(T, np.inf)  # squared distances for points, distances for a matrix
     i = int(start)
@@ -230,6 +234,8 @@ def greedy_landmarks(
             np.minimum(nearest, d, out=nearest)
         nearest[i] = 0.0
         i = int(np.argmax(nearest))
+        if k + 1 < n and nearest[i] <= same:  # every point repeats a landmark
+            return idx[: k + 1], 0.0
     if n == T:
         return idx, 0.0
     # the farthest point's distance, exactly (the product form loses digits near 0)

@@ -72,6 +72,8 @@ CONTACT_HEIGHT = 0.03
 FAST_CONTACT = 0.5
 #: Cadence search window, seconds.
 CYCLE_RANGE = (0.4, 2.5)
+#: The leg cycle is the first autocorrelation peak at least this fraction of the highest.
+CYCLE_PEAK = 0.85
 
 
 # ------------------------------------------------------------------ geometry
@@ -205,7 +207,14 @@ def _cycle(signal: np.ndarray, fps: float) -> float:
     spec = np.fft.rfft(k, 2 * n)
     ac = np.fft.irfft(spec * np.conj(spec))[:n] / np.arange(n, 0, -1)
     ac = ac / ac[0]
-    return (lo + int(np.argmax(ac[lo:hi]))) / fps
+    win = ac[lo:hi]
+    # the first local peak within CYCLE_PEAK of the highest: a clean capture's two cycles
+    # correlate as well as one (the synthetic walk of 1.1 s read 2.23 s by the highest)
+    top = float(win.max())
+    for k in range(1, win.size - 1):
+        if win[k] >= win[k - 1] and win[k] >= win[k + 1] and win[k] >= CYCLE_PEAK * top:
+            return (lo + k) / fps
+    return (lo + int(np.argmax(win))) / fps
 
 
 def _support(kin: _Kin, rig: _Rig) -> np.ndarray:
@@ -355,6 +364,7 @@ class GeneratedQuality:
     source_root_speed: float
     held_frames: int = 0
     notes: list[str] = field(default_factory=list)
+    knee_p99: tuple[float, ...] = ()  # degrees of flexion per leg (the table)
 
     # ---- derived
     @property
@@ -472,6 +482,7 @@ class GeneratedQuality:
             "longest_freeze_s": f(self.longest_freeze_s),
             "held_frames": self.held_frames,
             "knee_range_deg": [f(x) for x in self.knee_range],
+            "knee_p99_deg": [f(x) for x in self.knee_p99],
             "hip_range_deg": [f(x) for x in self.hip_range],
             "knee_range_ratio": [f(x) for x in self.knee_ratio],
             "hip_range_ratio": [f(x) for x in self.hip_ratio],
@@ -581,6 +592,7 @@ def measure_generated(
         source_root_speed=ref.root_speed * m,
         held_frames=int(held.sum()),
         notes=notes,
+        knee_p99=tuple(float(x) for x in np.percentile(kin.knee, 99, axis=0)),
     )
 
 

@@ -16,7 +16,9 @@ is what a viewer sees: how far the body's points move.
   step on the frames the cycle was made from;
 * **nearest-pose distance**: each cycle pose's distance to the nearest captured pose,
   over the capture's own **spread**, the 90th percentile over captured poses of the
-  distance to the nearest pose of another repetition (at least half a period away).
+  distance to the nearest pose of another repetition (at least half a period away), and
+  at least the capture's median frame step (a capture that repeats exactly has no
+  spread of its own).
   Under 1, a cycle pose is as close to something the actor did as nine in ten captured
   poses are to another repetition;
 * **jerk**: the mean norm of the points' third derivative (length units / s³), cycle over
@@ -41,6 +43,11 @@ MAX_POP = 2.0
 MAX_SEAM = 1.5
 #: Captured frames compared against (a long take is sampled evenly down to this).
 MAX_REFERENCE_FRAMES = 20_000
+#: The spread is at least this part of the capture's median frame step: a capture that
+#: repeats exactly (a synthetic walk) has a spread near 0, and a cycle pose between two of
+#: its frames is then as close to a captured pose as the sampling lets it be.
+SPREAD_FLOOR = 1.0
+
 #: Captured poses (evenly spaced) whose nearest other repetition gives the spread.
 MAX_SPREAD_PROBES = 2_000
 
@@ -251,6 +258,8 @@ def pose_quality(
     best = d.min(axis=1)
     best = best[np.isfinite(best)]
     spread = float(np.percentile(best, 90)) if best.size else float("nan")
+    if cap_steps.size:  # the sampling's own resolution (a capture that repeats exactly)
+        spread = max(spread, SPREAD_FLOOR * float(np.median(cap_steps)))
     jc = _jerk(cyc, cycle.fps, cyclic=True)
     jo = np.average([_jerk(p, capture.fps / every, False) for p in parts if len(p) >= 5],
                     weights=[len(p) for p in parts if len(p) >= 5]) \

@@ -381,10 +381,12 @@ def _solve(ik: _LegIK, rows, targets, weights, scale, iterations=_ITERATIONS):
     reg = _REGULARISATION * np.radians(1.0)  # the variables are in degrees
     eps = 1e-4
 
-    def residual(qq):
-        p = ik.positions(qq, rows)
-        r = (p - targets) * weights / scale
-        return np.concatenate([r.reshape(len(rows), -1), reg * (qq - q0)], axis=1)
+    def residual(qq, copies: int = 1):
+        """Residuals of ``copies`` stacked sets of variables ``(copies * n, V)`` on ``rows``
+        (one forward-kinematics pass for a whole finite-difference Jacobian)."""
+        p = ik.positions(qq, np.tile(rows, copies)).reshape((copies, len(rows)) + targets.shape[1:])
+        r = ((p - targets) * weights / scale).reshape(copies * len(rows), -1)
+        return np.concatenate([r, reg * (qq - np.tile(q0, (copies, 1)))], axis=1)
 
     def cost(rr):
         return np.einsum("ij,ij->i", rr, rr)
@@ -394,11 +396,10 @@ def _solve(ik: _LegIK, rows, targets, weights, scale, iterations=_ITERATIONS):
     r = residual(q)
     c = cost(r)
     for _ in range(iterations):
-        J = np.empty(r.shape + (V,))
-        for v in range(V):
-            dq = q.copy()
-            dq[:, v] += eps
-            J[:, :, v] = (residual(dq) - r) / eps
+        dq = np.repeat(q[None], V, axis=0)  # (V, n, V): variable v nudged in copy v
+        dq[np.arange(V), :, np.arange(V)] += eps
+        J = (residual(dq.reshape(V * n, V), V).reshape(V, n, -1) - r) / eps
+        J = np.moveaxis(J, 0, 2)  # (n, residuals, V)
         JT = np.swapaxes(J, 1, 2)
         JTJ = JT @ J
         diag = np.einsum("nvv->nv", JTJ)

@@ -8,7 +8,10 @@ weighted by agreement with the path's heading, ``"delaunay+ring+agree"``, which 
 2-D paths from stalling at a walk's cusps), paths that follow it or run to a target
 along the graph (:func:`follow_field`, :func:`path_to_target`), a playable result with a
 root trajectory (:class:`MotionGraphSynth`) and the paper's leave-one-out table
-(:func:`cross_validate`).
+(:func:`cross_validate`).  Beyond the paper, ``"delaunay+phase"`` (what ``cyclecoord
+graph`` generates with) follows a phase-aware field instead (:mod:`.phase`): the periodic
+pipeline's circular coordinate gives every training frame a phase, so the path keeps
+moving through the cusps where the paper's field stalls.
 """
 
 from .build import METHODS, MotionGraph, build_graph, training_vectors

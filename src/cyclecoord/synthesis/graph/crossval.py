@@ -359,6 +359,22 @@ def _graph_summary(takes: list, methods: list, dims: int, k: int, names: list) -
     return graph
 
 
+#: A fold graph's connectivity figures kept in :attr:`CrossValidation.fold_graphs`.
+_GRAPH_KEYS = ("nodes", "edges", "weak_components", "strong_components", "coplanar_dropped")
+#: The longer horizon's figures, medians over the folds per method.
+_LONG_KEYS = ("error_a_deg", "error_f_deg", "longest_freeze_s", "support_slip", "slip_ratio")
+
+
+def _long_medians(folds: list, methods: Sequence[str]) -> dict:
+    """Per method, the medians of the longer horizon's figures and the folds that froze."""
+    long = {}
+    for m in methods:
+        rows = [r["long"] for r in folds if r["method"] == m and "long" in r]
+        long[m] = {k: _nanmedian([r.get(k) for r in rows]) for k in _LONG_KEYS}
+        long[m]["freeze_folds"] = float(sum(1 for r in rows if r.get("freezes")))
+    return long
+
+
 @one_blas_thread
 def cross_validate(
     motions: Sequence[Motion],
@@ -449,41 +465,14 @@ def cross_validate(
             folds.append(row)
             paths[(names[i], method)] = path
             fold_graphs.append(
-                {
-                    "held_out": names[i],
-                    "method": method,
-                    **{
-                        key: c[key]
-                        for key in (
-                            "nodes",
-                            "edges",
-                            "weak_components",
-                            "strong_components",
-                            "coplanar_dropped",
-                        )
-                    },
-                    "H_connected": c["H"]["connected"],
-                }
+                {"held_out": names[i], "method": method, **{key: c[key] for key in _GRAPH_KEYS},
+                 "H_connected": c["H"]["connected"]}
             )
         train_names = [names[q] for q in range(len(takes)) if q != i]
         for key, row in _baseline_rows(ev, space, train, train_names, n).items():
             base[key].append({"held_out": names[i], **row})
     median = {m: _median([r for r in folds if r["method"] == m]) for m in methods}
-    long = {}
-    if horizon and horizon > 1:
-        for m in methods:
-            rows = [r["long"] for r in folds if r["method"] == m and "long" in r]
-            long[m] = {
-                k: _nanmedian([r.get(k) for r in rows])
-                for k in (
-                    "error_a_deg",
-                    "error_f_deg",
-                    "longest_freeze_s",
-                    "support_slip",
-                    "slip_ratio",
-                )
-            }
-            long[m]["freeze_folds"] = float(sum(1 for r in rows if r.get("freezes")))
+    long = _long_medians(folds, methods) if horizon and horizon > 1 else {}
     baselines = {b: {"folds": rows, "median": _median(rows)} for b, rows in base.items()}
     graph = _graph_summary(takes, methods, dims, k, names)
     params = {

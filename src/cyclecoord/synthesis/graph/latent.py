@@ -178,17 +178,31 @@ class PoseSpace:
         )
         return (a - self.mean_) @ self.components_.T
 
+    def residuals(self, motions: Sequence[Motion]) -> np.ndarray:
+        """What the latent space leaves out of each training frame: angles ``(N, A)``
+        minus their reconstruction, the takes' frames one after another."""
+        a = np.vstack([self.angles(m) for m in motions])
+        return a - self.inverse_transform(self.transform(a))
+
     def inverse_transform(self, z: np.ndarray) -> np.ndarray:
         """Joint angles ``(T, A)`` in degrees from latent points ``(T, d)``."""
         return np.asarray(z, dtype=float) @ self.components_ + self.mean_
 
-    def motion(self, z: np.ndarray, template: Motion, root: np.ndarray | None = None) -> Motion:
+    def motion(
+        self,
+        z: np.ndarray,
+        template: Motion,
+        root: np.ndarray | None = None,
+        detail: np.ndarray | None = None,
+    ) -> Motion:
         """A playable :class:`Motion`: ``template``'s channels and skeleton, joint angles
-        from ``z`` (wrapped into [-180, 180)), root channels from ``root`` ``(T, R)``
-        (zeros when None), other channels at the template's first frame."""
+        from ``z`` plus ``detail`` ``(T, A)`` when given (wrapped into [-180, 180)), root
+        channels from ``root`` ``(T, R)`` (zeros when None), other channels at the
+        template's first frame."""
         z = np.asarray(z, dtype=float)
         frames = np.repeat(np.asarray(template.frames[:1], dtype=float), z.shape[0], axis=0)
-        frames[:, self.columns_] = (self.inverse_transform(z) + 180.0) % 360.0 - 180.0
+        angles = self.inverse_transform(z) + (0.0 if detail is None else detail)
+        frames[:, self.columns_] = (angles + 180.0) % 360.0 - 180.0
         rc = template.root_channels()
         frames[:, rc] = 0.0 if root is None else root
         return template.with_frames(

@@ -27,6 +27,10 @@ __all__ = ["MotionGraphSynth", "Generation", "take_name", "AUTO_VARIANCE", "auto
 #: feet stay within a centimetre of the floor and slide against each other (support foot
 #: 0.96 m/s with the root carried by the feet); 4 explain 85 % and keep the stride.
 AUTO_VARIANCE = 0.85
+#: Gaussian width (s) of the smoothing of a phase-aware path's detail (the neighbours'
+#: joint angles the latent space leaves out): neighbours entering and leaving the
+#: neighbourhood change it faster than the pose itself changes.
+DETAIL_SMOOTH = 0.025
 #: Largest ``"auto"`` dimension.
 AUTO_MAX_DIMS = 6
 
@@ -74,7 +78,10 @@ class MotionGraphSynth:
     method : str, default "delaunay"
         ``"delaunay"``, ``"knn"`` or ``"union"``, optionally with the field options
         ``+ring`` and ``+agree`` (:func:`~.field.parse_variant`), e.g.
-        ``"delaunay+ring+agree"``.
+        ``"delaunay+ring+agree"``; or with ``+phase`` (``"delaunay+phase"``, what
+        ``cyclecoord graph`` generates with): the phase-aware field of
+        :mod:`~.phase`, which follows the gait's circular coordinate through the cusps
+        where the paper's field stalls (the graph still serves :meth:`to_target`).
     dims : int or "auto", default 2
         Latent dimensions (the paper's 2); ``"auto"``: :func:`auto_dims` (what ``cyclecoord
         graph`` generates with).
@@ -121,7 +128,7 @@ class MotionGraphSynth:
 
     @one_blas_thread
     def fit(self, takes: Sequence[Motion]) -> "MotionGraphSynth":
-        method, ring, agree = parse_variant(self.method)
+        method, ring, agree, phase = _parse(self.method)
         if self.integrator not in INTEGRATORS:
             raise ParameterError(
                 f"unknown integrator {self.integrator!r}; choose from {', '.join(INTEGRATORS)}"
@@ -134,6 +141,15 @@ class MotionGraphSynth:
         latent = [self.space_.transform(m) for m in self.takes_]
         self.graph_: MotionGraph = build_graph(latent, method, self.k, self.names_)
         self.field_ = VectorField(self.graph_, ring=ring, agree=agree)
+        self.phase_field_ = None
+        self.phase_notes_: list[str] = []
+        if phase:
+            from .phase import PhaseField, take_phases
+
+            tp = take_phases(self.takes_, latent)
+            self.phase_notes_ = tp.notes
+            self.phase_field_ = PhaseField(self.graph_, tp.phases)
+            self.residual_ = self.space_.residuals(self.takes_)
         return self
 
     def _start(self, start: Motion | int, frame: int) -> tuple[Motion, int, str]:
@@ -188,7 +204,12 @@ class MotionGraphSynth:
             check_memory(n_frames * 8.0 * (8 * D + 64), f"{n_frames:,} generated frames")
         motion, f, name = self._start(start, frame)
         x0 = self.space_.transform(motion[f])[0]
-        path = follow_field(self.field_, x0, n_frames, self.integrator, self.step_scale)
+        if self.phase_field_ is not None:
+            from .phase import follow_phase
+
+            path = follow_phase(self.phase_field_, x0, n_frames, self.step_scale)
+        else:
+            path = follow_field(self.field_, x0, n_frames, self.integrator, self.step_scale)
         return self._result(path, motion, f, name, x0)
 
     @one_blas_thread
@@ -212,7 +233,14 @@ class MotionGraphSynth:
         self, path: GraphPath, motion: Motion, f: int, name: str, x0: np.ndarray
     ) -> Generation:
         root = root_trajectory(self.takes_, path, motion, f)
-        out = self.space_.motion(path.points, self.takes_[0], root)
+        detail = None
+        if path.phases is not None and self.phase_field_ is not None:
+            # the neighbours share the path's phase: their detail is the pose's
+            from scipy.ndimage import gaussian_filter1d
+
+            detail = np.einsum("nk,nka->na", path.weights, self.residual_[path.neighbours])
+            detail = gaussian_filter1d(detail, DETAIL_SMOOTH * motion.fps, axis=0, mode="nearest")
+        out = self.space_.motion(path.points, self.takes_[0], root, detail)
         notes = []
         if self.carry and self.floor_ is not None:
             from ..carry import carry_by_feet, channel_bounds, lock_where_clean
@@ -238,6 +266,21 @@ class MotionGraphSynth:
             start={"take": name, "frame": f, "latent": x0.tolist()},
             notes=notes,
         )
+
+
+def _parse(method: str) -> tuple[str, bool, bool, bool]:
+    """``"METHOD[+ring][+agree][+phase]"`` -> ``(method, ring, agree, phase)``."""
+    parts = [p.strip() for p in str(method).split("+")]
+    phase = "phase" in parts[1:]
+    rest = "+".join(p for p in parts if p != "phase" or p is parts[0])
+    if phase and parts.count("phase") > 1:
+        raise ParameterError(f"{method!r}: +phase once")
+    m, ring, agree = parse_variant(rest)
+    if phase and (ring or agree):
+        raise ParameterError(
+            f"{method!r}: +phase replaces the Delaunay field, so +ring and +agree do not apply"
+        )
+    return m, ring, agree, phase
 
 
 def _ground(takes: Sequence[Motion]) -> tuple[float | None, float | None]:

@@ -68,6 +68,9 @@ class GraphPath:
         ``"graph:<method>"``.
     nodes : ndarray of int or None
         The graph nodes a shortest path visits.
+    phases : ndarray or None
+        The gait phase (cycles) of each point on a phase-aware path
+        (:mod:`~cyclecoord.synthesis.graph.phase`).
     """
 
     points: np.ndarray
@@ -77,6 +80,7 @@ class GraphPath:
     speed: float
     kind: str
     nodes: np.ndarray | None = None
+    phases: np.ndarray | None = None
 
     @property
     def n_frames(self) -> int:

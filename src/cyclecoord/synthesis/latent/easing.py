@@ -21,14 +21,17 @@ def smoothstep(n: int) -> np.ndarray:
     return u * u * (3.0 - 2.0 * u)
 
 
-def eased(n: int, ramp: int) -> np.ndarray:
-    """Arc-length fractions ``(n + 1,)`` from 0 to 1: constant speed with smooth starts and
-    stops over ``ramp`` frames (speed rising as a smoothstep), so a MOVE does not jerk the
-    particle into motion or stop it dead."""
+def eased(n: int, ramp: int, ramp_out: int | None = None) -> np.ndarray:
+    """Arc-length fractions ``(n + 1,)`` from 0 to 1: constant speed with a smooth start
+    over ``ramp`` frames and a smooth stop over ``ramp_out`` (default ``ramp``; speed
+    rising as a smoothstep; 0: none), so a MOVE does not jerk the particle into motion or
+    stop it dead, and one MOVE of a chain flows into the next."""
     k = np.arange(n, dtype=float) + 0.5
+    ramp_out = ramp if ramp_out is None else ramp_out
     r = max(1e-9, min(float(ramp), n / 2.0))
-    rise = np.clip(k / r, 0, 1)
-    fall = np.clip((n - k) / r, 0, 1)
+    r2 = max(1e-9, min(float(ramp_out), n / 2.0))
+    rise = np.clip(k / r, 0, 1) if ramp > 0 else np.ones(n)
+    fall = np.clip((n - k) / r2, 0, 1) if ramp_out > 0 else np.ones(n)
     v = np.minimum(rise * rise * (3 - 2 * rise), fall * fall * (3 - 2 * fall))
     c = np.concatenate([[0.0], np.cumsum(v)])
     return c / c[-1]

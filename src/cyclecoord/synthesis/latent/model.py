@@ -145,6 +145,7 @@ class LatentModel:
     def fit(
         self, motions: Sequence[Motion], names: Sequence[str] | None = None, *,
         progress: bool = False,
+        gait: bool = True,
     ) -> LatentModel:
         """Fit to training segments (each a contiguous capture; same channels and rate).
 
@@ -157,6 +158,9 @@ class LatentModel:
             One name per segment (default ``"segment0"``, ...).
         progress : bool, default False
             A tqdm bar on stderr over the GPLVM's optimisation (shown after 1 s).
+        gait : bool, default True
+            Also find the gait phase of every training frame (:meth:`gait`; a segment
+            without a cycle gets none), which MOVEs ``ahead`` and in-step TRANSITIONs use.
         """
         if not motions:
             raise ParameterError("a latent model needs at least one training segment")
@@ -220,7 +224,19 @@ class LatentModel:
             n_components=self.n_components, random_state=self.random_state, **(self.gplvm or {})
         ).fit(self.Y_, self.segments_, self.times_, progress=progress)
         self._precompute()
+        self.gait_ = None
+        if gait:
+            self.gait()
         return self
+
+    def gait(self):
+        """The gait phase of every training frame (:func:`~.gait.training_gait`, from the
+        periodic pipeline's circular coordinate; computed once, saved with the model)."""
+        if getattr(self, "gait_", None) is None:
+            from .gait import training_gait
+
+            self.gait_ = training_gait(self)
+        return self.gait_
 
     def _precompute(self) -> None:
         self.X_ = self.gp_.X_
@@ -367,6 +383,9 @@ class LatentModel:
                 ),
             }
         )
+        g = getattr(self, "gait_", None)
+        if g is not None:
+            arrays.update({"gait_phase": g.phase, "gait_period": g.period})
         with atomic_write(path, "wb") as fh:
             np.savez_compressed(fh, **arrays)
 
@@ -455,6 +474,19 @@ class LatentModel:
             m.gp_ = GPLVM.from_arrays(X, *hyper, m.Y_)
         except ParameterError as exc:
             raise ParseError(f"arrays 'X', 'hyper', 'Y': {exc}", spath) from None
+        if "gait_phase" in arrays:  # files written before the gait phase compute it on use
+            from .gait import Gait
+
+            phase = a.reals("gait_phase", (N,), allow_nan=True)  # NaN: a segment without gait
+            period = a.get("gait_period")
+            S = period.shape[0] if period.ndim == 1 else -1
+            if S < len(names):
+                raise a.error("gait_period", f"expected one period per segment ({len(names)}), "
+                              f"got shape {period.shape}")
+            period = a.reals("gait_period", (S,), allow_nan=True)
+            if (period <= 0).any():
+                raise a.error("gait_period", "frames per cycle are positive")
+            m.gait_ = Gait(phase, period, m.segments_)
         starts = np.flatnonzero(np.r_[True, m.segments_[1:] != m.segments_[:-1]])
         stops = np.r_[starts[1:], len(m.segments_)]
         try:

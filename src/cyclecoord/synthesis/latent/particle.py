@@ -123,6 +123,7 @@ def simulate(
     params: ParticleParams,
     force: RandomForce | None,
     t0: float = 0.0,
+    ride: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Move the particle along ``path``, one RK4 step a frame.
 
@@ -138,6 +139,13 @@ def simulate(
     force : RandomForce or None
     t0 : float
         Time of ``path[0]`` in seconds (keeps the random force continuous across commands).
+    ride : bool, default False
+        The particle rides the path: each change of the path's velocity at a vertex is
+        added to the particle's, so the forces act on its motion relative to the path.
+        Without it a particle behind a fast, curving path (a run's latent loop, a cycle
+        in 0.7 s) cut its corners and bounced off the radius: on the synthetic run the
+        joints accelerated up to 3.3x the training 99th percentile (4.9x without the
+        random and likelihood forces), 1.2x riding.
 
     Returns
     -------
@@ -177,11 +185,15 @@ def simulate(
                 F = F + lam * g
         return F
 
+    before = None
     # a diverging integration overflows before it is refused below (one line, no warnings)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         for k in range(T):
             p0, p1 = path[k], path[k + 1]
             pd = (p1 - p0) * fps
+            if ride and before is not None:
+                v = v + (pd - before)
+            before = pd
             t = t0 + k * dt
             pm = 0.5 * (p0 + p1)
             k1x, k1v = v, accel(x, v, p0, pd, t)

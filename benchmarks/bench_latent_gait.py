@@ -1,0 +1,203 @@
+"""Latent synthesis with a gait (issue 24 item 4): cadence, flowing MOVE chains, walk-run
+transitions in step, joints not flattened, freezes, IDLE, slip, pops, leg ranges, speed.
+
+Run from a checkout::
+
+    python benchmarks/bench_latent_gait.py [--quick] [--no-shared]
+
+Model pairs (30 fps, every 4th frame of 120 fps captures): a synthetic walk (1.1 s leg
+cycle) and run (0.7 s) from ``cyclecoord.datasets`` (two 5 s segments each), and the
+shared subject 35 walks (35_07/08/13/16) with the 143_01 jog.  The script, in the style
+of ``examples/latent_script.json``: walk 3 s (ten MOVEs ``{"ahead": 0.3}``), TRANSITION
+run, run 3 s (ten MOVEs), TRANSITION walk, IDLE 2 s.  Each gait section is measured by
+``cyclecoord.quality.generated`` against its own model's training takes; the whole
+motion is also checked by ``../shared/tools/motioncheck`` (independent kinematics).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+
+import cyclecoord as cc  # noqa: E402
+from cyclecoord.quality.generated import measure_generated  # noqa: E402
+from cyclecoord.synthesis.latent import LatentModel  # noqa: E402
+from cyclecoord.synthesis.latent.script import run_script, training_takes  # noqa: E402
+
+SHARED = ROOT.parent / "shared"
+CHECKER = SHARED / "tools" / "motioncheck" / "motioncheck.py"
+
+
+def synthetic_pair(quick: bool) -> dict:
+    out = {}
+    for name, kind, period, seed in (("walk", "walk", 132, 0), ("run", "jog", 84, 1)):
+        n = 960 if quick else 1200
+        m = cc.datasets.make_periodic_capture(
+            kind=kind, n_frames=n, period=period, noise=0.3, speed_variation=0.1,
+            random_state=seed,
+        ).motion
+        out[name] = [m[0 : n // 2 : 4], m[n // 2 : n : 4]]
+    return out
+
+
+def shared_pair() -> dict | None:
+    cmu = SHARED / "data" / "cmu"
+    walks = [cmu / "35" / f"35_{k}.amc" for k in ("07", "08", "13", "16")]
+    jog = cmu / "143" / "143_01.amc"
+    if not all(p.is_file() for p in walks + [jog]):
+        return None
+    return {"walk": [cc.load(p)[::4] for p in walks], "run": [cc.load(jog)[::4]]}
+
+
+def script(d: Path, blend: float = 0.4) -> Path:
+    ahead = [{"command": "MOVE", "to": {"ahead": 0.3}} for _ in range(10)]
+    spec = {
+        "fps": 30, "seed": 0, "models": {"walk": "walk.npz", "run": "run.npz"},
+        "start": {"model": "walk", "at": {"frame": 0}},
+        "commands": ahead + [{"command": "TRANSITION", "to": "run", "blend": blend}] + ahead
+        + [{"command": "TRANSITION", "to": "walk", "blend": blend},
+           {"command": "IDLE", "duration": 2.0}],
+    }
+    p = d / f"script_{blend:g}.json"
+    p.write_text(json.dumps(spec, indent=1))
+    return p
+
+
+def flattened(motion, models) -> int:
+    """Runs of 3+ frames where a joint angle sits still at its training range's end."""
+    count = 0
+    for m in models.values():
+        a = m.angles(motion.frames)
+        lo, hi = m.angles(m.frames_).min(0), m.angles(m.frames_).max(0)
+        at = ((np.abs(a - lo) < 1e-6) | (np.abs(a - hi) < 1e-6)) & (hi - lo > 1e-6)
+        still = np.r_[np.zeros((1, a.shape[1]), bool), np.abs(np.diff(a, axis=0)) < 1e-9]
+        run = at & still
+        count += int((run[1:] & run[:-1]).sum())
+    return count
+
+
+def sections(report) -> dict:
+    """Frames of the walk chain, the run chain, each TRANSITION and the IDLE."""
+    segs = report["commands"]
+
+    def span(cmds):
+        rows = [s for s in segs if s["command"] in cmds]
+        return rows[0]["start"], rows[-1]["stop"]
+
+    return {"walk": span(range(0, 10)), "T1": span([10]), "run": span(range(11, 21)),
+            "T2": span([21]), "idle": span([22])}
+
+
+def measure_pair(label: str, takes: dict, d: Path, quick: bool) -> None:
+    models = {}
+    for name, segs in takes.items():
+        t = time.perf_counter()
+        lm = LatentModel(gplvm={"max_iter": 100 if quick else 200}).fit(
+            segs, [f"{name}{k}" for k in range(len(segs))]
+        )
+        lm.save(d / f"{name}.npz")
+        models[name] = lm
+        g = lm.gait()
+        print(f"  {name}: {lm.X_.shape[0]} frames, fitted in {time.perf_counter() - t:.1f} s, "
+              f"gait period {np.nanmedian(g.period) / lm.fps_:.2f} s on "
+              f"{len(g.usable)}/{len(g.period)} segments")
+    t0 = time.perf_counter()
+    motion, rep = run_script(script(d))
+    wall = time.perf_counter() - t0
+    sec = sections(rep)
+    print(f"  script: {motion.n_frames} frames ({motion.duration:.1f} s); walk chain "
+          f"{(sec['walk'][1] - sec['walk'][0]) / 30:.2f} s for 3 s asked")
+    print("  section  slip m/s (x capt)  knee/hip range (min of capt)  cycle s (x capt)  "
+          "accel x p99  longest freeze s")
+    for part in ("walk", "run"):
+        a, b = sec[part]
+        src = training_takes(models, [part])
+        q = measure_generated(motion[a:b], src)
+        print(f"  {part:7s}  {q.support_slip:.2f} ({q.slip_ratio:.2f}x)           "
+              f"{min(q.knee_ratio):.2f} / {min(q.hip_ratio):.2f}                  "
+              f"{q.cycle_s:.2f} ({q.cadence_ratio:.2f}x)       {q.largest_accel:.2f}        "
+              f"{q.longest_freeze_s:.2f}")
+    whole = measure_generated(motion, training_takes(models), hold=_hold(motion, sec))
+    print(f"  whole: slip {whole.support_slip:.2f} m/s ({whole.slip_ratio:.2f}x captures), "
+          f"accel {whole.largest_accel:.2f}x p99, freezes outside IDLE "
+          f"{len(whole.freezes)} (longest {whole.longest_freeze_s:.2f} s)")
+    for ev, key in zip(rep["transitions"], ("T1", "T2")):
+        done = (sec[key][1] - sec[key][0]) / 30
+        print(f"  TRANSITION {' -> '.join(ev['transition'])}: in step {ev.get('in_step', False)}, "
+              f"route {'/'.join(ev['route'])}, completes {done:.2f} s after the command")
+    a, b = sec["idle"]
+    root = motion.skeleton.joints[0].name
+    cols = [motion.channel_index(root, "tx"), motion.channel_index(root, "tz")]
+    r = motion.frames[a + 15 : b][:, cols]
+    step = np.linalg.norm(r[5:] - r[:-5], axis=1).max() * 30 / 5  # over 1/6 s
+    idle_speed = step * cc.rig.metres_per_unit(motion)
+    print(f"  IDLE after 0.5 s: largest root speed {idle_speed:.3f} m/s")
+    print(f"  joints: {rep['clamped_to_training_range']['values']} values eased into the range "
+          f"(largest {rep['clamped_to_training_range']['max_deg']:.1f} deg), "
+          f"{flattened(motion, models)} flattened frames")
+    t = rep["timing"]
+    print(f"  speed: synthesis {motion.duration / t['particle_and_pose_s']:.0f}x real time "
+          f"(CPU {motion.duration / t['particle_and_pose_cpu_s']:.0f}x), whole script incl. "
+          f"planting {motion.duration / wall:.1f}x")
+    try:
+        run_script(script(d, blend=0.01))
+    except cc.errors.ParameterError as exc:
+        print(f"  blend 0.01 s: error: {str(exc).split(': ', 2)[-1]}")
+    _, short = run_script(script(d, blend=0.034))
+    said = [n for n in short["notes"] if "blend raised" in n]
+    print(f"  blend 0.034 s: {said[0].split(': ', 1)[1] if said else 'not raised'}")
+    _check(motion, models, d, a)
+
+
+def _hold(motion, sec):
+    h = np.zeros(motion.n_frames, bool)
+    h[sec["idle"][0] : sec["idle"][1]] = True
+    return h
+
+
+def _check(motion, models, d: Path, idle_start: int) -> None:
+    if not CHECKER.is_file():
+        return
+    out = d / "out.bvh"
+    cc.save(motion, out)
+    srcs = []
+    for k, m in enumerate(training_takes(models)):
+        p = d / f"src{k}.bvh"
+        cc.save(m, p)
+        srcs.append(str(p))
+    idle = (motion.n_frames - idle_start) / 30
+    r = subprocess.run([sys.executable, str(CHECKER), str(out), "--sources", *srcs,
+                        "--idle-last", f"{idle:.2f}"], capture_output=True, text=True)
+    for line in (r.stdout or r.stderr).strip().splitlines():
+        print(f"  motioncheck: {line}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="shorter takes, fewer iterations")
+    ap.add_argument("--no-shared", action="store_true", help="the synthetic pair only")
+    args = ap.parse_args(argv)
+    pairs = [("synthetic walk + run", synthetic_pair(args.quick))]
+    if not args.no_shared:
+        sp = shared_pair()
+        if sp is not None:
+            pairs.append(("subject 35 walks + 143_01 jog", sp))
+    for label, takes in pairs:
+        print(label)
+        with tempfile.TemporaryDirectory() as tmp:
+            measure_pair(label, takes, Path(tmp), args.quick)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

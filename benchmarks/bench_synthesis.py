@@ -1,0 +1,272 @@
+"""Generated motion against the captures and two baselines everyone knows (issue 24, item 5).
+
+Run from a checkout::
+
+    python benchmarks/bench_synthesis.py [--frames 1200] [--json out.json] [--data DIR]
+                                         [--no-limbs]
+
+For each set -- subject 35's walks (set w1: 35_16, 35_07, 35_08, 35_13; a walk of
+``--frames`` frames) and the 143_01 jog (one 100-frame take; a run of half as many
+frames) -- every method generates from the first take's frame 0 and is measured with
+one measure, :func:`cyclecoord.quality.generated.measure_generated`, against the set's
+captures:
+
+* **graph (ours)**: ``cyclecoord graph``'s defaults: the phase-aware field
+  (``delaunay+phase``), latent dims ``auto``, root carried by the feet, feet pinned
+  where clean;
+* **graph (paper, 2-D)**: Gauch & Peters' Delaunay field in 2 dims with the training
+  frames' mean root step, at the captured speed (``step_scale=2``);
+* **classic graph**: Kovar, Gleicher & Pighin 2002
+  (:class:`cyclecoord.synthesis.classic_graph.ClassicMotionGraph`), random walk, seed 0;
+* **nearest-take replay**: the training take nearest the start pose, cut to the nearest
+  pose at each take's end (:func:`~cyclecoord.synthesis.classic_graph.replay_nearest`);
+* **captures**: each training take itself (min-max over the takes).
+
+Columns: support-foot slip (m/s), freezes (count, longest seconds), knee flexion p99
+left / right (degrees), the smallest knee and hip p1-p99 range against the captures'
+(target >= 0.9), largest acceleration against the sources' p99 (target <= 1.5), leg
+cycle against the captures' at the same root speed, root speed (m/s), and frames where
+limbs pass through each other that the captures never do (``--no-limbs`` skips that
+check).  Then ratios of ours against each baseline measured in the same run, and CPU
+seconds: fitting, and generating 1,200 frames (target under 1 CPU-s), with and without
+the foot pinning.  The 143_01 jog is one take: our graph (two takes at least) is trained
+on its two halves; a walk-run-walk-idle script needs walks and runs of one skeleton,
+which the shared data does not hold.  Without the CMU data it runs on synthetic walks
+and says so.  Speed is printed, never asserted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import cyclecoord as cc
+from cyclecoord.errors import CycleCoordError
+from cyclecoord.io import atomic_write
+from cyclecoord.quality.generated import measure_generated, source_figures
+from cyclecoord.synthesis.classic_graph import THRESHOLD, ClassicMotionGraph, replay_nearest
+from cyclecoord.synthesis.graph import MotionGraphSynth
+
+DATA_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+W1 = ("35_16", "35_07", "35_08", "35_13")
+METHODS = ("graph (ours)", "graph (paper, 2-D)", "classic graph", "nearest-take replay")
+OURS = dict(method="delaunay+phase", dims="auto", step_scale=2.0)
+PAPER = dict(method="delaunay", dims=2, step_scale=2.0, carry=False)
+
+
+def load_sets(data: Path, frames: int) -> list[dict]:
+    """``[{name, takes, train, frames}]``: the shared walks and jog, or synthetic walks."""
+    sets = []
+    walks = [data / "cmu" / "35" / f"{n}.amc" for n in W1]
+    if all(p.is_file() for p in walks):
+        takes = [cc.load(p) for p in walks]
+        sets.append({"name": "walk: CMU 35 (w1)", "takes": takes, "train": takes,
+                     "frames": frames})
+    jog = data / "cmu" / "143" / "143_01.amc"
+    if jog.is_file():
+        m = cc.load(jog)
+        half = m.n_frames // 2
+        sets.append({"name": "run: CMU 143_01 jog (our graph on its halves)", "takes": [m],
+                     "train": [m[:half], m[half:]], "frames": frames // 2})
+    if not sets:
+        print(f"NOTE: no CMU data under {data}; four synthetic walks instead")
+        takes = [
+            cc.datasets.make_periodic_capture(kind="walk", n_frames=n, period=130,
+                                              random_state=s).motion
+            for s, n in enumerate((443, 360, 455, 454))
+        ]
+        sets.append({"name": "synthetic walks", "takes": takes, "train": takes,
+                     "frames": frames})
+    return sets
+
+
+def _cpu(fn):
+    t = time.process_time()
+    out = fn()
+    return out, time.process_time() - t
+
+
+def generate(s: dict) -> dict:
+    """``label -> {"motion", "fit_cpu", "gen_cpu", "note"}`` (motion None when it fails)."""
+    takes, train, n = s["takes"], s["train"], s["frames"]
+    out = {}
+    for label, kw in (("graph (ours)", OURS), ("graph (paper, 2-D)", PAPER)):
+        synth, fit = _cpu(lambda kw=kw: MotionGraphSynth(**kw).fit(train))
+        gen, cpu = _cpu(lambda synth=synth: synth.generate(n, 0, 0))
+        out[label] = {"motion": gen.motion, "fit_cpu": fit, "gen_cpu": cpu,
+                      "note": f"{synth.dims_} dims"}
+    out["classic graph"] = {"motion": None, "note": ""}
+    for threshold in (THRESHOLD, 2 * THRESHOLD):  # a short run has no close pair at 0.06
+        try:
+            g, fit = _cpu(lambda t=threshold: ClassicMotionGraph(threshold=t).fit(takes))
+            walk, cpu = _cpu(lambda g=g: g.walk(n, g.nearest_frame(takes[0], 0), seed=0))
+        except CycleCoordError as exc:
+            out["classic graph"]["note"] = str(exc)
+            continue
+        out["classic graph"] = {"motion": walk.motion, "fit_cpu": fit, "gen_cpu": cpu,
+                                "note": f"threshold {threshold:g} leg lengths, "
+                                f"{g.n_transitions} transition points, "
+                                f"{len(walk.transitions)} taken"}
+        break
+    rep, cpu = _cpu(lambda: replay_nearest(takes, n, takes[0], 0))
+    out["nearest-take replay"] = {"motion": rep.motion, "fit_cpu": 0.0, "gen_cpu": cpu,
+                                  "note": f"{len(rep.transitions)} cuts"}
+    return out
+
+
+def measure(motion, ref, takes, limbs: bool) -> dict:
+    q = measure_generated(motion, reference=ref)
+    d = q.to_dict()
+    d["limb_frames"] = None
+    if limbs:
+        from cyclecoord.quality.plausibility import check_plausibility
+
+        d["limb_frames"] = len(check_plausibility(motion, takes).new_contact_frames)
+    return d
+
+
+def _fmt(d: dict) -> list[str]:
+    knee = d["knee_p99_deg"]
+    ratio = min(d["knee_range_ratio"] + d["hip_range_ratio"])
+    fr = d["freezes"]
+    return [
+        f"{d['support_slip_m_per_s']:.2f}",
+        f"{len(fr)} ({d['longest_freeze_s']:.2f} s)",
+        f"{knee[0]:.0f} / {knee[1]:.0f}",
+        f"{ratio:.2f}",
+        f"{d['largest_accel_ratio']:.2f}",
+        f"{d['cadence_ratio']:.2f}" if d["cadence_ratio"] is not None else "-",
+        f"{d['root_speed_m_per_s']:.2f}",
+        "-" if d["limb_frames"] is None else str(d["limb_frames"]),
+    ]
+
+
+HEAD = ["method", "slip m/s", "freezes (longest)", "knee p99 L / R", "knee,hip range",
+        "accel / p99", "cycle ratio", "root m/s", "limb frames"]
+
+
+def _span(values: list[str]) -> str:
+    """Min-max of the captures' cells: numbers, ``"a / b"`` pairs or ``"n (x s)"``."""
+    if " / " in values[0]:
+        return " / ".join(_span([v.split(" / ")[i] for v in values]) for i in range(2))
+    nums = [float(v.split()[0]) for v in values if v != "-"]
+    if not nums:
+        return "-"
+    lo, hi = min(nums), max(nums)
+    digits = 0 if all(float(n).is_integer() for n in nums) else 2
+    one = f"{lo:.{digits}f}"
+    return one if abs(hi - lo) < 5e-3 else f"{one}-{hi:.{digits}f}"
+
+
+def table(rows: list[tuple[str, list[str]]]) -> str:
+    widths = [max(len(HEAD[i]), *(len(r[1][i - 1]) if i else len(r[0]) for r in rows))
+              for i in range(len(HEAD))]
+    line = " | ".join(h.ljust(w) for h, w in zip(HEAD, widths))
+    out = [line, "-" * len(line)]
+    for label, cells in rows:
+        out.append(" | ".join(c.ljust(w) for c, w in zip([label, *cells], widths)))
+    return "\n".join(out)
+
+
+def run_set(s: dict, limbs: bool) -> dict:
+    takes = s["takes"]
+    ref = source_figures(takes, takes[0].fps)
+    gens = generate(s)
+    figures, rows = {}, []
+    for label in METHODS:
+        g = gens[label]
+        if g["motion"] is None:
+            rows.append((label, ["-"] * (len(HEAD) - 1)))
+            figures[label] = {"note": g["note"]}
+            continue
+        figures[label] = measure(g["motion"], ref, takes, limbs)
+        figures[label].update(fit_cpu=g["fit_cpu"], gen_cpu=g["gen_cpu"], note=g["note"])
+        rows.append((label, _fmt(figures[label])))
+    caps = [measure(m, ref, takes, limbs) for m in takes]
+    figures["captures"] = caps
+    cells = [_fmt(c) for c in caps]
+    span = [_span([c[i] for c in cells]) for i in range(len(HEAD) - 1)]
+    rows.append((f"captures ({len(takes)})", span))
+    return {"name": s["name"], "frames": s["frames"], "figures": figures, "rows": rows}
+
+
+def ratios(fig: dict) -> list[str]:
+    """Ours against each baseline: slip, largest accel, smallest leg range, root speed."""
+    ours = fig["graph (ours)"]
+    caps = fig["captures"]
+    cap_slip = float(np.median([c["support_slip_m_per_s"] for c in caps]))
+    lines = [f"  ours: slip {ours['support_slip_m_per_s'] / cap_slip:.2f}x the captures' "
+             f"median ({cap_slip:.2f} m/s; target <= 1.5)"]
+    for label in METHODS[1:]:
+        b = fig[label]
+        if "support_slip_m_per_s" not in b:
+            lines.append(f"  vs {label}: not generated ({b['note']})")
+            continue
+        rng = min(ours["knee_range_ratio"] + ours["hip_range_ratio"]) / max(
+            min(b["knee_range_ratio"] + b["hip_range_ratio"]), 1e-9)
+        lines.append(
+            f"  vs {label}: slip {ours['support_slip_m_per_s'] / max(b['support_slip_m_per_s'], 1e-9):.2f}x, "
+            f"largest accel {ours['largest_accel_ratio'] / b['largest_accel_ratio']:.2f}x, "
+            f"smallest leg range {rng:.2f}x, root speed "
+            f"{ours['root_speed_m_per_s'] / max(b['root_speed_m_per_s'], 1e-9):.2f}x")
+    return lines
+
+
+def speed(takes: list, n: int = 1200) -> dict:
+    """CPU seconds of our graph: fit, then ``n`` frames with and without foot pinning."""
+    synth, fit = _cpu(lambda: MotionGraphSynth(**OURS).fit(takes))
+    _, full = _cpu(lambda: synth.generate(n, 0, 0))
+    synth.lock = False
+    _, carried = _cpu(lambda: synth.generate(n, 0, 0))
+    from cyclecoord.synthesis.graph.phase import follow_phase
+
+    x0 = synth.start_point(0, 0)
+    _, path = _cpu(lambda: follow_phase(synth.phase_field_, x0, n, synth.step_scale))
+    return {"fit": fit, "generate": full, "generate_no_lock": carried, "path": path}
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--frames", type=int, default=1200, help="walk length (the run: half)")
+    p.add_argument("--data", type=Path, default=DATA_DIR, help="the shared data folder")
+    p.add_argument("--json", default=None, help="also write every figure as JSON")
+    p.add_argument("--no-limbs", action="store_true", help="skip the limb-contact check")
+    args = p.parse_args(argv)
+    warnings.simplefilter("ignore")
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"{os.cpu_count()} cores, load average {load:.1f} at start; CPU seconds")
+    results = []
+    for s in load_sets(args.data, args.frames):
+        r = run_set(s, not args.no_limbs)
+        results.append(r)
+        print(f"\n{r['name']}: {r['frames']} frames generated from the first take's frame 0")
+        print(table(r["rows"]))
+        print("ratios measured in this run:")
+        print("\n".join(ratios(r["figures"])))
+        for label in METHODS:
+            f = r["figures"][label]
+            if "fit_cpu" in f:
+                print(f"  {label}: fit {f['fit_cpu']:.2f} s, generate {f['gen_cpu']:.2f} s CPU "
+                      f"({f['note']})")
+    sp = speed(load_sets(args.data, args.frames)[0]["train"])
+    print(f"\nspeed, our graph on the first set: fit {sp['fit']:.2f} s CPU (phases from the "
+          f"periodic pipeline); 1,200 frames {sp['generate']:.2f} s CPU with foot pinning, "
+          f"{sp['generate_no_lock']:.2f} s without, path alone {sp['path']:.2f} s "
+          "(target: 1,200 frames under 1 CPU-s)")
+    if args.json:
+        with atomic_write(args.json, "w") as fh:
+            json.dump({"sets": [{k: v for k, v in r.items() if k != "rows"} for r in results],
+                       "speed": sp, "python": sys.version}, fh, indent=1, default=str)
+        print(f"wrote {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

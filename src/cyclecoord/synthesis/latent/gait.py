@@ -1,0 +1,177 @@
+"""The gait phase of a latent model's training frames, from the periodic pipeline.
+
+:func:`training_gait` runs :func:`cyclecoord.extract` on each training segment and keeps
+its re-timed phase (the circular coordinate advancing at the capture's pace), so every
+training frame knows where it is in the leg cycle.  Each segment's phase is anchored to
+the body, not to the coordinate's arbitrary zero: phase 0 is where the first leg's ankle
+is furthest ahead of the other's (the first harmonic of their difference along its main
+direction), so the phase of a walk and the phase of a run of the same skeleton mean the
+same step.  Frames the pipeline left out (NaN) are filled by the segment's period.
+
+A :class:`Gait` maps an unwrapped phase back to a (fractional) training frame of a
+segment, wrapping by whole cycles at the segment's ends, which is what lets a MOVE go on
+stepping past a segment's end (``{"ahead": seconds}``) and a TRANSITION between two gaits
+blend them in step (:meth:`~.commands.Synthesizer.gait_hop`).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from .influence import pose_points
+
+__all__ = ["Gait", "MIN_CYCLES", "training_gait"]
+
+#: A segment needs at least this many cycles for its phase to be trusted.
+MIN_CYCLES = 1.5
+
+
+@dataclass(frozen=True)
+class Gait:
+    """Unwrapped, body-anchored phase (cycles) of every training frame of a model.
+
+    Attributes
+    ----------
+    phase : ndarray, shape (N,)
+        NaN on segments without a gait.
+    period : ndarray, shape (S,)
+        Frames per cycle of each segment (model frames; NaN without a gait).
+    segments : ndarray of int, shape (N,)
+    """
+
+    phase: np.ndarray
+    period: np.ndarray
+    segments: np.ndarray
+
+    def has(self, segment: int) -> bool:
+        return bool(np.isfinite(self.period[segment]))
+
+    @property
+    def usable(self) -> np.ndarray:
+        """Segment numbers with a gait."""
+        return np.flatnonzero(np.isfinite(self.period))
+
+    def rows(self, segment: int) -> np.ndarray:
+        return np.flatnonzero(self.segments == segment)
+
+    def _loop(
+        self, segment: int, values: np.ndarray | None = None
+    ) -> tuple[np.ndarray, float, float]:
+        """The segment's rows, the start ``s`` of its loop ``[s, s + K)`` and its whole
+        cycles ``K``.  With ``values``, the loop is placed where the values at one phase
+        and at the same phase ``K`` cycles later are closest (the seam where stepping
+        past the end jumps back; the capture's cycles differ a little)."""
+        rows = self.rows(segment)
+        ph = self.phase[rows]
+        lo, span = ph[0], ph[-1] - ph[0]
+        K = max(np.floor(span), 1.0)
+        if values is None or span < K:
+            return rows, lo, K
+        idx = np.arange(rows.size, dtype=float)
+        late = np.flatnonzero(ph >= lo + K)
+        early = self._lerp(values, rows[0] + np.interp(ph[late] - K, ph, idx))
+        gap = np.linalg.norm((values[rows[late]] - early).reshape(late.size, -1), axis=1)
+        return rows, float(ph[late[np.argmin(gap)]] - K), K
+
+    def frame_at(self, segment: int, u: np.ndarray, values: np.ndarray | None = None):
+        """Fractional training-frame indices (into the model's frames) of unwrapped phases
+        ``u`` on ``segment``, shifted by whole cycles into the segment's loop."""
+        rows, lo, K = self._loop(segment, values)
+        v = lo + np.mod(np.asarray(u, dtype=float) - lo, K)
+        return rows[0] + np.interp(v, self.phase[rows], np.arange(rows.size, dtype=float))
+
+    def at(self, values: np.ndarray, segment: int, u: np.ndarray) -> np.ndarray:
+        """Per-frame ``values`` (latent points, angles, ...) at unwrapped phases ``u``,
+        linear between frames, looping the segment by whole cycles at its best seam.
+
+        (A cross-fade of the two ends in latent space passed between the cycles, off the
+        data: on the synthetic run the particle's likelihood force then threw the pose
+        3.9x the training 99th percentile of acceleration.)"""
+        return self._lerp(values, self.frame_at(segment, u, values))
+
+    def _lerp(self, values: np.ndarray, frames: np.ndarray) -> np.ndarray:
+        f = np.asarray(frames, dtype=float)
+        a = np.floor(f).astype(int)
+        b = np.minimum(a + 1, len(values) - 1)
+        b = np.where(self.segments[b] == self.segments[a], b, a)
+        w = (f - a).reshape((-1,) + (1,) * (np.ndim(values) - 1))
+        return (1.0 - w) * values[a] + w * values[b]
+
+    def points(self, X: np.ndarray, frames: np.ndarray) -> np.ndarray:
+        """Latent points ``(T, q)`` at fractional training frames (linear in between)."""
+        return self._lerp(X, frames)
+
+
+def _anchor(model, rows: np.ndarray, phase: np.ndarray, leg_points: tuple[str, str]) -> float:
+    """Phase at which the first ankle is furthest ahead of the second (cycles)."""
+    names = list(model.skeleton_.names)
+    a, b = (names.index(n) for n in leg_points)
+    pts = pose_points(model.angles(model.frames_[rows]), model.channels_, model.skeleton_)
+    d = pts[:, a] - pts[:, b]
+    d = d - d.mean(axis=0)
+    _, _, vt = np.linalg.svd(d, full_matrices=False)
+    axis = vt[0] * np.sign(vt[0][np.argmax(np.abs(vt[0]))])  # the same sign on every model
+    s = d @ axis
+    c = np.sum(s * np.exp(-2j * np.pi * phase))
+    return float(np.angle(c) / (2 * np.pi))
+
+
+def _legs(model) -> tuple[str, str] | None:
+    from ...errors import CycleCoordError
+    from ...quality.legs import find_legs
+
+    try:
+        legs = find_legs(model.skeleton_, model.training_motion()).legs
+    except CycleCoordError:
+        return None
+    if len(legs) < 2:
+        return None
+    return legs[0].points[0], legs[1].points[0]
+
+
+def training_gait(model) -> Gait:
+    """The :class:`Gait` of a :class:`~.model.LatentModel` (segments the periodic pipeline
+    finds no cycle in, or shorter than :data:`MIN_CYCLES` cycles, get NaN)."""
+    import cyclecoord as cc
+
+    from ...errors import CycleCoordError
+
+    n = model.X_.shape[0]
+    segs = np.unique(model.segments_)
+    phase = np.full(n, np.nan)
+    period = np.full(int(segs.max()) + 1, np.nan)
+    legs = _legs(model)
+    train = model.training_motion()
+    for s in segs:
+        rows = np.flatnonzero(model.segments_ == s)
+        if legs is None or rows.size < 12:
+            continue
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                res = cc.extract(train[rows[0] : rows[-1] + 1], require_clear=False)
+        except (CycleCoordError, ValueError, np.linalg.LinAlgError):
+            continue
+        p = res.phase
+        P = float(res.period_frames)
+        if p is None or not np.isfinite(P) or P <= 1 or rows.size < MIN_CYCLES * P:
+            continue
+        ok = np.isfinite(p)
+        if ok.sum() < 3:
+            continue
+        k = np.arange(rows.size, dtype=float)
+        u = np.unwrap(2 * np.pi * p[ok]) / (2 * np.pi)
+        if u[-1] < u[0]:  # a coordinate running backwards
+            u = -u
+        # fill the left-out frames along the segment's period
+        full = np.interp(k, k[ok], u)
+        first, last = np.flatnonzero(ok)[[0, -1]]
+        full[:first] = u[0] - (first - k[:first]) / P
+        full[last + 1 :] = u[-1] + (k[last + 1 :] - last) / P
+        full -= _anchor(model, rows, full, legs)
+        phase[rows] = full
+        period[s] = P
+    return Gait(phase=phase, period=period, segments=np.asarray(model.segments_))

@@ -1,0 +1,193 @@
+"""Stepping at the training takes' cadence: MOVEs ahead along a gait and TRANSITIONs
+between two gaits in step, a part of :class:`~.commands.Synthesizer`.
+
+* ``{"ahead": seconds}`` targets: the training frames ``seconds`` further along the
+  particle's gait, reached along them at the pace they were captured at (wrapping by
+  whole cycles at a segment's end, :class:`~.gait.Gait`), so chained MOVEs step at the
+  captured cadence and with the captured stride.
+* :meth:`GaitMixin.gait_hop`: a TRANSITION between two models with a gait starts at once
+  (no approach MOVE, no bridge search): the other model's frame at the same gait phase
+  (nearest in pose among those) is taken, both models keep stepping with one shared
+  phase whose rate eases from the first model's cadence to the second's, and their
+  poses and root motions blend.  The walk-run crossings of the issue's shared-data
+  models were all 2.35-2.58x the bridge threshold apart: the idle blend there stood
+  still for the length of the blend; in step, the legs never stop.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..._words import plural
+from ...errors import ParameterError
+from .crossing import BLEND_ACCELERATION, blend_asked
+from .easing import smootherstep
+from .gait import Gait
+from .influence import pose_points
+
+__all__ = ["GaitMixin", "IN_STEP_LONGEST"]
+
+#: An in-step blend is raised (and said) up to this many seconds at most, so the
+#: TRANSITION completes within a second of the command.
+IN_STEP_LONGEST = 1.0
+
+
+class GaitMixin:
+    """Gaits, the gait cursor and the in-step TRANSITION of a Synthesizer."""
+
+    def gait(self, name: str) -> Gait:
+        """The :class:`~.gait.Gait` of model ``name`` (from the model file, else computed)."""
+        if name not in self._gaits:
+            self._gaits[name] = self.models[name].gait()
+        return self._gaits[name]
+
+    def _gait_place(self, name: str) -> tuple[int, float] | None:
+        """``(segment, unwrapped phase)`` of the particle in model ``name``'s gait: the
+        cursor the last stepping command left, else the nearest training frame on a
+        segment with a gait; None when the model has none."""
+        g = self.gait(name)
+        if not len(g.usable):
+            return None
+        if self._cursor is not None and self._cursor[0] == name:
+            return self._cursor[1], self._cursor[2]
+        m = self.models[name]
+        ok = np.isin(g.segments, g.usable)
+        d = ((m.X_ - self.x) ** 2).sum(1)
+        d[~ok] = np.inf
+        k = int(np.argmin(d))
+        return int(g.segments[k]), float(g.phase[k])
+
+    def _rate(self, name: str, segment: int) -> float:
+        """Gait cycles per output frame at the training cadence."""
+        m = self.models[name]
+        return m.fps_ / (self.gait(name).period[segment] * self.fps)
+
+    def ahead_path(self, seconds: Any) -> tuple[np.ndarray, np.ndarray] | None:
+        """``{"ahead": seconds}``: the latent path ``(M, q)`` and its times ``(M,)`` along
+        the particle's gait (None when the model has no gait: the caller steps through the
+        segment's frames instead)."""
+        if not (isinstance(seconds, (int, float)) and not isinstance(seconds, bool)):
+            raise ParameterError(f"ahead must be a number of seconds, got {seconds!r}")
+        if seconds <= 0:
+            raise ParameterError(f"ahead must be positive seconds, got {seconds!r}")
+        place = self._gait_place(self.current)
+        if place is None:
+            return None
+        seg, u0 = place
+        g, m = self.gait(self.current), self.models[self.current]
+        n = max(1, int(round(seconds * self.fps)))
+        u = u0 + self._rate(self.current, seg) * np.arange(n + 1)
+        X = g.at(m.X_, seg, u)
+        X[0] = self.x
+        self._next_cursor = (self.current, seg, float(u[-1]))
+        return X, np.arange(n + 1) / self.fps
+
+    def segment_ahead(self, seconds: float) -> tuple[np.ndarray, np.ndarray]:
+        """``{"ahead": seconds}`` on a model without a gait: along the nearest training
+        frame's segment at its captured pace, up to the segment's end."""
+        m = self.models[self.current]
+        k = int(m.nearest_frame(self.x[None])[0])
+        rows = np.flatnonzero(m.segments_ == m.segments_[k])
+        t0 = float(m.times_[k])
+        end = float(m.times_[rows[-1]])
+        if t0 + seconds > end + 1e-9:
+            raise ParameterError(
+                f"ahead {seconds:g} s runs past the end of segment "
+                f"{m.segment_names_[int(m.segments_[k])]!r} ({end - t0:.2f} s left) and the "
+                "model has no gait phase to go on stepping"
+            )
+        n = max(1, int(round(seconds * self.fps)))
+        t = t0 + np.arange(n + 1) / self.fps
+        X = np.stack([np.interp(t, m.times_[rows], m.X_[rows, j]) for j in range(m.X_.shape[1])], 1)
+        X[0] = self.x
+        return X, t - t0
+
+    def can_step_across(self, src: str, to: str) -> bool:
+        """Whether a TRANSITION from ``src`` to ``to`` can go in step (both have a gait)."""
+        return bool(len(self.gait(src).usable) and len(self.gait(to).usable))
+
+    def _matched(self, src: str, to: str, u0: float, x: np.ndarray) -> tuple[int, float, float]:
+        """The training frame of ``to`` at gait phase ``u0`` whose pose is nearest ``x``'s
+        pose in ``src``: (segment, its unwrapped phase, RMS pose distance)."""
+        m1, m2, g2 = self.models[src], self.models[to], self.gait(to)
+        best = None
+        for s in g2.usable:
+            rows = g2.rows(s)
+            ph = g2.phase[rows]
+            # the frames of this segment at phase u0 + whole cycles
+            cycles = np.arange(np.ceil(ph[0] - u0), np.floor(ph[-1] - u0) + 1)
+            for c in cycles:
+                u = u0 + c
+                x2 = g2.at(m2.X_, s, np.array([u]))[0]
+                best = _better(best, (int(s), float(u), x2), m1, m2, x)
+        if best is None:
+            raise ParameterError(f"no frame of {to!r} at gait phase {u0 % 1:.2f}")
+        return best[0][0], best[0][1], best[1]
+
+    def gait_hop(self, src: str, to: str, blend: float) -> None:
+        """TRANSITION from ``src`` into ``to`` in step (see the module's text)."""
+        m1, m2 = self.models[src], self.models[to]
+        sa, ua = self._gait_place(src)
+        sb, ub, dist = self._matched(src, to, ua, self.x)
+        asked = blend_asked(blend, self.fps)
+        x2 = self.gait(to).at(m2.X_, sb, np.array([ub]))[0]
+        need = min(self.blend_frames(src, to, self.x, x2), int(IN_STEP_LONGEST * self.fps))
+        n = max(asked, need)
+        if n != asked:
+            self.notes.append(
+                f"commands[{self.command}] TRANSITION {src} -> {to}: blend raised from "
+                f"{blend:g} s ({plural(asked, 'frame')}) to {n / self.fps:.2f} s ({n} frames): "
+                "blending "
+                f"poses {dist:.3g} units apart faster would accelerate joints over "
+                f"{BLEND_ACCELERATION:g}x the models' training 99th percentile"
+            )
+        ga, gb = self.gait(src), self.gait(to)
+        w = smootherstep(n)
+        ra, rb = self._rate(src, sa), self._rate(to, sb)
+        steps = (1.0 - w) * ra + w * rb
+        du = np.concatenate([[0.0], np.cumsum(steps)])[1:]
+        Xa = ga.at(m1.X_, sa, ua + du)
+        Xb = gb.at(m2.X_, sb, ub + du)
+        wc = w[:, None]
+        r1, r2 = self._root(m1, Xa), self._root(m2, Xb)
+        root = {
+            k: (1 - w.reshape((-1,) + (1,) * (r1[k].ndim - 1))) * r1[k]
+            + w.reshape((-1,) + (1,) * (r1[k].ndim - 1)) * r2[k]
+            for k in r1
+        }
+        blended = (1 - wc) * self._clip(src, m1.pose(Xa)) + wc * self._clip(to, m2.pose(Xb))
+        self._emit(to, Xb, blended, root, clip=False)
+        c = self.crossings_threshold(src)
+        self.events.append(
+            {
+                "command": self.command,
+                "transition": [src, to],
+                "route": [src, to],
+                "in_step": True,
+                "phase": float(ua % 1.0),
+                "bridge_frame": int(m1.nearest_frame(self.x[None])[0]),
+                "target_frame": int(m2.nearest_frame(Xb[:1])[0]),
+                "bridge_distance": dist,
+                "threshold": c,
+                "under_threshold": bool(dist < c),
+                "bridges": 0,
+                "blend_frames": n,
+                "blend_asked_frames": asked,
+                "start_frame": self.n_frames - n,
+            }
+        )
+        self.current, self.x = to, Xb[-1]
+        self.v = (Xb[-1] - Xb[-2]) * self.fps if n > 1 else np.zeros_like(self.x)
+        self._cursor = (to, sb, float(ub + du[-1]))
+
+
+def _better(best, cand, m1, m2, x):
+    """The nearer in pose of ``best`` ((segment, phase, point), distance) and ``cand``."""
+    seg, u, x2 = cand
+    p = pose_points(np.vstack([m1.pose(x[None]), m2.pose(x2[None])]), m1.channels_, m1.skeleton_)
+    d = float(np.sqrt(((p[0] - p[1]) ** 2).sum(-1).mean()))
+    if best is None or d < best[1]:
+        return (seg, u, x2), d
+    return best

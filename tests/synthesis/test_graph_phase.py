@@ -1,0 +1,132 @@
+"""The phase-aware field (issue 24, item 3): it never stalls where the paper's field does,
+keeps strides and makes no pop; fast synthetic cases, then set w1 (skipped without it)."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.errors import ParameterError
+from cyclecoord.quality.generated import measure_generated, source_figures
+from cyclecoord.quality.plausibility import check_plausibility
+from cyclecoord.synthesis.graph import MotionGraphSynth, build_graph
+from cyclecoord.synthesis.graph.phase import PhaseField, align_phases, follow_phase
+
+
+def folded(n: int, period: float, shift: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """A loop flattened onto itself: out along x and back nearly on the same line (a walk's
+    2-D projection at its cusps), and its phase in cycles."""
+    phase = shift + np.arange(n) / period
+    a = 2 * np.pi * phase
+    return np.stack([np.cos(a), 0.03 * np.sin(a) + 0.01 * np.cos(3 * a)], axis=1), phase
+
+
+def _longest_slow_run(points: np.ndarray, limit: float) -> int:
+    slow = np.linalg.norm(np.diff(points, axis=0), axis=1) < limit
+    runs = np.diff(np.flatnonzero(np.diff(np.r_[0, slow.astype(int), 0])))[::2]
+    return int(runs.max()) if runs.size else 0
+
+
+def test_phase_field_keeps_the_gait_moving_through_the_cusps():
+    """At a fold's cusps the loop itself slows (its x turns back) for a frame or two; a
+    stall is the path sitting there longer.  The phase-aware path keeps its phase
+    advancing at the training rate and its pose on the loop at that phase."""
+    takes = [folded(300, 60.0, s) for s in (0.0, 0.3, 0.55)]
+    graph = build_graph([z for z, _ in takes], "delaunay")
+    median = np.median(np.linalg.norm(graph.velocities, axis=1)) * 2  # one frame's step
+    field = PhaseField(graph, [p for _, p in takes])
+    path = follow_phase(field, takes[0][0][0], 600, step_scale=2.0)
+    assert _longest_slow_run(path.points, 0.1 * median) <= 3
+    assert path.phases[-1] - path.phases[0] == pytest.approx(599 / 60.0, rel=0.05)
+    turns = np.abs(np.diff(np.sign(path.points[:, 0]))).sum() / 4  # two crossings a turn
+    assert turns == pytest.approx(599 / 60.0, abs=1)
+    assert np.abs(path.points[:, 0] - np.cos(2 * np.pi * path.phases)).max() < 0.15
+
+
+def test_phase_advances_where_the_training_phase_dwells():
+    """A circular coordinate can sit still over frames whose pose moves on (a synthetic
+    walk's did for 20 frames, and the path stalled there 0.9 s): the path's phase still
+    advances at least MIN_RATE of the median rate every step."""
+    from cyclecoord.synthesis.graph.phase import MIN_RATE
+
+    takes = [folded(300, 60.0, s) for s in (0.0, 0.3, 0.55)]
+    dwelling = [p + np.sin(2 * np.pi * p) / (2 * np.pi) for _, p in takes]  # flat at half turns
+    assert min(np.diff(d).min() for d in dwelling) < 0.01 / 60  # nearly flat stretches
+    graph = build_graph([z for z, _ in takes], "delaunay")
+    field = PhaseField(graph, dwelling)
+    path = follow_phase(field, takes[0][0][0], 600, step_scale=2.0)
+    rate = np.median(np.diff(np.concatenate(dwelling))) / 2
+    assert np.diff(path.phases).min() >= 2 * MIN_RATE * rate * (1 - 1e-9)
+    assert path.phases[-1] - path.phases[0] > 5
+
+
+def test_phases_of_takes_are_put_on_one_origin():
+    base, phase = folded(240, 60.0)
+    z = np.column_stack([base, np.sin(2 * np.pi * phase)])  # no symmetry to confuse it
+    other = np.roll(z, 17, axis=0)  # the same loop, started 17 frames later
+    out = align_phases([phase, phase.copy()], [z, other])
+    assert ((out[1] - phase) % 1.0) == pytest.approx(1 - 17 / 60.0, abs=0.02)
+
+
+def test_phase_field_errors():
+    z, p = folded(100, 50.0)
+    graph = build_graph([z[:50], z[50:]], "delaunay")
+    with pytest.raises(ParameterError, match="100 phases|phases"):
+        PhaseField(graph, [p[:50]])
+    with pytest.raises(ParameterError, match="do not advance"):
+        PhaseField(graph, [np.zeros(50), np.zeros(50)])
+    with pytest.raises(ParameterError, match="pull"):
+        PhaseField(graph, [p[:50], p[50:]], pull=1.0)
+    with pytest.raises(ParameterError, match=r"\+ring"):
+        MotionGraphSynth(method="delaunay+ring+phase").fit([])
+
+
+@pytest.fixture(scope="module")
+def walks():
+    return [
+        cc.datasets.make_periodic_capture(kind="walk", n_frames=n, period=60, random_state=s).motion
+        for s, n in ((0, 200), (1, 180), (2, 190))
+    ]
+
+
+def test_synthetic_walk_neither_stalls_nor_limps_nor_pops(walks):
+    """(Following the circular coordinate itself, which dwells for 20 frames on these
+    walks while the pose moves on, the path stalled 0.9 s; the re-timed phase does not.)"""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(walks)
+    gen = synth.generate(400, 0, 0)
+    q = measure_generated(gen.motion, walks)
+    assert gen.path.kind == "field:phase:euler"
+    assert not q.freezes
+    assert min(q.knee_ratio + q.hip_ratio) >= 0.9
+    assert q.largest_accel <= 1.5
+    assert check_plausibility(gen.motion, walks).new_contact_frames == []
+
+
+# ------------------------------------------------------------------------------ set w1
+@pytest.fixture(scope="module")
+def w1(cmu_dir):
+    return [cc.load(cmu_dir / "35" / f"{n}.amc") for n in ("35_16", "35_07", "35_08", "35_13")]
+
+
+def test_w1_graph_default_walk_meets_the_targets(w1):
+    """cyclecoord graph's defaults on 1,200 frames from two starts: measured 0 freezes,
+    largest accel 0.75-0.76x the sources' p99 (the 4-D field popped at 3.30x), knee and
+    hip ranges 0.94-0.97 of the sources', support foot 0.02 m/s, no new limb contact."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(w1)
+    ref = source_figures(w1, w1[0].fps)
+    for take, frame in ((0, 0), (2, 50)):
+        gen = synth.generate(1200, take, frame)
+        q = measure_generated(gen.motion, reference=ref)
+        assert not q.freezes, q.freezes
+        assert q.largest_accel <= 1.5
+        assert min(q.knee_ratio + q.hip_ratio) >= 0.9
+        assert q.support_slip <= 1.5 * q.source_support_slip
+        assert 0.9 <= q.cadence_ratio <= 1.1
+        assert check_plausibility(gen.motion, w1).new_contact_frames == []
