@@ -69,6 +69,11 @@ def test_a_truncated_or_corrupted_model(model, tmp_path):
         ("segment_names", np.array("[not json"), ["'segment_names'", "JSON"]),
         ("segment_names", np.array("[" * 200 + "]" * 200), ["'segment_names'", "nested"]),
         ("params", np.array('{"unknown": 1}'), ["'params'", "unknown"]),
+        # a name twice: a segment with no frames, an IndexError in animate (fuzzer, model
+        # cases 100995 and 102743)
+        ("segment_names", np.array('["a", "a", "b"]'), ["'segment_names'", "repeat"]),
+        ("segment_names", np.array('["a", "b", "c"]'), ["'segments'", "no frames"]),
+        ("gait_phase", np.zeros(3), ["'gait_phase'", "shape"]),
         ("motion_frames", "inf", ["'motion_frames'", "inf"]),
         ("format", np.array("something else"), ["not a latent model"]),
     ],

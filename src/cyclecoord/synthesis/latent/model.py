@@ -446,9 +446,15 @@ class LatentModel:
         names = [str(x) for x in _json(a, "segment_names", list)]
         if not names:
             raise a.error("segment_names", "a model needs at least one segment")
+        if len(set(names)) != len(names):
+            twice = sorted({x for x in names if names.count(x) > 1})
+            raise a.error("segment_names", f"names repeat: {twice[:5]}")
         m.segment_names_ = names
         m.skeleton_, m.fps_, m.frames_ = train.skeleton, train.fps, np.array(train.frames)
         m.segments_ = np.asarray(a.integers("segments", N, 0, len(names) - 1))
+        empty = sorted(set(range(len(names))) - set(m.segments_.tolist()))
+        if empty:
+            raise a.error("segments", f"segment {empty[0]} ({names[empty[0]]!r}) has no frames")
         m.times_ = a.reals("times", (N,))
         comp = a.get("components")
         d = comp.shape[1] if comp.ndim == 2 else 0
