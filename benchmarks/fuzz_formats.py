@@ -14,7 +14,7 @@ on it and a script using it).  Case ``i`` of format ``F`` is generated from
 ``random.Random(f"{F}:{i}")`` alone, so any case can be made again.  Each case writes its
 files into a folder and runs the real command lines on them, in-process through
 :func:`cyclecoord.cli.main.main`: ``convert`` and one of ``extract``, ``feet`` and ``view``
-for glTF and USD, ``animate`` for models and scripts.  A worker process runs the cases
+for glTF and USD, ``animate`` (under ``--memory-limit 256M``) for models and scripts.  A worker process runs the cases
 under an address-space limit; a case fails on any exception that escapes ``main`` (a
 traceback: an error that is not the project's one-line error), on a hang (more than
 ``--timeout`` seconds), on a worker that dies, or when an input file was changed.
@@ -48,6 +48,8 @@ from multiprocessing.connection import wait
 from pathlib import Path
 
 FORMATS = ("gltf", "usd", "model", "script")
+#: --memory-limit of every animate case (see make_case).
+ANIMATE_MEMORY = "256M"
 
 # ------------------------------------------------------------------------------ values
 HOSTILE_NUMBERS = [
@@ -572,6 +574,10 @@ def make_case(fmt: str, index: int, seeds: dict, work: Path) -> Case:
         commands = [["animate", "{d}/s.json", "-o", "{o}/a.bvh", "--report", "{o}/a.json"]]
         if rng.random() < 0.5:
             commands[0].append("--no-check")
+        # a script may ask for any duration up to the frame limit (an IDLE of 4096 s is
+        # 122,880 frames and minutes of work, valid and not a hang): the memory limit
+        # bounds what one case may make (the frames a 256 MB limit allows take seconds)
+        commands[0] += ["--memory-limit", ANIMATE_MEMORY]
     return Case(fmt, index, files, commands, log)
 
 
