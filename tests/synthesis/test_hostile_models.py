@@ -204,10 +204,19 @@ def test_a_model_of_a_motion_that_never_moves(tmp_path, capsys):
 
 
 def test_a_particle_that_diverges_is_refused_at_once(model, tmp_path, capsys):
-    # a random force of 2e9 over 4096 s: the integration overflowed within frames, then
-    # made 122,880 frames of NaN for over a minute
-    script = _script(tmp_path, model, [{"command": "IDLE", "duration": 4096}],
-                     particle={"random": 2e9})
+    # steps of 33 s (0.03 fps): the integration overflowed within frames, then made NaN
+    # frames for over a minute
+    script = _script(tmp_path, model, [{"command": "IDLE", "duration": 40000}], fps=0.03)
     assert main(["animate", str(script), "-o", str(tmp_path / "o.bvh"), "--no-check"]) == 1
     err = _error(capsys)
     assert "commands[0] (IDLE)" in err and "left finite values" in err
+
+
+@pytest.mark.parametrize("value", [1e300, 10**30, 2e9])
+def test_particle_parameters_are_bounded(model, tmp_path, capsys, value):
+    # a radius of 1e300 was squared into an OverflowError
+    script = _script(tmp_path, model, [{"command": "IDLE", "duration": 1}],
+                     particle={"radius": value})
+    assert main(["animate", str(script), "-o", str(tmp_path / "o.bvh")]) == 1
+    err = _error(capsys)
+    assert "particle" in err and "at most 1e+06" in err

@@ -34,6 +34,11 @@ from ...errors import ParameterError
 __all__ = ["ParticleParams", "RandomForce", "simulate"]
 
 
+#: Largest value of any particle parameter (seconds, gains): the integration squares the
+#: radius (an OverflowError at 1e300) and larger forces leave finite values at once.
+MAX_PARAMETER = 1e6
+
+
 @dataclass(frozen=True)
 class ParticleParams:
     """Particle settings; lengths and accelerations are in units of the model's speed.
@@ -73,8 +78,15 @@ class ParticleParams:
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
-            if not isinstance(v, (int, float)) or isinstance(v, bool) or not np.isfinite(v):
-                raise ParameterError(f"particle parameter {f.name} must be a number, got {v!r}")
+            if (
+                not isinstance(v, (int, float))
+                or isinstance(v, bool)
+                or not abs(v) <= MAX_PARAMETER  # NaN, an infinity, an int of any size
+            ):
+                raise ParameterError(
+                    f"particle parameter {f.name} must be a number of at most "
+                    f"{MAX_PARAMETER:g}, got {str(v)[:40]}"
+                )
             if v < 0 or (f.name in ("width", "timescale", "alpha") and v == 0):
                 raise ParameterError(f"particle parameter {f.name} must be positive, got {v!r}")
 
