@@ -261,3 +261,15 @@ def test_usd_animation_arrays_that_disagree_with_its_joints(usda):
     first = text[a : text.index(",", a)]
     usda.write_text(text[:a] + first + ", " + text[a:])
     _refused(usda, "Animation.translations at time code 0", "for the animation's")
+
+
+def test_usd_rest_transforms_and_joint_paths_checked(usda):
+    # usd-core warned and went on with identity transforms or another hierarchy: the
+    # reader took a skeleton that was not the file's (fuzzer usd case 204058)
+    text = usda.read_text()
+    a = text.index("matrix4d[] restTransforms = [") + len("matrix4d[] restTransforms = [")
+    usda.write_text(text[:a] + text[text.index("]", a):])
+    _refused(usda, "restTransforms: 0 transforms for the skeleton's")
+    a = text.index("uniform token[] joints = [") + len("uniform token[] joints = [")
+    usda.write_text(text[:a] + '"a//b", ' + text[a:])
+    _refused(usda, "joints[0]", "is not a joint path")

@@ -225,11 +225,12 @@ def _open(path: Path):
         raise ParseError("no such USD file", str(path))
     try:
         cached = Sdf.Layer.Find(str(path))  # still held from an earlier read: read it again
-        if cached:
-            cached.Reload(force=True)
-        stage = Usd.Stage.Open(str(path))
+        reloaded = cached.Reload(force=True) if cached else True
+        stage = Usd.Stage.Open(str(path)) if reloaded else None
     except Exception as exc:  # noqa: BLE001 - pxr raises Tf errors of its own types
         raise ParseError(f"not a readable USD file ({_why(exc)})", str(path)) from None
+    if stage is None:  # a failed reload keeps the earlier content: never read that instead
+        raise ParseError("not a readable USD file (usd-core could not read it again)", str(path))
     skel_prim = next((p for p in stage.Traverse() if p.IsA(UsdSkel.Skeleton)), None)
     if skel_prim is None:
         raise ParseError("no UsdSkel Skeleton prim in the stage", str(path))
@@ -240,6 +241,7 @@ def _open(path: Path):
     n_joints = len(query.GetJointOrder())
     if n_joints == 0:
         raise ParseError(f"skeleton {skel_prim.GetPath()}: the joints array is empty", str(path))
+    _check_topology(skel, n_joints, Sdf, path)
     if n_joints > 2 * MAX_JOINTS:  # joints and end sites
         raise ParseError(
             f"skeleton {skel_prim.GetPath()}: {n_joints:,} joints; at most "
@@ -274,6 +276,25 @@ def _open(path: Path):
     )
     times = np.arange(round(start), round(end) + 1)
     return stage, skel_prim, query, times, fps
+
+
+def _check_topology(skel, n_joints: int, Sdf, path: Path) -> None:
+    """Every joint a well-formed path, and the rest and bind transforms one per joint:
+    usd-core warns about either and goes on (a hierarchy that is not the file's, identity
+    transforms), so a broken skeleton would read as another one."""
+    where = skel.GetPrim().GetPath()
+    for k, token in enumerate(skel.GetJointsAttr().Get() or []):
+        if not Sdf.Path.IsValidPathString(str(token)):
+            raise ParseError(f"{where}.joints[{k}]: {str(token)[:80]!r} is not a joint path",
+                             str(path))
+    for name in ("restTransforms", "bindTransforms"):
+        attr = skel.GetPrim().GetAttribute(name)
+        value = attr.Get() if attr and attr.HasAuthoredValue() else None
+        if value is not None and len(value) != n_joints:
+            raise ParseError(
+                f"{where}.{name}: {len(value)} transforms for the skeleton's {n_joints} joints",
+                str(path),
+            )
 
 
 def _slerp(qa: np.ndarray, qb: np.ndarray, u: np.ndarray) -> np.ndarray:
