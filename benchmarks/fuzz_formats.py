@@ -566,7 +566,8 @@ def make_case(fmt: str, index: int, seeds: dict, work: Path) -> Case:
             ["extract", "{d}/" + name, "--report", "{o}/r.json"],
             ["view", "{d}/" + name, "-o", "{o}/v.html"],
             ["convert", "{d}/" + name, "-o", "{o}/c.glb"],
-            ["latent", "fit", "{d}/" + name, "-o", "{o}/m.npz", "--step", "1", "--max-iter", "5"],
+            ["latent", "fit", "{d}/" + name, "-o", "{o}/m.npz", "--step", "1", "--max-iter", "5",
+             "--no-progress"],
         ])
         commands = [["convert", "{d}/" + name, "-o", "{o}/c.npz"], second]
     else:
@@ -577,7 +578,8 @@ def make_case(fmt: str, index: int, seeds: dict, work: Path) -> Case:
         # a script may ask for any duration up to the frame limit (an IDLE of 4096 s is
         # 122,880 frames and minutes of work, valid and not a hang): the memory limit
         # bounds what one case may make (the frames a 256 MB limit allows take seconds)
-        commands[0] += ["--memory-limit", ANIMATE_MEMORY]
+        # (and no progress bar: a terminal redraws it, captured it reads as extra lines)
+        commands[0] += ["--memory-limit", ANIMATE_MEMORY, "--no-progress"]
     return Case(fmt, index, files, commands, log)
 
 
