@@ -24,6 +24,8 @@ why; the score is killed over the mutants not judged equivalent.
     python benchmarks/mutation.py --list                  # mutants per module
     python benchmarks/mutation.py --every 25 --jobs 2 --out mutation.json
     python benchmarks/mutation.py --report mutation.json  # score, survivors
+    python benchmarks/mutation.py --show ID               # one mutant's diff
+    python benchmarks/mutation.py --run ID [--tests T..]  # one mutant: killed or not
 
 Not part of the test suite: a sampled run takes an hour or more.
 """
@@ -112,10 +114,14 @@ class Mutant:
     line: int
     col: int
     operator: str
+    #: 2, 3... for the later mutants that would share an id (``a - b - c`` has two
+    #: subtractions at one column, ``1 <= n <= T`` two comparisons): their id ends ``#2``...
+    dup: int = 0
 
     @property
     def id(self) -> str:
-        return f"{self.module}:{self.line}:{self.col}:{self.operator}"
+        plain = f"{self.module}:{self.line}:{self.col}:{self.operator}"
+        return f"{plain}#{self.dup}" if self.dup else plain
 
 
 def _sites(tree: ast.AST) -> list[tuple[ast.AST, str, object]]:
@@ -213,8 +219,13 @@ def mutants(modules: list[str]) -> list[Mutant]:
     out = []
     for module in modules:
         tree = ast.parse((SRC / module).read_text())
+        seen: dict[str, int] = {}
         for i, (node, op, _) in enumerate(_sites(tree)):
-            out.append(Mutant(module, i, node.lineno, node.col_offset, op))
+            m = Mutant(module, i, node.lineno, node.col_offset, op)
+            seen[m.id] = seen.get(m.id, 0) + 1
+            if seen[m.id] > 1:
+                m.dup = seen[m.id]
+            out.append(m)
     return out
 
 
@@ -248,12 +259,12 @@ class Worker:
         self.src = base / f"w{k}" / "src"
         shutil.copytree(SRC, self.src, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
 
-    def run(self, m: Mutant, timeout: float) -> dict:
+    def run(self, m: Mutant, timeout: float, tests: list[str] | None = None) -> dict:
         path = self.src / m.module
         original = path.read_text()
         try:
             path.write_text(mutate(original, m.index))
-            status, seconds, first = run_tests(self.src, TESTS[m.module], timeout)
+            status, seconds, first = run_tests(self.src, tests or TESTS[m.module], timeout)
         finally:
             path.write_text(original)
         killed = status != "passed"
@@ -319,14 +330,30 @@ def main(argv=None) -> int:
     ap.add_argument("--list", action="store_true", help="count the mutants and stop")
     ap.add_argument("--report", type=Path, default=None, help="print the score of a results file")
     ap.add_argument("--show", default=None, help="print the diff of one mutant id")
+    ap.add_argument("--run", default=None, help="run the tests of one mutant id (exit 0 if killed)")
+    ap.add_argument("--tests", nargs="+", default=None,
+                    help="with --run: these tests (pytest ids) instead of the module's own")
     args = ap.parse_args(argv)
     if args.report:
         report(json.loads(args.report.read_text())["results"])
         return 0
     modules = args.modules or sorted(TESTS)
     every = mutants(modules)
+    one = args.show or args.run
+    if one:
+        found = [m for m in every if m.id == one]
+        if not found:
+            sys.exit(f"no mutant {one!r} in the current source (see --list; ids carry line numbers)")
+        (m,) = found
+    if args.run:
+        base = Path(tempfile.mkdtemp(prefix="mutation-"))
+        try:
+            r = Worker(base, 0).run(m, timeout=3600, tests=args.tests)
+        finally:
+            shutil.rmtree(base, ignore_errors=True)
+        print(f"{'killed' if r['killed'] else 'SURVIVED'} {m.id} ({r['seconds']} s) {r['failure']}")
+        return 0 if r["killed"] else 1
     if args.show:
-        (m,) = [m for m in every if m.id == args.show]
         original = ast.unparse(ast.parse((SRC / m.module).read_text())).splitlines()
         changed = mutate((SRC / m.module).read_text(), m.index).splitlines()
         import difflib

@@ -58,6 +58,12 @@ nitpicky = True
 
 # ------------------------------------------------------------------ API reference
 autosummary_generate = True
+# autosummary writes a page per module into generated/ but never removes one: a module
+# moved or renamed since the last build would leave a page that no longer imports (a
+# warning, so a failed -W build), so every build starts from an empty folder
+import shutil  # noqa: E402
+
+shutil.rmtree(Path(__file__).resolve().parent / "generated", ignore_errors=True)
 autosummary_imported_members = False
 autodoc_default_options = {"members": True, "inherited-members": False}
 autodoc_typehints = "none"  # the numpydoc sections give the types, in words

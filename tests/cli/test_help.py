@@ -120,5 +120,6 @@ def test_blend_prints_jerk_as_a_ratio_and_with_a_prefix(tmp_path, capsys):
     capsys.readouterr()
     assert main(["blend", str(walk), str(jog), "-o", str(tmp_path / "b.bvh")]) == 0
     line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("blend "))
-    assert "x the inputs' mean" in line and "deg/s³" in line
+    # joint positions (the cycles have skeletons): metres per second cubed, as extract
+    assert "x the inputs' mean" in line and "m/s³" in line and "largest step" in line
     assert "e+" not in line and "e-" not in line

@@ -1,12 +1,12 @@
 """``extract`` and ``batch`` write the same partial report for a capture with nothing
-periodic: both build it with :func:`cyclecoord.report.partial_report`."""
+periodic: both build it with :func:`cyclecoord.periodic.report.partial_report`."""
 
 import json
 
 import cyclecoord as cc
 from cyclecoord.cli import main
 from cyclecoord.errors import NoPeriodicMotionError
-from cyclecoord.report import partial_report
+from cyclecoord.periodic.report import partial_report
 
 
 def test_extract_and_batch_write_the_same_partial_report(tmp_path):

@@ -686,6 +686,24 @@ def test_latent_fit_options_reach_the_model(monkeypatch, takes, tmp_path):
     assert not (tmp_path / "m.npz").exists()
 
 
+def test_latent_fit_default_step_trains_near_30_fps(monkeypatch, takes, tmp_path):
+    """A 30 fps BVH keeps every frame by default (every 4th left 38 frames of a 150-frame
+    walk, too few for a gait phase); a 120 fps one every 4th; --step overrides both."""
+    slow = tmp_path / "walk30.bvh"
+    cc.save(cc.load(takes[0])[::4], slow)  # 150 frames at 120 fps -> 38 frames at 30 fps
+
+    def frames(path, *extra):
+        fit = Spy(monkeypatch, "cyclecoord.synthesis.latent.model.LatentModel.fit")
+        with pytest.raises(Reached):
+            main(["latent", "fit", str(path), "-o", str(tmp_path / "m.npz"), *extra])
+        return [(m.n_frames, m.fps) for m in fit.args[1]]
+
+    assert cc.load(takes[0]).fps == 120.0
+    assert frames(takes[0]) == [(38, 30.0)]
+    assert frames(slow) == [(38, 30.0)]
+    assert frames(slow, "--step", "2") == [(19, 15.0)]
+
+
 def test_latent_fit_no_progress_reaches_fit(monkeypatch, takes, tmp_path):
     def progress(*extra):
         fit = Spy(monkeypatch, "cyclecoord.synthesis.latent.model.LatentModel.fit")

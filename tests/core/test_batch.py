@@ -13,11 +13,11 @@ import pytest
 
 import cyclecoord as cc
 from _measured import at_most
-from cyclecoord import batch
+from cyclecoord.batch import runner
 from cyclecoord.batch import SUMMARY_COLUMNS, find_captures, run_batch
 from cyclecoord.errors import ParameterError
 
-_ORIGINAL_PROCESS_ONE = batch._process_one
+_ORIGINAL_PROCESS_ONE = runner._process_one
 
 # relative path -> (kind, seed); the two "walk" files share a stem on purpose
 PERIODIC = {"walk.npz": ("walk", 1), "walk.bvh": ("walk", 2), "sub/deep/jog.bvh": ("jog", 3)}
@@ -121,8 +121,9 @@ def test_statuses_summary_and_reports(first, folder):
         assert int(r["frames"]) == N_FRAMES and int(r["dims"]) == report["dims"] > 0
         assert 0 < float(r["birth"]) < float(r["scale"]) < float(r["death"])  # "inf" parses too
         assert float(r["birth"]) == pytest.approx(report["selected"]["birth"], rel=1e-5)
-        # the typical cycle is smoother than the noisy capture: measured 0.050-0.055 of its jerk
-        assert 0 < float(r["jerk_ratio"]) <= at_most(0.055)
+        # the typical cycle is smoother than the noisy capture: measured 0.090-0.095 of its
+        # jerk (joint positions, as extract prints it)
+        assert 0 < float(r["jerk_ratio"]) <= at_most(0.095)
         assert float(r["jerk_ratio"]) == pytest.approx(report["jerk"]["cycle"] / report["jerk"]["original"], rel=1e-5)
         assert float(r["loop_closure"]) == pytest.approx(report["loop_closure"], rel=1e-5)
         assert float(r["seconds"]) >= 0
@@ -242,7 +243,7 @@ def _crash_on_marker(task):
 def test_a_dying_worker_fails_only_its_capture(tmp_path, monkeypatch):
     src = _build(tmp_path / "in", {"a.npz": ("walk", 1), "crash.npz": ("walk", 2), "z.npz": ("squat", 4)},
                  static=False, broken=False)
-    monkeypatch.setattr(batch, "_process_one", _crash_on_marker)
+    monkeypatch.setattr(runner, "_process_one", _crash_on_marker)
     result = run_batch(src, tmp_path / "out", jobs=2, progress=False)
     assert {r["file"]: r["status"] for r in result.rows} == {"a.npz": "ok", "crash.npz": "error", "z.npz": "ok"}
     assert "worker process died" in result.row("crash.npz")["message"]

@@ -660,6 +660,13 @@ def _asf_error_cases():
     cut = t[: t.rindex("  end")]
     n = len(cut.rstrip("\n").split("\n"))
     cases.append(("unclosed hierarchy", cut, n, "hierarchy block opened"))
+    # 'begin' and 'end' are keywords only alone on their line
+    s, n = _replace_line(t, "=end", "  end\n  end", 1)
+    cases.append(("end outside a bone block", s, n + 1, "expected 'begin' to open a bone block"))
+    s, n = _replace_line(t, "=begin", "  begin bone", 1)
+    cases.append(("begin with a word", s, n, "got 'begin bone'"))
+    s, n = _replace_line(t, "spine arm head", "    spine arm head\n  end here")
+    cases.append(("hierarchy end with a word", s, n + 1, "parent 'end', which is not defined"))
     return cases
 
 

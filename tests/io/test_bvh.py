@@ -286,11 +286,14 @@ def test_writer_makes_names_bvh_safe(tmp_path):
     sk = Skeleton((
         Joint("my root", -1, [0, 0, 0], ("rx",), "X"),
         Joint("my{root}", 0, [0, 1, 0], ("rx",), "X", end_site=[0, 1, 0]),
+        # names that clash once made safe get _2, _3, ... in order
+        Joint("my\troot", 0, [1, 0, 0], ("rx",), "X", end_site=[0, 1, 0]),
+        Joint(" my root ", 0, [0, 0, 1], ("rx",), "X", end_site=[0, 1, 0]),
     ))
-    m = Motion(np.array([[10.0, 20.0]]), sk.channels, skeleton=sk)
+    m = Motion(np.array([[10.0, 20.0, 30.0, 40.0]]), sk.channels, skeleton=sk)
     write_bvh(m, tmp_path / "n.bvh")
     back = read_bvh(tmp_path / "n.bvh")
-    assert back.skeleton.names == ["my_root", "my_root_"]
+    assert back.skeleton.names == ["my_root", "my_root_", "my_root_2", "my_root_3"]
     np.testing.assert_allclose(back.positions().positions, m.positions().positions, atol=1e-9)
 
 

@@ -129,11 +129,11 @@ def test_foreign_gltf_without_extras(tmp_path):
 def test_bad_input_writes_nothing(tmp_path):
     m = _arm()
     bare = Motion(m.frames, m.channels, fps=m.fps)
-    with pytest.raises(ParameterError, match="skeleton"):
+    with pytest.raises(ParameterError, match="^motion: .*needs a skeleton"):  # no source
         cc.save(bare, tmp_path / "a.glb")
     frames = m.frames.copy()
     frames[3, 2] = np.nan
-    with pytest.raises(ParameterError, match="frame 3"):
+    with pytest.raises(ParameterError, match="^arm: frame 3"):  # the message names the source
         cc.save(m.with_frames(frames), tmp_path / "b.gltf")
     with pytest.raises(ParameterError, match="scale"):
         write_gltf(m, tmp_path / "c.glb", scale=0)
@@ -187,3 +187,83 @@ def test_save_with_lock_feet(walk_69_01, tmp_path):
     cc.save(m, tmp_path / "locked.glb", lock_feet=True)
     back = cc.load(tmp_path / "locked.glb")
     assert foot_skating(back, contacts).skating_frames <= 1
+
+
+def _foreign(tmp_path, m):
+    """``m`` written without a mesh and loaded back as a pygltflib document, extras dropped."""
+    import pygltflib
+
+    out = tmp_path / "arm.gltf"
+    write_gltf(m, out, mesh=False)
+    gltf = pygltflib.GLTF2.load(str(out))
+    gltf.extras = {}
+    return gltf
+
+
+def test_cubic_spline_samplers_read_their_values_not_tangents(tmp_path):
+    """A CUBICSPLINE sampler holds (in-tangent, value, out-tangent) per key; the reader
+    takes the values (between keys it interpolates linearly, as for LINEAR)."""
+    import base64
+
+    import pygltflib
+
+    m = _arm()
+    gltf = _foreign(tmp_path, m)
+    blob = bytearray()
+    for s in gltf.animations[0].samplers:
+        acc = gltf.accessors[s.output]
+        view = gltf.bufferViews[acc.bufferView]
+        data = (tmp_path / gltf.buffers[view.buffer].uri).read_bytes()
+        ncomp = {"VEC3": 3, "VEC4": 4}[acc.type]
+        start = (view.byteOffset or 0) + (acc.byteOffset or 0)
+        v = np.frombuffer(data, np.float32, acc.count * ncomp, start).reshape(-1, ncomp)
+        # tangents far from the values (a reader taking them would be far off)
+        keys = np.stack([v + 7.0, v, v - 5.0], axis=1).astype(np.float32)
+        gltf.bufferViews.append(pygltflib.BufferView(buffer=len(gltf.buffers),
+                                                     byteOffset=len(blob),
+                                                     byteLength=keys.nbytes))
+        gltf.accessors.append(pygltflib.Accessor(bufferView=len(gltf.bufferViews) - 1,
+                                                 componentType=5126, count=3 * acc.count,
+                                                 type=acc.type))
+        blob += keys.tobytes()
+        s.output = len(gltf.accessors) - 1
+        s.interpolation = "CUBICSPLINE"
+    uri = "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode()
+    gltf.buffers.append(pygltflib.Buffer(byteLength=len(blob), uri=uri))
+    (tmp_path / "cubic.gltf").write_text(gltf.gltf_to_json())
+    back = read_gltf(tmp_path / "cubic.gltf")
+    assert back.n_frames == m.n_frames
+    assert np.abs(back.positions().positions[:, :3] - m.positions().positions).max() < 1e-5
+
+
+def test_identity_matrix_beside_trs_is_no_matrix(tmp_path):
+    """Some exporters write the identity ``matrix`` beside the node's translation and
+    rotation: the reader then uses the translation and rotation."""
+    m = _arm()
+    gltf = _foreign(tmp_path, m)
+    assert gltf.nodes[1].translation is not None and np.linalg.norm(gltf.nodes[1].translation) > 0
+    gltf.nodes[1].matrix = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
+    (tmp_path / "identity.gltf").write_text(gltf.gltf_to_json())
+    back = read_gltf(tmp_path / "identity.gltf")
+    assert np.abs(back.positions().positions[:, :3] - m.positions().positions).max() < 1e-5
+
+
+def test_stick_mesh_prisms_are_closed_and_outward():
+    """Each bone's prism: 8 vertices, 12 triangles, every edge shared by two triangles in
+    opposite directions (closed, consistently wound), outward normals (positive volume
+    2 r^2 L for a square of half-diagonal r)."""
+    from cyclecoord.io.gltf import _stick_mesh
+
+    rest = np.array([[0, 0, 0], [0, 2.0, 0], [3.0, 2.0, 0], [3.0, 2.0, 0]])
+    verts, joints, tris = _stick_mesh(rest, [(0, (0, 1)), (1, (1, 2)), (2, (2, 3))], 0.1)
+    assert verts.shape == (16, 3) and tris.shape == (24, 3)  # the zero-length bone is skipped
+    assert joints.tolist() == [0] * 8 + [1] * 8
+    for b, length in enumerate([2.0, 3.0]):
+        own = tris[12 * b : 12 * (b + 1)]
+        assert (own // 8 == b).all()
+        directed = [(t[i], t[(i + 1) % 3]) for t in own.tolist() for i in range(3)]
+        assert len(set(directed)) == 36
+        assert all((y, x) in directed for x, y in directed)
+        p = verts[own]
+        volume = np.einsum("ij,ij->i", p[:, 0], np.cross(p[:, 1], p[:, 2])).sum() / 6
+        assert volume == pytest.approx(2 * 0.1**2 * length, rel=1e-12)

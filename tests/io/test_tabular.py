@@ -131,6 +131,23 @@ def test_npz_errors(tmp_path):
         read_npz(tmp_path / "badaxes.npz")
 
 
+def test_npz_whole_numbers_stored_as_floats(tmp_path):
+    """A frame number written as a float reads when it is whole (7.0), and is refused
+    naming the key when it is not (7.5, nan)."""
+    m = Motion(np.arange(6.0).reshape(3, 2), [("a", "x"), ("b", "")], fps=30)
+    write_npz(m, tmp_path / "plain.npz")
+    with np.load(tmp_path / "plain.npz") as z:
+        arrays = {k: z[k] for k in z.files}
+    for value, start in [(7.0, 7), (7.5, None), (np.nan, None)]:
+        arrays["start_frame"] = np.array(value)
+        np.savez(tmp_path / "f.npz", **arrays)
+        if start is None:
+            with pytest.raises(ParseError, match=r"array 'start_frame': expected a whole number"):
+                read_npz(tmp_path / "f.npz")
+        else:
+            assert read_npz(tmp_path / "f.npz").start_frame == start
+
+
 # --------------------------------------------------------------------------- CSV
 def test_csv_round_trip(tmp_path):
     m = sample_motion(skeleton=False)

@@ -47,6 +47,14 @@ def test_good_primes(p):
     assert check_prime(p) == p
 
 
+def test_retry_primes_are_the_primes_from_47_to_97():
+    """The primes a failed lift is retried with: each a valid coefficient prime, in order."""
+    from cyclecoord.periodic.coordinates import RETRY_PRIMES
+
+    assert RETRY_PRIMES == tuple(p for p in range(47, 98) if all(p % d for d in range(2, p)))
+    assert all(check_prime(p) == p for p in RETRY_PRIMES)
+
+
 def test_circle_has_one_clear_bar_and_recovers_the_angle():
     x, phase = noisy_circle()
     est = CircularCoordinates().fit(x)
@@ -134,6 +142,26 @@ def test_scale_outside_the_bar_is_refused():
         select_bar(bc, len(bc.h1))
 
 
+def test_select_bar_figures_on_a_known_barcode():
+    """Gap to the next-longest bar (the last bar has none: infinite), ratio, scale and
+    clearness on hand-made bars; deaths are capped at the threshold."""
+    from cyclecoord.periodic.barcode import Barcode
+
+    h1 = np.array([[1.0, np.inf], [1.0, 2.0], [0.5, 1.0]])  # persistence 4, 1, 0.5
+    bc = Barcode(h0=np.zeros((0, 2)), h1=h1, cocycles=[], threshold=5.0, prime=47, n_points=9)
+    figures = [(s.gap, s.ratio, s.scale, s.clear) for s in (select_bar(bc, k) for k in range(3))]
+    assert figures == [
+        (4.0, 5.0, pytest.approx(4.6), True),
+        (2.0, 2.0, pytest.approx(1.9), True),
+        (np.inf, 2.0, pytest.approx(0.95), True),
+    ]
+    # a bar shorter than 5 % of the threshold is not clear, however isolated
+    short = Barcode(h0=np.zeros((0, 2)), h1=np.array([[0.1, 0.3]]), cocycles=[], threshold=5.0,
+                    prime=47, n_points=9)
+    s = select_bar(short, 0)
+    assert (s.gap, s.ratio, s.clear) == (np.inf, pytest.approx(3.0), False)
+
+
 def test_noise_has_no_clear_bar():
     rng = np.random.default_rng(3)
     x = rng.standard_normal((200, 6))
@@ -181,6 +209,17 @@ def _check_by_unique(edges, z, n):
     tri = np.sort(np.column_stack([ea, eb, c]), axis=1)
     key = (tri[:, 0] * n + tri[:, 1]) * n + tri[:, 2]
     return len(np.unique(key)), len(np.unique(key[bad]))
+
+
+def test_rips_edges_known_answer_and_empty():
+    """Edges i < j within the scale, sorted, from points or a distance matrix; none at a
+    scale below every distance is still an (0, 2) integer array."""
+    x = np.array([[0.0, 0.0], [3.0, 0.0], [1.0, 0.0], [0.0, 1.5]])
+    d = np.linalg.norm(x[:, None] - x[None], axis=2)
+    for edges in (rips_edges(x, 2.0), rips_edges(x, 2.0, d)):
+        assert edges.dtype == np.int64 and edges.tolist() == [[0, 2], [0, 3], [1, 2], [2, 3]]
+    for edges in (rips_edges(x, 0.5), rips_edges(x, 0.5, d)):
+        assert edges.shape == (0, 2) and edges.dtype == np.int64
 
 
 @pytest.mark.parametrize("seed", range(4))

@@ -322,3 +322,92 @@ def test_motion_cycles_need_one_and_a_half_cycles(chain):
         m for m, (_, c) in sorted(longest.items()) if c >= fewest + 0.01
     ]
     assert len(motion_cycles(res, min_cycles=fewest)) == res.n_motions
+
+
+def test_class_period_turns_and_frames_per_turn():
+    """A coordinate advancing 1/40 of a turn per frame from 0.2: 5 turns over frames
+    0..200 and a period of 40 frames, from complete windings or, with under 0.75 excited
+    turns, from the whole segment."""
+    from cyclecoord.periodic.detection._segments import class_period
+
+    theta = np.mod(0.2 + np.arange(201) / 40.0, 1.0)
+    cyc, period = class_period(theta, np.ones(201, bool), 0, 201)
+    assert cyc == pytest.approx(5.0) and period == pytest.approx(40.0)
+    few = np.arange(201) < 30  # 29 excited steps: 0.725 turns
+    cyc, period = class_period(theta, few, 0, 201)
+    assert cyc == pytest.approx(5.0) and period == pytest.approx(200 / 5.0)
+
+
+def test_drop_unsteady_keeps_a_piece_exactly_min_run_long():
+    """No pause and no root: the segment is kept whole when it is exactly ``min_run``
+    frames long, dropped (labels -1) when ``min_run`` is one more."""
+    from cyclecoord.motion import Motion
+    from cyclecoord.periodic.detection._segments import drop_unsteady
+
+    T = 90
+    ang = 2 * np.pi * np.arange(T) / 30
+    joints = 30.0 * np.column_stack([np.sin(ang), np.cos(ang)])  # constant joint speed
+    motion = Motion(joints, [("a", "rx"), ("b", "rx")], fps=30.0)
+    seg = Segment(0, T, 0, (0,), 1.0, 2.0, 1.5, 3.0, 30.0)
+    labels, out = drop_unsteady(np.zeros(T, int), [seg], joints, motion, min_run=T)
+    assert out == [seg] and np.all(labels == 0)
+    labels, out = drop_unsteady(np.zeros(T, int), [seg], joints, motion, min_run=T + 1)
+    assert out == [] and np.all(labels == -1)
+
+
+def test_read_classes_min_consistency_is_inclusive():
+    """Every step of a clean ramp goes one way: its consistency is exactly 1, and
+    ``min_consistency=1`` (at least 1) keeps it."""
+    from types import SimpleNamespace
+
+    from cyclecoord.periodic.detection.classes import read_classes
+
+    theta = np.mod(np.arange(300) / 50.0, 1.0)  # 6 turns at 1/50 of a turn per frame
+
+    class Stub:
+        def with_coordinate_params(self, class_index):
+            return SimpleNamespace(fit_coordinate=lambda: None, coordinates_=theta,
+                                   selection_=SimpleNamespace(birth=1.0, death=3.0, scale=2.0))
+
+    (c,) = read_classes(Stub(), [0], window=11, min_speed=0.01, min_consistency=1.0,
+                        min_cycles=2.0, notes=[])
+    assert c.status == "kept" and c.mask.all() and np.all(c.consistency == 1.0)
+
+
+def test_window_table_uses_every_frame_of_a_window_within_max_points():
+    from cyclecoord.periodic.detection import window_table
+    from cyclecoord.periodic.preprocess import Preprocessor
+
+    m = cc.datasets.make_periodic_capture(n_frames=300, period=100, random_state=0).motion
+    prep = Preprocessor(delay=30).fit_transform(m)
+    n = int(round(2.0 * m.fps))
+    for max_points, step in [(n, 1), (n - 1, 2), (n // 3, 3)]:
+        wins = window_table(prep.points, prep.poses, m.fps, lengths=(2.0,), max_points=max_points,
+                            progress=False)
+        assert wins and all(w.step == step and w.stop - w.start == n for w in wins)
+
+
+def test_three_windows_covering_exactly_min_cycles_make_a_motion():
+    """No window turns ``min_cycles`` times, but three alike ones together cover 18 frames
+    of a 20-frame period: 0.9 turns, exactly ``min_cycles``, which is enough."""
+    from cyclecoord.periodic.detection.result import WindowInfo
+    from cyclecoord.periodic.detection.windows import windowed_motions
+
+    ang = 2 * np.pi * np.arange(16) / 16
+    cycle = 10.0 * np.column_stack([np.cos(ang), np.sin(ang)])
+    poses = cycle[np.arange(18) % 16]  # every frame on the cycle
+
+    def win(a, b):
+        return WindowInfo(start=a, stop=b, step=1, birth=1.0, death=5.0, threshold=6.0, scale=4.0,
+                          clear=True, cycles=0.5, steadiness=1.0, period_frames=20.0,
+                          looping=True, cycle=cycle)
+
+    for min_cycles, motions in [(0.9, 1), (0.91, 0)]:
+        windows = [win(0, 8), win(5, 13), win(10, 18)]
+        labels, segments, n = windowed_motions(
+            windows, [], np.full(18, -1), 0, poses, window=3, min_cycles=min_cycles,
+            similarity=0.5, merge_overlap=0.5,
+        )
+        assert n == motions and len(segments) == motions
+        assert np.all(labels == (0 if motions else -1))
+        assert all(w.motion == (0 if motions else -1) for w in windows)

@@ -49,6 +49,9 @@ def test_choice_of_landmarks():
     assert choose_landmarks(big, 1.0)[0] == AUTO_LANDMARKS
     assert choose_landmarks(big, 1.0, landmarks=None)[0] is None
     assert choose_landmarks(big, 1.0, landmarks=300)[0] == 300
+    assert choose_landmarks(big, 1.0, landmarks=10)[0] == 10  # the fewest allowed
+    with pytest.raises(cc.ParameterError, match="at least 10 landmarks, got 9"):
+        choose_landmarks(big, 1.0, landmarks=9)
     with pytest.raises(cc.ParameterError):
         choose_landmarks(big, 1.0, landmarks="many")
 
@@ -247,6 +250,10 @@ def test_greedy_landmarks_make_ripsers_choice(shape):
     assert nearest.max() == pytest.approx(radius, rel=1e-12)
     full, r0 = greedy_landmarks(x[:20], 20)
     assert sorted(full) == list(range(20)) and r0 == 0.0
+    # one landmark: the start, covering every point at its farthest distance
+    one, r1 = greedy_landmarks(x[:20], 1, start=7)
+    assert one.tolist() == [7]
+    assert r1 == pytest.approx(np.linalg.norm(x[:20] - x[7], axis=1).max(), rel=1e-12)
     for bad in (0, len(x) + 1, 2.5, True):
         with pytest.raises(ParameterError):
             greedy_landmarks(x, bad)

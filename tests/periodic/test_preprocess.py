@@ -87,3 +87,49 @@ def test_delay_embedding_turns_an_out_and_back_motion_into_a_loop():
     assert two.shape == (400, 24)
     with pytest.raises(ParameterError):
         Preprocessor(delay=2.5).fit(make(f))
+
+
+def _walker(order="ZYX", channels=None):
+    """A root that walks, turns past 180 degrees, pitches and rolls, and one joint."""
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    root_dofs = ("tx", "ty", "tz") + tuple("r" + a.lower() for a in order)
+    sk = Skeleton((
+        Joint("root", -1, [0, 0, 0], root_dofs, order),
+        Joint("leg", 0, [0, -1, 0], ("rx",), "X", end_site=[0, -1, 0]),
+    ))
+    T = 40
+    t = np.arange(T) / 10.0
+    cols = {"tx": 3 * np.sin(t), "ty": 1 + 0.1 * t, "tz": 2 * t, "rx": 10 * np.sin(2 * t),
+            "ry": 15 * np.cos(t), "rz": 60 * t}  # the middle (Y) angle stays small
+    channels = channels or sk.channels
+    frames = np.column_stack([cols[d] if j == "root" else 20 * np.sin(3 * t) for j, d in channels])
+    return Motion(frames, channels, fps=10, skeleton=sk)
+
+
+def test_body_root_differences_integrate_back_to_the_capture():
+    """integrate_root inverts the body-frame differences: from the first frame's root
+    values, the per-frame changes rebuild every frame's root channels."""
+    from cyclecoord.periodic.preprocess import body_frame_differences, _root_layout
+
+    m = _walker()
+    prep = Preprocessor(root="body").fit(m)
+    assert prep.root_mode_ == "body"
+    cols = prep.root_columns_
+    deltas = body_frame_differences(m.frames, cols, *_root_layout(m, cols))
+    want = m.frames[:, cols]
+    got = prep.integrate_root(deltas, want[0], None, m)
+    np.testing.assert_allclose(got, want, atol=1e-9)
+    # the mean change it is asked for is the one it has: nothing moves
+    got = prep.integrate_root(deltas, want[0], deltas.mean(axis=0), m)
+    np.testing.assert_allclose(got, want, atol=1e-9)
+
+
+def test_body_root_needs_the_skeleton_to_order_every_root_rotation():
+    """Root channels rx ry rz over a skeleton whose root only orders ZY: the body frame
+    is undefined, so the plain Euler differences are used."""
+    chans = [("root", d) for d in ("tx", "ty", "tz", "rx", "ry", "rz")] + [("leg", "rx")]
+    m = _walker("ZY", channels=chans)
+    assert len(m.root_channels()) == 6
+    assert Preprocessor(root="body").fit(m).root_mode_ == "euler"
+    assert Preprocessor(root="body").fit(_walker("ZYX")).root_mode_ == "body"

@@ -121,3 +121,12 @@ def test_rotation_vector_is_the_angle_from_the_mean():
     rmap = fit_rotation_map(m.with_frames(f), exclude=np.asarray(m.root_channels()))
     v = rmap.to_vectors(f)[:, cols]
     np.testing.assert_allclose(np.linalg.norm(v, axis=1), np.abs(ang), atol=1e-6)
+
+
+def test_hinge_angles_move_by_whole_turns_into_half_a_turn_of_their_centre():
+    """Centre 10: every angle lands in [-170, 190) by whole turns; one there stays exact."""
+    rmap = RotationMap(groups=(), hinge_columns=np.array([0]), hinge_centres=np.array([10.0]))
+    x = np.array([10.0, 189.5, 191.0, -171.0, 550.0, -700.0, 0.1])
+    out = rmap.to_vectors(np.column_stack([x, x]))
+    np.testing.assert_array_equal(out[:, 0], [10.0, 189.5, -169.0, 189.0, -170.0, 20.0, 0.1])
+    np.testing.assert_array_equal(out[:, 1], x)  # not a hinge column: copied

@@ -135,3 +135,35 @@ def test_steady_turning_rejects_the_start_of_a_turn_and_a_u_turn():
     assert not ok[420:580].any() and ok[:350].all() and ok[650:].all()
     u_turn = np.interp(t, [0, 450, 550, 999], [0, 0, 180, 180])
     assert not steady_turning(u_turn, P)[450:550].any()
+
+
+def test_a_fast_shake_at_30_fps_is_motion():
+    """The poses are smoothed only lightly (0.04 s: 1.2 frames at 30 fps) before their
+    speed is read: a 6 Hz shake of 10 degrees moves as much as a slow 30-degree swing."""
+    from cyclecoord.periodic.steady import moving_mask
+
+    t = np.arange(180)
+    swing_then_shake = np.where(t < 90, 30 * np.sin(2 * np.pi * t / 60), 10 * np.sin(2 * np.pi * t / 5))
+    assert moving_mask(np.repeat(swing_then_shake[:, None], 3, axis=1), 30.0).all()
+
+
+def test_centred_window_stays_inside():
+    from cyclecoord.periodic.steady import centred_window
+
+    lo, hi = centred_window(10, 2)
+    assert lo.tolist() == [0, 0, 0, 1, 2, 3, 4, 5, 5, 5]
+    assert hi.tolist() == [4, 4, 4, 5, 6, 7, 8, 9, 9, 9]
+    lo, hi = centred_window(3, 5)  # wider than the frames: all of them
+    assert lo.tolist() == [0, 0, 0] and hi.tolist() == [2, 2, 2]
+
+
+def test_a_two_frame_stretch_at_pace_is_steady():
+    """Pace over the frames a stretch has: two candidate frames half a turn apart with a
+    period of 2 frames turn once a period (a stretch this short is kept only when it is
+    as long as the period: runs under a period are dropped)."""
+    u = np.full(8, np.nan)
+    u[3:5] = [0.3, 0.8]
+    cand = ~np.isnan(u)
+    assert np.flatnonzero(steady_mask(u, cand, 2.0)).tolist() == [3, 4]
+    u[4] = 0.4  # 0.2 turns per period: too slow
+    assert not steady_mask(u, cand, 2.0).any()

@@ -160,6 +160,68 @@ def test_typical_amplitude_restores_what_averaging_flattens():
     assert np.argmax(out[:, 0]) == np.argmax(avg[:, 0])  # the shape is kept, only widened
 
 
+def test_typical_amplitude_windows_start_at_every_frame_for_short_cycles():
+    """A 4-frame cycle: P // 8 is 0, so a window of one period starts at every frame of the
+    phased run (not every other one); no running median (spike 1), so the known answer is
+    the median of the 6 windows' ranges 0, 0, 1, 2, 2, 2: 1.5, a gain of 1.5 on a cycle of
+    range 1, about its mean."""
+    from cyclecoord.periodic.clip import typical_amplitude
+
+    poses = np.array([0, 0, 0, 0, 0, 1, 2, 0, 0], float)[:, None]
+    phase = np.zeros(9)  # every frame phased; only finiteness is read
+    cycle = np.array([[0.0], [1.0], [0.0], [0.0]])
+    out = typical_amplitude(cycle, phase, poses, spike=1)
+    np.testing.assert_allclose(out[:, 0], 0.25 + 1.5 * (cycle[:, 0] - 0.25))
+    # a run shorter than the cycle gives no window: the cycle is returned as it is
+    np.testing.assert_array_equal(typical_amplitude(cycle, phase[:3], poses[:3], spike=1), cycle)
+
+
+def test_register_straightens_a_warped_phase_and_keeps_runs_too_short_to_align():
+    """Poses on a circle, one turn per 50 frames; the phase given is warped by up to 0.03
+    of a cycle.  Registration brings the long run back to the true phase (to a sample of
+    the 50-sample cycle: exactly, since the frames sit on the samples); a run of 2 frames
+    is left as it was."""
+    from cyclecoord.periodic.registration import register
+
+    t = np.arange(200)
+    true = t / 50.0
+    poses = np.column_stack([np.cos(2 * np.pi * true), np.sin(2 * np.pi * true)])
+    given = np.full(200, np.nan)
+    runs = [(0, 140), (150, 152)]
+    for a, b in runs:
+        given[a:b] = np.mod(true[a:b] + 0.03 * np.sin(2 * np.pi * t[a:b] / 37), 1.0)
+    out = register(given, poses, runs, n_samples=50, width=0.02)
+
+    err = np.abs(np.mod(out - true + 0.5, 1.0) - 0.5)
+    was = np.abs(np.mod(given - true + 0.5, 1.0) - 0.5)
+    assert was[:140].max() > 0.025 and err[:140].max() < 1e-12
+    np.testing.assert_array_equal(out[150:152], given[150:152])
+    assert np.all(np.isnan(out[140:150])) and np.all(np.isnan(out[152:]))
+
+
+def test_one_complete_winding_has_no_spread():
+    """From 0.99 to 2.015 turns at 1/40 a frame: level 0 alone is crossed twice, one
+    winding of 40 frames, and one length has no spread."""
+    w = complete_windings(0.99 + np.arange(42) / 40, [(0, 42)])
+    assert w.pooled.tolist() == [pytest.approx(40.0)]
+    assert w.period_frames == pytest.approx(40.0) and w.spread == 0.0
+
+
+def test_retime_from_a_single_pin_runs_at_one_cycle_a_period():
+    """A run that crosses its one anchor once: the phase is 0 there and advances one cycle
+    per period before and after (here the coordinate's own fraction)."""
+    from cyclecoord.periodic.windings import Windings
+
+    w = Windings(levels=np.array([0.0]), anchors=np.array([0]), reference=0,
+                 lengths=np.zeros(0), pooled=np.array([20.0]), period_frames=20.0,
+                 spread=0.0, turns=1.0, positions=np.array([0.0]))
+    u = np.full(14, np.nan)
+    u[2:12] = 0.7 + np.arange(10) / 20  # reaches 1.0 at frame 8
+    out = retime(u, [(2, 12)], w)
+    np.testing.assert_allclose(out[2:12], np.mod(u[2:12], 1.0), atol=1e-12)
+    assert out[8] == pytest.approx(0.0, abs=1e-12) and np.isnan(out[:2]).all() and np.isnan(out[12:]).all()
+
+
 def test_hold_weights_give_a_held_stretch_one_vote():
     from cyclecoord.periodic.registration import hold_weights
 

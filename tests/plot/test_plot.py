@@ -19,7 +19,6 @@ from matplotlib.colors import to_rgba  # noqa: E402
 import cyclecoord as cc  # noqa: E402
 from cyclecoord.plot import figures as plot  # noqa: E402
 from cyclecoord.errors import NoPeriodicMotionError, ParameterError  # noqa: E402
-from cyclecoord.quality.metrics import jerk  # noqa: E402
 
 from PIL import Image  # noqa: E402  (Pillow ships with matplotlib)
 from _skips import need_program  # noqa: E402
@@ -247,8 +246,13 @@ def test_channels_cycle_follows_original_and_jerk(result):
     assert n == round(3 * result.period_frames)
     (jo,) = [ln for ln in ax_j.get_lines() if ln.get_label() == "original"]
     (jc,) = [ln for ln in ax_j.get_lines() if ln.get_label() == "cycle"]
-    # the jerk shown is the one reported (prepared space, all channels; issue 18)
-    expected = np.linalg.norm(jerk(result.prepared.poses, result.motion.fps), axis=1)
+    # the jerk shown is the one reported: joint positions in the root's frame, metres / s³
+    # (quality.pose_space, one computation for every command; issue 25)
+    from cyclecoord.quality.pose_space import point_jerk, root_frame_points
+    from cyclecoord.rig import describe_rig
+
+    points = root_frame_points(result.motion, describe_rig(result.motion))
+    expected = point_jerk(points, result.motion.fps, False) * result.pose_quality.figures.metres_per_unit
     np.testing.assert_allclose(jo.get_ydata(), expected[: len(jo.get_ydata())])
     assert f"cycle {result.jerk['cycle']:.3g}" in ax_j.get_title()
     # the averaged cycle is smoother than the noisy synthetic capture

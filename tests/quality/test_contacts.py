@@ -173,3 +173,15 @@ def test_skating_line(walk_69_01):
     assert skating_line(skating_report(m)) == foot_skating(m).summary()
     assert skating_line(skating_report(m), "blend").startswith("blend foot skating: ")
     assert "not measured" in skating_line(None, "cycle")
+
+
+def test_clean_closes_short_gaps_inside_and_drops_short_runs():
+    """min_frames 3: gaps of 2 and 1 frames between contacts are closed, a 3-frame gap
+    is kept, a gap at either end is not between contacts; a 2-frame contact is dropped."""
+    from cyclecoord.quality.contacts import _clean
+
+    m = np.array([0, 1, 1, 1, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1, 0, 1, 1, 0, 0, 0, 1, 1, 0], bool)
+    want = np.array([0, 1, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0, 0, 0],
+                    bool)
+    np.testing.assert_array_equal(_clean(m, 3), want)
+    np.testing.assert_array_equal(_clean(m, 1), m)  # 1 frame: nothing to clean

@@ -375,3 +375,38 @@ def test_person_on_all_fours_keeps_two_legs():
     legs = find_legs(raised, crawl)
     assert legs.method == "names" and legs.feet == ("LeftFoot", "LeftToeBase", "RightFoot",
                                                     "RightToeBase")
+
+
+def test_hands_mostly_off_the_floor_stay_arms():
+    """A dog rig named like a person gets front legs from the geometry only when its
+    hands stay low in the take (median within 0.15 of the body height): paws in the air
+    80 % of the time, 4 units high (median 0.22 of the height), leave two legs."""
+    from cyclecoord.quality.legs import _Geometry
+
+    names = quadruped_names("human")
+    dog = quadruped_skeleton(names)
+    assert find_legs(dog, trot(dog, names)).method == "names and geometry"
+    prancing = trot(dog, names, stance=0.2, lift=4.0)
+    geo = _Geometry(dog, prancing, "y")
+    hands = [e for e in geo.ends if e < len(dog.names) and "Hand" in dog.names[e]]
+    assert len(hands) == 2
+    assert all(0.2 < geo.median[e] / geo.height < 0.25 and geo.low[e] < 0.01 * geo.height
+               for e in hands)
+    legs = find_legs(dog, prancing)
+    assert legs.method == "names" and [g.label for g in legs.legs] == ["left", "right"]
+
+
+@pytest.mark.parametrize("trotting", [False, True])
+def test_short_quadruped_pairs_legs_where_they_part_lowest(trotting):
+    """A body of 4 (legs of about 8): a front and a hind leg are alike enough from the
+    pelvis to pair, but the pairs are those whose chains part lowest in the tree (the
+    front legs at the chest, the hind legs at the pelvis)."""
+    names = quadruped_names("anonymous")
+    skel = quadruped_skeleton(names, body=4.0)
+    legs = find_legs(skel, trot(skel, names, body=4.0) if trotting else None)
+    assert legs.method == "geometry"
+    assert [(g.label, g.points) for g in legs.legs] == [
+        (label, (names[f"{k}_ankle"], names[f"{k}_toe"]))
+        for label, k in (("front left", "fl"), ("front right", "fr"), ("hind left", "hl"),
+                         ("hind right", "hr"))
+    ]

@@ -111,6 +111,31 @@ def test_arm_through_the_torso_is_flagged(walk):
     assert payload["clean"] is False and payload["joint_range_violations"]
 
 
+def test_a_reference_of_another_size_is_measured_at_the_motions_size(walk):
+    """The same walk built at a total bone length of 0.5 (other units) keeps its bones
+    as far apart, relative to its size: the arm through the torso is as new as against
+    the walk itself."""
+    from dataclasses import replace
+
+    from cyclecoord.skeleton import Skeleton
+
+    sk = walk.skeleton
+    k = 0.5 / sk.total_length()
+    small_sk = Skeleton(tuple(
+        replace(j, offset=j.offset * k, end_site=None if j.end_site is None else j.end_site * k)
+        for j in sk.joints), name=sk.name, length_unit=sk.length_unit,
+        source_format=sk.source_format)
+    f = np.array(walk.frames)
+    for c in walk.root_channels():
+        if walk.channels[c][1].startswith("t"):
+            f[:, c] *= k
+    small = cc.Motion(f, walk.channels, fps=walk.fps, skeleton=small_sk)
+    assert small_sk.total_length() == pytest.approx(0.5)
+    bad = arm_through_torso(walk)
+    want = check_plausibility(bad, [walk]).new_contact_frames
+    assert len(want) >= 30 and check_plausibility(bad, [small]).new_contact_frames == want
+
+
 def test_contacts_the_inputs_share_are_explained_not_new(walk):
     bad = arm_through_torso(walk)
     report = check_plausibility(bad, [walk, bad])
@@ -136,6 +161,17 @@ def test_joint_range(walk):
     assert v.channel == ("ltibia", "rx") and v.frames == 1 and v.first_frame == 10
     assert v.excess == pytest.approx(7.0) and v.high == pytest.approx(top + 5.0)
     assert joint_range_violations(walk.with_frames(g), [walk], margin_deg=15.0) == []
+    # a second reference one turn up is brought onto the first's turn: the same range
+    found = joint_range_violations(walk.with_frames(g), [walk, walk.with_frames(f)], margin_deg=5.0)
+    assert len(found) == 1 and found[0].high == pytest.approx(top + 5.0)
+
+
+def test_bones_are_frozen(walk):
+    import dataclasses
+
+    bn = bones(walk)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        bn.names = []
 
 
 def test_bad_arguments(walk):

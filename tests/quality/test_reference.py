@@ -77,6 +77,16 @@ def test_autocorrelation_period_finds_the_true_period(steady):
     assert np.isnan(autocorrelation_period(steady.motion, used_frames=[[0, 40]]))
 
 
+@pytest.mark.parametrize("period", [100.4, 37.3])
+def test_autocorrelation_period_to_a_fraction_of_a_frame(period):
+    """The parabola through the peak and its neighbours finds a period between whole
+    frames (measured errors 0.0011 and 0.0056 frames, noise-free; whole lags are 0.3-0.4
+    off)."""
+    m = cc.datasets.make_periodic_capture(n_frames=600, period=period, noise=0.0,
+                                          speed_variation=0.0, random_state=3).motion
+    assert abs(autocorrelation_period(m) - period) < 0.02
+
+
 def test_autocorrelation_period_of_noise_is_nan():
     rng = np.random.default_rng(0)
     m = _motion({"lfemur.rx": rng.normal(size=400), "ltibia.rx": rng.normal(size=400)}, fps=120.0)
@@ -352,3 +362,19 @@ def test_coverage_simulation_bounds_what_an_average_can_reach(capsys):
     assert table[(3, "smooth")] > 1.05 and table[(3, "noise")] < 0.95
     assert sim.main(["--takes", "1"]) == 0
     assert "repetitions" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("order", ["ZYX", "XYZ"])
+def test_root_orientation_of_single_turns(order):
+    """A turn about y alone is heading, about x alone pitch, about z alone roll, each
+    with its sign (right-handed, y up, z forward), whatever the Euler order."""
+    from cyclecoord.motion import Motion
+    from cyclecoord.quality.cycle_quality import root_orientation
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    dofs = ("tx", "ty", "tz") + tuple("r" + a.lower() for a in order)
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], dofs, order, end_site=[0, 1, 0]),))
+    rows = [{"ry": 30.0}, {"rx": 20.0}, {"rz": 20.0}, {"rz": -15.0}]
+    frames = np.array([[r.get(d, 0.0) for _, d in sk.channels] for r in rows])
+    hpr = root_orientation(Motion(frames, sk.channels, fps=30, skeleton=sk))
+    np.testing.assert_allclose(hpr, [[30, 0, 0], [0, 20, 0], [0, 0, 20], [0, 0, -15]], atol=1e-9)

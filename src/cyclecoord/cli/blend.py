@@ -285,6 +285,7 @@ def finish(
 def cmd_blend(args: argparse.Namespace) -> int:
     from ..quality.plausibility import check_plausibility
     from ..synthesis.blend import blend
+    from .._words import si
     from ..synthesis.sources import cycle_summary
 
     _check_outputs(args)
@@ -318,7 +319,9 @@ def cmd_blend(args: argparse.Namespace) -> int:
         f"blend {', '.join(f'{w:g}' for w in info['weights'])}: {out.n_frames} frames "
         f"({s['seconds']:.3f} s; inputs "
         + ", ".join(f"{v['frames']}" for v in summaries)
-        + f"), loop closure {s['loop_closure']:.2f}, {_jerk_words(s, summaries)}"
+        + f"), loop closure {s['loop_closure']:.2f}, largest step "
+        + si(s["largest_step"], "m" if s["unit"] == "m" else "units")
+        + f", {_jerk_words(s, summaries)}"
     )
     for note in info["notes"]:
         print(f"note: {note}")
@@ -340,7 +343,8 @@ def cmd_blend(args: argparse.Namespace) -> int:
 
 def _jerk_words(out: dict, inputs: list[dict]) -> str:
     """The blend's jerk against its inputs': a ratio, then the figures with an SI prefix
-    (mean jerk norm of the channels, degrees / s³ for joint angles)."""
+    (:func:`~cyclecoord.synthesis.sources.cycle_summary`: metres / s³ on joint positions,
+    channel units / s³ without a skeleton)."""
     import math
 
     from .._words import si
@@ -348,9 +352,25 @@ def _jerk_words(out: dict, inputs: list[dict]) -> str:
     mean = sum(v["jerk"] for v in inputs) / max(len(inputs), 1)
     if not (math.isfinite(mean) and mean > 0 and math.isfinite(out["jerk"])):
         return "jerk not measured (fewer than 7 frames)"
+    unit = "m/s³" if out.get("unit") == "m" else "units/s³"
     ratio = f"{out['jerk'] / mean:.2f}x the inputs' mean"
-    figures = ", ".join(si(v["jerk"], "deg/s³") for v in inputs)
-    return f"jerk {ratio} ({si(out['jerk'], 'deg/s³')}; inputs {figures})"
+    figures = ", ".join(si(v["jerk"], unit) for v in inputs)
+    return f"jerk {ratio} ({si(out['jerk'], unit)}; inputs {figures})"
+
+
+def figures_line(s: dict) -> str:
+    """A cycle's loop closure, jerk and largest step in words (a
+    :func:`~cyclecoord.synthesis.sources.cycle_summary` dict): the line ``transition``
+    and ``view`` print for each cycle, ``extract`` and ``blend`` print the same figures."""
+    from .._words import si
+
+    unit = "m" if s.get("unit") == "m" else "units"
+    return (
+        f"loop closure {s['loop_closure']:.2f}, jerk {si(s['jerk'], unit + '/s³')}, "
+        f"largest step {si(s['largest_step'], unit)} ({s['largest_step'] / s['median_step']:.2f} "
+        f"median steps; on {s['space']})"
+        if s.get("median_step") else f"loop closure {s['loop_closure']:.2f}"
+    )
 
 
 def _lead(motion, sources: list, feet: str | None = None) -> dict | None:
@@ -386,6 +406,7 @@ def _skating(motion, inputs: list, what: str, feet: str | None = None) -> tuple[
 def cmd_transition(args: argparse.Namespace) -> int:
     from ..quality.plausibility import check_plausibility
     from ..synthesis.blend import transition
+    from ..synthesis.sources import cycle_summary
 
     _check_outputs(args)
     try:
@@ -413,6 +434,9 @@ def cmd_transition(args: argparse.Namespace) -> int:
         f"aligned {args.inputs[1]} to {args.inputs[0]}: shift {al['shift_frames']:.2f} frames"
         + (", reversed" if al["reversed"] else "")
     )
+    summaries = [cycle_summary(c) for c in (a, b)]
+    for name, sm in zip(args.inputs, summaries):
+        print(f"{name}: {figures_line(sm)}")
     print(
         f"transition: {clip.n_frames} frames ({info['lead_in_frames']} of A, ramp "
         f"{info['ramp_frames']} frames = {info['ramp_cycles']:.2f} cycles, "
@@ -426,8 +450,8 @@ def cmd_transition(args: argparse.Namespace) -> int:
     meta = {k: v for k, v in info.items() if k not in ("weight", "phase")}
     payload = {
         "inputs": [
-            dict(src.to_dict(), path=p, foot_skating=sk)
-            for src, p, sk in zip(sources, args.inputs, inputs_skating)
+            dict(src.to_dict(), path=p, summary=sm, foot_skating=sk)
+            for src, p, sm, sk in zip(sources, args.inputs, summaries, inputs_skating)
         ],
         "output": {"path": args.output, "frames": clip.n_frames, "fps": clip.fps},
         "foot_skating": skating,

@@ -11,6 +11,9 @@ from ._outputs import Outputs, declare
 
 __all__ = ["add_parser", "parse_take", "run"]
 
+#: latent fit trains at about this rate by default (--step).
+TRAINING_FPS = 30.0
+
 
 def parse_take(text: str) -> tuple[str, int | None, int | None, str | None]:
     """``PATH[:A:B][=NAME]`` -> (path, start, stop, name); A, B 0-based half-open frames."""
@@ -70,8 +73,9 @@ def add_parser(subparsers) -> None:
     f.add_argument(
         "--step",
         type=int,
-        default=4,
-        help="keep every STEP-th frame (default 4: 120 fps captures train at 30 fps)",
+        default=None,
+        help="keep every STEP-th frame (default: the step that brings each take nearest "
+        "30 fps: 4 for CMU's 120 fps, 1 for a 30 fps BVH)",
     )
     f.add_argument("--max-iter", type=int, default=200, help="optimiser iterations (default 200)")
     f.add_argument("--report", metavar="R.json", help="also write the model's summary as JSON")
@@ -117,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--dims must be >= 1, got {args.dims}")
     if not 0 < args.variance <= 1:
         raise ParameterError(f"--variance must be in (0, 1], got {args.variance}")
-    if args.step < 1 or args.max_iter < 1:
+    if (args.step is not None and args.step < 1) or args.max_iter < 1:
         raise ParameterError("--step and --max-iter must be >= 1")
     out = Path(args.output)
     for target in [out] + ([Path(args.report)] if args.report else []):
@@ -128,10 +132,11 @@ def run(args: argparse.Namespace) -> int:
     for i, text in enumerate(args.takes):
         path, a, b, name = parse_take(text)
         motion = load(path).window((a, b))
-        seg = motion[:: args.step]
+        step = args.step or max(1, int(round(motion.fps / TRAINING_FPS)))
+        seg = motion[::step]
         if seg.n_frames < 3:
             raise ParameterError(
-                f"take {text!r} has only {seg.n_frames} frames after --step {args.step}"
+                f"take {text!r} has only {seg.n_frames} frames after --step {step}"
             )
         segments.append(seg)
         label = name or Path(path).stem + (

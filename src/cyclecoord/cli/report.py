@@ -1,7 +1,7 @@
 """A command's input (a file or a built-in example) and its printed and JSON reports.
 
 The JSON writing and the partial report of a capture with nothing periodic live in the neutral
-:mod:`cyclecoord.report`, which ``cyclecoord.batch`` shares without importing the CLI."""
+:mod:`cyclecoord.periodic.report`, which ``cyclecoord.batch`` shares without importing the CLI."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ..report import clean, partial_report, write_json
+from ..periodic.report import clean, partial_report, write_json
 
 __all__ = ["clean", "load_input", "partial_report", "summary_barcode", "write_json"]
 

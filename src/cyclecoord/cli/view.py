@@ -38,7 +38,12 @@ def add_parser(subparsers) -> None:
         "--frames", metavar="A:B", help="0-based half-open frame range of INPUT, e.g. 200:450"
     )
     p.add_argument("--other-frames", metavar="A:B", help="frame range of OTHER")
-    p.add_argument("--cycle", action="store_true", help="INPUT is a loop: show its phase and seam")
+    p.add_argument(
+        "--cycle",
+        action="store_true",
+        help="INPUT is a loop: show its phase and seam, and print its loop closure, jerk and "
+        "largest step",
+    )
     p.add_argument("--other-cycle", action="store_true", help="OTHER is a loop")
     p.add_argument(
         "--skeleton", metavar="ASF", help="skeleton for an .amc INPUT (default: beside it)"
@@ -98,6 +103,11 @@ def run(args: argparse.Namespace) -> int:
             ViewerInput(o, Path(args.side_by_side).name, args.other_cycle, feet_option(args, o))
         )
     for it in items:
+        if it.cycle and it.motion.n_frames >= 5:
+            from ..synthesis.sources import cycle_summary
+            from .blend import figures_line
+
+            print(f"{it.label}: {figures_line(cycle_summary(it.motion))}")
         try:
             print(f"{it.label}: {foot_skating(it.motion, feet=it.feet).summary()}")
         except ParameterError as exc:

@@ -18,7 +18,9 @@ Import them from ``cyclecoord.io``; their modules ``_atomic`` and ``_paths`` are
 
 from __future__ import annotations
 
+import math
 import os
+import re
 import tempfile
 from dataclasses import replace
 from pathlib import Path
@@ -30,6 +32,7 @@ from ..errors import ParameterError, ParseError
 from ..motion import DEFAULT_FPS, Motion
 from ..skeleton import Skeleton
 from ._atomic import StagedOutputs, atomic_path, atomic_write
+from ._limits import MAX_FPS
 from ._paths import input_files, refuse_clobber, same_file
 from .bvh import read_bvh, write_bvh
 from .tabular import read_csv, read_npz, write_csv, write_npz
@@ -175,6 +178,8 @@ def load(
     if suffix == ".amc":
         from .asfamc import read_amc
 
+        if rate is None:
+            rate = _amc_written_rate(p)
         return read_amc(p, skeleton=skeleton, fps=DEFAULT_FPS if rate is None else rate)
     if suffix == ".bvh":
         if skeleton is not None:
@@ -250,6 +255,61 @@ def _check_kwargs(suffix: str, kwargs: dict, allowed: tuple[str, ...]) -> None:
         )
 
 
+#: The comment :func:`save` writes in an AMC whose rate is not CMU's 120 Hz.
+_AMC_RATE = re.compile(r"^#\s*frame rate ([0-9.eE+]+) fps \(cyclecoord\)\s*$", re.M)
+
+
+def _amc_written_rate(path: Path) -> float | None:
+    """The frame rate an AMC written by :func:`save` names in its header comment, or None
+    (AMC files carry no rate of their own)."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4096).decode("latin-1")
+    except OSError:
+        return None  # read_amc says what is wrong with the file
+    head = head.split(":FULLY-SPECIFIED")[0]
+    found = _AMC_RATE.search(head)
+    if found is None:
+        return None
+    try:
+        rate = float(found.group(1))
+    except ValueError:
+        return None
+    return rate if math.isfinite(rate) and 0 < rate <= MAX_FPS else None
+
+
+def _acclaim_ready(motion: Motion) -> Motion:
+    """A motion of another rig written as ASF/AMC: in its analysis rig and with its unit.
+
+    An ASF has one root with position channels and bones that only turn, lengths in the
+    unit ``:units length`` names.  A BVH rig with a static root above the travelling hips
+    or constant position channels on its joints (the Bandai layout), or with Z up, is
+    written as :func:`cyclecoord.rig.normalize_rig` reads it (the same joint positions,
+    Y up), and the skeleton's length unit is the one :func:`cyclecoord.rig.describe_rig`
+    found (a centimetre rig is ``length 2.54``: read back in centimetres, not inches).  An
+    ASF skeleton, or a motion without one, is written as it is."""
+    skel = motion.skeleton
+    if skel is None or skel.source_format == "asf" or motion.n_frames < 2:
+        return motion
+    import dataclasses
+
+    from ..rig import describe_rig, normalize_rig
+
+    try:
+        with np.errstate(all="ignore"):
+            info = describe_rig(motion)
+    except (ParameterError, ValueError, FloatingPointError):  # a rig too odd to read
+        return motion
+    if info.static_root or info.constant_position_joints or info.up_axis == "Z":
+        motion, _ = normalize_rig(motion, info, drop_reference=False)
+        skel = motion.skeleton
+    if info.units_source != "given" and not (np.isfinite(info.metres_per_unit)
+                                             and info.metres_per_unit > 0):
+        return motion
+    unit = 0.0254 / info.metres_per_unit  # ASF: inches = value / length
+    return dataclasses.replace(motion, skeleton=dataclasses.replace(skel, length_unit=unit))
+
+
 def _amc_default_skeleton(motion: Motion, amc_path: Path) -> Path | None:
     """Where :func:`save` writes the skeleton of an AMC at ``amc_path`` when no
     ``asf_path`` is given: :func:`default_asf_path`, or None when an equal skeleton is
@@ -323,6 +383,8 @@ def save(motion: Motion, path: str | os.PathLike[str], **kwargs: Any) -> None:
     if suffix == ".amc":
         _check_kwargs(suffix, kwargs, ("asf_path", "write_skeleton"))
         from .asfamc import write_amc
+
+        motion = _acclaim_ready(motion)
 
         asf = kwargs.get("asf_path")
         if motion.skeleton is None or not kwargs.get("write_skeleton", True):

@@ -34,10 +34,34 @@ __all__ = ["read_amc", "find_skeleton"]
 
 
 # --------------------------------------------------------------------------- AMC read
+def _header_skeleton(amc_path: Path) -> Path | None:
+    """The file an ``#!OML:ASF NAME`` line before the first frame names, if it is a file
+    beside the AMC (a bare name only: a path in the header is not followed)."""
+    try:
+        with open(amc_path, "rb") as fh:
+            head = fh.read(4096).decode("latin-1")
+    except OSError:
+        return None
+    for line in head.splitlines():
+        line = line.strip()
+        if line.startswith("#!OML:ASF"):
+            name = line[len("#!OML:ASF"):].strip()
+            if name and Path(name).name == name and name.lower().endswith(".asf"):
+                p = amc_path.parent / name
+                return p if p.is_file() else None
+            return None
+        if line and not line.startswith("#") and not line.startswith(":"):
+            return None  # the frames have begun
+    return None
+
+
 def find_skeleton(amc_path: Path) -> Path:
     """The .asf that :func:`read_amc` uses for ``amc_path`` when no skeleton is given.
 
-    The only .asf in the AMC's folder, else ``<subject>.asf`` for ``<subject>_<trial>.amc``.
+    The .asf the AMC's ``#!OML:ASF NAME`` header line names, when it lies beside the AMC
+    (:func:`cyclecoord.io.save` writes that line); else the only .asf in the AMC's
+    folder; else ``<stem>.asf`` for ``<stem>.amc`` (where :func:`cyclecoord.io.save` puts
+    it) or ``<subject>.asf`` for ``<subject>_<trial>.amc``.
 
     Raises
     ------
@@ -45,6 +69,9 @@ def find_skeleton(amc_path: Path) -> Path:
         When neither rule finds exactly one file (the message says what was looked for).
     """
     folder = amc_path.parent
+    named = _header_skeleton(amc_path)
+    if named is not None:
+        return named
     try:
         asfs = sorted(
             p for p in folder.iterdir() if p.suffix.lower() == ".asf" and p.is_file()
@@ -53,6 +80,9 @@ def find_skeleton(amc_path: Path) -> Path:
         raise ParseError(f"cannot list folder {folder}: {exc.strerror or exc}", amc_path) from None
     if len(asfs) == 1:
         return asfs[0]
+    for p in asfs:
+        if p.stem == amc_path.stem:
+            return p
     subject = amc_path.stem.split("_", 1)[0] if "_" in amc_path.stem else None
     if subject:
         for p in asfs:

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ..motion import Motion
+from ..motion import DEFAULT_FPS, Motion
 from ..skeleton import Skeleton
 from ._acclaim import (
     PathLike,
@@ -219,6 +219,8 @@ def write_amc(
     out: list[str] = []
     if skeleton_path is not None:
         out.append(f"#!OML:ASF {Path(skeleton_path).name}")
+    if abs(float(motion.fps) - DEFAULT_FPS) > 1e-9:  # AMC has no rate; CMU's is 120 Hz
+        out.append(f"# frame rate {fmt_float(float(motion.fps))} fps (cyclecoord)")
     out += [":FULLY-SPECIFIED", ":DEGREES"]
     for t, row in enumerate(data.tolist(), start=1):
         strs = [fmt_float(x) for x in row]

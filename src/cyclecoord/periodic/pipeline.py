@@ -246,24 +246,7 @@ def extract(
                 f"delay must be 'auto', a number of seconds or None, got {delay!r}"
             )
         options = {k: v for k, v in locals().items() if k not in ("motion", "frames", "delay")}
-        try:
-            return extract(motion, frames=frames, delay=None, **options)
-        except NoPeriodicMotionError as first:
-            try:
-                res = extract(motion, frames=frames, delay=AUTO_DELAY, **options)
-            except NoPeriodicMotionError:
-                raise first from None
-            # what the poses alone showed: the refusal's reason, without the file it names
-            # and without its advice (the delay was what helped)
-            reason = getattr(first.result, "reason", None) or str(first)
-            seen = reason.removeprefix("no periodic motion found: ").split("; ")[0]
-            res.warnings.insert(
-                0,
-                f"read with a {AUTO_DELAY:g} s delay embedding (each pose joined by the pose "
-                f"{AUTO_DELAY:g} s later), because the poses alone showed no periodic motion: "
-                f"{seen}",
-            )
-            return res
+        return _with_auto_delay(motion, frames, options)
     opts = _check_options(
         motion,
         weighting=weighting,
@@ -303,7 +286,26 @@ def extract(
         timing=timing, travel=travel, min_turns=min_turns,
         feet=None if feet is None else list(feet),
     )
-    motion = motion.window(frames)
+    motion, info, adapter = _analysis_motion(motion.window(frames), n_neighbors, rig)
+    run = TakeFit(motion, params, require_clear)
+    fit, used = run.fit_steady()
+    res = _finish(
+        motion, run.prepared, run.prep, fit, used, run.notes, run.timings, params, run.fail,
+        n_components=n_components, n_samples=n_samples, n_neighbors=n_neighbors,
+        weighting=weighting, sampling=sampling, bandwidth=bandwidth, random_state=random_state,
+        cycle_start=cycle_start, timing=timing, travel=travel, min_turns=min_turns,
+        feet=feet,
+    )
+    if adapter is not None:
+        # the cycle in the capture's own rig (static root, position channels, up axis)
+        res = replace(res, cycle=adapter.restore(res.cycle), rig_changes=adapter.changes())
+    return replace(res, rig=info)
+
+
+def _analysis_motion(motion: Motion, n_neighbors: int, rig: bool):
+    """The window to analyse in the analysis rig: ``(motion, rig info, adapter)``, the
+    adapter None when nothing changed (or ``rig`` is False), info None without a
+    skeleton; too few frames are refused."""
     if motion.n_frames < 2 * n_neighbors or motion.n_frames < 10:
         raise ParameterError(
             f"{motion.source or 'capture'}: {motion.n_frames} frames are too few to find a cycle "
@@ -318,19 +320,31 @@ def extract(
             motion, adapter = normalize_rig(motion, info)
             if adapter.identity:
                 adapter = None
-    run = TakeFit(motion, params, require_clear)
-    fit, used = run.fit_steady()
-    res = _finish(
-        motion, run.prepared, run.prep, fit, used, run.notes, run.timings, params, run.fail,
-        n_components=n_components, n_samples=n_samples, n_neighbors=n_neighbors,
-        weighting=weighting, sampling=sampling, bandwidth=bandwidth, random_state=random_state,
-        cycle_start=cycle_start, timing=timing, travel=travel, min_turns=min_turns,
-        feet=feet,
-    )
-    if adapter is not None:
-        # the cycle in the capture's own rig (static root, position channels, up axis)
-        res = replace(res, cycle=adapter.restore(res.cycle), rig_changes=adapter.changes())
-    return replace(res, rig=info)
+    return motion, info, adapter
+
+
+def _with_auto_delay(motion: Motion, frames, options: dict) -> ExtractionResult:
+    """``delay="auto"``: :func:`extract` without a delay embedding, and when that finds no
+    periodic motion, once more with :data:`AUTO_DELAY` (a warning says what the poses
+    alone showed); the first refusal is raised when both refuse."""
+    try:
+        return extract(motion, frames=frames, delay=None, **options)
+    except NoPeriodicMotionError as first:
+        try:
+            res = extract(motion, frames=frames, delay=AUTO_DELAY, **options)
+        except NoPeriodicMotionError:
+            raise first from None
+        # what the poses alone showed: the refusal's reason, without the file it names
+        # and without its advice (the delay was what helped)
+        reason = getattr(first.result, "reason", None) or str(first)
+        seen = reason.removeprefix("no periodic motion found: ").split("; ")[0]
+        res.warnings.insert(
+            0,
+            f"read with a {AUTO_DELAY:g} s delay embedding (each pose joined by the pose "
+            f"{AUTO_DELAY:g} s later), because the poses alone showed no periodic motion: "
+            f"{seen}",
+        )
+        return res
 
 
 #: What :func:`extract`'s options may be (:mod:`cyclecoord._validation`); the scale and
@@ -400,6 +414,10 @@ def _finish(
     t0 = time.perf_counter()
     jerk, closure, distance = _cycle_figures(prepared, typ, runs, rows, motion.fps)
     poses = pose_quality(cycle_motion, motion, runs, period)
+    if poses is not None and poses.figures is not None:
+        # the figures every command prints, on joint positions (quality.pose_space)
+        jerk = {"original": poses.capture_jerk, "cycle": poses.figures.jerk}
+        closure = poses.figures.loop_closure
     pop = poses.pop if poses is not None else (
         distance["largest_cycle_step"] / distance["p99_frame_step"])
     if np.isfinite(pop) and pop > MAX_POP:

@@ -152,9 +152,13 @@ class ExtractionResult:
         The typical cycle as a motion at the capture's rate, root re-integrated so it
         travels like the original; loops.
     jerk : dict
-        ``{"original": ..., "cycle": ...}`` mean jerk norm (channel units / s³).
+        ``{"original": ..., "cycle": ...}`` mean jerk norm: with a skeleton on joint
+        positions in the root's frame, metres / s³ (the capture's on the frames the cycle
+        was made from; :func:`cyclecoord.quality.pose_space.cycle_figures`), without one
+        on the prepared channels (channel units / s³).
     loop_closure : float
-        Last-to-first step of the cycle over its median step (prepared space).
+        Last-to-first step of the cycle over its median step: on joint positions with a
+        skeleton (``pose_quality.seam``), the prepared space without.
     distance : dict
         Distance of the clip's frames to the cycle (median, 90th percentile, max), in
         the prepared space's units, next to the capture's median and 99th-percentile
@@ -240,7 +244,7 @@ class ExtractionResult:
 
     def to_report(self) -> dict[str, Any]:
         """JSON-ready summary (see the CLI's ``--report``)."""
-        from ..report import capture_header
+        from .report import capture_header
 
         return {
             **capture_header(self.motion),

@@ -124,12 +124,11 @@ def plot_channels(
     ``result.phase``), so the curves stay in step over repetitions of different lengths;
     frames without a phase, and results timed by the coordinate, play the cycle at its
     own constant rate from the phase of the clip's first frame (paper Fig. 6).  The right panel is
-    the jerk as the console and the report give it
-    (:func:`~cyclecoord.quality.metrics.jerk_summary`: third derivative by 4th-order finite
-    differences of every prepared channel, root as per-frame steps, norm over channels; the cycle
-    looped so its seam
-    counts), per frame over one period of each; the title gives the means over the whole
-    clip and the whole cycle, ``result.jerk``.
+    the jerk as the console and the report give it: with a skeleton on joint positions in the
+    root's frame, metres / s³ (:func:`~cyclecoord.quality.pose_space.point_jerk`), without one
+    on the prepared channels (:func:`~cyclecoord.quality.metrics.jerk_summary`); the cycle
+    looped so its seam counts, per frame over one period of each; the title gives the means
+    over the frames the cycle was made from and the whole cycle, ``result.jerk``.
 
     Parameters
     ----------
@@ -211,17 +210,26 @@ def plot_channels(
     _draw_jerk(ax_j, res, s0, j0, P, period)
     return fig
 
-def _draw_jerk(
-    ax_j: "Axes", res: "ExtractionResult", s0: int, j0: int, P: int, period: float
-) -> None:
-    """The jerk panel: one period of the capture from frame ``s0`` and of the cycle from its
-    frame ``j0`` (of ``P``), in the space ``result.jerk`` is measured in."""
-    from ..quality.metrics import jerk
+def _point_jerks(res, s0: int, n_j: int, metres: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per-frame jerk on joint positions: ``n_j`` frames of the capture from ``s0`` and
+    the looped cycle (metres / s³)."""
+    from ..quality.pose_space import point_jerk, root_frame_points
+    from ..rig import describe_rig
 
     motion = res.motion
-    fps = motion.fps
-    # jerk in the space result.jerk is measured in (one definition everywhere), one period
-    n_j = int(min(motion.n_frames - s0, max(8, round(period))))
+    seg = motion.window((s0, min(motion.n_frames, s0 + n_j + 3)))
+    jo = point_jerk(root_frame_points(seg, describe_rig(motion)), motion.fps, False)[:n_j]
+    # the cycle is written in the capture's own rig: read with its own description
+    cyc = root_frame_points(res.cycle, describe_rig(res.cycle))
+    jc = point_jerk(cyc, res.cycle.fps, True)
+    return jo * metres, jc * metres
+
+
+def _channel_jerks(res, s0: int, n_j: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per-frame jerk on the prepared channels (4th-order stencil), capture and cycle."""
+    from ..quality.metrics import jerk
+
+    fps = res.motion.fps
     stencil = 7
     poses = np.asarray(res.prepared.poses, dtype=float)[s0:]
     typ = np.asarray(res.typical.frames, dtype=float)
@@ -230,7 +238,26 @@ def _draw_jerk(
         np.linalg.norm(jerk(seg_o, fps), axis=1)[:n_j] if seg_o.shape[0] >= stencil else np.zeros(0)
     )
     Pt = typ.shape[0]
-    jc_all = np.linalg.norm(jerk(typ, fps, cyclic=True), axis=1) if Pt >= stencil else np.zeros(Pt)
+    jc = np.linalg.norm(jerk(typ, fps, cyclic=True), axis=1) if Pt >= stencil else np.zeros(Pt)
+    return jo, jc
+
+
+def _draw_jerk(
+    ax_j: "Axes", res: "ExtractionResult", s0: int, j0: int, P: int, period: float
+) -> None:
+    """The jerk panel: one period of the capture from frame ``s0`` and of the cycle from its
+    frame ``j0`` (of ``P``), in the space ``result.jerk`` is measured in."""
+    motion = res.motion
+    # jerk in the space result.jerk is measured in (one definition everywhere), one period
+    n_j = int(min(motion.n_frames - s0, max(8, round(period))))
+    pq = getattr(res, "pose_quality", None)
+    if pq is not None and pq.figures is not None:
+        jo, jc_all = _point_jerks(res, s0, n_j, pq.figures.metres_per_unit)
+        unit = "m / s³, joint positions"
+    else:
+        jo, jc_all = _channel_jerks(res, s0, n_j)
+        unit = "units / s³, all channels"
+    Pt = jc_all.size
     jc = jc_all[(j0 * Pt // max(P, 1) + np.arange(min(n_j, Pt))) % Pt] if Pt else np.zeros(0)
     ax_j.plot(
         np.arange(jo.size) + motion.start_frame + s0,
@@ -247,7 +274,7 @@ def _draw_jerk(
         label="cycle",
     )
     ax_j.set_xlabel("frame")
-    ax_j.set_ylabel("jerk norm, all channels (units / s³)")
+    ax_j.set_ylabel(f"jerk norm ({unit})")
     jr = res.jerk
     ratio = jr["cycle"] / jr["original"] if jr.get("original", 0) > 0 else float("nan")
     ax_j.set_title(

@@ -23,6 +23,13 @@ is what a viewer sees: how far the body's points move.
   poses are to another repetition;
 * **jerk**: the mean norm of the points' third derivative (length units / s³), cycle over
   capture (a ratio: no unit to picture).
+
+:func:`cycle_figures` gives a cycle's own three figures the same way, with no capture
+beside it: **loop closure** (the seam above), **jerk** in metres per second cubed and the
+**largest step** in metres (the skeleton's length unit from
+:func:`cyclecoord.rig.describe_rig`).  ``extract``, ``blend``, ``transition``, ``view``,
+``batch`` and every report print these, so a cycle read from AMC, BVH, NPZ or glTF reads
+the same.
 """
 
 from __future__ import annotations
@@ -35,7 +42,11 @@ from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
 
-__all__ = ["PoseQuality", "root_frame_points", "pose_quality", "MAX_POP", "MAX_SEAM"]
+__all__ = [
+    "CycleFigures", "PoseQuality", "cycle_figures", "point_jerk", "root_frame_points",
+    "pose_quality",
+    "MAX_POP", "MAX_SEAM",
+]
 
 #: A cycle step over this many times the capture's 99th-percentile step is a pop.
 MAX_POP = 2.0
@@ -50,6 +61,23 @@ SPREAD_FLOOR = 1.0
 
 #: Captured poses (evenly spaced) whose nearest other repetition gives the spread.
 MAX_SPREAD_PROBES = 2_000
+
+
+def _distinct_points(skeleton, names: list[str]) -> list[int]:
+    """Indices of the forward-kinematics points that are not a parent's place again: a
+    joint or end site at zero offset from its parent always sits on it (a BVH ``Head``
+    end site of length 0; the zero-length bones an ASF adds where a BVH joint's children
+    start at different places), and counting it twice would weigh that place double in
+    every RMS figure, differently in each format."""
+    joints = {j.name: j for j in skeleton.joints}
+    scale = max([float(np.linalg.norm(j.offset)) for j in skeleton.joints] + [1e-300])
+    keep = []
+    for i, n in enumerate(names):
+        j = joints.get(n[:-4] if n.endswith("/end") else n)
+        off = None if j is None else (j.end_site if n.endswith("/end") else j.offset)
+        if i == 0 or off is None or np.linalg.norm(off) > 1e-9 * scale:
+            keep.append(i)
+    return keep
 
 
 def root_frame_points(motion: Motion, rig=None, names=None) -> np.ndarray:
@@ -69,10 +97,11 @@ def root_frame_points(motion: Motion, rig=None, names=None) -> np.ndarray:
 
     Returns
     -------
-    ndarray, shape (T, 3 * (J + E) + 1)
+    ndarray, shape (T, 3 * P + 1)
         Per frame: every point's position minus the travelling root's, turned by the
         inverse of the root's heading (skeleton length units), then the root's up (y)
-        coordinate.
+        coordinate.  Without ``names``, a point at zero offset from its parent (always on
+        it) is left out, so each place of the body counts once in every format.
     """
     from ..periodic.root import root_layout, root_rotations
     from ..rig import normalize_rig
@@ -84,6 +113,8 @@ def root_frame_points(motion: Motion, rig=None, names=None) -> np.ndarray:
     if names is not None:
         index = {n: i for i, n in enumerate(fk.names)}
         pos = pos[:, [0] + [index[n] for n in names if n != fk.names[0]], :]
+    elif motion.skeleton is not None:
+        pos = pos[:, _distinct_points(motion.skeleton, fk.names), :]
     layout = root_layout(motion)
     root = pos[:, :1, :]
     rel = pos - root
@@ -104,14 +135,103 @@ def _steps(x: np.ndarray, cyclic: bool = False) -> np.ndarray:
     return np.linalg.norm(d, axis=1) / np.sqrt(n)
 
 
+def point_jerk(x: np.ndarray, fps: float, cyclic: bool) -> np.ndarray:
+    """Per-frame jerk of :func:`root_frame_points` rows: the norm of the third difference
+    times ``fps**3``, RMS over the points (length units / s³).  ``cyclic``: the loop's
+    last 3 frames lead into its first, one value per frame (each ending at that frame),
+    so the seam counts like any other frame."""
+    if cyclic:
+        x = np.concatenate([x[-3:], x])
+    j = np.diff(x, n=3, axis=0) * fps**3
+    n = x.shape[1] // 3 or 1
+    return np.linalg.norm(j, axis=1) / np.sqrt(n)
+
+
 def _jerk(x: np.ndarray, fps: float, cyclic: bool) -> float:
     if len(x) < 5:
         return float("nan")
-    if cyclic:
-        x = np.concatenate([x[-3:], x, x[:3]])
-    j = np.diff(x, n=3, axis=0) * fps**3
-    n = x.shape[1] // 3 or 1
-    return float(np.mean(np.linalg.norm(j, axis=1) / np.sqrt(n)))
+    return float(np.mean(point_jerk(x, fps, cyclic)))
+
+
+def _seam(steps: np.ndarray) -> float:
+    """Last (seam) step of a loop's cyclic steps over their median."""
+    med = float(np.median(steps))
+    if med > 0:
+        return float(steps[-1] / med)
+    return 1.0 if steps[-1] == 0 else float("inf")
+
+
+@dataclass(frozen=True)
+class CycleFigures:
+    """A cycle's own figures on joint positions in the root's frame (module notes).
+
+    Attributes
+    ----------
+    loop_closure : float
+        Last-to-first step over the median step around the loop (no unit; up to
+        :data:`MAX_SEAM` loops cleanly).
+    jerk : float
+        Mean norm of the third time derivative of the points around the loop, RMS over the
+        body's points, metres / s³.
+    largest_step : float
+        Largest step around the loop (the seam included), RMS over the points, metres.
+    median_step : float
+        Median step around the loop, metres.
+    metres_per_unit : float
+        The skeleton's length unit the figures were converted with.
+    """
+
+    loop_closure: float
+    jerk: float
+    largest_step: float
+    median_step: float
+    metres_per_unit: float
+
+    def to_dict(self) -> dict:
+        return {k: (None if not np.isfinite(v) else float(v)) for k, v in asdict(self).items()}
+
+
+def _figures(points: np.ndarray, fps: float, metres: float) -> CycleFigures:
+    steps = _steps(points, cyclic=True)
+    return CycleFigures(
+        loop_closure=_seam(steps),
+        jerk=_jerk(points, fps, cyclic=True) * metres,
+        largest_step=float(steps.max()) * metres,
+        median_step=float(np.median(steps)) * metres,
+        metres_per_unit=float(metres),
+    )
+
+
+def cycle_figures(cycle: Motion, rig=None, names=None) -> CycleFigures | None:
+    """Loop closure, jerk and largest step of a loop, on joint positions.
+
+    The one computation behind every console line and report that gives these figures:
+    joint and end-site positions by forward kinematics in the root's heading frame
+    (:func:`root_frame_points`), so the rotation channels (Euler orders, wraps, ASF axes,
+    quaternions) do not matter.
+
+    Parameters
+    ----------
+    cycle : Motion
+        One loop of frames (frame ``T - 1`` is followed by frame 0), with a skeleton.
+    rig : RigInfo, optional
+        How to read the rig and its length unit; default :func:`cyclecoord.rig.describe_rig`
+        of ``cycle``.
+    names : sequence of str, optional
+        Only these points (see :func:`root_frame_points`).
+
+    Returns
+    -------
+    CycleFigures or None
+        None without a skeleton or with fewer than 5 frames.
+    """
+    if cycle.skeleton is None or cycle.n_frames < 5:
+        return None
+    if rig is None:
+        from ..rig import describe_rig
+
+        rig = describe_rig(cycle)
+    return _figures(root_frame_points(cycle, rig, names), cycle.fps, rig.metres_per_unit)
 
 
 @dataclass(frozen=True)
@@ -133,6 +253,12 @@ class PoseQuality:
         The capture's spread (length units).
     jerk_ratio : float
         The cycle's jerk over the capture's.
+    capture_jerk : float
+        The capture's jerk on the frames the cycle was made from, metres / s³ (the cycle's
+        is ``figures.jerk``).
+    figures : CycleFigures or None
+        The cycle's own loop closure (``seam``), jerk and largest step in metres
+        (:func:`cycle_figures`, read with the capture's rig).
     """
 
     seam: float
@@ -144,6 +270,8 @@ class PoseQuality:
     nearest_median: float
     spread: float
     jerk_ratio: float
+    capture_jerk: float = float("nan")
+    figures: CycleFigures | None = None
 
     @property
     def pops(self) -> bool:
@@ -159,7 +287,10 @@ class PoseQuality:
         return bool(np.isfinite(self.nearest_max) and self.nearest_max > 1.0)
 
     def to_dict(self) -> dict:
-        return {k: (None if not np.isfinite(v) else float(v)) for k, v in asdict(self).items()}
+        out = {k: (None if not np.isfinite(v) else float(v))
+               for k, v in asdict(self).items() if k != "figures"}
+        out["figures"] = None if self.figures is None else self.figures.to_dict()
+        return out
 
 
 def _point_names(motion: Motion, rig) -> list[str]:
@@ -236,7 +367,8 @@ def pose_quality(
     every = max(1, int(np.ceil(sum(b - a for a, b in runs) / MAX_REFERENCE_FRAMES)))
     cyc = root_frame_points(cycle, rig, names)
     csteps = _steps(cyc, cyclic=True)
-    seam = float(csteps[-1] / np.median(csteps)) if np.median(csteps) > 0 else float("nan")
+    figures = _figures(cyc, cycle.fps, rig.metres_per_unit) if len(cyc) >= 5 else None
+    seam = _seam(csteps)
     cap_steps = _capture_steps(capture, runs, rig, names)
     p99 = float(np.percentile(cap_steps, 99)) if cap_steps.size else float("nan")
     pop = float(csteps.max() / p99) if p99 > 0 else float("nan")
@@ -260,7 +392,7 @@ def pose_quality(
     spread = float(np.percentile(best, 90)) if best.size else float("nan")
     if cap_steps.size:  # the sampling's own resolution (a capture that repeats exactly)
         spread = max(spread, SPREAD_FLOOR * float(np.median(cap_steps)))
-    jc = _jerk(cyc, cycle.fps, cyclic=True)
+    jc = figures.jerk / rig.metres_per_unit if figures is not None else float("nan")
     jo = np.average([_jerk(p, capture.fps / every, False) for p in parts if len(p) >= 5],
                     weights=[len(p) for p in parts if len(p) >= 5]) \
         if any(len(p) >= 5 for p in parts) else float("nan")
@@ -274,4 +406,6 @@ def pose_quality(
         nearest_median=float(np.median(near) / spread) if spread > 0 else float("nan"),
         spread=spread,
         jerk_ratio=float(jc / jo) if jo and np.isfinite(jo) and jo > 0 else float("nan"),
+        capture_jerk=float(jo) * rig.metres_per_unit,
+        figures=figures,
     )

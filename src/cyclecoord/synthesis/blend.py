@@ -4,7 +4,8 @@
 of aligned cycles; :func:`transition` ramps the weight from one cycle to another while
 the phase keeps advancing (the paper's homotopy).
 
-Before blending, cycles are brought into a common frame: cycles of one skeleton written
+Before blending, cycles are brought into a common frame
+(:mod:`cyclecoord.synthesis.common_frame`): cycles of one skeleton written
 in different conventions (an AMC capture, a BVH cycle) are re-expressed in one
 (:func:`cyclecoord.conventions.common_channels`), root translations are scaled to the
 reference skeleton's size, every cycle is turned about the vertical axis so that it faces
@@ -28,26 +29,8 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Motion
-from .align import (
-    Alignment,
-    align_curves,
-    apply_alignment,
-    check_up,
-    harmonise_angles,
-    mean_heading,
-    root_rotation,
-    rotate_heading,
-)
-from ..conventions import bvh_ready, common_channels, wrap_degrees
-from ..periodic.rotations import fit_rotation_map
-from .curve import (
-    CycleCurve,
-    angle_columns,
-    continuous_root,
-    horizontal_columns,
-    root_columns,
-    root_drift,
-)
+from .curve import CycleCurve, horizontal_columns, root_columns
+from .common_frame import Prepared, common_frame, turn_back
 from .sources import cycle_of
 
 __all__ = [
@@ -186,177 +169,6 @@ def _check_weights(weights: object, n: int) -> np.ndarray:
     return w
 
 
-@dataclass
-class _Prepared:
-    curves: list
-    alignments: list
-    headings: list
-    root_scales: list
-    notes: list
-    reference: Motion
-    reference_heading: float
-    turned: bool
-    up: int
-    base: Motion  # the reference in the common channels, not turned
-    rotations: Any = None  # RotationMap: joints blended as rotation vectors about a mean
-
-
-def _skeleton_size(m: Motion) -> float | None:
-    if m.skeleton is None:
-        return None
-    size = m.skeleton.total_length()
-    return size if size > 0 else None
-
-
-def _common_frame(
-    motions: Sequence[Motion],
-    *,
-    allow_reverse: bool,
-    align_heading: bool,
-    scale_root: bool,
-    up: str,
-) -> _Prepared:
-    """Bring cycles into the reference's (``motions[0]``) frame as aligned curves."""
-    u = check_up(up)
-    notes: list[str] = []
-    # every cycle carries the next loop's first frame through the conversions below, so
-    # its per-loop root change stays exact in whatever frame it ends up in
-    extended = [_with_next_frame(m) for m in motions]
-    converted = common_channels(extended)
-    if any(set(c.channels) != set(m.channels) for c, m in zip(converted, motions)):
-        style = bvh_ready(converted[0].skeleton)
-        notes.append(
-            "the cycles store their joints in different conventions; all were re-expressed in "
-            + (
-                f"BVH conventions ({style} Euler order)"
-                if style
-                else "the ASF conventions (axes, dofs)"
-            )
-            + " to share channels"
-        )
-    motions = converted
-    ref = motions[0]
-    fixed: list[Motion] = []
-    scales: list[float] = []
-    ref_size = _skeleton_size(ref)
-    for i, m in enumerate(motions):
-        scale = 1.0
-        size = _skeleton_size(m)
-        if (
-            i
-            and scale_root
-            and ref_size is not None
-            and size is not None
-            and abs(size - ref_size) > 1e-9 * ref_size
-        ):
-            scale = ref_size / size
-            frames = np.array(m.frames, dtype=float)
-            tcols = [c for c in root_columns(m) if m.channels[c][1] in ("tx", "ty", "tz")]
-            frames[:, tcols] *= scale
-            m = m.with_frames(frames)
-        scales.append(scale)
-        fixed.append(m)
-
-    headings: list[float] = [0.0] * len(fixed)
-    turned = False
-    if align_heading:
-        try:
-            hs = [mean_heading(m[:-1], up) for m in fixed]
-        except ParameterError as exc:
-            notes.append(f"cycles not turned to a common heading: {exc}")
-            hs = []
-        if hs and all(np.isfinite(h) for h in hs):
-            if max(abs(wrap_degrees(h - hs[0])) for h in hs) > 1e-9:
-                turned = True
-                headings = hs
-                fixed = [
-                    rotate_heading(m, -h, up, near=None) if abs(h) > 0 else m
-                    for m, h in zip(fixed, hs)
-                ]
-        elif hs:
-            notes.append(
-                "cycles not turned to a common heading: a cycle spins round (no mean heading)"
-            )
-
-    # joint rotations are blended as rotations: rotation vectors about each joint's mean
-    # over all the cycles (a weighted sum of them is a weighted mean of rotations to second
-    # order, and a wrap or Euler flip in one input changes nothing); the root keeps its own
-    # treatment (heading turned, travel per loop)
-    rotations = fit_rotation_map(
-        fixed[0].with_frames(np.vstack([m.frames for m in fixed])),
-        exclude=np.asarray(root_columns(fixed[0]), dtype=int),
-    )
-    if rotations.columns.size:
-        fixed = [m.with_frames(rotations.to_vectors(m.frames)) for m in fixed]
-    else:
-        rotations = None
-    curves = [_curve_of_extended(m) for m in fixed]
-    ref_curve = curves[0]
-    pose = np.array(
-        [i for i in range(ref_curve.n_channels) if i not in set(ref_curve.root_columns)], dtype=int
-    )
-    if pose.size == 0:
-        pose = np.arange(ref_curve.n_channels)
-    alignments: list[Alignment] = [Alignment(0.0, False, 0.0, 0.0, 0.0)]
-    out = [ref_curve]
-    horiz = horizontal_columns(ref, u)
-    start_ref = ref_curve(0.0)[0]
-    for c in curves[1:]:
-        c = harmonise_angles(c, ref_curve)
-        al = align_curves(ref_curve, c, pose, allow_reverse)
-        c = apply_alignment(c, al)
-        if horiz.size:
-            delta = np.zeros(c.n_channels)
-            delta[horiz] = start_ref[horiz] - c(0.0)[0, horiz]
-            c = c.offset(delta)
-        alignments.append(al)
-        out.append(c)
-    return _Prepared(
-        curves=out,
-        alignments=alignments,
-        headings=[float(h) for h in headings],
-        root_scales=scales,
-        notes=notes,
-        reference=fixed[0][:-1],
-        reference_heading=float(headings[0]),
-        turned=turned,
-        up=u,
-        base=ref[:-1],
-        rotations=rotations,
-    )
-
-
-def _with_next_frame(cycle: Motion) -> Motion:
-    """The cycle with one more frame: the next loop's first (root moved by its drift)."""
-    nxt = np.array(cycle.frames[:1], dtype=float)
-    root = root_columns(cycle)
-    if root.size:
-        nxt[0, root] = cycle.frames[0, root] + root_drift(cycle)
-    meta = {k: v for k, v in cycle.metadata.items() if k != "root_displacement"}
-    return replace(cycle, frames=np.vstack([cycle.frames, nxt]), metadata=meta)
-
-
-def _curve_of_extended(extended: Motion) -> CycleCurve:
-    """The curve of a cycle carrying its next loop's first frame (see :func:`_with_next_frame`)."""
-    root = root_columns(extended)
-    rot = angle_columns([extended.channels[c] for c in root])
-    x = continuous_root(extended.frames[:, root], rot)
-    return CycleCurve.from_motion(extended[:-1], displacement=x[-1] - x[0])
-
-
-def _turn_back(frames: np.ndarray, prep: _Prepared, original: Motion) -> np.ndarray:
-    """Frames from the common heading back to the reference's, root Euler near the original's;
-    joint rotation vectors back to Euler channels, continuous and near the original's."""
-    if prep.rotations is not None:
-        frames = prep.rotations.to_channels(frames, near=original.frames[0])
-    if not prep.turned or prep.reference_heading == 0.0:
-        return frames
-    m = prep.reference.with_frames(frames)
-    _, _, rcols = root_rotation(original)
-    back = rotate_heading(m, prep.reference_heading, "xyz"[prep.up], near=original.frames[0, rcols])
-    return np.array(back.frames)
-
-
 def blend(
     cycles: Sequence[Motion],
     weights: Sequence[float],
@@ -435,7 +247,7 @@ def blend(
         isinstance(n_frames, bool) or not isinstance(n_frames, Integral) or n_frames < 4
     ):
         raise ParameterError(f"n_frames must be an integer >= 4, got {n_frames!r}")
-    prep = _common_frame(
+    prep = common_frame(
         motions,
         allow_reverse=allow_reverse,
         align_heading=align_heading,
@@ -452,7 +264,7 @@ def blend(
     # one frame more than the loop: the next loop's first frame gives the exact displacement
     loop = mixed.sample(n_out)
     values = np.vstack([loop, loop[:1] + drift])
-    values = _turn_back(values, prep, ref)
+    values = turn_back(values, prep, ref)
     root = root_columns(ref)
     displacement = values[-1, root] - values[0, root]
     frames = values[:-1]
@@ -607,7 +419,7 @@ def transition_steps(
 
 
 def _transition_frames(
-    prep: "_Prepared", p_a: float, p_b: float, n_ramp: int, n_in: int, n_out: int
+    prep: "Prepared", p_a: float, p_b: float, n_ramp: int, n_in: int, n_out: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Values ``(T, D)`` (common frame), phase and weight per frame of a transition clip."""
     ca, cb = prep.curves
@@ -641,7 +453,7 @@ def _transition_frames(
 
 
 def _longer_ramp(
-    prep: _Prepared, p_a: float, p_b: float, n_ramp: int, n_in: int, n_out: int
+    prep: Prepared, p_a: float, p_b: float, n_ramp: int, n_in: int, n_out: int
 ) -> int | None:
     """The shortest ramp, ``n_ramp`` times a power of 1.25 up to 1.25^16 (about 35x), whose
     steps all stay within :data:`STEP_LIMIT`; None when none does."""
@@ -720,7 +532,7 @@ def transition(
     for name, v in (("lead_in", lead_in), ("lead_out", lead_out)):
         if isinstance(v, bool) or not isinstance(v, Integral) or v < 0:
             raise ParameterError(f"{name} must be a whole number of cycles >= 0, got {v!r}")
-    prep = _common_frame(
+    prep = common_frame(
         [a, b],
         allow_reverse=allow_reverse,
         align_heading=align_heading,
@@ -761,7 +573,7 @@ def transition(
                 else "even a ramp 35x longer does not keep every step within the limit"
             )
         )
-    values = _turn_back(values, prep, a)
+    values = turn_back(values, prep, a)
     meta = {
         "transition": {
             "sources": [a.source or "cycle a", b.source or "cycle b"],

@@ -92,28 +92,48 @@ def _capture_signs(motion: Motion) -> list[str]:
     return why
 
 
-def cycle_summary(motion: Motion) -> dict[str, float]:
-    """Figures of a cycle: frames, seconds, loop closure and jerk in the prepared space.
+def cycle_summary(motion: Motion) -> dict[str, Any]:
+    """Figures of a cycle: frames, seconds, loop closure, jerk and steps.
+
+    With a skeleton they are :func:`cyclecoord.quality.pose_space.cycle_figures`, the
+    figures ``extract`` reports: joint positions in the root's frame, so the same cycle
+    read from AMC, BVH, NPZ or glTF gives the same numbers.  Without one they are taken
+    on the channels (the root as steps, :func:`~cyclecoord.synthesis.curve.prepare_cycle`).
 
     Returns
     -------
     dict
         ``frames``, ``seconds``, ``loop_closure`` (last-to-first step over the median
-        step; up to about 1.5 loops cleanly; see
-        :func:`cyclecoord.quality.metrics.loop_closure`), ``jerk`` (mean jerk norm,
-        looping, channel units / s³) and ``median_step``.
+        step; up to about 1.5 loops cleanly), ``jerk`` (mean jerk norm around the loop),
+        ``largest_step`` and ``median_step``, ``unit`` (``"m"`` on joint positions, else
+        ``"channel units"``: degrees for joint angles) and ``space`` (``"joint
+        positions"`` or ``"channels"``).
     """
-    prep = prepare_cycle(motion)
-    steps = np.linalg.norm(np.roll(prep, -1, axis=0) - prep, axis=1)
-    return {
+    from ..quality.pose_space import cycle_figures
+
+    out: dict[str, Any] = {
         "frames": int(motion.n_frames),
         "seconds": float(motion.n_frames / motion.fps),
-        "loop_closure": float(loop_closure(prep)),
-        "jerk": float(jerk_summary(prep, motion.fps, cyclic=True))
-        if motion.n_frames >= 7
-        else float("nan"),
-        "median_step": float(np.median(steps)),
     }
+    fig = cycle_figures(motion) if motion.skeleton is not None else None
+    if fig is not None:
+        out.update(
+            loop_closure=fig.loop_closure, jerk=fig.jerk, largest_step=fig.largest_step,
+            median_step=fig.median_step, unit="m", space="joint positions",
+        )
+        return out
+    prep = prepare_cycle(motion)
+    steps = np.linalg.norm(np.roll(prep, -1, axis=0) - prep, axis=1)
+    out.update(
+        loop_closure=float(loop_closure(prep)),
+        jerk=float(jerk_summary(prep, motion.fps, cyclic=True))
+        if motion.n_frames >= 7 else float("nan"),
+        largest_step=float(steps.max()),
+        median_step=float(np.median(steps)),
+        unit="channel units",
+        space="channels",
+    )
+    return out
 
 
 @dataclass
@@ -129,7 +149,8 @@ class CycleSource:
     reason : str
         Why the input was (not) taken as a cycle.
     loop_closure : float
-        Last-to-first step over the median step of the input (prepared space).
+        Last-to-first step over the median step of the input (joint positions, as
+        :func:`cycle_summary`).
     period_estimate : float or None
         Repeat found by autocorrelation, frames (``None``: no repeat within the input).
     extraction : ExtractionResult or None
@@ -237,7 +258,14 @@ def _pose_spread(motion: Motion) -> float:
 
 
 def _input_closure(motion: Motion) -> float:
+    """Last-to-first step over the median step: on joint positions with a skeleton (as
+    :func:`cycle_summary`), else on the channels with the root as steps."""
     from ..periodic.preprocess import difference_root
+    from ..quality.pose_space import cycle_figures
+
+    fig = cycle_figures(motion) if motion.skeleton is not None else None
+    if fig is not None:
+        return float(fig.loop_closure)
 
     root = root_columns(motion)
     rot = angle_columns([motion.channels[c] for c in root])
@@ -263,8 +291,9 @@ def as_cycle(
        (``period_frames`` and ``cycles_in_source``; kept by NPZ files) or by
        :func:`blend` (``cycle: true``) is a cycle, unless ``frames`` cuts it;
     2. otherwise it is a cycle when all hold: its last-to-first step is at most
-       :data:`CYCLE_CLOSURE_LIMIT` (1.5) times its median step in the prepared space
-       (it loops); it does not repeat itself within its length: the autocorrelation of
+       :data:`CYCLE_CLOSURE_LIMIT` (1.5) times its median step (on joint positions in
+       the root's frame, :func:`cycle_summary`; in the prepared space without a
+       skeleton: it loops); it does not repeat itself within its length: the autocorrelation of
        its pose channels (:func:`estimate_period`) finds no period ``L`` with
        ``T > 1.5 L`` (it is at most about 1.5 periods long); and it moves: some pose is
        at least 3 median steps from the mean pose (a still capture's noise "loops" too);

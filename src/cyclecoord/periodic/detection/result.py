@@ -201,7 +201,7 @@ class DetectionResult:
     def to_report(self) -> dict[str, Any]:
         bc = self.barcode.to_dict()
         chosen = {c.index: c.motion for c in self.classes if c.motion >= 0}
-        from ...report import capture_header
+        from ..report import capture_header
 
         return {
             **capture_header(self.motion),

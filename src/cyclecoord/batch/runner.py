@@ -1,4 +1,4 @@
-"""Batch extraction: :func:`~cyclecoord.periodic.pipeline.extract` over every capture in a folder.
+"""The batch run: :func:`~cyclecoord.periodic.pipeline.extract` over every capture in a folder.
 
 :func:`run_batch` finds the captures under a folder (recursively, in sorted order), runs
 load + extract on each -- in this process, in a local process pool or on a Dask
@@ -28,8 +28,9 @@ input folder or lie inside it (captures written there would be picked up by the 
 scan), and an input folder inside the output folder is allowed only when no output
 falls inside it.  Every file is written atomically (temporary file, then rename).
 
-The folder scan lives in :mod:`cyclecoord.batch_discovery` and the summary (its type, rows
-and ``summary.csv``) in :mod:`cyclecoord.batch_summary`; both are re-exported here.
+The folder scan lives in :mod:`cyclecoord.batch.discovery` and the summary (its type, rows
+and ``summary.csv``) in :mod:`cyclecoord.batch.summary`; :mod:`cyclecoord.batch`
+re-exports all three.
 """
 
 from __future__ import annotations
@@ -49,8 +50,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
-from .batch_discovery import DEFAULT_PATTERNS, as_patterns, find_captures
-from .batch_summary import (
+from .discovery import DEFAULT_PATTERNS, as_patterns, find_captures
+from .summary import (
     STATUSES,
     SUMMARY_COLUMNS,
     SUMMARY_NAME,
@@ -58,9 +59,9 @@ from .batch_summary import (
     summary_row,
     write_summary,
 )
-from .errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
-from .io import refuse_clobber
-from .report import clean, partial_report, write_json
+from ..errors import CycleCoordError, NoPeriodicMotionError, ParameterError, ParseError
+from ..io import refuse_clobber
+from ..periodic.report import clean, partial_report, write_json
 
 __all__ = [
     "run_batch",
@@ -113,7 +114,7 @@ def _check_options(options: dict) -> dict:
     The normalised form (every parameter with its default filled in) feeds the options
     hash, so ``{}`` and ``{"random_state": 0}`` count as the same run.
     """
-    from .periodic.pipeline import extract
+    from ..periodic.pipeline import extract
 
     if not isinstance(options, dict):
         raise ParameterError(f"extract_options must be a dict, got {type(options).__name__}")
@@ -147,7 +148,7 @@ def _options_hash(normalised: dict, fps: float | None, cycle_format: str | None)
 
 # ------------------------------------------------------------------ reports
 def _batch_block(task: _Task, status: str, message: str, **extra: Any) -> dict[str, Any]:
-    from . import __version__
+    from .. import __version__
 
     return {
         "file": task.file,
@@ -185,8 +186,8 @@ def _cycle_path(task: _Task, fmt: str) -> Path:
 
 def _analyse(task: _Task) -> dict[str, Any]:
     """Load + extract one capture, write its cycle; return its report (not yet written)."""
-    from .io import load, save
-    from .periodic.pipeline import extract
+    from ..io import load, save
+    from ..periodic.pipeline import extract
 
     motion = load(task.input, fps=task.fps)
     try:
@@ -268,7 +269,7 @@ def _skeleton_signature(path: Path) -> list | None:
     """
     if path.suffix.lower() != ".amc":
         return None
-    from .io.asfamc import find_skeleton
+    from ..io.asfamc import find_skeleton
 
     try:
         asf = find_skeleton(path)
@@ -519,7 +520,7 @@ def _check_run_arguments(
             f"write_cycles must be one of {', '.join(CYCLE_FORMATS)} or None, got {write_cycles!r}"
         )
     if write_cycles in ("usda", "usdc"):
-        from .io.usd import require_usd
+        from ..io.usd import require_usd
 
         require_usd()  # usd-core missing: one clear error before anything runs
     if fps is not None:

@@ -8,7 +8,7 @@ import os
 from pathlib import Path
 from typing import Sequence
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 __all__ = ["find_captures", "as_patterns", "DEFAULT_PATTERNS"]
 

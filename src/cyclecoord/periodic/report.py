@@ -1,7 +1,10 @@
-"""JSON reports: strict JSON writing and the partial report of a run with nothing periodic.
+"""The extraction report's shared pieces: its header, strict JSON writing and the partial
+report of a run with nothing periodic.
 
-Shared by the command line (``cyclecoord.cli``) and :mod:`cyclecoord.batch`; it imports
-neither, so neither imports the other for it.
+:meth:`~cyclecoord.periodic.results.ExtractionResult.to_report` starts with
+:func:`capture_header`; the command line (``cyclecoord.cli``) and :mod:`cyclecoord.batch`
+write reports with :func:`write_json` and :func:`partial_report`.  It imports neither, so
+neither imports the other for it.
 """
 
 from __future__ import annotations
@@ -11,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
-from .errors import NoPeriodicMotionError
+from ..errors import NoPeriodicMotionError
 
-__all__ = ["clean", "partial_report", "write_json"]
+__all__ = ["capture_header", "clean", "partial_report", "write_json"]
 
 
 def capture_header(motion: Any) -> dict[str, Any]:
@@ -28,7 +31,7 @@ def capture_header(motion: Any) -> dict[str, Any]:
 
 def write_json(path: str, payload: dict) -> None:
     """Write ``payload`` as indented strict JSON, atomically (numpy scalars and arrays allowed)."""
-    from .io import atomic_write
+    from ..io import atomic_write
 
     with atomic_write(path, "w") as fh:
         json.dump(payload, fh, indent=1, allow_nan=False, default=_json_default)

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Sequence
 
-from .batch_discovery import DEFAULT_PATTERNS
-from .io import atomic_write
+from .discovery import DEFAULT_PATTERNS
+from ..io import atomic_write
 
 __all__ = [
     "BatchSummary",
