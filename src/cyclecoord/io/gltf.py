@@ -851,6 +851,19 @@ def _node_tracks(gltf, buffers, extras: dict | None = None, anim_index: int = 0)
                     f"{vals.shape[1]} for the {path} of {len(times)} keys; expected {keys} of "
                     f"{width}"
                 )
+            if interp == "CUBICSPLINE":
+                # (in-tangent, value, out-tangent) per key: the tangents need not be unit
+                # quaternions, only finite; the values are read (and interpolated linearly)
+                triples = vals.reshape(len(times), 3, width)
+                tangents = triples[:, [0, 2]]
+                if not np.all(np.isfinite(tangents)) or np.abs(tangents).max(
+                    initial=0
+                ) > MAX_MAGNITUDE:
+                    raise Invalid(
+                        f"{where}.samplers[{k}].output: tangents that are not finite numbers of "
+                        f"at most {MAX_MAGNITUDE:g} in magnitude"
+                    )
+                vals, interp = triples[:, 1], "LINEAR"
             if quat:
                 vals = _unit_quaternions(vals, f"{where}.samplers[{k}].output")
             elif not np.all(np.isfinite(vals)) or np.abs(vals).max(initial=0) > MAX_MAGNITUDE:
