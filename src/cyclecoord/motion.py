@@ -18,6 +18,19 @@ DEFAULT_FPS = 120.0
 Channel = tuple[str, str]
 
 
+def _frozen_floats(a) -> bool:
+    """Whether ``a`` is a float64 array nobody can write to (it and every array it views
+    read-only): a motion keeps such an array as it is, a reader's frames or a slice of
+    another motion's, instead of copying it."""
+    if not isinstance(a, np.ndarray) or a.dtype != np.float64:
+        return False
+    while isinstance(a, np.ndarray):
+        if a.flags.writeable:
+            return False
+        a = a.base
+    return True
+
+
 @dataclass(frozen=True, eq=False)
 class Motion:
     """A capture: ``T`` frames of ``D`` channel values.
@@ -52,7 +65,9 @@ class Motion:
     metadata: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        frames = np.array(self.frames, dtype=float)  # own copy: the caller's array is never frozen
+        frames = self.frames
+        if not _frozen_floats(frames):  # own copy: the caller's array is never frozen
+            frames = np.array(frames, dtype=float)
         if frames.ndim == 1:
             frames = frames[:, None]
         if frames.ndim != 2:

@@ -752,3 +752,45 @@ def test_spy_sees_what_it_replaced(monkeypatch):
     with pytest.raises(Reached):
         cc.datasets.example_capture(noise=0.0)
     assert spy.kwargs == {"noise": 0.0} and np.isfinite(m.frames).all()
+
+
+# ------------------------------------------------- --memory-limit: the limit readers see
+#: command -> its argv before the option ({walk}: a BVH, {out}: a folder, {script}: a script)
+MEMORY_LIMITED = {
+    "convert": ["convert", "{walk}", "-o", "{out}/w.npz"],
+    "view": ["view", "{walk}", "-o", "{out}/w.html"],
+    "feet": ["feet", "{walk}"],
+    "graph": ["graph", "{walk}", "-o", "{out}/g.bvh"],
+    "latent fit": ["latent", "fit", "{walk}", "-o", "{out}/m.npz"],
+    "animate": ["animate", "{script}", "-o", "{out}/a.bvh"],
+}
+
+
+@pytest.fixture(scope="module")
+def script(files, tmp_path_factory):
+    d = tmp_path_factory.mktemp("script")
+    assert main(["latent", "fit", str(files.walk), "-o", str(d / "m.npz"),
+                      "--max-iter", "3"]) == 0
+    spec = {"models": {"w": "m.npz"}, "commands": [{"command": "IDLE", "duration": 0.5}]}
+    (d / "s.json").write_text(json.dumps(spec))
+    return d / "s.json"
+
+
+@pytest.mark.parametrize("command", list(MEMORY_LIMITED))
+def test_memory_limit_reaches_the_readers(monkeypatch, files, script, tmp_path, command):
+    """--memory-limit 500M is the limit every memory check of the command sees (the first
+    check, a reader's, stops the run)."""
+    from cyclecoord.io import _limits
+
+    seen = []
+
+    def check(nbytes, what):
+        seen.append(_limits.stated_memory_limit())
+        raise Reached
+
+    monkeypatch.setattr(_limits, "memory_problem", check)
+    argv = [a.format(walk=files.walk, out=tmp_path, script=script)
+            for a in MEMORY_LIMITED[command]]
+    with pytest.raises(Reached):
+        main(argv + ["--memory-limit", "500M"])
+    assert seen == [500 * 1024**2]

@@ -31,6 +31,7 @@ GRAPH_WALK = W + "test_graph_start_target_and_frames_reach_the_walk"
 LATENT = W + "test_latent_fit_options_reach_the_model"
 FEET = W + "test_feet_reach_the_library"
 UNITS = W + "test_units_reach_the_gltf_and_usd_writers"
+MEMORY = W + "test_memory_limit_reaches_the_readers"
 CLI = "tests/cli/test_cli.py::"
 BLEND = "tests/cli/test_cli_blend.py::"
 
@@ -65,6 +66,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         "--json": CLI + "test_barcode_json",
     },
     "convert": {
+        "--memory-limit": MEMORY,
         "-o": CLI + "test_convert_round_trip_and_refuses_to_overwrite",
         "--skeleton": READER,
         "--fps": READER,
@@ -113,6 +115,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         "--feet": FEET,
     },
     "view": {
+        "--memory-limit": MEMORY,
         "-o": W + "test_view_writes_the_page",
         "--skeleton": READER,
         "--fps": READER,
@@ -122,6 +125,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         "--feet": FEET,
     },
     "feet": {
+        "--memory-limit": MEMORY,
         "--skeleton": READER,
         "--fps": READER,
         "--units": UNITS,
@@ -133,6 +137,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
                         W + "test_feet_lock_writes_the_locked_motion_and_the_report"),
     },
     "graph": {
+        "--memory-limit": MEMORY,
         **dict.fromkeys(("--method", "--dims", "-k", "--integrator", "--step-scale"), GRAPH),
         **dict.fromkeys(("--start", "--target", "--frames"), GRAPH_WALK),
         **dict.fromkeys(("-o", "--report", "--plot"),
@@ -147,12 +152,14 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
                           W + "test_graph_no_progress_reaches_the_loading_bar"),
     },
     "latent fit": {
+        "--memory-limit": MEMORY,
         **dict.fromkeys(("--dims", "--variance", "--step", "--max-iter"), LATENT),
         **dict.fromkeys(("-o", "--report"), W + "test_latent_fit_writes_the_model_and_the_report"),
         "--no-progress": W + "test_latent_fit_no_progress_reaches_fit",
         "--step": (LATENT, W + "test_latent_fit_default_step_trains_near_30_fps"),
     },
     "animate": {
+        "--memory-limit": MEMORY,
         **dict.fromkeys(("-o", "--report"), "tests/synthesis/test_latent_cli.py::"
                         "test_animate_writes_bvh_and_report_reproducibly"),
         "--no-check": W + "test_animate_no_check_reaches_run_script",

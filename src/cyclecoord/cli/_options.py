@@ -271,6 +271,20 @@ def add_selection_options(
     return g
 
 
+def add_memory_option(g: argparse._ActionsContainer) -> None:
+    """``--memory-limit`` of a command that reads captures, models or scripts and makes
+    frames: what reading and generating may allocate (default: what the machine allows)."""
+    g.add_argument(
+        "--memory-limit",
+        type=byte_size,
+        default=None,
+        metavar="SIZE",
+        help="memory the command may use for its inputs and the frames it makes, e.g. 2G: "
+        "an input, a frame count or a duration that would need more is refused before "
+        "anything is allocated (default: what the machine allows)",
+    )
+
+
 def add_cycle_options(g: argparse._ArgumentGroup) -> None:
     """Options of the typical cycle, the same on extract, detect --extract and batch."""
     g.add_argument(

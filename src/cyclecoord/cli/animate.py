@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ._options import add_feet_option
+from ._options import add_feet_option, add_memory_option
 from ._outputs import Outputs, declare
 
 __all__ = ["add_parser", "run"]
@@ -37,6 +37,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("--no-check", action="store_true", help="skip the plausibility checks")
     p.add_argument("--no-progress", action="store_true", help="no progress bar over the commands")
     add_feet_option(p)
+    add_memory_option(p)
     p.set_defaults(func=run)
     declare(p, inputs=_script_files, files=("-o", "--report"), derived=_skeleton_output)
 

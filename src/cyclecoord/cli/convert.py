@@ -8,6 +8,7 @@ from ._options import (
     FORMATS,
     INPUT_HELP,
     EXIT_OK,
+    add_memory_option,
     add_units_option,
     check_output,
     export_units,
@@ -40,6 +41,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     c.add_argument("--frames", type=frame_range, metavar="A:B", help="only these frames")
     add_units_option(c)
+    add_memory_option(c)
     c.set_defaults(func=cmd_convert)
     declare(c, inputs=capture_inputs(), files=("-o",))
     return c

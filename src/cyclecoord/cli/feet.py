@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ._options import add_feet_option, add_units_option, export_units, rig_line
+from ._options import add_feet_option, add_memory_option, add_units_option, export_units, rig_line
 from ._outputs import Outputs, capture_inputs, declare
 
 
@@ -37,6 +37,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("--skeleton", metavar="ASF", help="skeleton for an .amc INPUT")
     p.add_argument("--fps", type=float, metavar="HZ", help="frame rate of INPUT")
     add_units_option(p)
+    add_memory_option(p)
     p.add_argument(
         "--height",
         type=float,

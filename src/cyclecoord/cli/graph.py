@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ..errors import ParameterError
 from ..io import input_files
-from ._options import EXIT_OK, check_output, positive_float, positive_int
+from ._options import EXIT_OK, add_memory_option, check_output, positive_float, positive_int
 from ._outputs import Outputs, declare
 from .report import clean, load_input, write_json
 
@@ -121,6 +121,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "freeze and slip columns (default 3; 0 skips it)",
     )
     _feet_options(p)
+    add_memory_option(p)
     p.set_defaults(func=run)
     declare(p, inputs=_files_read, files=("-o", "--report"), folders={"--plot": r".*\.png"})
     return p

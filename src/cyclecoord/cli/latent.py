@@ -6,6 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
+from ._options import add_memory_option
 from ._outputs import Outputs, declare
 
 __all__ = ["add_parser", "parse_take", "run"]
@@ -80,6 +81,7 @@ def add_parser(subparsers) -> None:
     f.add_argument("--report", metavar="R.json", help="also write the model's summary as JSON")
     f.add_argument("--no-progress", action="store_true",
                    help="no progress bar over the GPLVM's optimisation")
+    add_memory_option(f)
     f.set_defaults(func=run)
     declare(f, inputs=_take_files, files=("-o", "--report"))
     p.set_defaults(func=lambda args: _usage(p))

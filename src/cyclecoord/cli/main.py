@@ -13,6 +13,7 @@ import sys
 from collections.abc import Sequence
 
 from ..errors import CycleCoordError
+from ..io._limits import memory_limit
 from ._options import FORMATS, EXIT_ERROR, EXIT_NO_PERIODIC, EXIT_OK, EXIT_USAGE, named
 from ._outputs import check_paths
 
@@ -102,7 +103,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"cyclecoord: error: {exc}", file=sys.stderr)
         return EXIT_ERROR
     try:
-        return int(args.func(args))
+        # readers and generators refuse what would not fit (cyclecoord.io._limits)
+        with memory_limit(getattr(args, "memory_limit", None)):
+            return int(args.func(args))
     except CycleCoordError as exc:
         print(f"cyclecoord: error: {named(getattr(args, 'input', None), exc)}", file=sys.stderr)
         return EXIT_ERROR

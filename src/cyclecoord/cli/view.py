@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..io import input_files
-from ._options import add_feet_option
+from ._options import add_feet_option, add_memory_option
 from ._outputs import Outputs, declare
 
 
@@ -58,6 +58,7 @@ def add_parser(subparsers) -> None:
     )
     p.add_argument("--no-contacts", action="store_true", help="do not mark planted feet")
     add_feet_option(p)
+    add_memory_option(p)
     p.set_defaults(func=run)
     declare(
         p,

@@ -12,7 +12,11 @@ naming the output.
 from __future__ import annotations
 
 import json
+import os
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Any
 
 import numpy as np
@@ -39,6 +43,12 @@ __all__ = [
     "metadata_problem",
     "metadata_json",
     "check_writable",
+    "machine_memory",
+    "memory_limit",
+    "stated_memory_limit",
+    "memory_problem",
+    "check_memory",
+    "format_bytes",
 ]
 
 #: Joints in one skeleton (rigs with fingers and a face have a few hundred).
@@ -152,6 +162,10 @@ def skeleton_problem(skeleton: Any) -> str | None:
     return None
 
 
+#: Values checked at a time by :func:`frames_problem` (32 MB of float64).
+_CHECK_BLOCK_VALUES = 1 << 22
+
+
 def frames_problem(frames: np.ndarray, channels) -> str | None:
     """What makes a ``(T, D)`` frame array unfit for a file (frames counted from 1)."""
     frames = np.asarray(frames)
@@ -162,15 +176,19 @@ def frames_problem(frames: np.ndarray, channels) -> str | None:
         return f"{T:,} frames; at most {MAX_FRAMES:,} are supported"
     if frames.ndim != 2 or frames.shape[1] == 0:
         return "no channels"
-    bad = _bad_values(frames)
-    if bad.any():
-        t, c = (int(v) for v in np.argwhere(bad)[0])
-        v = float(frames[t, c])
-        kind = "value" if np.isfinite(v) else "non-finite value"
-        return (
-            f"frame {t + 1}, channel {'.'.join(channels[c])}: {kind} {_describe(v)}; "
-            f"expected a finite number of at most {MAX_MAGNITUDE:g} in magnitude"
-        )
+    # a block of rows at a time: checking the whole array at once took twice its size
+    # again (np.abs's copy and the masks), 2 GB more for a 2-million-frame motion
+    step = max(1, _CHECK_BLOCK_VALUES // frames.shape[1])
+    for a in range(0, T, step):
+        bad = _bad_values(frames[a : a + step])
+        if bad.any():
+            t, c = (int(v) for v in np.argwhere(bad)[0])
+            v = float(frames[a + t, c])
+            kind = "value" if np.isfinite(v) else "non-finite value"
+            return (
+                f"frame {a + t + 1}, channel {'.'.join(channels[c])}: {kind} {_describe(v)}; "
+                f"expected a finite number of at most {MAX_MAGNITUDE:g} in magnitude"
+            )
     return None
 
 
@@ -256,3 +274,115 @@ def check_writable(motion: Any, path: Any, fmt: str, skeleton: bool = True) -> N
         problem = skeleton_problem(motion.skeleton)
         if problem is not None:
             raise fail(f"skeleton: {problem}")
+
+
+# ----------------------------------------------------------------------------- memory
+#: The memory limit a command runs under (``--memory-limit``, bytes), set by
+#: :func:`memory_limit`; ``None``: what the machine allows (:func:`machine_memory`).
+_STATED_LIMIT: ContextVar[float | None] = ContextVar("cyclecoord_memory_limit", default=None)
+
+
+def _mapped_bytes() -> float:
+    """Virtual memory this process has mapped already (Linux; 0 elsewhere)."""
+    try:
+        with open("/proc/self/statm") as fh:
+            return float(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError, AttributeError):
+        return 0.0
+
+
+def machine_memory() -> float:
+    """Bytes this process can allocate at most: physical memory, lowered by a cgroup
+    memory limit and by an address-space or data rlimit (less what is mapped already).
+    ``inf`` when nothing can be read."""
+    found = []
+    try:
+        found.append(float(os.sysconf("SC_PAGE_SIZE")) * float(os.sysconf("SC_PHYS_PAGES")))
+    except (ValueError, OSError, AttributeError):
+        pass
+    for path in ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"):
+        try:
+            with open(path) as fh:
+                text = fh.read().strip()
+        except OSError:
+            continue
+        if text.isdigit() and int(text) < 2**60:  # "max" or a huge number: no limit
+            found.append(float(text))
+    try:
+        import resource
+
+        for which in (resource.RLIMIT_AS, resource.RLIMIT_DATA):
+            soft, _ = resource.getrlimit(which)
+            if soft != resource.RLIM_INFINITY and soft > 0:
+                found.append(max(float(soft) - _mapped_bytes(), 0.0))
+    except (ImportError, ValueError, OSError):
+        pass
+    return min(found) if found else float("inf")
+
+
+def format_bytes(n: float) -> str:
+    """``123 MB``, ``2.15 GB``: decimal units, three significant figures."""
+    n = float(n)
+    for unit, size in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n >= size:
+            return f"{n / size:.3g} {unit}"
+    return f"{n:.0f} bytes"
+
+
+@contextmanager
+def memory_limit(limit: float | None) -> Iterator[None]:
+    """Run the body under a stated memory limit (bytes; ``None`` leaves the machine's).
+
+    The command line wraps every command in it with the command's ``--memory-limit``;
+    readers and generators then refuse, before allocating, what would not fit
+    (:func:`check_memory`).
+    """
+    if limit is not None and (
+        isinstance(limit, bool) or not np.isfinite(float(limit)) or float(limit) <= 0
+    ):
+        raise ParameterError(f"memory limit must be a positive number of bytes, got {limit!r}")
+    token = _STATED_LIMIT.set(None if limit is None else float(limit))
+    try:
+        yield
+    finally:
+        _STATED_LIMIT.reset(token)
+
+
+def stated_memory_limit() -> float | None:
+    """The limit :func:`memory_limit` set, or ``None``."""
+    return _STATED_LIMIT.get()
+
+
+def memory_problem(nbytes: float, what: str) -> str | None:
+    """Why ``nbytes`` for ``what`` (e.g. ``"1,000,000 frames of 62 channels"``) would not
+    fit, or ``None``: over the stated limit, or over what the machine allows."""
+    need = float(nbytes)
+    stated = _STATED_LIMIT.get()
+    if stated is not None and need > stated:
+        return (
+            f"{what} need {format_bytes(need)} of memory, over the memory limit of "
+            f"{format_bytes(stated)} (--memory-limit)"
+        )
+    machine = machine_memory()
+    if need > machine:
+        return (
+            f"{what} need {format_bytes(need)} of memory; this machine allows "
+            f"{format_bytes(machine)}"
+        )
+    return None
+
+
+def check_memory(nbytes: float, what: str, path: Any = None) -> None:
+    """Refuse, before allocating, ``nbytes`` that would not fit (see :func:`memory_problem`).
+
+    Raises :class:`~cyclecoord.errors.ParseError` naming ``path`` when one is given (a
+    reader), else :class:`~cyclecoord.errors.ParameterError`.
+    """
+    problem = memory_problem(nbytes, what)
+    if problem is None:
+        return
+    if path is not None:
+        from ..errors import ParseError
+
+        raise ParseError(problem, str(path))
+    raise ParameterError(problem)

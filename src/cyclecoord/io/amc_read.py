@@ -21,6 +21,7 @@ from ._acclaim import (
     read_text,
     safe_name,
 )
+from ._stream import CHUNK_FRAMES, FrameArray, count_lines, text_lines
 from ._limits import (
     MAX_FRAME_NUMBER,
     MAX_FRAMES,
@@ -134,14 +135,30 @@ def _amc_bone_map(skel: Skeleton) -> dict[str, tuple[str, tuple[str, ...]]]:
 class _AmcScan:
     """What the line-by-line scan of an AMC file has gathered so far.
 
-    The values stay text tokens in ``flat``, record after record (one record: one bone of
-    one frame, in the bone order of the first frame); ``rec_start`` is where each record
-    starts in ``flat`` and ``rec_info`` its ``(line, frame, bone)``, for the messages.
+    The values of the frames not yet converted stay text tokens in ``flat``, record after
+    record (one record: one bone of one frame, in the bone order of the first frame);
+    ``rec_start`` is where each record starts in ``flat`` and ``rec_info`` its ``(line,
+    frame, bone)``, for the messages.  Every :data:`~._stream.CHUNK_FRAMES` frames they
+    are converted into ``out`` (:meth:`flush`), allocated for ``expected`` frames when the
+    first frame has been read.
     """
 
-    def __init__(self, path: PathLike, bone_map: dict) -> None:
+    def __init__(
+        self, path: PathLike, bone_map: dict, expected: int = 1, size: int | None = None,
+        default_angle: str | None = None,
+    ) -> None:
         self.path = path
         self.bone_map = bone_map
+        self.expected = expected
+        self.size = size
+        self.default_angle = default_angle
+        self.out: FrameArray | None = None
+        self.pending = 0
+        # the first value that is no finite number, and the first beyond the magnitude cap:
+        # raised once every line is read, as a whole-file read would (a malformed line
+        # anywhere comes first)
+        self.bad_value: ParseError | None = None
+        self.big_value: ParseError | None = None
         self.header: list[str] = []
         self.angle: str | None = None
         self.angle_line = 0
@@ -177,6 +194,8 @@ class _AmcScan:
             )
         if first_bones is None:
             self.first_bones = self._first_frame_bones()
+            n_cols = sum(len(self.bone_map[b][1]) for b in self.first_bones)
+            self.out = FrameArray(self.expected, n_cols, path, self.size)
             self.emit(frame_no, entries)
         elif len(entries) == len(first_bones) and all(
             e[0] == b for e, b in zip(entries, first_bones)
@@ -185,6 +204,31 @@ class _AmcScan:
         else:
             self.emit(frame_no, self._in_first_frame_order())
         self.n_frames += 1
+        self.pending += 1
+        if self.pending >= CHUNK_FRAMES:
+            self.flush()
+
+    def unit(self) -> str:
+        """``"deg"`` or ``"rad"``: the header's, else the skeleton's (fixed at the first frame)."""
+        return self.angle or self.default_angle or "deg"
+
+    def flush(self) -> None:
+        """Convert the pending frames' tokens into rows of ``out`` (values checked)."""
+        if not self.pending:
+            return
+        assert self.out is not None
+        rows = self.out.rows(self.pending)
+        if self.bad_value is None:
+            try:
+                _amc_values(self, self.path, self.unit(), rows)
+            except _BadValue as exc:
+                self.bad_value = exc.error
+            except ParseError as exc:
+                self.big_value = self.big_value or exc
+        self.flat.clear()
+        self.rec_start.clear()
+        self.rec_info.clear()
+        self.pending = 0
 
     def _first_frame_bones(self) -> list[str]:
         """The bones of the first frame, each naming a different joint."""
@@ -333,11 +377,13 @@ class _AmcScan:
 
 
 def _scan_amc(
-    text: str, path: PathLike, skel: Skeleton, bone_map: dict, skel_file: PathLike | None
+    lines, path: PathLike, skel: Skeleton, bone_map: dict, skel_file: PathLike | None,
+    expected: int = 1, size: int | None = None, default_angle: str | None = None,
 ) -> _AmcScan:
-    """Read every line of an AMC into an :class:`_AmcScan`, every frame closed."""
-    scan = _AmcScan(path, bone_map)
-    for ln, raw in enumerate(text.split("\n"), 1):
+    """Read every line of an AMC into an :class:`_AmcScan`, every frame closed and its
+    values converted."""
+    scan = _AmcScan(path, bone_map, expected, size, default_angle)
+    for ln, raw in enumerate(lines, 1):
         if "#" in raw:
             if scan.frame_no is None and raw.lstrip().startswith("#"):
                 scan.header.append(raw.strip())
@@ -359,25 +405,42 @@ def _scan_amc(
             "no frames: expected a frame number after the header", path, scan.last_line or 1
         )
     scan.close_frame()
+    scan.flush()
     assert scan.first_bones is not None
+    if scan.bad_value is not None or scan.big_value is not None:
+        raise scan.bad_value or scan.big_value
     return scan
 
 
-def _amc_values(scan: _AmcScan, path: PathLike, unit: str) -> tuple[np.ndarray, list]:
-    """Frames ``(T, D)`` in degrees and their ``(joint, dof)`` channels, values checked."""
-    bone_map, first_bones, flat = scan.bone_map, scan.first_bones, scan.flat
-    n_cols = sum(len(bone_map[b][1]) for b in first_bones)
+class _BadValue(Exception):
+    """A value that is no finite number (its ParseError in ``error``)."""
+
+    def __init__(self, error: ParseError) -> None:
+        super().__init__(str(error))
+        self.error = error
+
+
+def _channels(scan: _AmcScan) -> list:
+    """The ``(joint, dof)`` channels of the columns (the first frame's bones)."""
+    bone_map = scan.bone_map
+    return [(bone_map[b][0], d) for b in scan.first_bones for d in bone_map[b][1]]
+
+
+def _amc_values(scan: _AmcScan, path: PathLike, unit: str, frames: np.ndarray) -> None:
+    """The pending frames' values, in degrees, into ``frames`` ``(k, D)``, checked."""
+    flat = scan.flat
     try:
-        values = np.array(flat, dtype=float)
+        frames.reshape(-1)[:] = np.fromiter(map(float, flat), dtype=float, count=len(flat))
+        ok = bool(np.isfinite(frames).all())
     except ValueError:
-        values = None
-    if values is None or not np.all(np.isfinite(values)):
-        _locate_bad_value(flat, scan.rec_start, scan.rec_info, path)
-    assert values is not None
-    frames = values.reshape(scan.n_frames, n_cols)
-    channels = [(bone_map[b][0], d) for b in first_bones for d in bone_map[b][1]]
+        ok = False
+    if not ok:
+        try:
+            _locate_bad_value(flat, scan.rec_start, scan.rec_info, path)
+        except ParseError as exc:
+            raise _BadValue(exc) from None
     if unit == "rad":
-        rot = [i for i, (_, d) in enumerate(channels) if d.startswith("r")]
+        rot = [i for i, (_, d) in enumerate(_channels(scan)) if d.startswith("r")]
         frames[:, rot] *= DEG_PER_RAD
     big = np.abs(frames) > MAX_MAGNITUDE
     if big.any():
@@ -391,21 +454,29 @@ def _amc_values(scan: _AmcScan, path: PathLike, unit: str) -> tuple[np.ndarray, 
             ln,
             frame,
         )
-    return frames, channels
+
+
+#: A line holding a frame number alone (how many frames the file holds, counted first).
+_FRAME_LINE = rb"^[ \t]*[+-]?[0-9]+[ \t\r]*$"
 
 
 def _parse_amc(
-    text: str, path: PathLike, skel: Skeleton, default_angle: str | None, fps: float,
+    amc_path: Path, path: PathLike, skel: Skeleton, default_angle: str | None, fps: float,
     skel_file: PathLike | None = None,
 ) -> Motion:
-    if not text.strip():
-        raise ParseError("file is empty; expected an AMC header and frames", path, 1)
-    scan = _scan_amc(text, path, skel, _amc_bone_map(skel), skel_file)
-    unit = scan.angle or default_angle or "deg"
-    frames, channels = _amc_values(scan, path, unit)
+    try:
+        expected = count_lines(amc_path, _FRAME_LINE)
+        size = amc_path.stat().st_size
+        scan = _scan_amc(
+            text_lines(amc_path, newlines_only=True), path, skel, _amc_bone_map(skel),
+            skel_file, expected, size, default_angle,
+        )
+    except OSError as exc:
+        raise ParseError(f"cannot read file: {exc.strerror or exc}", path) from None
+    assert scan.out is not None
     return Motion(
-        frames=frames,
-        channels=tuple(channels),
+        frames=scan.out.result(),
+        channels=tuple(_channels(scan)),
         fps=fps,
         skeleton=skel,
         source=str(path),
@@ -473,12 +544,21 @@ def read_amc(
     if not math.isfinite(fps) or fps <= 0:
         raise ParameterError(f"fps must be a positive number, got {fps}")
     amc_path = Path(path)
-    text = read_text(amc_path)
-    if not text.strip():
+    if _blank(amc_path, path):
         raise ParseError("file is empty; expected an AMC header and frames", path, 1)
     skel, default_angle = _resolve_skeleton(amc_path, skeleton)
     if isinstance(skeleton, Skeleton):
         skel_file = None
     else:
         skel_file = find_skeleton(amc_path) if skeleton is None else Path(skeleton)
-    return _parse_amc(text, path, skel, default_angle, fps, skel_file)
+    return _parse_amc(amc_path, path, skel, default_angle, fps, skel_file)
+
+
+def _blank(amc_path: Path, path: PathLike) -> bool:
+    """Whether the file holds nothing but white space (read until it holds something)."""
+    if amc_path.is_dir():
+        raise ParseError("is a folder, expected a file", path)
+    try:
+        return all(not line.strip() for line in text_lines(amc_path, newlines_only=True))
+    except OSError as exc:
+        raise ParseError(f"cannot read file: {exc.strerror or exc}", path) from None

@@ -25,6 +25,7 @@ from ..motion import Motion
 from ..skeleton import AXIS_INDEX, Joint, Skeleton, rotation_order_from_dofs
 from ..conventions import check_order
 from ._atomic import atomic_write
+from ._stream import CHUNK_FRAMES, FrameArray, text_lines
 from ._limits import (
     MAX_DEPTH,
     MAX_FPS,
@@ -60,6 +61,8 @@ _CHANNEL_LIST = "Xposition Yposition Zposition Xrotation Yrotation Zrotation"
 _STRUCTURE_WORDS = {"offset", "channels", "joint", "end", "{", "}", "root", "hierarchy"}
 _FRAMES_RE = re.compile(r"^frames\s*:\s*(.*)$", re.IGNORECASE)
 _FRAME_TIME_RE = re.compile(r"^frame\s+time\s*:\s*(.*)$", re.IGNORECASE)
+#: Words of a hierarchy: MAX_JOINTS joints of about 20 words each, with room to spare.
+_MAX_HIERARCHY_TOKENS = 64 * MAX_JOINTS
 
 
 # ----------------------------------------------------------------------------- reading
@@ -271,16 +274,19 @@ class _HierarchyParser:
         return self.joints
 
 
-def _read_text(path: Path) -> str:
+def _lines(path: Path):
+    """The file's lines (``str.splitlines``), read a block at a time; ParseError when the
+    file cannot be read."""
+    if path.is_dir():
+        raise ParseError("is a directory, expected a BVH file", path)
+    if not path.exists():
+        raise ParseError("no such file", path)
     try:
-        data = path.read_bytes()
+        yield from text_lines(path, bom=False)
     except FileNotFoundError:
         raise ParseError("no such file", path) from None
-    except IsADirectoryError:
-        raise ParseError("is a directory, expected a BVH file", path) from None
     except OSError as exc:
         raise ParseError(f"cannot read file: {exc.strerror or exc}", path) from None
-    return data.decode("utf-8", errors="replace")
 
 
 def _round_fps(fps: float) -> float:
@@ -319,18 +325,16 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
     """
     path = Path(path)
     spath = str(path)
-    text = _read_text(path)
-    lines = text.splitlines()
-    if not text.strip():
-        raise ParseError("file is empty; expected a BVH file starting with HIERARCHY", spath)
+    lines = enumerate(_lines(path))
     builds, motion_line = _read_hierarchy(lines, spath)
     skeleton = _bvh_skeleton(builds, path.stem, spath)
     channels = skeleton.channels
-    body = [(i + 1, ln.strip()) for i, ln in enumerate(lines) if i > motion_line and ln.strip()]
+    body = ((i + 1, ln.strip()) for i, ln in lines if ln.strip())
+    head = [line for _, line in zip(range(2), body)]
     n_frames, frame_time, tline = _motion_header(
-        body, len(channels), builds[0].line, motion_line, spath
+        head, len(channels), builds[0].line, motion_line, spath
     )
-    frames = _frame_values(body[2:], n_frames, channels, tline, spath)
+    frames = _frame_values(body, n_frames, channels, tline, spath, path.stat().st_size)
     return Motion(
         frames=frames,
         channels=channels,
@@ -341,19 +345,31 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
     )
 
 
-def _read_hierarchy(lines: list[str], spath: str) -> tuple[list, int]:
-    """The joints of the HIERARCHY section and the 0-based index of the MOTION line."""
+def _read_hierarchy(lines, spath: str) -> tuple[list, int]:
+    """The joints of the HIERARCHY section and the 0-based index of the MOTION line, from
+    ``(index, line)`` pairs (read up to the MOTION line)."""
     tokens: list[tuple[str, int]] = []
     motion_line: int | None = None  # 0-based index of the MOTION line
-    for i, raw in enumerate(lines):
+    n_lines = 0
+    for i, raw in lines:
+        n_lines = i + 1
         parts = raw.replace("{", " { ").replace("}", " } ").split()
         if not parts:
             continue
         if parts[0].upper() == "MOTION":
             motion_line = i
             break
+        if len(tokens) > _MAX_HIERARCHY_TOKENS:
+            raise ParseError(
+                f"the hierarchy runs past {_MAX_HIERARCHY_TOKENS:,} words without MOTION; "
+                f"at most {MAX_JOINTS:,} joints are supported",
+                spath,
+                i + 1,
+            )
         tokens.extend((p, i + 1) for p in parts)
-    end_line = motion_line + 1 if motion_line is not None else len(lines)
+    end_line = motion_line + 1 if motion_line is not None else n_lines
+    if not tokens and motion_line is None:
+        raise ParseError("file is empty; expected a BVH file starting with HIERARCHY", spath)
     if not tokens:
         raise ParseError(
             "expected HIERARCHY at the start of the file, found MOTION", spath, end_line
@@ -363,7 +379,7 @@ def _read_hierarchy(lines: list[str], spath: str) -> tuple[list, int]:
         raise ParseError(
             "missing MOTION section after the hierarchy (expected a line 'MOTION')",
             spath,
-            len(lines),
+            n_lines,
         )
     return builds, motion_line
 
@@ -440,66 +456,119 @@ def _motion_header(
 
 
 def _frame_values(
-    frame_lines: list[tuple[int, str]], n_frames: int, channels: tuple, tline: int, spath: str
+    frame_lines, n_frames: int, channels: tuple, tline: int, spath: str, size: int
 ) -> np.ndarray:
-    """Frames ``(T, D)`` from the frame lines, their count and every value checked."""
+    """Frames ``(T, D)`` from the ``(line number, text)`` frame lines, their count and every
+    value checked, a chunk of lines at a time into an array allocated once.
+
+    Problems are reported as a whole-file read would: a frame count that differs from
+    ``Frames:`` first, then the first line with a wrong number of values, the first value
+    that is no number, the first beyond the magnitude cap.
+    """
     n_channels = len(channels)
-    if len(frame_lines) < n_frames:
-        where = frame_lines[-1][0] if frame_lines else tline
-        raise ParseError(
-            f"'Frames: {n_frames}' declared but only {len(frame_lines)} frame lines found",
-            spath,
-            where,
-        )
-    if len(frame_lines) > n_frames:
-        raise ParseError(
-            f"'Frames: {n_frames}' declared but {len(frame_lines)} frame lines found "
-            f"(line {frame_lines[n_frames][0]} is frame {n_frames + 1})",
-            spath,
-            frame_lines[n_frames][0],
-        )
-    split_lines = []
-    for k, (lno, txt) in enumerate(frame_lines, start=1):
+    # a frame line holds at least two bytes a value ("0 "): the file bounds the frames
+    out = FrameArray(min(n_frames, size // (2 * n_channels) + 1), n_channels, spath, size)
+    found = 0
+    last_line = tline
+    extra_line = None  # the line of frame n_frames + 1
+    wrong_count: ParseError | None = None
+    bad = _FirstBad()
+    chunk: list[tuple[int, list[str]]] = []
+
+    def convert() -> None:
+        if wrong_count is None and bad.number is None:
+            _convert(chunk, out.rows(len(chunk)), channels, spath, bad)
+        chunk.clear()
+
+    for lno, txt in frame_lines:
+        found += 1
+        last_line = lno
+        if found > n_frames:
+            if extra_line is None:
+                extra_line = lno
+            continue
         vals = txt.split()
         if len(vals) != n_channels:
-            raise ParseError(
-                f"frame {k} has {len(vals)} values, the hierarchy declares "
-                f"{n_channels} channels",
-                spath,
-                lno,
-            )
-        split_lines.append(vals)
-    flat = [tok for vals in split_lines for tok in vals]
+            if wrong_count is None:
+                wrong_count = ParseError(
+                    f"frame {found} has {len(vals)} values, the hierarchy declares "
+                    f"{n_channels} channels",
+                    spath,
+                    lno,
+                )
+            continue
+        chunk.append((lno, vals))
+        if len(chunk) >= CHUNK_FRAMES:
+            convert()
+    convert()
+    if found < n_frames:
+        raise ParseError(
+            f"'Frames: {n_frames}' declared but only {found} frame lines found",
+            spath,
+            last_line if found else tline,
+        )
+    if found > n_frames:
+        raise ParseError(
+            f"'Frames: {n_frames}' declared but {found} frame lines found "
+            f"(line {extra_line} is frame {n_frames + 1})",
+            spath,
+            extra_line,
+        )
+    for problem in (wrong_count, bad.number, bad.value):
+        if problem is not None:
+            raise problem
+    return out.result()
+
+
+class _FirstBad:
+    """The first value that is no number, and the first that is not finite or too big."""
+
+    number: ParseError | None = None
+    value: ParseError | None = None
+    frame = 0  # frames converted so far
+
+
+def _convert(
+    chunk: list[tuple[int, list[str]]], rows: np.ndarray, channels: tuple, spath: str,
+    bad: _FirstBad,
+) -> None:
+    """One chunk of frame lines into ``rows``; its problems into ``bad`` (first ones kept)."""
+    first = bad.frame
+    bad.frame += len(chunk)
     try:
-        numbers = list(map(float, flat))
+        rows.reshape(-1)[:] = np.fromiter(
+            (float(tok) for _, vals in chunk for tok in vals), dtype=float, count=rows.size
+        )
     except ValueError:
-        for k, ((lno, _), vals) in enumerate(zip(frame_lines, split_lines), start=1):
+        for k, (lno, vals) in enumerate(chunk, start=first + 1):
             for c, tok in enumerate(vals):
                 try:
                     float(tok)
                 except ValueError:
                     j, d = channels[c]
-                    raise ParseError(
+                    bad.number = ParseError(
                         f"frame {k}: value {c + 1} ({j} {_DOF_TO_BVH[d]}) is {tok!r}, "
                         "expected a number",
                         spath,
                         lno,
-                    ) from None
-        raise ParseError("frame values are not all numbers", spath)  # pragma: no cover
-    frames = np.asarray(numbers, dtype=float).reshape(n_frames, n_channels)
+                    )
+                    return
+        raise  # pragma: no cover
+    if bad.value is not None:
+        return
     with np.errstate(invalid="ignore"):
-        bad = ~np.isfinite(frames) | (np.abs(frames) > MAX_MAGNITUDE)
-    if bad.any():
-        k, c = (int(v) for v in np.argwhere(bad)[0])
+        wrong = ~np.isfinite(rows) | (np.abs(rows) > MAX_MAGNITUDE)
+    if wrong.any():
+        k, c = (int(v) for v in np.argwhere(wrong)[0])
         j, d = channels[c]
-        raise ParseError(
-            f"frame {k + 1}: value {c + 1} ({j} {_DOF_TO_BVH[d]}) is "
-            f"{split_lines[k][c]!r}, expected a finite number of at most {MAX_MAGNITUDE:g} "
+        lno, vals = chunk[k]
+        bad.value = ParseError(
+            f"frame {first + k + 1}: value {c + 1} ({j} {_DOF_TO_BVH[d]}) is "
+            f"{vals[c]!r}, expected a finite number of at most {MAX_MAGNITUDE:g} "
             "in magnitude",
             spath,
-            frame_lines[k][0],
+            lno,
         )
-    return frames
 
 
 # ----------------------------------------------------------------------------- writing

@@ -50,12 +50,14 @@ from ..errors import ParameterError, ParseError
 from ..motion import DEFAULT_FPS, Motion
 from ..skeleton import Joint, Skeleton
 from ._atomic import atomic_write
+from ._stream import CHUNK_FRAMES, FrameArray, count_lines, text_lines
 from ._limits import (
     MAX_FRAME_NUMBER,
     MAX_FRAMES,
     MAX_JOINTS,
     MAX_MAGNITUDE,
     MAX_NPZ_BYTES,
+    check_memory,
     check_writable,
     fps_problem,
     frames_problem,
@@ -201,16 +203,17 @@ class _Arrays:
     Every failure is a :class:`ParseError` naming the file and the key.
     """
 
-    def __init__(self, data: dict[str, np.ndarray], spath: str) -> None:
+    def __init__(self, data: dict[str, np.ndarray], spath: str, prefix: str = "") -> None:
         self.data = data
         self.spath = spath
+        self.prefix = prefix  # how the archive names the keys ("motion_" in a latent model)
 
     def error(self, key: str, message: str) -> ParseError:
-        return ParseError(f"array {key!r}: {message}", self.spath)
+        return ParseError(f"array {self.prefix + key!r}: {message}", self.spath)
 
     def get(self, key: str) -> np.ndarray:
         if key not in self.data:
-            raise ParseError(f"missing array {key!r}", self.spath)
+            raise ParseError(f"missing array {self.prefix + key!r}", self.spath)
         return self.data[key]
 
     def _one(self, key: str, kinds: str, what: str):
@@ -373,6 +376,7 @@ def _open_npz(p: Path, spath: str) -> dict[str, np.ndarray]:
                     "supported",
                     spath,
                 )
+            check_memory(size, f"the archive's arrays ({size:,} bytes unpacked)", spath)
             data = {}
             for k in npz.files:
                 try:
@@ -438,12 +442,17 @@ def read_npz(
     spath = str(p)
     if not p.is_file():
         raise ParseError("no such file" if not p.exists() else "not a file", spath)
-    arr = _Arrays(_open_npz(p, spath), spath)
-    data = arr.data
+    return npz_motion(_Arrays(_open_npz(p, spath), spath), skeleton, fps)
+
+
+def npz_motion(arr: _Arrays, skeleton=None, fps: float | None = None) -> Motion:
+    """The motion the arrays of ``arr`` describe (:func:`read_npz`'s layout), checked."""
+    data, spath = arr.data, arr.spath
     missing = [k for k in _MOTION_KEYS if k not in data]
     if missing:
         raise ParseError(
-            f"missing array {missing[0]!r} (an .npz motion needs {', '.join(_MOTION_KEYS)})",
+            f"missing array {arr.prefix + missing[0]!r} (an .npz motion needs "
+            f"{', '.join(arr.prefix + k for k in _MOTION_KEYS)})",
             spath,
         )
     if "format" in data and arr.text("format") != _NPZ_FORMAT:
@@ -493,8 +502,9 @@ def read_npz(
             metadata=metadata,
         )
     except ParameterError as exc:
-        raise ParseError(f"{exc} (arrays 'frames', 'channel_joints', 'channel_dofs')",
-                         spath) from None
+        keys = ("frames", "channel_joints", "channel_dofs")
+        names = ", ".join(repr(arr.prefix + k) for k in keys)
+        raise ParseError(f"{exc} (arrays {names})", spath) from None
 
 
 # ----------------------------------------------------------------------------- CSV
@@ -605,18 +615,16 @@ def read_csv(
     """
     p = Path(path)
     spath = str(p)
+    if p.is_dir():
+        raise ParseError("is a directory, expected a CSV file", spath)
     try:
-        text = p.read_bytes().decode("utf-8", errors="replace")
+        lines = enumerate(text_lines(p), start=1)
+        info, header, header_line = _csv_header(lines, spath)
+        frames = _csv_frames(header, header_line, lines, spath, p)
     except FileNotFoundError:
         raise ParseError("no such file", spath) from None
-    except IsADirectoryError:
-        raise ParseError("is a directory, expected a CSV file", spath) from None
     except OSError as exc:
         raise ParseError(f"cannot read file: {exc.strerror or exc}", spath) from None
-    if text.startswith("\ufeff"):
-        text = text[1:]
-    info, header, header_line, rows = _split_csv(text.splitlines(), spath)
-    frames = _csv_frames(header, header_line, rows, spath)
     channels = _csv_channels(header, header_line, spath)
     if fps is not None:
         rate = _check_fps(fps)
@@ -636,98 +644,146 @@ def read_csv(
         raise ParseError(str(exc), spath) from None
 
 
-def _split_csv(
-    lines: list[str], spath: str
-) -> tuple[dict[str, float], list[str], int, list[tuple[int, list[str]]]]:
-    """The ``key=value`` comments before the header, the header row (and its line) and the
-    value rows as ``(line, text fields)``."""
+def _csv_header(lines, spath: str) -> tuple[dict[str, float], list[str], int]:
+    """The ``key=value`` comments before the header and the header row (and its line), read
+    from ``(line number, line)`` pairs up to the header."""
     info: dict[str, float] = {}
-    header: list[str] | None = None
-    header_line = 0
-    rows: list[tuple[int, list[str]]] = []
-    for i, line in enumerate(lines, start=1):
+    n_lines = 0
+    for i, line in lines:
+        n_lines = i
         stripped = line.strip()
         if not stripped:
             continue
         if stripped.startswith("#"):  # comments: key=value pairs count before the header
-            if header is None:
-                info.update(_parse_comment(stripped, spath, i))
+            info.update(_parse_comment(stripped, spath, i))
             continue
-        if header is None:
-            try:
-                header = next(csv.reader(io.StringIO(line)))
-            except csv.Error as exc:
-                raise ParseError(f"cannot read header row: {exc}", spath, i) from None
-            header = [h.strip() for h in header]
-            header_line = i
-            if any(not h for h in header):
-                raise ParseError(
-                    f"empty channel name in column {header.index('') + 1} of the header row",
-                    spath,
-                    i,
-                )
-            continue
-        rows.append((i, stripped.split(",")))
-    if header is None:
-        raise ParseError(
-            "no header row; expected channel names such as 'root.tx,root.ty,...'", spath,
-            len(lines) or None,
-        )
-    return info, header, header_line, rows
+        try:
+            header = next(csv.reader(io.StringIO(line)))
+        except csv.Error as exc:
+            raise ParseError(f"cannot read header row: {exc}", spath, i) from None
+        header = [h.strip() for h in header]
+        if any(not h for h in header):
+            raise ParseError(
+                f"empty channel name in column {header.index('') + 1} of the header row",
+                spath,
+                i,
+            )
+        return info, header, i
+    raise ParseError(
+        "no header row; expected channel names such as 'root.tx,root.ty,...'", spath,
+        n_lines or None,
+    )
 
 
-def _csv_frames(
-    header: list[str], header_line: int, rows: list[tuple[int, list[str]]], spath: str
-) -> np.ndarray:
-    """Frames ``(T, D)`` of the value rows, their shape and every value checked."""
+#: A line that is neither blank nor a comment (a row of values, or the header).
+_DATA_LINE = rb"^[ \t\r\f\v]*[^#\s]"
+
+
+def _csv_frames(header: list[str], header_line: int, lines, spath: str, path: Path
+                ) -> np.ndarray:
+    """Frames ``(T, D)`` of the value rows after the header, their shape and every value
+    checked, a chunk of rows at a time into an array allocated once (for the rows a first
+    count of the file's lines found).
+
+    Problems are reported as a whole-file read would: too many columns or rows first,
+    then the first row with a wrong number of values, the first value that is no number,
+    the first beyond the magnitude cap.
+    """
     D = len(header)
     if D > 6 * MAX_JOINTS:
         raise ParseError(
             f"{D:,} columns; at most {6 * MAX_JOINTS:,} channels are supported", spath, header_line
         )
-    if not rows:
+    expected = max(count_lines(path, _DATA_LINE) - 1, 1)
+    out = FrameArray(min(expected, MAX_FRAMES), D, spath, path.stat().st_size)
+    n_rows = 0
+    last_line = header_line
+    wrong_count: ParseError | None = None
+    bad = _FirstBad()
+    chunk: list[tuple[int, list[str]]] = []
+
+    def convert() -> None:
+        if wrong_count is None and bad.number is None and n_rows <= MAX_FRAMES:
+            _convert_rows(chunk, out.rows(len(chunk)), header, spath, bad)
+        chunk.clear()
+
+    for lno, line in lines:
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        n_rows += 1
+        last_line = lno
+        if n_rows > MAX_FRAMES or wrong_count is not None:
+            continue
+        vals = stripped.split(",")
+        if len(vals) != D:
+            wrong_count = ParseError(
+                f"row has {len(vals)} values, the header (line {header_line}) names {D} columns",
+                spath,
+                lno,
+            )
+            continue
+        chunk.append((lno, vals))
+        if len(chunk) >= CHUNK_FRAMES:
+            convert()
+    convert()
+    if not n_rows:
         raise ParseError(
             f"no frames: the header row (line {header_line}) is followed by no rows of values",
             spath,
             header_line,
         )
-    if len(rows) > MAX_FRAMES:
+    if n_rows > MAX_FRAMES:
         raise ParseError(
-            f"{len(rows):,} rows; at most {MAX_FRAMES:,} frames are supported", spath, rows[-1][0]
+            f"{n_rows:,} rows; at most {MAX_FRAMES:,} frames are supported", spath, last_line
         )
-    for lno, vals in rows:
-        if len(vals) != D:
-            raise ParseError(
-                f"row has {len(vals)} values, the header (line {header_line}) names {D} columns",
-                spath,
-                lno,
-            )
+    for problem in (wrong_count, bad.number, bad.value):
+        if problem is not None:
+            raise problem
+    return out.result()
+
+
+class _FirstBad:
+    """The first value that is no number, and the first that is not finite or too big."""
+
+    number: ParseError | None = None
+    value: ParseError | None = None
+
+
+def _convert_rows(
+    chunk: list[tuple[int, list[str]]], rows: np.ndarray, header: list[str], spath: str,
+    bad: _FirstBad,
+) -> None:
+    """One chunk of value rows into ``rows``; its problems into ``bad`` (first ones kept)."""
     try:
-        numbers = [float(v) for _, vals in rows for v in vals]
+        rows.reshape(-1)[:] = np.fromiter(
+            (float(v) for _, vals in chunk for v in vals), dtype=float, count=rows.size
+        )
     except ValueError:
-        for lno, vals in rows:
+        for lno, vals in chunk:
             for c, v in enumerate(vals):
                 try:
                     float(v)
                 except ValueError:
-                    raise ParseError(
+                    bad.number = ParseError(
                         f"column {c + 1} ({header[c]}) is {v.strip()!r}, expected a number",
                         spath,
                         lno,
-                    ) from None
-        raise ParseError("values are not all numbers", spath)  # pragma: no cover
-    frames = np.asarray(numbers, dtype=float).reshape(len(rows), D)
+                    )
+                    return
+        raise  # pragma: no cover
+    if bad.value is not None:
+        return
     with np.errstate(invalid="ignore"):
-        bad = ~np.isfinite(frames) | (np.abs(frames) > MAX_MAGNITUDE)
-    if bad.any():
-        r, c = (int(v) for v in np.argwhere(bad)[0])
-        raise ParseError(
-            f"column {c + 1} ({header[c]}) is {rows[r][1][c].strip()!r}, expected a finite "
+        wrong = ~np.isfinite(rows) | (np.abs(rows) > MAX_MAGNITUDE)
+    if wrong.any():
+        r, c = (int(v) for v in np.argwhere(wrong)[0])
+        bad.value = ParseError(
+            f"column {c + 1} ({header[c]}) is {chunk[r][1][c].strip()!r}, expected a finite "
             f"number of at most {MAX_MAGNITUDE:g} in magnitude",
             spath,
-            rows[r][0],
+            chunk[r][0],
         )
-    return frames
 
 
 def _csv_channels(header: list[str], header_line: int, spath: str) -> list[tuple[str, str]]:

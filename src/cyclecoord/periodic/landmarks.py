@@ -17,13 +17,13 @@ filtration gets :data:`DEFAULT_MEMORY_LIMIT`, within what the machine has left.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from math import comb
 
 import numpy as np
 
 from ..errors import ParameterError
+from ..io._limits import machine_memory
 from ._rips import DENSE_BYTES_PER_PAIR
 
 __all__ = [
@@ -60,44 +60,6 @@ _WORDS_PER_FRAME = 16
 _EM_BYTES_PER_VALUE = 8 * 3 * 30 * 3
 _EM_MAX_VALUES = 20_000
 _FIXED_SCRATCH = 40 * 1024**2
-
-
-def _mapped_bytes() -> float:
-    """Virtual memory this process has mapped already (Linux; 0 elsewhere)."""
-    try:
-        with open("/proc/self/statm") as fh:
-            return float(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
-    except (OSError, ValueError, IndexError, AttributeError):
-        return 0.0
-
-
-def machine_memory() -> float:
-    """Bytes this process can allocate at most: physical memory, lowered by a cgroup
-    memory limit and by an address-space or data rlimit (less what is mapped already).
-    ``inf`` when nothing can be read."""
-    found = []
-    try:
-        found.append(float(os.sysconf("SC_PAGE_SIZE")) * float(os.sysconf("SC_PHYS_PAGES")))
-    except (ValueError, OSError, AttributeError):
-        pass
-    for path in ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"):
-        try:
-            with open(path) as fh:
-                text = fh.read().strip()
-        except OSError:
-            continue
-        if text.isdigit() and int(text) < 2**60:  # "max" or a huge number: no limit
-            found.append(float(text))
-    try:
-        import resource
-
-        for which in (resource.RLIMIT_AS, resource.RLIMIT_DATA):
-            soft, _ = resource.getrlimit(which)
-            if soft != resource.RLIM_INFINITY and soft > 0:
-                found.append(max(float(soft) - _mapped_bytes(), 0.0))
-    except (ImportError, ValueError, OSError):
-        pass
-    return min(found) if found else float("inf")
 
 
 def run_bytes(n_frames: int, n_dims: int, n_channels: int | None = None) -> float:

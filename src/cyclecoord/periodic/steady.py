@@ -65,6 +65,9 @@ def _smoothed_steps(
     O(block x channels) beside the output instead of three copies of the take.
     """
     T = len(joints)
+    # a kernel wider than the take smooths no more than one as wide (and its weights would
+    # take memory in proportion to the frame rate)
+    sigma = min(float(sigma), float(max(T, 1)))
     radius = int(4.0 * sigma + 0.5)  # gaussian_filter1d's default truncation
     out = np.empty(T - 1)
     for a in range(0, T - 1, block):

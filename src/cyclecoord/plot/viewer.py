@@ -378,10 +378,14 @@ def _add_floor(fig, go, prepared) -> None:
     """The floor plane and fixed scene ranges covering every frame of every motion."""
     allpos = np.concatenate([p[0].reshape(-1, 3) for p in prepared])
     lo, hi = np.nanmin(allpos, axis=0), np.nanmax(allpos, axis=0)
-    pad = 0.1 * float(np.max(hi - lo))
+    extent = float(np.max(hi - lo))
+    if not np.isfinite(extent) or extent <= 0:  # one joint that never moves: a unit box
+        extent = max(1.0, float(np.max(np.abs(lo))) * 1e-3)
+    pad = 0.1 * extent
     lo, hi = lo - pad, hi + pad
     floor = min(p[3] for p in prepared)
     lo[2] = min(lo[2], floor)
+    hi[2] = max(hi[2], floor + pad)
     fig.add_trace(
         go.Mesh3d(
             x=[lo[0], hi[0], hi[0], lo[0]],

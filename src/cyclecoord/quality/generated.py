@@ -382,15 +382,15 @@ class GeneratedQuality:
 
     @property
     def knee_ratio(self) -> tuple[float, ...]:
-        return tuple(k / self.source_knee_range for k in self.knee_range)
+        return tuple(k / max(self.source_knee_range, 1e-9) for k in self.knee_range)
 
     @property
     def hip_ratio(self) -> tuple[float, ...]:
-        return tuple(k / self.source_hip_range for k in self.hip_range)
+        return tuple(k / max(self.source_hip_range, 1e-9) for k in self.hip_range)
 
     @property
     def cadence_ratio(self) -> float:
-        return self.cycle_s / self.source_cycle_s
+        return self.cycle_s / max(self.source_cycle_s, 1e-9)
 
     @property
     def root_ratio(self) -> float:

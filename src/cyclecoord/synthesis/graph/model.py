@@ -194,6 +194,14 @@ class MotionGraphSynth:
         frame : int
             0-based frame of ``start`` (negative counts from the end).
         """
+        from ...io._limits import MAX_FRAMES, check_memory
+
+        if isinstance(n_frames, (int, np.integer)) and not isinstance(n_frames, bool):
+            if n_frames > MAX_FRAMES:
+                raise ParameterError(f"{n_frames:,} frames; at most {MAX_FRAMES:,} are supported")
+            # the path, the motion made of it and the plausibility checks' kinematics
+            D = self.takes_[0].n_channels
+            check_memory(n_frames * 8.0 * (8 * D + 64), f"{n_frames:,} generated frames")
         motion, f, name = self._start(start, frame)
         x0 = self.space_.transform(motion[f])[0]
         if self.phase_field_ is not None:

@@ -100,6 +100,10 @@ def _check_start(field: VectorField, start: np.ndarray) -> np.ndarray:
     return x
 
 
+#: Largest step, in training steps: beyond it a step leaves the training data at once.
+MAX_STEP_SCALE = 1e3
+
+
 def follow_field(
     field: VectorField,
     start: np.ndarray,
@@ -138,9 +142,18 @@ def follow_field(
             f"unknown integrator {integrator!r}; choose from {', '.join(INTEGRATORS)}"
         )
     s = float(step_scale)
-    if not np.isfinite(s) or s <= 0:
-        raise ParameterError(f"step_scale must be a positive number, got {step_scale!r}")
+    if not np.isfinite(s) or not 0 < s <= MAX_STEP_SCALE:
+        raise ParameterError(
+            f"step_scale must be a positive number of at most {MAX_STEP_SCALE:g} training "
+            f"steps, got {step_scale!r}"
+        )
+    from ...io._limits import MAX_FRAMES, check_memory
+
+    if n_frames > MAX_FRAMES:
+        raise ParameterError(f"{n_frames:,} frames; at most {MAX_FRAMES:,} are supported")
     d = field.dims
+    # the path, each step's neighbours and weights (Python lists of arrays)
+    check_memory(n_frames * (8.0 * d + 400.0 + 24.0 * field.k), f"a path of {n_frames:,} frames")
     pts = np.empty((n_frames, d))
     inside = np.ones(n_frames, dtype=bool)
     nbrs, wts = [], []
@@ -165,6 +178,10 @@ def follow_field(
             inside[t] = bool(ins[0] and i2[0] and i3[0] and i4[0])
             step = s * (k1 + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]) / 6.0
         x = x + step
+        if not np.all(np.isfinite(x)):
+            raise ParameterError(
+                f"the path left every finite value at frame {t + 1} (step scale {s:g})"
+            )
         if field.agree and np.any(step):
             h = step[None]
     width = max(len(a) for a in nbrs)

@@ -37,7 +37,7 @@ from scipy.spatial import cKDTree
 from ...errors import CycleCoordError, ParameterError
 from ...motion import Motion
 from .build import MotionGraph
-from .paths import GraphPath
+from .paths import MAX_STEP_SCALE, GraphPath
 
 __all__ = ["PhaseField", "TakePhases", "take_phases", "align_phases", "follow_phase"]
 
@@ -274,8 +274,18 @@ def follow_phase(
     if isinstance(n_frames, bool) or not isinstance(n_frames, (int, np.integer)) or n_frames < 1:
         raise ParameterError(f"n_frames must be a whole number >= 1, got {n_frames!r}")
     s = float(step_scale)
-    if not np.isfinite(s) or s <= 0:
-        raise ParameterError(f"step_scale must be a positive number, got {step_scale!r}")
+    if not np.isfinite(s) or not 0 < s <= MAX_STEP_SCALE:
+        raise ParameterError(
+            f"step_scale must be a positive number of at most {MAX_STEP_SCALE:g} training "
+            f"steps, got {step_scale!r}"
+        )
+    from ...io._limits import MAX_FRAMES, check_memory
+
+    if n_frames > MAX_FRAMES:
+        raise ParameterError(f"{n_frames:,} frames; at most {MAX_FRAMES:,} are supported")
+    # the path, the phases, each step's neighbours and weights
+    check_memory(n_frames * (8.0 * field.dims + 8.0 + 16.0 * field.k),
+                 f"a path of {n_frames:,} frames")
     p = field.phase_of(x) if phase is None else float(phase)
     pts = np.empty((n_frames, field.dims))
     phases = np.empty(n_frames)
@@ -284,6 +294,10 @@ def follow_phase(
     for t in range(n_frames):
         pts[t], phases[t] = x, p
         x, p, nbrs[t], wts[t] = field.step(x, p, s)
+        if not (np.all(np.isfinite(x)) and np.isfinite(p)):
+            raise ParameterError(
+                f"the path left every finite value at frame {t + 1} (step scale {s:g})"
+            )
     return GraphPath(
         points=pts,
         neighbours=nbrs,

@@ -15,6 +15,7 @@ segment as it was.  Root motion comes from the training frames nearest the parti
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -57,6 +58,13 @@ LIMIT_MARGIN = 0.1
 #: synthetic run the full radius let the random force throw the pose 3.2x the training
 #: 99th percentile of pose speed in one step.
 AHEAD_RADIUS = 0.25
+#: Bytes of one edge of a networkx graph (its weight dict in both directions).
+_EDGE_BYTES = 400
+#: Bytes a synthesised frame takes until the motion is written, besides a training frame
+#: (latent point, pose, root motion, the motion's frames, forward kinematics of the
+#: checks) and per training frame (the kernel and root weights of the frame).
+_FRAME_BYTES = 8 * 16
+_FRAME_BYTES_PER_TRAINING_FRAME = 8 * 4
 #: Training frames this close in a segment are joined at their captured pace by a MOVE.
 PACE_GAP = 2
 
@@ -73,14 +81,27 @@ def _path_times(m: LatentModel, poly: np.ndarray, nodes: list[int]) -> np.ndarra
     return np.concatenate([[0.0], np.cumsum(dt)])
 
 
+def _isfinite(value: Any) -> bool:
+    """``math.isfinite`` of a JSON or Python number; False, not an error as from
+    ``np.isfinite``, for an integer too large for a float."""
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
 class CommandGraph:
     """Shortest paths over a model's training latent points (complete graph, cost ``d^p``)."""
 
     def __init__(self, model: LatentModel, power: float = 4.0) -> None:
         self.model = model
         self.power = power
+        from ...io._limits import check_memory
+
         X = model.X_
         n = X.shape[0]
+        # networkx keeps every edge of the complete graph as Python objects
+        check_memory(_EDGE_BYTES * n * (n - 1) / 2, f"the command graph of {n:,} latent points")
         i, j = np.triu_indices(n, 1)
         cost = np.sqrt(sqdist(X, X))[i, j] ** power
         self.graph = nx.Graph()
@@ -172,7 +193,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
     def __post_init__(self) -> None:
         if not self.models:
             raise ParameterError("no models")
-        if not np.isfinite(self.fps) or self.fps <= 0:
+        if not _isfinite(self.fps) or self.fps <= 0:
             raise ParameterError(f"fps must be positive, got {self.fps}")
         if self.plant not in ("transitions", "all", "off"):
             raise ParameterError(
@@ -201,6 +222,23 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         # (model, segment, unwrapped phase) where the last stepping command left the
         # particle, and the one the MOVE being made will leave
         self._cursor = self._next_cursor = None
+        widest = max(m.X_.shape[0] for m in self.models.values())
+        channels = max(len(m.all_channels_) for m in self.models.values())
+        self.frame_bytes = _FRAME_BYTES * channels + _FRAME_BYTES_PER_TRAINING_FRAME * widest
+
+    def reserve(self, n: float, what: str = "") -> int:
+        """``n`` more frames as a whole number, or ParameterError when the script's frames
+        would pass :data:`~cyclecoord.io._limits.MAX_FRAMES` or the memory limit."""
+        from ...io._limits import MAX_FRAMES, check_memory
+
+        total = self.n_frames + float(n)
+        if not np.isfinite(total) or total > MAX_FRAMES:
+            raise ParameterError(
+                f"{what or 'the script'} would make {total:.4g} frames in all at {self.fps:g} "
+                f"fps; at most {MAX_FRAMES:,} are supported"
+            )
+        check_memory(total * self.frame_bytes, f"{int(total):,} synthesised frames")
+        return int(n)
 
     def _range(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         if name not in self._ranges:
@@ -224,6 +262,15 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         if isinstance(spec, Point):
             return np.asarray(spec, dtype=float)
         q = m.X_.shape[1]
+        if isinstance(spec, (list, tuple)) and (
+            len(spec) != q or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) for v in spec
+            )
+        ):
+            raise ParameterError(
+                f"a latent target of {name!r} must be {q} numbers or a frame/segment, "
+                f"got {str(spec)[:80]}"
+            )
         if isinstance(spec, dict):
             unknown = sorted(set(spec) - {"frame", "segment", "time"})
             if unknown:
@@ -282,6 +329,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self._cursor, self._next_cursor = self._next_cursor, None
         params = self.params if radius is None else self.params.replace(radius=radius)
         t0, c0 = time.perf_counter(), time.process_time()
+        self.reserve(path.shape[0] - 1)
         X, V = simulate(m, path, self.x, self.v, self.fps, params, self.force, self.t, ride)
         self._emit(self.current, X, m.pose(X), self._root(m, X))
         self.sim_seconds += time.perf_counter() - t0
@@ -350,7 +398,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         MOVEs flows through its waypoints.
         """
         m = self._need_start("MOVE")
-        if not (isinstance(speed, (int, float)) and speed > 0):
+        if not (
+            isinstance(speed, (int, float)) and not isinstance(speed, bool)
+            and _isfinite(speed) and speed > 0
+        ):
             raise ParameterError(f"MOVE speed must be a positive number, got {speed!r}")
         if isinstance(to, dict) and "ahead" in to:
             if set(to) != {"ahead"}:
@@ -372,7 +423,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             times = _path_times(m, poly, nodes)
         times = times / speed
         if duration is not None:
-            if not (isinstance(duration, (int, float)) and duration > 0):
+            if not (
+                isinstance(duration, (int, float)) and not isinstance(duration, bool)
+                and _isfinite(duration) and duration > 0
+            ):
                 raise ParameterError(
                     f"MOVE duration must be a positive number of seconds, got {duration!r}"
                 )
@@ -380,7 +434,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         ramp = int(round(self.ease * self.fps))
         still = self.v is None or np.linalg.norm(self.v) < 0.25 * m.speed_
         r_in, r_out = (ramp if still else 0), (ramp if stop else 0)
-        n = max(1, int(round(times[-1] * self.fps)) + (r_in + r_out) // 2)
+        with np.errstate(all="ignore"):
+            frames = np.round(times[-1] * self.fps)
+        n = max(1, self.reserve(frames if np.isfinite(frames) else np.inf, "MOVE"))
+        n += (r_in + r_out) // 2
         u = eased(n, r_in, r_out) * times[-1]
         samples = np.stack([np.interp(u, times, poly[:, k]) for k in range(poly.shape[1])], 1)
         self._run(samples, radius, ride=True)
@@ -390,10 +447,19 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
     ) -> None:
         """IDLE within ``radius`` of one point (default: where the particle is) or several."""
         self._need_start("IDLE")
-        if not (isinstance(duration, (int, float)) and duration > 0):
+        if not (
+            isinstance(duration, (int, float)) and not isinstance(duration, bool)
+            and _isfinite(duration) and duration > 0
+        ):
             raise ParameterError(
                 f"IDLE duration must be a positive number of seconds, got {duration!r}"
             )
+        if not (
+            isinstance(hover, (int, float)) and not isinstance(hover, bool)
+            and _isfinite(hover) and hover > 0
+        ):
+            raise ParameterError(f"IDLE hover must be a positive number of seconds, got {hover!r}")
+        self.reserve(duration * self.fps, "IDLE")
         many = isinstance(at, list) and at and all(isinstance(a, (dict, list)) for a in at)
         points = (
             [self.target(a) for a in at]
@@ -433,6 +499,12 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             ) from None
         idx = np.flatnonzero(m.segments_ == s)
         length = m.times_[idx][-1]
+        for what, value in (("start", start), ("stop", stop)):
+            if value is not None and (
+                not isinstance(value, (int, float)) or isinstance(value, bool)
+                or not _isfinite(value)
+            ):
+                raise ParameterError(f"PLAY {what} must be a number of seconds, got {value!r}")
         stop = length if stop is None else float(stop)
         if not 0 <= float(start) < stop <= length + 1e-9:
             raise ParameterError(
@@ -441,6 +513,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             )
         first = idx[np.argmin(np.abs(m.times_[idx] - start))]
         self.move(Point(m.X_[first]), radius=0.25 * self.params.radius)
+        self.reserve((stop - float(start)) * self.fps, "PLAY")
         t = np.arange(float(start), stop, 1.0 / self.fps)
         tt = m.times_[idx]
 

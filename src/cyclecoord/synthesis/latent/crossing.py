@@ -220,7 +220,12 @@ class CrossingMixin:
         src = self.current
         m2 = self.model(to)
         check_compatible(self.models[src], m2, f"TRANSITION from {src!r} to {to!r}: ")
-        if not (isinstance(blend, (int, float)) and not isinstance(blend, bool) and blend > 0):
+        from .commands import _isfinite
+
+        if not (
+            isinstance(blend, (int, float)) and not isinstance(blend, bool)
+            and _isfinite(blend) and blend > 0
+        ):
             raise ParameterError(
                 f"TRANSITION blend must be a positive number of seconds, got {blend!r}"
             )
@@ -253,6 +258,7 @@ class CrossingMixin:
         self.move(Point(x1), radius=small, speed=APPROACH_SPEED)
         asked = blend_asked(blend, self.fps)
         n = min(max(asked, self.blend_frames(src, to, x1, x2)), int(MAX_BLEND * self.fps))
+        self.reserve(n + 1, "TRANSITION")
         if n != asked:
             self.notes.append(
                 f"commands[{self.command}] TRANSITION {src} -> {to}: blend raised from "

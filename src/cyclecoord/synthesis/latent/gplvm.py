@@ -293,6 +293,8 @@ class GPLVM:
         X0 = Y[:, :q] / max(Y[:, 0].std(), 1e-12)
         st = self.settings(Y, seg, t, X0)
         s0 = float(Y.var(axis=0).mean())
+        if not np.isfinite(s0) or s0 <= 0:
+            raise ParameterError(f"the training frames' variance is {s0:g}; a GPLVM needs motion")
         theta0 = np.concatenate([X0.ravel(), np.log([s0, 1.0, 0.05 * s0])])
         bounds = [(None, None)] * (n * q) + [
             (np.log(s0) - 10, np.log(s0) + 5),

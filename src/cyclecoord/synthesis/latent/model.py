@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import ParameterError, ParseError
+from ...io._limits import check_memory
 from ...motion import Motion
 from ...skeleton import Skeleton
 from .gplvm import GPLVM, rbf, sqdist
@@ -207,6 +208,11 @@ class LatentModel:
         self.weights_ = influence_weights(angles, self.channels_, self.skeleton_)
         Z = (angles - self.mean_) * self.weights_
         _, S, Vt = np.linalg.svd(Z, full_matrices=False)
+        if not S.size or not S[0] > 1e-12:  # nothing to learn (and a log of zero variance)
+            raise ParameterError(
+                f"segments {self.segment_names_}: no joint angle changes over the training "
+                "frames; a model needs motion"
+            )
         ratio = np.cumsum(S**2) / max((S**2).sum(), 1e-300)
         d_pca = int(np.searchsorted(ratio, self.variance - 1e-12) + 1)
         d_pca = max(d_pca, int(self.n_components) + 1)
@@ -385,53 +391,143 @@ class LatentModel:
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> LatentModel:
-        """Read a model written by :meth:`save`."""
-        from ...io.tabular import read_npz
+        """Read a model written by :meth:`save`.
+
+        Raises
+        ------
+        ParseError
+            One line naming the file and the array: not a readable archive (a truncated
+            or corrupted zip), not a latent model, a missing array, an array of the wrong
+            dtype or shape, values that are not finite, sizes that do not agree, or a
+            model too large for the memory limit.
+        """
+        from ...io.tabular import _Arrays, _open_npz, npz_motion
 
         p = Path(path)
+        spath = str(p)
+        if not p.is_file():
+            raise ParseError("no such file" if not p.exists() else "not a file", spath)
+        arrays = _open_npz(p, spath)  # zip integrity, no pickle, within the size cap
+        a = _Arrays(arrays, spath)
+        if "format" not in arrays or a.text("format") != _FORMAT:
+            raise ParseError(f"not a latent model (no format '{_FORMAT}')", spath)
+        version = a.integer("version", -(2**62), 2**62)
+        if version != _VERSION:
+            raise a.error("version", f"model version {version}; this cyclecoord reads {_VERSION}")
+        train = npz_motion(
+            _Arrays({k[7:]: v for k, v in arrays.items() if k.startswith("motion_")}, spath,
+                    "motion_")
+        )
+        if train.skeleton is None:
+            raise a.error("motion_has_skeleton", "a model's training frames need their skeleton")
+        N = train.n_frames
+        # the kernel matrix, its inverse and the temporaries of _finish and densities()
+        check_memory(48.0 * N * N, f"a model of {N:,} training frames", spath)
+        params = _json(a, "params", dict)
+        unknown = sorted(set(params) - {"n_components", "variance", "gplvm", "random_state"})
+        if unknown:
+            raise a.error("params", f"unknown key(s) {unknown}")
         try:
-            with np.load(p, allow_pickle=False) as data:
-                arrays = {k: data[k] for k in data.files}
-        except (OSError, ValueError) as exc:
-            raise ParseError(f"cannot read a latent model: {exc}", p) from None
-        if str(arrays.get("format", "")) != _FORMAT:
-            raise ParseError(f"not a latent model (no format '{_FORMAT}')", p)
-        with tempfile.TemporaryDirectory() as tmp:
-            np.savez(
-                Path(tmp) / "train.npz",
-                **{k[7:]: v for k, v in arrays.items() if k.startswith("motion_")},
-            )
-            train = read_npz(Path(tmp) / "train.npz")
-        params = json.loads(str(arrays["params"]))
-        m = cls(**params)
-        n_root = int(arrays["n_root"])
+            m = cls(**params)
+            m.gplvm = None if m.gplvm is None else dict(m.gplvm)
+        except (TypeError, ValueError):
+            raise a.error("params", "expects n_components, variance, gplvm, random_state") from None
         m.all_channels_ = train.channels
         root = set(train.root_channels())
         m.root_channels_ = tuple(c for i, c in enumerate(train.channels) if i in root)
         m.channels_ = tuple(c for i, c in enumerate(train.channels) if i not in root)
-        if len(m.root_channels_) != n_root or len(m.channels_) != int(arrays["n_modelled"]):
+        n_root = a.integer("n_root", 0, len(train.channels))
+        n_modelled = a.integer("n_modelled", 0, len(train.channels))
+        if len(m.root_channels_) != n_root or len(m.channels_) != n_modelled:
             raise ParseError("the stored training frames do not match the model's channels", p)
+        C = n_modelled
+        if C < 1:
+            raise a.error("n_modelled", "a model needs at least one modelled channel")
+        names = [str(x) for x in _json(a, "segment_names", list)]
+        if not names:
+            raise a.error("segment_names", "a model needs at least one segment")
+        if len(set(names)) != len(names):
+            twice = sorted({x for x in names if names.count(x) > 1})
+            raise a.error("segment_names", f"names repeat: {twice[:5]}")
+        m.segment_names_ = names
         m.skeleton_, m.fps_, m.frames_ = train.skeleton, train.fps, np.array(train.frames)
-        m.segments_, m.times_ = arrays["segments"], arrays["times"]
-        m.segment_names_ = json.loads(str(arrays["segment_names"]))
-        m.mean_, m.weights_, m.components_ = arrays["mean"], arrays["weights"], arrays["components"]
-        m.Y_, m.explained_variance_ = arrays["Y"], float(arrays["explained_variance"])
-        m.gp_ = GPLVM.from_arrays(arrays["X"], *arrays["hyper"], m.Y_)
+        m.segments_ = np.asarray(a.integers("segments", N, 0, len(names) - 1))
+        empty = sorted(set(range(len(names))) - set(m.segments_.tolist()))
+        if empty:
+            raise a.error("segments", f"segment {empty[0]} ({names[empty[0]]!r}) has no frames")
+        m.times_ = a.reals("times", (N,))
+        comp = a.get("components")
+        d = comp.shape[1] if comp.ndim == 2 else 0
+        if not 1 <= d <= C:
+            raise a.error("components", f"expected shape ({C}, d) with 1 <= d <= {C}, got "
+                          f"{comp.shape}")
+        X = a.get("X")
+        q = X.shape[1] if X.ndim == 2 else 0
+        if not 1 <= q <= d:
+            raise a.error("X", f"expected shape ({N}, q) with 1 <= q <= {d}, got {X.shape}")
+        m.mean_ = a.reals("mean", (C,))
+        m.weights_ = a.reals("weights", (C,))
+        if (m.weights_ < 0).any():
+            raise a.error("weights", "influence weights are never negative")
+        m.components_ = a.reals("components", (C, d))
+        m.Y_ = a.reals("Y", (N, d))
+        X = a.reals("X", (N, q))
+        m.explained_variance_ = a.real("explained_variance")
+        hyper = a.reals("hyper", (3,))
+        if not (hyper > 0).all():
+            raise a.error("hyper", f"variance, length scale and noise are positive, got {hyper}")
+        try:
+            m.gp_ = GPLVM.from_arrays(X, *hyper, m.Y_)
+        except ParameterError as exc:
+            raise ParseError(f"arrays 'X', 'hyper', 'Y': {exc}", spath) from None
         if "gait_phase" in arrays:  # files written before the gait phase compute it on use
             from .gait import Gait
 
-            m.gait_ = Gait(arrays["gait_phase"], arrays["gait_period"], m.segments_)
+            phase = a.reals("gait_phase", (N,), allow_nan=True)  # NaN: a segment without gait
+            period = a.get("gait_period")
+            S = period.shape[0] if period.ndim == 1 else -1
+            if S < len(names):
+                raise a.error("gait_period", f"expected one period per segment ({len(names)}), "
+                              f"got shape {period.shape}")
+            period = a.reals("gait_period", (S,), allow_nan=True)
+            if (period <= 0).any():
+                raise a.error("gait_period", "frames per cycle are positive")
+            m.gait_ = Gait(phase, period, m.segments_)
         starts = np.flatnonzero(np.r_[True, m.segments_[1:] != m.segments_[:-1]])
         stops = np.r_[starts[1:], len(m.segments_)]
-        tracks = [root_track(train[a:b]) for a, b in zip(starts, stops)]
+        try:
+            tracks = [root_track(train[a:b]) for a, b in zip(starts, stops)]
+        except (KeyError, ValueError, ParameterError) as exc:
+            raise ParseError(f"training frames: no root motion to take ({exc})", spath) from None
         m.root_ = RootTrack(
             *(
                 np.concatenate([getattr(t, f) for t in tracks])
                 for f in ("height", "velocity", "turn", "tilt")
             )
         )
-        m._precompute()
+        with np.errstate(all="ignore"):
+            m._precompute()
+        if not (np.isfinite(m.speed_) and m.speed_ > 0 and np.isfinite(m._B).all()):
+            raise a.error("X", "the latent points do not move (no latent speed), or the pose "
+                          "map is not finite")
         return m
+
+
+def _json(a, key: str, kind: type):
+    """The JSON value a string array holds, of type ``kind`` (size and depth checked first)."""
+    from ...io._limits import metadata_problem
+
+    text = a.text(key)
+    problem = metadata_problem(text)
+    if problem is not None:
+        raise a.error(key, problem)
+    try:
+        value = json.loads(text)
+    except (ValueError, RecursionError):
+        raise a.error(key, "not valid JSON") from None
+    if not isinstance(value, kind):
+        raise a.error(key, f"expected a JSON {kind.__name__}, got {type(value).__name__}")
+    return value
 
 
 def _check_skeleton(a: Skeleton, b: Skeleton) -> bool:

@@ -51,6 +51,8 @@ class OutputMixin:
         pos = np.concatenate([np.zeros((1, 3)), np.cumsum(world[:-1], axis=0)])
         pos[:, 1] = root["height"]
         U, _, Vt = np.linalg.svd(root["tilt"])
+        # the nearest rotation to the weighted mean of rotations (never a reflection)
+        U[:, :, 2] *= np.sign(np.linalg.det(U @ Vt))[:, None]
         tilt = U @ Vt
         mats = head @ tilt
         rj = first.skeleton_.joints[0]

@@ -34,6 +34,11 @@ from ...errors import ParameterError
 __all__ = ["ParticleParams", "RandomForce", "simulate"]
 
 
+#: Largest value of any particle parameter (seconds, gains): the integration squares the
+#: radius (an OverflowError at 1e300) and larger forces leave finite values at once.
+MAX_PARAMETER = 1e6
+
+
 @dataclass(frozen=True)
 class ParticleParams:
     """Particle settings; lengths and accelerations are in units of the model's speed.
@@ -73,8 +78,15 @@ class ParticleParams:
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
-            if not isinstance(v, (int, float)) or isinstance(v, bool) or not np.isfinite(v):
-                raise ParameterError(f"particle parameter {f.name} must be a number, got {v!r}")
+            if (
+                not isinstance(v, (int, float))
+                or isinstance(v, bool)
+                or not abs(v) <= MAX_PARAMETER  # NaN, an infinity, an int of any size
+            ):
+                raise ParameterError(
+                    f"particle parameter {f.name} must be a number of at most "
+                    f"{MAX_PARAMETER:g}, got {str(v)[:40]}"
+                )
             if v < 0 or (f.name in ("width", "timescale", "alpha") and v == 0):
                 raise ParameterError(f"particle parameter {f.name} must be positive, got {v!r}")
 
@@ -186,25 +198,34 @@ def simulate(
         return F
 
     before = None
-    for k in range(T):
-        p0, p1 = path[k], path[k + 1]
-        pd = (p1 - p0) * fps
-        if ride and before is not None:
-            v = v + (pd - before)
-        before = pd
-        t = t0 + k * dt
-        pm = 0.5 * (p0 + p1)
-        k1x, k1v = v, accel(x, v, p0, pd, t)
-        k2x, k2v = (
-            v + 0.5 * dt * k1v,
-            accel(x + 0.5 * dt * k1x, v + 0.5 * dt * k1v, pm, pd, t + 0.5 * dt),
-        )
-        k3x, k3v = (
-            v + 0.5 * dt * k2v,
-            accel(x + 0.5 * dt * k2x, v + 0.5 * dt * k2v, pm, pd, t + 0.5 * dt),
-        )
-        k4x, k4v = v + dt * k3v, accel(x + dt * k3x, v + dt * k3v, p1, pd, t + dt)
-        x = x + dt / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x)
-        v = v + dt / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)
-        X[k], V[k] = x, v
+    # a diverging integration overflows before it is refused below (one line, no warnings)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        for k in range(T):
+            p0, p1 = path[k], path[k + 1]
+            pd = (p1 - p0) * fps
+            if ride and before is not None:
+                v = v + (pd - before)
+            before = pd
+            t = t0 + k * dt
+            pm = 0.5 * (p0 + p1)
+            k1x, k1v = v, accel(x, v, p0, pd, t)
+            k2x, k2v = (
+                v + 0.5 * dt * k1v,
+                accel(x + 0.5 * dt * k1x, v + 0.5 * dt * k1v, pm, pd, t + 0.5 * dt),
+            )
+            k3x, k3v = (
+                v + 0.5 * dt * k2v,
+                accel(x + 0.5 * dt * k2x, v + 0.5 * dt * k2v, pm, pd, t + 0.5 * dt),
+            )
+            k4x, k4v = v + dt * k3v, accel(x + dt * k3x, v + dt * k3v, p1, pd, t + dt)
+            x = x + dt / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x)
+            v = v + dt / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)
+            if not (math.isfinite(float(x @ x)) and math.isfinite(float(v @ v))):
+                # the integration diverged: every later frame would be NaN, and slow to make
+                raise ParameterError(
+                    f"the particle left finite values at frame {k + 1} of {T} (time step "
+                    f"{dt:.3g} s, random force {params.random:g}): a higher frame rate or a "
+                    "smaller random force keeps it stable"
+                )
+            X[k], V[k] = x, v
     return X, V

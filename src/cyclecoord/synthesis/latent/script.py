@@ -35,7 +35,7 @@ import numpy as np
 from ..._blas import one_blas_thread
 from ...errors import CycleCoordError, ParameterError, ParseError
 from ...quality.contacts import skating_report
-from .commands import Synthesizer
+from .commands import Synthesizer, _isfinite
 from .model import LatentModel
 from .particle import ParticleParams
 
@@ -84,8 +84,8 @@ def script_files(path: str | Path) -> list[Path]:
         return []
     files = [p]
     try:
-        spec = json.loads(p.read_text(encoding="utf-8"))
-    except (OSError, ValueError, RecursionError):
+        spec = _read_spec(p)
+    except CycleCoordError:
         return files
     models = spec.get("models") if isinstance(spec, dict) else None
     for entry in models.values() if isinstance(models, dict) else ():
@@ -99,17 +99,104 @@ def script_files(path: str | Path) -> list[Path]:
     return files
 
 
-def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel]]:
-    """Read and check a script and load its models (nothing is run)."""
-    p = Path(path)
+#: Commands in one script, models it names, and targets one IDLE hovers between.
+MAX_COMMANDS = 10_000
+MAX_MODELS = 64
+MAX_TARGETS = 1_000
+#: Longest TRANSITION blend asked for, seconds (blends are capped at MAX_BLEND anyway).
+MAX_BLEND_ASKED = 3600.0
+
+
+def _number(p: Path, where: str, value: Any, low: float, high: float, what: str) -> float:
+    """A finite number in ``(low, high]`` (``what`` says what it is, for the message)."""
+    if (
+        not isinstance(value, (int, float))
+        or isinstance(value, bool)
+        or not _isfinite(value)
+        or not low < value <= high
+    ):
+        raise _fail(p, where, f"{what} must be a number in ({low:g}, {high:g}], got {value!r}")
+    return float(value)
+
+
+def _read_spec(p: Path) -> Any:
+    """The script's JSON, its size and nesting checked before it is parsed."""
+    from ...io._limits import MAX_METADATA_BYTES, metadata_problem
+
     try:
-        spec = json.loads(p.read_text(encoding="utf-8"))
+        size = p.stat().st_size
+        if size > MAX_METADATA_BYTES:
+            raise ParseError(
+                f"the script is {size:,} bytes; at most {MAX_METADATA_BYTES:,} are supported", p
+            )
+        text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ParameterError(f"{p}: script not found") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ParseError(f"cannot read the script: {exc}", p) from None
+    problem = metadata_problem(text)
+    if problem is not None:
+        raise ParseError(f"the script's JSON is {problem}", p)
+    try:
+        return json.loads(text)
     except json.JSONDecodeError as exc:
         raise ParseError(f"not valid JSON: {exc.msg}", p, line=exc.lineno) from None
+    except (ValueError, RecursionError) as exc:
+        raise ParseError(f"not valid JSON: {str(exc)[:100]}", p) from None
+
+
+def _check_command(p: Path, where: str, kind: str, c: dict, fps: float) -> float:
+    """The command's values checked for their types and ranges; the seconds it asks for
+    (0 when its length depends on the models)."""
+    from ...io._limits import MAX_FRAMES, MAX_MAGNITUDE
+
+    longest = MAX_FRAMES / fps  # seconds the frame limit allows at the script's rate
+    seconds = 0.0
+    if "duration" in c:
+        seconds = _number(p, where, c["duration"], 0.0, longest, "duration (seconds)")
+    if "radius" in c and c["radius"] is not None:
+        _number(p, where, c["radius"], 0.0, MAX_MAGNITUDE, "radius")
+    if kind == "MOVE":
+        if c.get("path", "line") not in ("line", "graph"):
+            raise _fail(p, where, f"path must be 'line' or 'graph', got {c['path']!r}")
+        if "speed" in c:
+            _number(p, where, c["speed"], 1e-6, 1e6, "speed")
+    elif kind == "IDLE":
+        if "hover" in c:
+            _number(p, where, c["hover"], 1e-3, longest, "hover (seconds)")
+        at = c.get("at")
+        if isinstance(at, list) and len(at) > MAX_TARGETS:
+            raise _fail(p, where, f"{len(at):,} targets; at most {MAX_TARGETS:,} are supported")
+    elif kind == "TRANSITION":
+        if not isinstance(c["to"], str):
+            raise _fail(p, where, f"to must name a model, got {c['to']!r}")
+        if "blend" in c:
+            _number(p, where, c["blend"], 0.0, MAX_BLEND_ASKED, "blend (seconds)")
+        if not isinstance(c.get("route", True), bool):
+            raise _fail(p, where, f"route must be true or false, got {c['route']!r}")
+    else:  # PLAY
+        if not isinstance(c["segment"], str):
+            raise _fail(p, where, f"segment must be a segment's name, got {c['segment']!r}")
+        start = c.get("start", 0.0)
+        if start != 0:
+            start = _number(p, where, start, 0.0, longest, "start (seconds)")
+        if c.get("stop") is not None:
+            seconds = _number(p, where, c["stop"], float(start), longest, "stop (seconds)") - start
+    return seconds
+
+
+def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel]]:
+    """Read and check a script and load its models (nothing is run).
+
+    Every value is checked for its type and range before a model is loaded: numbers
+    finite, durations, times and the frames they ask for within
+    :data:`~cyclecoord.io._limits.MAX_FRAMES` and the memory limit
+    (:func:`~cyclecoord.io._limits.check_memory`), models that exist and are models.
+    """
+    from ...io._limits import MAX_FPS, MAX_FRAMES, MIN_FPS
+
+    p = Path(path)
+    spec = _read_spec(p)
     if not isinstance(spec, dict):
         raise _fail(p, "top level", "a script is a JSON object")
     unknown = sorted(set(spec) - TOP_KEYS)
@@ -119,22 +206,48 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
     if (
         not isinstance(fps, (int, float))
         or isinstance(fps, bool)
-        or not np.isfinite(fps)
-        or fps <= 0
+        or not _isfinite(fps)
+        or not MIN_FPS <= fps <= MAX_FPS
     ):
-        raise _fail(p, "fps", f"must be a positive number, got {fps!r}")
+        raise _fail(p, "fps", f"must be a number of frames a second in {MIN_FPS:g}..{MAX_FPS:g}, "
+                    f"got {fps!r}")
     seed = spec.get("seed", 0)
-    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-        raise _fail(p, "seed", f"must be a whole number >= 0, got {seed!r}")
+    if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 2**63:
+        raise _fail(p, "seed", f"must be a whole number in 0..2**63-1, got {seed!r}")
     models_spec = spec.get("models")
     if not isinstance(models_spec, dict) or not models_spec:
         raise _fail(p, "models", "must map model names to .npz files")
+    if len(models_spec) > MAX_MODELS:
+        raise _fail(p, "models", f"{len(models_spec)} models; at most {MAX_MODELS} are supported")
+    commands = spec.get("commands")
+    if not isinstance(commands, list) or not commands:
+        raise _fail(p, "commands", "must be a non-empty list")
+    if len(commands) > MAX_COMMANDS:
+        raise _fail(p, "commands", f"{len(commands):,} commands; at most {MAX_COMMANDS:,} are "
+                    "supported")
+    total = 0.0
+    for i, c in enumerate(commands):  # types and lengths, before any model is loaded
+        if isinstance(c, dict) and isinstance(c.get("command"), str):
+            kind = c["command"].upper()
+            if kind in COMMANDS and not _REQUIRED[kind] - set(c):
+                where = f"commands[{i}] ({c['command']})"
+                total += _check_command(p, where, kind, c, float(fps))
+                if total * fps > MAX_FRAMES:
+                    raise _fail(
+                        p, where, f"the commands up to here last {total:.6g} s, "
+                        f"{total * fps:.4g} frames at {fps:g} fps; at most {MAX_FRAMES:,} are "
+                        "supported"
+                    )
     models: dict[str, LatentModel] = {}
     for name, file in models_spec.items():
         if not isinstance(file, str):
             raise _fail(p, f"models.{name}", f"must be a path, got {file!r}")
         mp = model_file(p, file)
-        if not mp.is_file():
+        try:
+            found = mp.is_file()
+        except (OSError, ValueError):  # a name the OS refuses (NUL, too long)
+            found = False
+        if not found:
             raise _fail(p, f"models.{name}", f"model file {mp} not found")
         try:
             models[name] = LatentModel.load(mp)
@@ -143,19 +256,22 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
     start = spec.get("start", {"model": next(iter(models))})
     if not isinstance(start, dict) or "model" not in start or set(start) - {"model", "at"}:
         raise _fail(p, "start", 'must be {"model": NAME} with an optional "at" target')
-    if start["model"] not in models:
+    if not isinstance(start["model"], str) or start["model"] not in models:
         raise _fail(
             p, "start", f"unknown model {start['model']!r}; the script defines {sorted(models)}"
         )
+    particle = spec.get("particle") or {}
+    if not isinstance(particle, dict):
+        raise _fail(p, "particle", f"must be an object of particle parameters, got {particle!r}")
     try:
-        ParticleParams().replace(**(spec.get("particle") or {}))
+        ParticleParams().replace(**particle)
     except (ParameterError, TypeError) as exc:
         raise _fail(p, "particle", str(exc)) from None
     thr = spec.get("bridge_threshold")
-    if thr is not None and (not isinstance(thr, (int, float)) or isinstance(thr, bool) or thr <= 0):
-        raise _fail(
-            p, "bridge_threshold", f"must be a positive number of skeleton units, got {thr!r}"
-        )
+    if thr is not None:
+        from ...io._limits import MAX_MAGNITUDE
+
+        _number(p, "bridge_threshold", thr, 0.0, MAX_MAGNITUDE, "the threshold (skeleton units)")
     if spec.get("plant", "all") not in ("transitions", "all", "off"):
         raise _fail(p, "plant", f"must be transitions, all or off, got {spec['plant']!r}")
     if not isinstance(spec.get("lock_feet", True), bool):
@@ -165,9 +281,6 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
         not isinstance(feet, list) or not feet or not all(isinstance(f, str) for f in feet)
     ):
         raise _fail(p, "feet", f"must be a list of joint names, got {feet!r}")
-    commands = spec.get("commands")
-    if not isinstance(commands, list) or not commands:
-        raise _fail(p, "commands", "must be a non-empty list")
     for i, c in enumerate(commands):
         where = f"commands[{i}]"
         if not isinstance(c, dict) or not isinstance(c.get("command"), str):
@@ -184,6 +297,7 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
         missing = sorted(_REQUIRED[kind] - set(c))
         if missing:
             raise _fail(p, where, f"missing {missing}")
+        _check_command(p, where, kind, c, float(fps))
         if kind == "TRANSITION" and c["to"] not in models:
             raise _fail(p, where, f"unknown model {c['to']!r}; the script defines {sorted(models)}")
     return spec, models
