@@ -73,20 +73,10 @@ _NPZ_FORMAT = "cyclecoord-motion"
 _NPZ_VERSION = 1
 _MOTION_KEYS = ("frames", "channel_joints", "channel_dofs", "fps", "start_frame")
 _SKELETON_KEYS = (
-    "skeleton_name",
-    "skeleton_length_unit",
-    "skeleton_source_format",
-    "joint_names",
-    "joint_parents",
-    "joint_offsets",
-    "joint_dofs",
-    "joint_rotation_orders",
-    "joint_axes",
-    "joint_end_sites",
-    "joint_has_end_site",
-    "limit_joints",
-    "limit_dofs",
-    "limit_ranges",
+    "skeleton_name", "skeleton_length_unit", "skeleton_source_format",
+    "joint_names", "joint_parents", "joint_offsets", "joint_dofs", "joint_rotation_orders",
+    "joint_axes", "joint_end_sites", "joint_has_end_site",
+    "limit_joints", "limit_dofs", "limit_ranges",
 )
 
 

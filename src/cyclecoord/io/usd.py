@@ -585,7 +585,7 @@ def read_usd(path: str | os.PathLike[str]) -> Motion:
     ParseError
         One line naming the file and what was wrong: no skeleton or an empty joints
         array, time codes that are not finite or not ordered, more frames than
-        :data:`~._limits.MAX_FRAMES` or than the memory limit allows, rotations that are
+        ``MAX_FRAMES`` or than the memory limit allows, rotations that are
         not unit quaternions, a ``customData`` entry that is not the JSON this writer
         stores.
     """
