@@ -21,7 +21,7 @@ import numpy as np
 
 from ._limits import MAX_FRAMES, check_memory, format_bytes
 
-__all__ = ["BLOCK", "FrameArray", "count_lines", "text_lines"]
+__all__ = ["BLOCK", "FirstBad", "FrameArray", "count_lines", "text_lines"]
 
 #: Bytes read at a time.
 BLOCK = 1 << 22
@@ -164,3 +164,13 @@ class FrameArray:
             a.resize((self.n, self.n_channels), refcheck=False)
         a.flags.writeable = False
         return a
+
+
+class FirstBad:
+    """While converting frames a chunk at a time: the first value that is no number and
+    the first that is not finite or too big (each a ParseError, raised after the whole
+    file's count is checked, in a whole-file read's order)."""
+
+    number = None  # ParseError | None
+    value = None  # ParseError | None
+    frame = 0  # frames converted so far

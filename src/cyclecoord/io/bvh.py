@@ -25,7 +25,7 @@ from ..motion import Motion
 from ..skeleton import AXIS_INDEX, Joint, Skeleton, rotation_order_from_dofs
 from ..conventions import check_order
 from ._atomic import atomic_write
-from ._stream import CHUNK_FRAMES, FrameArray, text_lines
+from ._stream import CHUNK_FRAMES, FirstBad, FrameArray, text_lines
 from ._limits import (
     MAX_DEPTH,
     MAX_FPS,
@@ -472,7 +472,7 @@ def _frame_values(
     last_line = tline
     extra_line = None  # the line of frame n_frames + 1
     wrong_count: ParseError | None = None
-    bad = _FirstBad()
+    bad = FirstBad()
     chunk: list[tuple[int, list[str]]] = []
 
     def convert() -> None:
@@ -520,17 +520,9 @@ def _frame_values(
     return out.result()
 
 
-class _FirstBad:
-    """The first value that is no number, and the first that is not finite or too big."""
-
-    number: ParseError | None = None
-    value: ParseError | None = None
-    frame = 0  # frames converted so far
-
-
 def _convert(
     chunk: list[tuple[int, list[str]]], rows: np.ndarray, channels: tuple, spath: str,
-    bad: _FirstBad,
+    bad: FirstBad,
 ) -> None:
     """One chunk of frame lines into ``rows``; its problems into ``bad`` (first ones kept)."""
     first = bad.frame

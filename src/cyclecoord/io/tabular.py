@@ -50,7 +50,7 @@ from ..errors import ParameterError, ParseError
 from ..motion import DEFAULT_FPS, Motion
 from ..skeleton import Joint, Skeleton
 from ._atomic import atomic_write
-from ._stream import CHUNK_FRAMES, FrameArray, count_lines, text_lines
+from ._stream import CHUNK_FRAMES, FirstBad, FrameArray, count_lines, text_lines
 from ._limits import (
     MAX_FRAME_NUMBER,
     MAX_FRAMES,
@@ -689,7 +689,7 @@ def _csv_frames(header: list[str], header_line: int, lines, spath: str, path: Pa
     n_rows = 0
     last_line = header_line
     wrong_count: ParseError | None = None
-    bad = _FirstBad()
+    bad = FirstBad()
     chunk: list[tuple[int, list[str]]] = []
 
     def convert() -> None:
@@ -733,16 +733,9 @@ def _csv_frames(header: list[str], header_line: int, lines, spath: str, path: Pa
     return out.result()
 
 
-class _FirstBad:
-    """The first value that is no number, and the first that is not finite or too big."""
-
-    number: ParseError | None = None
-    value: ParseError | None = None
-
-
 def _convert_rows(
     chunk: list[tuple[int, list[str]]], rows: np.ndarray, header: list[str], spath: str,
-    bad: _FirstBad,
+    bad: FirstBad,
 ) -> None:
     """One chunk of value rows into ``rows``; its problems into ``bad`` (first ones kept)."""
     try:
