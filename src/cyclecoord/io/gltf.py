@@ -428,5 +428,5 @@ def write_gltf(
         tj.write_text(gltf.gltf_to_json(), encoding="utf-8")
 
 
-# the reader lives in gltf_read (it imports this module's skeleton <-> JSON helpers)
+# the reader lives in gltf_read (imported last: it imports this module's helpers lazily)
 from .gltf_read import gltf_joint_positions, read_gltf  # noqa: E402

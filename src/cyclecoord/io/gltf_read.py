@@ -1,12 +1,10 @@
-"""glTF 2.0 import (``.glb`` and ``.gltf`` + ``.bin``): the reader of :mod:`.gltf`.
+"""glTF 2.0 import (``.glb`` and ``.gltf`` + ``.bin``): :func:`read_gltf` and
+:func:`gltf_joint_positions` (re-exported by :mod:`cyclecoord.io.gltf`, which writes).
 
-Everything it reads is checked before use (``io._checked``, ``io._limits``): accessor,
-buffer-view and buffer indices and byte ranges, one parent per node and no cycle, key
-times finite and increasing, the frame count and memory before allocating, extras of
-their types, unit quaternions before any decomposition.  Each refusal is one
-:class:`~cyclecoord.errors.ParseError` line naming the file and the entry.  A file
-written by :func:`~cyclecoord.io.gltf.write_gltf` gives back the motion's own skeleton
-and channels from its extras.
+Everything read is checked before it is used: accessor, buffer view and buffer indices and
+byte ranges, one parent per node and no cycle, the depth, key times finite and increasing,
+the resampled frame count and the memory it needs, rotations unit quaternions, and the
+``extras`` the writer keeps; each refusal is one ParseError naming the file and the entry.
 """
 
 from __future__ import annotations
@@ -21,7 +19,6 @@ from ..errors import ParameterError, ParseError
 from ..motion import Motion
 from ..skeleton import Joint, Skeleton
 from ._limits import MAX_JOINTS, MAX_MAGNITUDE, skeleton_problem
-from .gltf import _EXTRAS_KEY, skeleton_from_dict
 
 __all__ = ["gltf_joint_positions", "read_gltf"]
 
@@ -293,6 +290,7 @@ def _extras(gltf) -> dict:
     """Our entry of the document's ``extras``, checked (``{}`` for a glTF from elsewhere)."""
     from ._checked import Invalid, mapping, number, numbers, rotation, sequence, text, whole
     from ._limits import MAX_FPS, MAX_FRAME_NUMBER, MAX_FRAMES, MIN_FPS
+    from .gltf import _EXTRAS_KEY, skeleton_from_dict  # (gltf imports this module)
 
     extras = gltf.extras
     if not isinstance(extras, dict) or extras.get(_EXTRAS_KEY) is None:
@@ -552,11 +550,10 @@ def gltf_joint_positions(path: str | os.PathLike[str]) -> tuple[list[str], np.nd
 def read_gltf(path: str | os.PathLike[str]) -> Motion:
     """Read a glTF 2.0 skeleton animation (``.glb`` or ``.gltf``) as a :class:`Motion`.
 
-    A file written by :func:`~cyclecoord.io.gltf.write_gltf` gives back the original
-    skeleton, channels and units; any other file gives one joint per skeleton node (skin
-    joints when there is a skin) with ``rx ry rz`` rotations (order ``ZYX``) and
-    ``tx ty tz`` on the root and on nodes whose translation is animated, lengths in
-    metres.
+    A file written by :func:`write_gltf` gives back the original skeleton, channels and
+    units; any other file gives one joint per skeleton node (skin joints when there is a
+    skin) with ``rx ry rz`` rotations (order ``ZYX``) and ``tx ty tz`` on the root and on
+    nodes whose translation is animated, lengths in metres.
 
     Raises
     ------

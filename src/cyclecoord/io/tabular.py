@@ -50,6 +50,7 @@ from ..errors import ParameterError, ParseError
 from ..motion import DEFAULT_FPS, Motion
 from ..skeleton import Joint, Skeleton
 from ._atomic import atomic_write
+from ._checked import NpzArrays as _Arrays  # (also the latent model reader's)
 from ._stream import CHUNK_FRAMES, FirstBad, FrameArray, count_lines, text_lines
 from ._limits import (
     MAX_FRAME_NUMBER,
@@ -73,10 +74,20 @@ _NPZ_FORMAT = "cyclecoord-motion"
 _NPZ_VERSION = 1
 _MOTION_KEYS = ("frames", "channel_joints", "channel_dofs", "fps", "start_frame")
 _SKELETON_KEYS = (
-    "skeleton_name", "skeleton_length_unit", "skeleton_source_format",
-    "joint_names", "joint_parents", "joint_offsets", "joint_dofs", "joint_rotation_orders",
-    "joint_axes", "joint_end_sites", "joint_has_end_site",
-    "limit_joints", "limit_dofs", "limit_ranges",
+    "skeleton_name",
+    "skeleton_length_unit",
+    "skeleton_source_format",
+    "joint_names",
+    "joint_parents",
+    "joint_offsets",
+    "joint_dofs",
+    "joint_rotation_orders",
+    "joint_axes",
+    "joint_end_sites",
+    "joint_has_end_site",
+    "limit_joints",
+    "limit_dofs",
+    "limit_ranges",
 )
 
 
@@ -185,99 +196,6 @@ def write_npz(motion: Motion, path: str | os.PathLike[str]) -> None:
         )
     with atomic_write(path, "wb") as fh:
         np.savez_compressed(fh, **arrays)
-
-
-class _Arrays:
-    """The arrays of an NPZ motion, each fetched with its expected kind and shape.
-
-    Every failure is a :class:`ParseError` naming the file and the key.
-    """
-
-    def __init__(self, data: dict[str, np.ndarray], spath: str, prefix: str = "") -> None:
-        self.data = data
-        self.spath = spath
-        self.prefix = prefix  # how the archive names the keys ("motion_" in a latent model)
-
-    def error(self, key: str, message: str) -> ParseError:
-        return ParseError(f"array {self.prefix + key!r}: {message}", self.spath)
-
-    def get(self, key: str) -> np.ndarray:
-        if key not in self.data:
-            raise ParseError(f"missing array {self.prefix + key!r}", self.spath)
-        return self.data[key]
-
-    def _one(self, key: str, kinds: str, what: str):
-        a = self.get(key)
-        if a.size != 1 or a.ndim > 1:
-            raise self.error(key, f"expected a single {what}, got shape {a.shape}")
-        if a.dtype.kind not in kinds:
-            raise self.error(key, f"expected a single {what}, got dtype {a.dtype}")
-        return a.reshape(()).item()
-
-    def real(self, key: str) -> float:
-        value = float(self._one(key, "iuf", "number"))
-        if not np.isfinite(value) or abs(value) > MAX_MAGNITUDE:
-            raise self.error(key, f"expected a finite number, got {value!r}")
-        return value
-
-    def integer(self, key: str, low: int, high: int) -> int:
-        value = self._one(key, "iuf", "whole number")
-        if isinstance(value, float) and not (np.isfinite(value) and value == int(value)):
-            raise self.error(key, f"expected a whole number, got {value!r}")
-        value = int(value)
-        if not low <= value <= high:
-            raise self.error(key, f"expected a whole number in {low:,}..{high:,}, got {value:,}")
-        return value
-
-    def flag(self, key: str) -> bool:
-        return bool(self._one(key, "b", "boolean (True or False)"))
-
-    def text(self, key: str) -> str:
-        return str(self._one(key, "U", "string"))
-
-    def strings(self, key: str, n: int | None = None, per: str = "") -> list[str]:
-        a = self.get(key)
-        if a.ndim != 1 or (a.size and a.dtype.kind != "U"):
-            raise self.error(key, f"expected a 1-D array of strings, got {a.dtype} {a.shape}")
-        if n is not None and a.shape[0] != n:
-            raise self.error(key, f"expected {n} strings{per}, got {a.shape[0]}")
-        return [str(v) for v in a]
-
-    def reals(self, key: str, shape: tuple[int, ...], allow_nan: bool = False,
-              allow_inf: bool = False) -> np.ndarray:
-        a = self.get(key)
-        if a.dtype.kind not in "iuf":
-            raise self.error(key, f"expected real numbers, got dtype {a.dtype}")
-        if a.shape != shape:
-            raise self.error(key, f"expected shape {shape}, got {a.shape}")
-        out = a.astype(float)
-        with np.errstate(invalid="ignore"):
-            bad = np.abs(out) > MAX_MAGNITUDE
-            if not allow_inf:
-                bad |= np.isinf(out)
-            else:
-                bad &= np.isfinite(out)
-        if not allow_nan:
-            bad |= np.isnan(out)
-        if bad.any():
-            at = tuple(int(v) for v in np.argwhere(bad)[0])
-            raise self.error(
-                key, f"entry {at} is {out[at]!r}; expected a finite number of at most "
-                f"{MAX_MAGNITUDE:g} in magnitude"
-            )
-        return out
-
-    def integers(self, key: str, n: int, low: int, high: int) -> list[int]:
-        a = self.get(key)
-        if a.dtype.kind not in "iu" and not (a.dtype.kind == "f" and a.size == 0):
-            raise self.error(key, f"expected whole numbers, got dtype {a.dtype}")
-        if a.shape != (n,):
-            raise self.error(key, f"expected shape ({n},), got {a.shape}")
-        out = [int(v) for v in a]
-        for k, v in enumerate(out):
-            if not low <= v <= high:
-                raise self.error(key, f"entry {k} is {v}; expected {low}..{high}")
-        return out
 
 
 def _npz_skeleton(arr: _Arrays) -> Skeleton:
