@@ -106,20 +106,34 @@ def test_ctrl_c_while_usd_core_loads_in_a_real_process(walk_bvh, tmp_path):
     code = ("import sys, time\nfrom cyclecoord.cli import main\nprint('ready', flush=True)\n"
             "rc = main(sys.argv[1:])\nprint('returned', time.time(), flush=True)\nsys.exit(rc)")
     rng = random.Random(26)
+    argv = [sys.executable, "-c", code, "convert", str(walk_bvh), "-o"]
+    p = subprocess.Popen(argv + [str(tmp_path / "whole.usda")], env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "ready"
+    ready = time.time()
+    stdout, _ = p.communicate(timeout=120)
+    done = [float(ln.split()[1]) for ln in stdout.splitlines() if ln.startswith("returned")]
+    whole = done[0] - ready  # a run without Ctrl-C: ready to returned
+    interrupted = 0
     for i in range(6):
         out = tmp_path / f"o{i}.usda"
-        p = subprocess.Popen([sys.executable, "-c", code, "convert", str(walk_bvh), "-o", str(out)],
+        p = subprocess.Popen(argv + [str(out)],
                              env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         assert p.stdout.readline().strip() == "ready"
-        time.sleep(rng.uniform(0.0, 0.4))
+        time.sleep(rng.uniform(0.0, 0.5 * whole))
         sent = time.time()
         p.send_signal(signal.SIGINT)
         stdout, stderr = p.communicate(timeout=120)
         returned = [float(ln.split()[1]) for ln in stdout.splitlines() if ln.startswith("returned")]
-        if returned and returned[0] < sent:
-            continue  # the run had finished before the signal
+        if returned and returned[0] < sent + 0.2:
+            # it had finished before the signal, or returned while the signal was on its
+            # way (on a loaded machine delivery can lag: rc 0 with "returned" just after
+            # the send is that race, not a swallowed Ctrl-C)
+            continue
+        interrupted += 1
         assert p.returncode in (130, -signal.SIGINT), stderr
         assert "postprocessing module" not in stderr
+    assert interrupted >= 3  # signals within the first half of a run: most runs are hit
 
 
 @pytest.fixture(scope="module")
