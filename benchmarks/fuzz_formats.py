@@ -30,6 +30,7 @@ import base64
 import contextlib
 import hashlib
 import io
+import copy
 import json
 import multiprocessing as mp
 import os
@@ -78,7 +79,9 @@ def hostile_value(rng: random.Random):
         for _ in range(rng.choice([10, 70, 300])):
             value = [value]
         return value
-    return rng.choice(HOSTILE_VALUES)
+    # a copy: a list or dict placed twice in one case (or mutated later) must not be shared,
+    # nor change the constant for the cases after it (it made a script nest inside itself)
+    return copy.deepcopy(rng.choice(HOSTILE_VALUES))
 
 
 # ------------------------------------------------------------------------------ bytes

@@ -100,6 +100,25 @@ def _matrices(trans: np.ndarray, rots: np.ndarray) -> np.ndarray:
     return m
 
 
+def _interrupt_held(func):
+    """``func`` with Ctrl-C held back until it returns, then raised
+    (:func:`cyclecoord._signals.deferred_interrupt`): usd-core runs Python code from C++
+    while it loads its modules and plugins (also lazily, at the first stage a fresh
+    install opens) and can swallow a ``KeyboardInterrupt`` raised there; in a new virtual
+    environment a Ctrl-C during ``convert x.bvh -o x.usda`` was lost (exit 0) after the
+    modules had loaded."""
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        from .._signals import deferred_interrupt
+
+        with deferred_interrupt():
+            return func(*args, **kwargs)
+
+    return wrapper
+
+
+@_interrupt_held
 def write_usd(
     motion: Motion,
     path: str | os.PathLike[str],
@@ -515,6 +534,7 @@ def _refusing(func):
     return wrapper
 
 
+@_interrupt_held
 @_refusing
 def usd_joint_positions(path: str | os.PathLike[str]) -> tuple[list[str], np.ndarray, float]:
     """Joint positions ``(T, J, 3)`` computed by usd-core (``ComputeJointSkelTransforms``).
@@ -572,6 +592,7 @@ def _custom_data(prim, path: Path) -> dict | None:
     return out
 
 
+@_interrupt_held
 @_refusing
 def read_usd(path: str | os.PathLike[str]) -> Motion:
     """Read the first UsdSkel skeleton of a stage and its animation as a :class:`Motion`.
