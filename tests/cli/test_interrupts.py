@@ -94,15 +94,19 @@ def test_ctrl_c_while_usd_core_loads_exits_130(walk_bvh, tmp_path, monkeypatch, 
     assert not out.exists()
 
 
-@pytest.mark.xfail(strict=False, reason=(
-    "issue 26, open: in a freshly made virtual environment (.ci/run) one Ctrl-C of six "
-    "during convert -o x.usda is still lost (exit 0, nothing on stderr) although the USD "
-    "readers and writer hold Ctrl-C; it passes in a venv that has run once. Cause not "
-    "found yet"))
+def _as_at_a_terminal():
+    """Ctrl-C's default action, as in a terminal.  A job started in the background of a
+    non-interactive shell (``.ci/run &``, ``nohup``) inherits SIGINT *ignored*, and
+    Python then installs no handler: every Ctrl-C would be ignored as POSIX asks, which is
+    what made this test fail in CI (exit 0, nothing on stderr), not a swallowed Ctrl-C."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_ctrl_c_while_usd_core_loads_in_a_real_process(walk_bvh, tmp_path):
-    """The issue's run: Ctrl-C at random times in the first half second of a .usda convert
-    (usd-core loading): every run that was still going exits 130, none with usd-core's
-    warning that it caught the interrupt."""
+    """The issue's run: Ctrl-C at random times in the first 60 % of a .usda convert
+    (usd-core loading, the stage written): every run still going exits 130 with the one
+    line "cyclecoord: interrupted", none with usd-core's warning that it caught the
+    interrupt, and none with a traceback."""
     import os
     import random
     import subprocess
@@ -112,33 +116,48 @@ def test_ctrl_c_while_usd_core_loads_in_a_real_process(walk_bvh, tmp_path):
             "rc = main(sys.argv[1:])\nprint('returned', time.time(), flush=True)\nsys.exit(rc)")
     rng = random.Random(26)
     argv = [sys.executable, "-c", code, "convert", str(walk_bvh), "-o"]
-    p = subprocess.Popen(argv + [str(tmp_path / "whole.usda")], env=env,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    assert p.stdout.readline().strip() == "ready"
-    ready = time.time()
-    stdout, _ = p.communicate(timeout=120)
-    done = [float(ln.split()[1]) for ln in stdout.splitlines() if ln.startswith("returned")]
-    whole = done[0] - ready  # a run without Ctrl-C: ready to returned
+
+    def start(out):
+        p = subprocess.Popen(argv + [str(out)], env=env, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, preexec_fn=_as_at_a_terminal)
+        assert p.stdout.readline().strip() == "ready"
+        return p, time.time()
+
+    wholes = []
+    for i in range(2):  # the second run is the measure (the first may warm caches)
+        p, ready = start(tmp_path / f"whole{i}.usda")
+        stdout, _ = p.communicate(timeout=120)
+        done = [float(ln.split()[1]) for ln in stdout.splitlines() if ln.startswith("returned")]
+        wholes.append(done[0] - ready)  # a run without Ctrl-C: ready to returned
+    whole = wholes[-1]
     interrupted = 0
     for i in range(6):
         out = tmp_path / f"o{i}.usda"
-        p = subprocess.Popen(argv + [str(out)],
-                             env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        assert p.stdout.readline().strip() == "ready"
-        time.sleep(rng.uniform(0.0, 0.5 * whole))
+        p, _ = start(out)
+        time.sleep(rng.uniform(0.0, 0.6 * whole))
         sent = time.time()
         p.send_signal(signal.SIGINT)
         stdout, stderr = p.communicate(timeout=120)
         returned = [float(ln.split()[1]) for ln in stdout.splitlines() if ln.startswith("returned")]
-        if returned and returned[0] < sent + 0.2:
-            # it had finished before the signal, or returned while the signal was on its
-            # way (on a loaded machine delivery can lag: rc 0 with "returned" just after
-            # the send is that race, not a swallowed Ctrl-C)
+        if p.returncode == 0:  # only a run that had finished before the signal was sent
+            assert returned and returned[0] < sent + 0.01, ("Ctrl-C lost", sent, returned)
             continue
         interrupted += 1
-        assert p.returncode in (130, -signal.SIGINT), stderr
-        assert "postprocessing module" not in stderr
-    assert interrupted >= 3  # signals within the first half of a run: most runs are hit
+        assert p.returncode == 130, (p.returncode, stderr)
+        assert stderr.strip().splitlines() == ["cyclecoord: interrupted"], stderr
+        assert not out.exists()
+    assert interrupted >= 3, wholes  # signals within the first 60 % of a run: most are hit
+
+
+def test_ctrl_c_while_the_parser_is_built_is_one_line(monkeypatch, capsys):
+    """main builds its parser (importing every command) before anything runs: a Ctrl-C
+    there is the same one line and exit 130, not a traceback from argparse or an import."""
+    def ctrl_c():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sys.modules["cyclecoord.cli.main"], "build_parser", ctrl_c)
+    assert main(["convert", "x.bvh", "-o", "y.npz"]) == 130
+    assert capsys.readouterr().err == "cyclecoord: interrupted\n"
 
 
 @pytest.fixture(scope="module")

@@ -92,8 +92,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one command line; returns the exit code (errors become one line on stderr)."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    try:  # a Ctrl-C while the parser is built (it imports the commands) is one line too
+        parser = build_parser()
+        args = parser.parse_args(argv)
+    except KeyboardInterrupt:
+        print("cyclecoord: interrupted", file=sys.stderr)
+        return 130
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_USAGE
