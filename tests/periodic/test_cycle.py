@@ -423,6 +423,9 @@ def test_heldout_times_interpolate_from_the_neighbours_left_out():
     # frame 0 from frames 2 and 3: 0.04 - 2 (0.09 - 0.04) = -0.06, wrapped; frame 9 from 7, 6
     np.testing.assert_allclose(out[[0, 1, 8, 9]], [0.94, 0.95, 0.58, 0.75], atol=1e-12)
     np.testing.assert_allclose(_heldout_times(theta[:5], identity, exclude=1), theta[:5], atol=1e-15)
+    # six frames are the fewest read from neighbours with exclude=1
+    np.testing.assert_allclose(_heldout_times(theta[:6], identity, exclude=1),
+                               [0.94, 0.95, 0.08, 0.13, 0.10, 0.19], atol=1e-12)
     for n in (2, 3):
         np.testing.assert_allclose(_heldout_times(theta[[0, 4, 9]][:n], identity), theta[[0, 4, 9]][:n], atol=1e-15)
     # four frames are the fewest read from neighbours with exclude=0

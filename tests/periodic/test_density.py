@@ -212,8 +212,12 @@ def test_fit_ignores_the_seed_and_leaves_a_generator_where_it_was():
     a = PeriodicDensity(random_state=0).fit(theta)
     b = PeriodicDensity(random_state=123).fit(theta)
     np.testing.assert_array_equal(a.means_, b.means_)
-    for seed in (9, 0, 2):
+    for seed, word in [(9, None), (0, None), (2, None), (1, 12345), (1, 2**31 - 1)]:
         g1, g2 = np.random.default_rng(seed), np.random.default_rng(seed)
+        if word is not None:  # the next 32-bit word of both; 2^31 - 1 is one that the
+            # bounded draw (Lemire's method) rejects for [0, 2^31 - 1), taking another
+            for g in (g1, g2):
+                g.bit_generator.state = {**g.bit_generator.state, "has_uint32": 1, "uinteger": word}
         PeriodicDensity(random_state=g1).fit(theta)
         g2.integers(0, 2**31 - 1)  # one draw, as when the generator seeded scikit-learn
         # the whole state (a 32-bit draw keeps half of a 64-bit one for the next), so the
@@ -253,3 +257,16 @@ def test_ppf_inverts_the_cdf_in_the_first_and_last_cells_of_its_table():
     q = d.cdf(x)
     np.testing.assert_allclose(d.ppf(q), x, rtol=0, atol=1e-9)
     np.testing.assert_allclose(d.cdf(d.ppf(q)), q, rtol=0, atol=1e-9)
+
+
+def test_em_with_a_k_means_run_left_empty_stays_finite():
+    """Six equal values and one other in three components: a k-means run comes out empty
+    (two means meet); its component keeps a weight of about 0 and the fit is finite, the
+    others the two values' shares."""
+    from cyclecoord.periodic.density import _em_1d
+
+    weights, means, var, converged, _ = _em_1d(np.array([0.0] * 6 + [1.0]), 3, 100, 1e-5)
+    assert np.all(np.isfinite(weights)) and np.all(np.isfinite(means)) and converged
+    np.testing.assert_allclose(weights, [6 / 7, 1 / 7, 0.0], atol=1e-12)
+    np.testing.assert_allclose(means[:2], [0.0, 1.0], atol=1e-12)
+    np.testing.assert_allclose(var, 1e-5, rtol=1e-9)
