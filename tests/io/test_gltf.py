@@ -124,6 +124,19 @@ def test_foreign_gltf_without_extras(tmp_path):
     assert back.skeleton.names == ["root", "arm", "arm_end"]
     fk = m.positions().positions  # root, arm, arm/end
     assert np.abs(back.positions().positions[:, :3] - fk).max() < 1e-5
+    # translations on the root and on nodes with a translation channel only
+    rot, move = ("rx", "ry", "rz"), ("tx", "ty", "tz", "rx", "ry", "rz")
+    assert [j.dofs for j in back.skeleton.joints] == [move, rot, rot]
+    # the root's translation channel moved to the arm: the root (no parent) keeps its
+    # translations, the arm gets them, and both read as the file's own nodes place them
+    for c in gltf.animations[0].channels:
+        if c.target.path == "translation":
+            c.target.node = 1
+    (tmp_path / "moved.gltf").write_text(gltf.gltf_to_json())
+    back = read_gltf(tmp_path / "moved.gltf")
+    assert [j.dofs for j in back.skeleton.joints] == [move, move, rot]
+    _, own, _ = gltf_joint_positions(tmp_path / "moved.gltf")
+    assert np.abs(back.positions().positions[:, :3] - own).max() < 1e-5
 
 
 def test_bad_input_writes_nothing(tmp_path):
@@ -267,3 +280,35 @@ def test_stick_mesh_prisms_are_closed_and_outward():
         p = verts[own]
         volume = np.einsum("ij,ij->i", p[:, 0], np.cross(p[:, 1], p[:, 2])).sum() / 6
         assert volume == pytest.approx(2 * 0.1**2 * length, rel=1e-12)
+
+
+def _accessor(gltf, folder, index, ncomp):
+    acc = gltf.accessors[index]
+    view = gltf.bufferViews[acc.bufferView]
+    data = (folder / gltf.buffers[view.buffer].uri).read_bytes()
+    start = (view.byteOffset or 0) + (acc.byteOffset or 0)
+    return np.frombuffer(data, np.float32, acc.count * ncomp, start).reshape(-1, ncomp)
+
+
+def test_stick_mesh_radius_is_a_hundredth_of_the_bone_length(tmp_path):
+    """Each bone's prism has its corners 1 % of the skeleton's total bone length from the
+    bone (documented in :func:`write_gltf`): the arm's two bones of 1 unit at 0.5 m a unit
+    make a skeleton 1 m long, so corners 1 cm from the bone, the bones 0.5 m long; a
+    radius over a quarter of a bone's length is cut to that quarter."""
+    import pygltflib
+
+    from cyclecoord.io.gltf import _stick_mesh
+
+    out = tmp_path / "arm.gltf"
+    write_gltf(_arm(), out, scale=0.5)
+    gltf = pygltflib.GLTF2.load(str(out))
+    verts = _accessor(gltf, tmp_path, gltf.meshes[0].primitives[0].attributes.POSITION, 3)
+    rings = verts.reshape(-1, 4, 3).astype(float)  # per bone: the ring at p, the ring at q
+    assert rings.shape[0] == 4  # two bones
+    centres = rings.mean(axis=1)
+    np.testing.assert_allclose(np.linalg.norm(rings - centres[:, None], axis=2), 0.01, rtol=1e-5)
+    np.testing.assert_allclose(np.linalg.norm(centres[1::2] - centres[::2], axis=1), 0.5, rtol=1e-6)
+    # a bone of length 2 given a radius of 1: corners at a quarter of its length
+    verts, _, _ = _stick_mesh(np.array([[0.0, 0, 0], [0, 0, 2.0]]), [(0, (0, 1))], 1.0)
+    assert np.linalg.norm(verts[:4] - [0, 0, 0], axis=1) == pytest.approx([0.5] * 4)
+    assert np.linalg.norm(verts[4:] - [0, 0, 2.0], axis=1) == pytest.approx([0.5] * 4)

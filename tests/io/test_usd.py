@@ -52,3 +52,20 @@ def test_bad_input_writes_nothing(walk_69_01, tmp_path):
     bad.write_text("#usda 1.0\n(\n broken")
     with pytest.raises(ParseError, match="bad.usda"):
         cc.load(bad)
+
+
+def test_matrices_are_row_vector_transforms():
+    """USD matrices act on row vectors: ``[p, 1] @ M = [R p + t, 1]``, for one matrix per
+    joint and for a (frames, joints) batch alike."""
+    from scipy.spatial.transform import Rotation
+
+    from cyclecoord.io.usd import _matrices
+
+    rots = Rotation.from_rotvec([[0, 0, np.pi / 2], [0.3, -0.2, 0.5]]).as_matrix()
+    trans = np.array([[1.0, 2.0, 3.0], [-0.5, 0.0, 4.0]])
+    p = np.array([0.7, -1.1, 0.4])
+    for m in (_matrices(trans, rots), _matrices(trans[None], rots[None])[0]):
+        assert m.shape == (2, 4, 4)
+        for k in range(2):
+            np.testing.assert_allclose(np.append(p, 1.0) @ m[k],
+                                       np.append(rots[k] @ p + trans[k], 1.0), atol=1e-12)

@@ -185,10 +185,21 @@ def test_transform_of_new_points_matches_fit():
 def test_invalid_points():
     with pytest.raises(ParameterError):
         CircularCoordinates().fit(np.array([[0.0, np.nan], [1, 2], [3, 4]]))
-    with pytest.raises(ParameterError):
+    with pytest.raises(ParameterError, match="need at least 3 points, got 2"):
         CircularCoordinates().fit(np.zeros((2, 3)))
     with pytest.raises(ParameterError, match="not fitted"):
         CircularCoordinates().transform(np.zeros((5, 3)))
+
+
+def test_three_points_are_enough_for_a_barcode():
+    """Three points are the fewest accepted: their barcode has no H1 bar (a triangle is
+    filled as soon as its edges are there); a fourth point on a unit square makes the one
+    loop, born at the side and dead at the diagonal."""
+    tri = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    assert len(CircularCoordinates().fit_barcode(tri).h1) == 0
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    np.testing.assert_allclose(CircularCoordinates().fit_barcode(square).h1, [[1.0, np.sqrt(2)]],
+                               rtol=1e-6)
 
 
 def _check_by_unique(edges, z, n):

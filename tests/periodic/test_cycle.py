@@ -403,3 +403,31 @@ def test_windowed_kernel_centroids_equal_the_dense_sum(seed):
         got = kernel_centroids(theta, poses, phases, bandwidth=sigma)
         want = _dense_kernel(np.mod(theta, 1.0) % 1.0, poses, phases, sigma)
         np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12 * np.abs(poses).max())
+
+
+def test_heldout_times_interpolate_from_the_neighbours_left_out():
+    """Each frame's time is read from frames ``exclude + 1`` before and after it (their
+    midpoint), the end frames extrapolated linearly from their one-sided neighbours; with
+    fewer than ``2 exclude + 4`` frames the frames' own times are given.  With the cdf the
+    identity and theta_i = i^2 / 100 the answers are exact: frame i's midpoint of
+    frames i -+ 2 is (i^2 + 4) / 100."""
+    from types import SimpleNamespace
+
+    from cyclecoord.periodic.cycle import _heldout_times
+
+    identity = SimpleNamespace(cdf=lambda x: np.asarray(x, dtype=float))
+    i = np.arange(10)
+    theta = i**2 / 100
+    out = _heldout_times(theta, identity, exclude=1)
+    np.testing.assert_allclose(out[2:8], (i[2:8] ** 2 + 4) / 100, atol=1e-12)
+    # frame 0 from frames 2 and 3: 0.04 - 2 (0.09 - 0.04) = -0.06, wrapped; frame 9 from 7, 6
+    np.testing.assert_allclose(out[[0, 1, 8, 9]], [0.94, 0.95, 0.58, 0.75], atol=1e-12)
+    np.testing.assert_allclose(_heldout_times(theta[:5], identity, exclude=1), theta[:5], atol=1e-15)
+    # six frames are the fewest read from neighbours with exclude=1
+    np.testing.assert_allclose(_heldout_times(theta[:6], identity, exclude=1),
+                               [0.94, 0.95, 0.08, 0.13, 0.10, 0.19], atol=1e-12)
+    for n in (2, 3):
+        np.testing.assert_allclose(_heldout_times(theta[[0, 4, 9]][:n], identity), theta[[0, 4, 9]][:n], atol=1e-15)
+    # four frames are the fewest read from neighbours with exclude=0
+    np.testing.assert_allclose(_heldout_times(theta[[0, 1, 3, 6]], identity),
+                               [0.93, 0.045, 0.185, 0.17], atol=1e-12)

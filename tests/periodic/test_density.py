@@ -212,7 +212,61 @@ def test_fit_ignores_the_seed_and_leaves_a_generator_where_it_was():
     a = PeriodicDensity(random_state=0).fit(theta)
     b = PeriodicDensity(random_state=123).fit(theta)
     np.testing.assert_array_equal(a.means_, b.means_)
-    g1, g2 = np.random.default_rng(9), np.random.default_rng(9)
-    PeriodicDensity(random_state=g1).fit(theta)
-    g2.integers(0, 2**31 - 1)  # one draw, as when the generator seeded scikit-learn
-    assert g1.random() == g2.random()
+    for seed, word in [(9, None), (0, None), (2, None), (1, 12345), (1, 2**31 - 1)]:
+        g1, g2 = np.random.default_rng(seed), np.random.default_rng(seed)
+        if word is not None:  # the next 32-bit word of both; 2^31 - 1 is one that the
+            # bounded draw (Lemire's method) rejects for [0, 2^31 - 1), taking another
+            for g in (g1, g2):
+                g.bit_generator.state = {**g.bit_generator.state, "has_uint32": 1, "uinteger": word}
+        PeriodicDensity(random_state=g1).fit(theta)
+        g2.integers(0, 2**31 - 1)  # one draw, as when the generator seeded scikit-learn
+        # the whole state (a 32-bit draw keeps half of a 64-bit one for the next), so the
+        # next draws of every kind are unchanged
+        assert g1.bit_generator.state == g2.bit_generator.state
+        assert g1.integers(0, 2**31 - 1, size=3).tolist() == g2.integers(0, 2**31 - 1, size=3).tolist()
+        assert g1.random() == g2.random()
+
+
+def test_em_on_two_separate_clusters_is_their_sample_moments():
+    """Two clusters far apart (0.5 between, widths 0.02 and 0.04): the k-means start is
+    the two clusters, EM's responsibilities are 0 or 1, so the fit is each cluster's
+    share, mean and (population) variance plus ``reg_covar``; started at that fixed
+    point EM stops at its second step, the first whose log-likelihood change (here 0)
+    is below ``tol``."""
+    from cyclecoord.periodic.density import _em_1d
+
+    a = 0.2 + 0.01 * np.linspace(-1, 1, 30)
+    b = 0.7 + 0.02 * np.linspace(-1, 1, 70) ** 3
+    x = np.random.default_rng(0).permutation(np.concatenate([b, a]))
+    weights, means, var, converged, n_iter = _em_1d(x, 2, 100, 1e-5)
+    np.testing.assert_allclose(weights, [0.3, 0.7], rtol=1e-12)
+    np.testing.assert_allclose(means, [a.mean(), b.mean()], rtol=1e-12)
+    np.testing.assert_allclose(var, [a.var() + 1e-5, b.var() + 1e-5], rtol=1e-9)
+    assert converged and n_iter == 2
+    # stopped by max_iter: not converged, and the iterations run are counted
+    assert _em_1d(x, 2, 1, 1e-5)[3:] == (False, 1)
+
+
+def test_ppf_inverts_the_cdf_in_the_first_and_last_cells_of_its_table():
+    """ppf's table spans [0, 1] in 4096 cells; phases inside the first and the last cell
+    (where the table is pinned to 0 and 1) come back from their cdf to 1e-9 too, on a
+    density of about 1 there."""
+    d = PeriodicDensity().fit((np.arange(400) + 0.5) / 400)
+    x = np.array([0.25, 0.75, 4095.25, 4095.75]) / 4096
+    assert np.all(d.pdf(x) > 0.5)
+    q = d.cdf(x)
+    np.testing.assert_allclose(d.ppf(q), x, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(d.cdf(d.ppf(q)), q, rtol=0, atol=1e-9)
+
+
+def test_em_with_a_k_means_run_left_empty_stays_finite():
+    """Six equal values and one other in three components: a k-means run comes out empty
+    (two means meet); its component keeps a weight of about 0 and the fit is finite, the
+    others the two values' shares."""
+    from cyclecoord.periodic.density import _em_1d
+
+    weights, means, var, converged, _ = _em_1d(np.array([0.0] * 6 + [1.0]), 3, 100, 1e-5)
+    assert np.all(np.isfinite(weights)) and np.all(np.isfinite(means)) and converged
+    np.testing.assert_allclose(weights, [6 / 7, 1 / 7, 0.0], atol=1e-12)
+    np.testing.assert_allclose(means[:2], [0.0, 1.0], atol=1e-12)
+    np.testing.assert_allclose(var, 1e-5, rtol=1e-9)

@@ -309,6 +309,44 @@ def test_autocorrelation_period_refines_a_window_length_guess():
     assert autocorrelation_period(poses, float("nan")) != autocorrelation_period(poses, float("nan"))
 
 
+def test_autocorrelation_period_with_three_lags_to_choose_from():
+    """A guess of 2.5 frames examines lags 2, 3 and 4 (half to one and a half times the
+    guess, at most 0.8 of the frames): on a pattern repeating every 3 frames lag 3
+    correlates perfectly, an interior maximum, so the period is 3; other guesses examine
+    other lags."""
+    poses = np.tile([[0.0, 1.0], [1.0, -1.0], [-1.0, 0.0]], (20, 1))
+    assert autocorrelation_period(poses, 2.5) == 3.0
+    assert autocorrelation_period(poses, 4.0) == 3.0  # lags 2 to 6: the first maximum
+    assert autocorrelation_period(poses, 10.0) == 6.0  # lags 5 to 15: 3 is not among them
+    # a pattern of 7 frames: lags 2 to 6 (guess 4) cannot show it, so the guess stands;
+    # lags 2 to 8 (guess 5) can
+    seven = np.tile([[0, 0], [3, 1], [1, -2], [-2, 2], [2, 3], [-1, -1], [0, -3]], (10, 1))
+    assert autocorrelation_period(seven.astype(float), 4.0) == 4.0
+    assert autocorrelation_period(seven.astype(float), 5.0) == 7.0
+    # no lag beyond 0.8 T: 12 frames of a 9-frame pattern show it, 11 do not
+    nine = np.tile([[0, 0], [3, 1], [1, -2], [-2, 2], [2, 3], [-1, -1], [0, -3], [4, 0], [1, 1]],
+                   (2, 1)).astype(float)
+    assert autocorrelation_period(nine[:12], 6.0) == 9.0
+    assert autocorrelation_period(nine[:11], 6.0) <= 0.8 * 11
+
+
+def test_to_dict_writes_an_infinite_death_as_none():
+    """Reports are JSON: a class alive at the threshold (death inf) is written with death
+    None, a finite death as it is, in segments, classes and windows alike."""
+    from cyclecoord.periodic.detection import DetectedClass, WindowInfo
+
+    for death in (np.inf, 2.5):
+        want = None if death == np.inf else 2.5
+        seg = Segment(start=0, stop=10, motion=0, classes=(1,), birth=1.0, death=death,
+                      scale=1.5, cycles=2.0, period_frames=5.0)
+        cls = DetectedClass(index=1, birth=1.0, death=death, scale=1.5, coordinate=np.zeros(3),
+                            speed=np.zeros(3), consistency=np.zeros(3), mask=np.ones(3, bool))
+        win = WindowInfo(start=0, stop=10, step=1, birth=1.0, death=death, threshold=4.0)
+        for d in (seg.to_dict(), cls.to_dict(), win.to_dict()):
+            assert d["death"] == want and d["birth"] == 1.0
+            json.dumps(d, allow_nan=False)
+
+
 def test_motion_cycles_need_one_and_a_half_cycles(chain):
     """The rule extract applies (min_turns): a motion of one repetition and a part gets no
     cycle; the CLI says which and why."""

@@ -283,6 +283,65 @@ def test_short_clip_is_refused_with_the_reason():
     assert info.value.result is not None
 
 
+@pytest.mark.parametrize("n_frames", [300, 301])
+def test_a_take_of_over_300_moving_frames_is_first_read_on_150_landmarks(monkeypatch, n_frames):
+    """extract's ``landmarks`` documentation: with ``steady`` and ``"auto"``, over 300
+    moving frames are first read on 150 landmarks, then fitted again (as asked); 300 are
+    fitted once."""
+    from cyclecoord.periodic import fitting
+
+    asked = []
+    make = fitting.TakeFit.make_estimator
+
+    def spy(self, first_pass=False):
+        est = make(self, first_pass)
+        asked.append((int(self.moving.sum()), first_pass, est.landmarks))
+        return est
+
+    monkeypatch.setattr(fitting.TakeFit, "make_estimator", spy)
+    cap = cc.datasets.make_periodic_capture(n_frames=n_frames, period=60.0, random_state=0)
+    cc.extract(cap.motion)
+    if n_frames == 300:
+        assert asked == [(300, False, "auto")]
+    else:
+        assert asked == [(301, True, 150), (301, False, "auto")]
+
+
+def test_a_later_class_is_taken_when_the_first_does_not_wind_steadily(monkeypatch):
+    """TakeFit._other_class on stand-in windings and bars: the first class stands when it
+    turns min_turns times or more with a spread of at most MAX_SPREAD (more is not
+    steady), else the first of classes 1-3 with a death/birth ratio of at least
+    CLEAR_RATIO that does both; each bound itself passes."""
+    from types import SimpleNamespace as NS
+
+    from cyclecoord.periodic import fitting
+    from cyclecoord.periodic.barcode import CLEAR_RATIO
+
+    monkeypatch.setattr(fitting, "complete_windings", lambda windings, runs: windings)
+    monkeypatch.setattr(fitting, "select_bar", lambda bc, j, scale, fraction: NS(ratio=bc.ratios[j]))
+
+    def chosen(first, others, ratios=None):
+        ratios = ratios or [9.0] + [CLEAR_RATIO] * len(others)
+        fits = {j: NS(unwrapped=w, notes=[]) for j, w in enumerate(others, 1)}
+        run = NS(p={"min_turns": 1.5, "scale_fraction": 0.5},
+                 coordinate_of=lambda j, rows: fits[j])
+        fit = NS(unwrapped=first, notes=[])
+        out = fitting.TakeFit._other_class(
+            run, fit, NS(with_coordinate_params=lambda class_index: class_index),
+            NS(h1=np.zeros((len(ratios), 2)), ratios=ratios), np.arange(10))
+        return 0 if out is fit else next(j for j, f in fits.items() if f is out)
+
+    spread, good = fitting.MAX_SPREAD, NS(turns=3.0, spread=0.1)
+    assert chosen(NS(turns=1.5, spread=spread), [good]) == 0
+    assert chosen(NS(turns=1.49, spread=0.1), [good]) == 1
+    assert chosen(NS(turns=3.0, spread=spread + 0.01), [good]) == 1
+    assert chosen(NS(turns=1.0, spread=0.1), [NS(turns=1.5, spread=spread)]) == 1
+    assert chosen(NS(turns=1.0, spread=0.1), [NS(turns=1.49, spread=0.1), NS(turns=2.0, spread=spread + 0.01),
+                                              good]) == 3
+    assert chosen(NS(turns=1.0, spread=0.1), [good, good], [9.0, CLEAR_RATIO - 0.01, CLEAR_RATIO]) == 2
+    assert chosen(NS(turns=1.0, spread=0.1), [NS(turns=1.0, spread=0.1)] * 3 + [good]) == 0
+
+
 def test_synthetic_whole_take():
     cap = cc.datasets.make_whole_take(random_state=0)
     res = cc.extract(cap.motion)

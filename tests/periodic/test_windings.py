@@ -176,6 +176,25 @@ def test_typical_amplitude_windows_start_at_every_frame_for_short_cycles():
     np.testing.assert_array_equal(typical_amplitude(cycle, phase[:3], poses[:3], spike=1), cycle)
 
 
+def test_typical_amplitude_never_narrows_nor_widens_a_glitch():
+    """Three channels of a 12-frame cycle against a capture of four repetitions of a
+    plateaued pattern (range 3; a running median of 3 frames keeps it): a channel 1.2x
+    narrower than the capture is widened 1.2x about its mean; one wider than the capture
+    is kept (never narrowed); one flat but for a one-frame glitch has no amplitude after
+    the running median and is kept as it is (a glitch is not amplitude to restore)."""
+    from cyclecoord.periodic.clip import typical_amplitude
+
+    pattern = np.array([0, 0, 0, 1, 2, 3, 3, 3, 2, 1, 0, 0], float)
+    glitch = np.zeros(12)
+    glitch[5] = 1.0
+    cycle = np.column_stack([pattern, 2.0 * pattern, glitch])
+    poses = np.tile(np.column_stack([1.2 * pattern, pattern, 5.0 * pattern]), (4, 1))
+    out = typical_amplitude(cycle, np.zeros(len(poses)), poses, spike=3)
+    mean = pattern.mean()
+    np.testing.assert_allclose(out[:, 0], mean + 1.2 * (pattern - mean))
+    np.testing.assert_allclose(out[:, 1:], cycle[:, 1:], rtol=0, atol=1e-12)
+
+
 def test_register_straightens_a_warped_phase_and_keeps_runs_too_short_to_align():
     """Poses on a circle, one turn per 50 frames; the phase given is warped by up to 0.03
     of a cycle.  Registration brings the long run back to the true phase (to a sample of

@@ -393,7 +393,8 @@ def write_gltf(
         Metres per skeleton length unit; default ``0.0254 / length_unit`` for ASF, else
         measured (:func:`cyclecoord.rig.metres_per_unit`).
     mesh : bool, default True
-        Add a skinned stick mesh (one prism per bone).
+        Add a skinned stick mesh: one square prism per bone, its corners 1 % of the
+        skeleton's total bone length from the bone (at most a quarter of the bone's length).
 
     Raises
     ------

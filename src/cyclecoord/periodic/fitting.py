@@ -240,7 +240,11 @@ class TakeFit:
     def _other_class(self, fit: Fit, est: CircularCoordinates, barcode: Barcode,
                      rows: np.ndarray) -> Fit:
         """The most persistent class of a long take can be a loop of the whole take (a
-        circuit, a drift); a later clear class that winds regularly is the motion's."""
+        circuit, a drift); a later clear class that winds regularly is the motion's.
+
+        The first class stands when it turns at least ``min_turns`` times and its windings
+        spread by no more than :data:`MAX_SPREAD`; otherwise the first of classes 1 to 3
+        whose death/birth ratio is at least ``CLEAR_RATIO`` and that does both is taken."""
         min_turns = self.p["min_turns"]
         wind = complete_windings(fit.unwrapped, row_runs(rows))
         j = 1

@@ -172,6 +172,9 @@ def extract(
     landmarks : "auto", int or None
         Build the filtration on greedy max-min landmarks (``"auto"``: every frame up to
         1,000 frames, 500 landmarks beyond) and extend the coordinate to every frame.
+        With ``steady``, a take of more than 300 moving frames is first read roughly, on
+        150 landmarks with ``"auto"`` (:data:`~cyclecoord.periodic.fitting.FIRST_PASS_LANDMARKS`),
+        to find its steady frames; the coordinate is then fitted again on those.
     memory_limit : float, optional
         Bytes the run's large arrays may take, the per-frame arrays and the filtration
         (whose landmarks are reduced to fit); default 2 GiB for the filtration alone.
