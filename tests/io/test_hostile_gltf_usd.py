@@ -273,3 +273,13 @@ def test_usd_rest_transforms_and_joint_paths_checked(usda):
     a = text.index("uniform token[] joints = [") + len("uniform token[] joints = [")
     usda.write_text(text[:a] + '"a//b", ' + text[a:])
     _refused(usda, "joints[0]", "is not a joint path")
+
+
+@pytest.mark.parametrize("attr", ["bindTransforms", "restTransforms"])
+def test_usd_skeleton_value_of_an_unknown_type(usda, attr):
+    # a digit of `matrix4d[]` changed: usd-core reads the value as an UnregisteredValue
+    # (the attribute's declared type stays the schema's) and len() of it was a TypeError
+    # (fuzzer usd cases 1001913, 1002852)
+    text = usda.read_text()
+    usda.write_text(text.replace(f"matrix4d[] {attr} =", f"matrix0d[] {attr} ="))
+    _refused(usda, f"Skeleton.{attr}: a UnregisteredValue value", "Matrix4dArray")

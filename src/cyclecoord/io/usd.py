@@ -302,6 +302,18 @@ def _check_topology(skel, n_joints: int, Sdf, path: Path) -> None:
     usd-core warns about either and goes on (a hierarchy that is not the file's, identity
     transforms), so a broken skeleton would read as another one."""
     where = skel.GetPrim().GetPath()
+    from pxr import Vt
+
+    expected = {"joints": Vt.TokenArray, "restTransforms": Vt.Matrix4dArray,
+                "bindTransforms": Vt.Matrix4dArray}
+    for name, kind in expected.items():
+        # a value authored with another (or an unknown) type reads as one usd-core cannot
+        # index or measure (the attribute's declared type is the schema's): refused first
+        attr = skel.GetPrim().GetAttribute(name)
+        value = attr.Get() if attr and attr.HasAuthoredValue() else None
+        if value is not None and not isinstance(value, kind):
+            raise ParseError(f"{where}.{name}: a {type(value).__name__} value, not the "
+                             f"{kind.__name__} the skeleton needs", str(path))
     for k, token in enumerate(skel.GetJointsAttr().Get() or []):
         if not Sdf.Path.IsValidPathString(str(token)):
             raise ParseError(f"{where}.joints[{k}]: {str(token)[:80]!r} is not a joint path",
