@@ -15,7 +15,7 @@ import numpy as np
 
 from .errors import ParameterError
 from .motion import Motion
-from .skeleton import AXIS_INDEX, Skeleton, _levels, _Plan, _world
+from .skeleton import AXIS_INDEX, Skeleton, _levels, _plan, _world
 
 __all__ = ["channels_from_local", "global_transforms", "local_transforms"]
 
@@ -28,8 +28,10 @@ def local_transforms(
     if skel is None:
         raise ParameterError("local transforms need a skeleton; this motion has none")
     frames = np.asarray(motion.frames, dtype=float)
-    trans, rots = _Plan(skel, motion.channels).local(frames, exact=True)
-    return np.ascontiguousarray(trans.swapaxes(0, 1)), np.ascontiguousarray(rots.swapaxes(0, 1))
+    trans, rots = _plan(skel, motion.channels).local(frames, exact=True)
+    return np.ascontiguousarray(trans.transpose(2, 1, 0)), np.ascontiguousarray(
+        rots.transpose(3, 2, 0, 1)
+    )
 
 
 def global_transforms(

@@ -23,6 +23,7 @@ in degrees.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 from typing import Protocol, Sequence
 
@@ -297,27 +298,71 @@ class _Plan:
         self.levels = _levels(np.array([j.parent for j in skel.joints], dtype=int))
 
     def local(self, frames: np.ndarray, exact: bool = False) -> tuple[np.ndarray, np.ndarray]:
-        """Local translations ``(J, T, 3)`` and rotations ``(J, T, 3, 3)``, joints first
+        """Local translations ``(3, J, T)`` and rotations ``(3, 3, J, T)``, components first
+        so that every product below is a few operations on rows of ``T`` values
         (``exact``: every rest axis that is not exactly the identity is applied)."""
         T = frames.shape[0]
         ext = np.concatenate([frames, np.zeros((T, 1))], axis=1).T  # (D + 1, T)
-        trans = np.repeat(self.offsets[:, None], T, axis=1)
+        trans = np.repeat(self.offsets.T[:, :, None], T, axis=2)
         for i, a, c in self.trans_cols:
-            trans[i, :, a] = ext[c]
-        rots = np.empty((self.n, T, 3, 3))
-        rots[self.fixed] = np.eye(3)
+            trans[a, i] = ext[c]
+        rots = np.zeros((3, 3, self.n, T))
+        for i in range(3):
+            rots[i, i, self.fixed] = 1.0
         for order, idx, cols in self.groups:
-            r = rotation_matrices(ext[cols].swapaxes(1, 2), order)  # (len(idx), T, 3, 3)
+            ang = np.radians(ext[cols])  # (k, len(order), T)
+            cos, sin = np.cos(ang), np.sin(ang)
+            # axis @ R(channels) @ axis.T: the product starts at the rest axis
             tilt = (self.not_eye if exact else self.tilted)[idx]
+            a = np.where(tilt[:, None, None], self.axes[idx], np.eye(3)).transpose(1, 2, 0)
+            r = np.repeat(a[..., None], T, axis=3)  # (3, 3, k, T)
+            for k, ax in enumerate(order.lower()):
+                j, m = ("xyz".index(ax) + 1) % 3, ("xyz".index(ax) + 2) % 3
+                c, s_ = cos[:, k], sin[:, k]
+                rj = r[:, j].copy()
+                r[:, j] = rj * c + r[:, m] * s_
+                r[:, m] = r[:, m] * c - rj * s_
             if tilt.any():
-                a = self.axes[idx[tilt]][:, None]
-                r[tilt] = a @ r[tilt] @ np.swapaxes(a, -1, -2)
-            rots[idx] = r
+                r = _mm(r, a.swapaxes(0, 1)[..., None])
+            rots[:, :, idx] = r
         return trans, rots
 
     def world(self, trans: np.ndarray, rots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """World positions ``(J, T, 3)`` and rotations ``(J, T, 3, 3)`` from :meth:`local`'s."""
-        return _world(trans, rots, self.levels)
+        """World positions ``(3, J, T)`` and rotations ``(3, 3, J, T)`` from :meth:`local`'s:
+        one batched product per level of the hierarchy."""
+        pos = trans.copy()
+        rot = rots.copy()
+        for idx, par in self.levels:
+            rp = rot[:, :, par]
+            rot[:, :, idx] = _mm(rp, rots[:, :, idx])
+            pos[:, idx] = pos[:, par] + _mv(rp, trans[:, idx])
+        return pos, rot
+
+
+def _mm(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Products of 3x3 matrices stored components first: ``(3, 3, ...)`` each."""
+    return x[:, 0, None] * y[0][None] + x[:, 1, None] * y[1][None] + x[:, 2, None] * y[2][None]
+
+
+def _mv(x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Matrices ``(3, 3, ...)`` times vectors ``(3, ...)``, components first."""
+    return x[:, 0] * v[0] + x[:, 1] * v[1] + x[:, 2] * v[2]
+
+
+#: plans by skeleton and channel list (skeletons and their joints are immutable)
+_PLANS: "weakref.WeakKeyDictionary[Skeleton, dict]" = weakref.WeakKeyDictionary()
+
+
+def _plan(skel: "Skeleton", channels: Sequence[tuple[str, str]]) -> _Plan:
+    """The :class:`_Plan` of ``skel`` for ``channels``, made once."""
+    key = tuple(channels)
+    plans = _PLANS.setdefault(skel, {})
+    plan = plans.get(key)
+    if plan is None:
+        if len(plans) > 16:
+            plans.clear()
+        plan = plans[key] = _Plan(skel, key)
+    return plan
 
 
 def _levels(parents: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -366,19 +411,18 @@ def forward_kinematics(
     if skel is None:
         raise ParameterError("forward kinematics needs a skeleton; this motion has none")
     frames = np.asarray(motion.frames, dtype=float)
-    plan = _Plan(skel, motion.channels)
+    plan = _plan(skel, motion.channels)
     pos, rot = plan.world(*plan.local(frames))
     names = skel.names
     parents = list(skel.parents)
     ends = [i for i, j in enumerate(skel.joints) if j.end_site is not None]
     if ends:
-        sites = np.array([skel.joints[i].end_site for i in ends])
-        extra = pos[ends] + np.einsum("ktab,kb->kta", rot[ends], sites)
-        pos = np.concatenate([pos, extra], axis=0)
+        sites = np.array([skel.joints[i].end_site for i in ends]).T[:, :, None]  # (3, E, 1)
+        pos = np.concatenate([pos, pos[:, ends] + _mv(rot[:, :, ends], sites)], axis=1)
         names += [f"{skel.joints[i].name}/end" for i in ends]
         parents += ends
     return JointPositions(
-        positions=np.ascontiguousarray(pos.transpose(1, 0, 2)),
+        positions=np.ascontiguousarray(pos.transpose(2, 1, 0)),
         names=names,
         parents=np.asarray(parents, dtype=int),
     )
