@@ -17,7 +17,7 @@ from .errors import ParameterError
 from .motion import Motion
 from .skeleton import AXIS_INDEX, Skeleton, _levels, _plan, _world
 
-__all__ = ["channels_from_local", "global_transforms", "local_transforms"]
+__all__ = ["channels_from_local", "global_transforms", "local_transforms", "world_transforms"]
 
 
 def local_transforms(
@@ -31,6 +31,18 @@ def local_transforms(
     trans, rots = _plan(skel, motion.channels).local(frames, exact=True)
     return np.ascontiguousarray(trans.transpose(2, 1, 0)), np.ascontiguousarray(
         rots.transpose(3, 2, 0, 1)
+    )
+
+
+def world_transforms(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+    """World positions ``(T, J, 3)`` and rotations ``(T, J, 3, 3)`` of every joint:
+    :func:`global_transforms` of :func:`local_transforms`, in one pass."""
+    if motion.skeleton is None:
+        raise ParameterError("world transforms need a skeleton; this motion has none")
+    plan = _plan(motion.skeleton, motion.channels)
+    pos, rot = plan.world(*plan.local(np.asarray(motion.frames, dtype=float), exact=True))
+    return np.ascontiguousarray(pos.transpose(2, 1, 0)), np.ascontiguousarray(
+        rot.transpose(3, 2, 0, 1)
     )
 
 

@@ -456,11 +456,10 @@ def _lock_once(
     motion: Motion, contacts: FootContacts, nb: int, cyclic: bool
 ) -> tuple[Motion, float]:
     """One locking pass: the edited motion and the largest horizontal lock error."""
-    from .._kinematics import global_transforms, local_transforms
+    from .._kinematics import world_transforms
 
     skel = motion.skeleton
-    trans, rots = local_transforms(motion)
-    wpos, wrot = global_transforms(trans, rots, skel.parents)
+    wpos, wrot = world_transforms(motion)
     frames = np.array(motion.frames, dtype=float)
     scale = contacts.leg_length
     worst = 0.0
