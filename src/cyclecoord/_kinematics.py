@@ -15,9 +15,9 @@ import numpy as np
 
 from .errors import ParameterError
 from .motion import Motion
-from .skeleton import AXIS_INDEX, Skeleton, rotation_matrices
+from .skeleton import AXIS_INDEX, Skeleton, _levels, _plan, _world
 
-__all__ = ["channels_from_local", "global_transforms", "local_transforms"]
+__all__ = ["channels_from_local", "global_transforms", "local_transforms", "world_transforms"]
 
 
 def local_transforms(
@@ -28,45 +28,34 @@ def local_transforms(
     if skel is None:
         raise ParameterError("local transforms need a skeleton; this motion has none")
     frames = np.asarray(motion.frames, dtype=float)
-    T = frames.shape[0]
-    col = {c: i for i, c in enumerate(motion.channels)}
-    n = len(skel.joints)
-    trans = np.empty((T, n, 3))
-    rots = np.empty((T, n, 3, 3))
-    for i, j in enumerate(skel.joints):
-        t = np.broadcast_to(j.offset, (T, 3)).copy()
-        for d in j.dofs:
-            if d.startswith("t") and (j.name, d) in col:
-                t[:, AXIS_INDEX[d[1]]] = frames[:, col[(j.name, d)]]
-        trans[:, i] = t
-        if j.rotation_order:
-            vals = np.zeros((T, len(j.rotation_order)))
-            for k, ax in enumerate(j.rotation_order.lower()):
-                c = (j.name, "r" + ax)
-                if c in col:
-                    vals[:, k] = frames[:, col[c]]
-            local = rotation_matrices(vals, j.rotation_order)
-            rots[:, i] = j.axis @ local @ j.axis.T
-        else:
-            rots[:, i] = np.eye(3)
-    return trans, rots
+    trans, rots = _plan(skel, motion.channels).local(frames, exact=True)
+    return np.ascontiguousarray(trans.transpose(2, 1, 0)), np.ascontiguousarray(
+        rots.transpose(3, 2, 0, 1)
+    )
+
+
+def world_transforms(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+    """World positions ``(T, J, 3)`` and rotations ``(T, J, 3, 3)`` of every joint:
+    :func:`global_transforms` of :func:`local_transforms`, in one pass."""
+    if motion.skeleton is None:
+        raise ParameterError("world transforms need a skeleton; this motion has none")
+    plan = _plan(motion.skeleton, motion.channels)
+    pos, rot = plan.world(*plan.local(np.asarray(motion.frames, dtype=float), exact=True))
+    return np.ascontiguousarray(pos.transpose(2, 1, 0)), np.ascontiguousarray(
+        rot.transpose(3, 2, 0, 1)
+    )
 
 
 def global_transforms(
     translations: np.ndarray, rotations: np.ndarray, parents: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """World positions ``(T, J, 3)`` and rotations ``(T, J, 3, 3)`` from local transforms."""
-    T, n = translations.shape[:2]
-    pos = np.empty((T, n, 3))
-    rot = np.empty((T, n, 3, 3))
-    for i, p in enumerate(parents):
-        if p < 0:
-            pos[:, i] = translations[:, i]
-            rot[:, i] = rotations[:, i]
-        else:
-            rot[:, i] = rot[:, p] @ rotations[:, i]
-            pos[:, i] = pos[:, p] + np.einsum("tab,tb->ta", rot[:, p], translations[:, i])
-    return pos, rot
+    pos, rot = _world(
+        np.ascontiguousarray(np.swapaxes(translations, 0, 1), dtype=float),
+        np.ascontiguousarray(np.swapaxes(rotations, 0, 1), dtype=float),
+        _levels(parents),
+    )
+    return np.ascontiguousarray(pos.swapaxes(0, 1)), np.ascontiguousarray(rot.swapaxes(0, 1))
 
 
 def _euler(matrices: np.ndarray, order: str) -> np.ndarray:

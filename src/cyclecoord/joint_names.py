@@ -58,7 +58,9 @@ nothing, is :func:`cyclecoord.quality.legs.find_legs`.
 
 from __future__ import annotations
 
+import functools
 import re
+import weakref
 from dataclasses import dataclass
 from types import MappingProxyType
 
@@ -436,8 +438,10 @@ def _match(words: list[str]) -> tuple[str, int, int] | None:
     return None
 
 
+@functools.lru_cache(maxsize=4096)
 def _classify(name: str) -> tuple[JointRole, str] | None:
-    """:func:`classify_joint` and the body word that gave the role."""
+    """:func:`classify_joint` and the body word that gave the role (a name's reading
+    depends on the name alone, so each is read once)."""
     base = re.split(r"[:|]", name)[-1]
     if _VERTEBRA.fullmatch(base):  # Xsens MVN's L5, L3, T12, T8
         return JointRole("spine"), "vertebra"
@@ -513,6 +517,19 @@ def classify_skeleton(skeleton: Skeleton) -> dict[str, JointRole]:
         (Mixamo's ``LeftShoulder``, Bandai's ``Shoulder_L``) and a hip joint with another
         below it as a pelvis bone.
     """
+    key = tuple((j.name, j.parent) for j in skeleton.joints)
+    cached = _SKELETON_ROLES.get(skeleton)
+    if cached is None or cached[0] != key:
+        cached = (key, _classify_skeleton(skeleton))
+        _SKELETON_ROLES[skeleton] = cached
+    return dict(cached[1])
+
+
+#: classify_skeleton's answers by skeleton (with the names and parents they read)
+_SKELETON_ROLES: "weakref.WeakKeyDictionary[Skeleton, tuple]" = weakref.WeakKeyDictionary()
+
+
+def _classify_skeleton(skeleton: Skeleton) -> dict[str, JointRole]:
     found = {j.name: _classify(j.name) for j in skeleton.joints}
     roles = {n: f[0] for n, f in found.items() if f is not None}
     words = {n: f[1] for n, f in found.items() if f is not None}

@@ -23,6 +23,7 @@ in degrees.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 from typing import Protocol, Sequence
 
@@ -221,19 +222,14 @@ class JointPositions:
         return self.positions[:, self.names.index(name)]
 
 
-def _axis_rotation(axis: str, angle_deg: np.ndarray) -> np.ndarray:
-    """Elementary rotations ``(T, 3, 3)`` about x, y or z by ``angle_deg`` (T,)."""
-    a = np.radians(angle_deg)
-    c, s = np.cos(a), np.sin(a)
-    m = np.zeros(a.shape + (3, 3))
-    i = "xyz".index(axis.lower())
-    j, k = (i + 1) % 3, (i + 2) % 3
-    m[..., i, i] = 1.0
-    m[..., j, j] = c
-    m[..., k, k] = c
-    m[..., j, k] = -s
-    m[..., k, j] = s
-    return m
+def _mix(m: np.ndarray, axis: int, c: np.ndarray, s: np.ndarray) -> None:
+    """``m @ R_axis`` in place for stacked matrices ``m`` (..., 3, 3): an elementary
+    rotation mixes two columns only (``R[j, j] = R[k, k] = c``, ``R[k, j] = -R[j, k] = s``)."""
+    j, k = (axis + 1) % 3, (axis + 2) % 3
+    c, s = c[..., None], s[..., None]
+    mj, mk = m[..., j].copy(), m[..., k]
+    m[..., j] = mj * c + mk * s
+    m[..., k] = mk * c - mj * s
 
 
 def rotation_matrices(values: np.ndarray, order: str) -> np.ndarray:
@@ -242,24 +238,155 @@ def rotation_matrices(values: np.ndarray, order: str) -> np.ndarray:
     The product of the elementary rotations in listed order (SciPy's upper-case,
     intrinsic convention), e.g. ``"ZXY"`` gives ``Rz @ Rx @ Ry``; equal to
     ``Rotation.from_euler(order, values, degrees=True).as_matrix()`` to 1e-12 (tested),
-    composed directly in NumPy (several times faster than going through quaternions).
+    composed directly in NumPy (several times faster than going through quaternions):
+    each elementary rotation mixes two columns of the product so far.
 
     Parameters
     ----------
-    values : array_like, shape (T, len(order))
+    values : array_like, shape (..., len(order))
         Angles in degrees, one column per letter of ``order``.
     order : str
         Axis letters, e.g. ``"ZXY"`` (case is ignored).
 
     Returns
     -------
-    ndarray, shape (T, 3, 3)
+    ndarray, shape (..., 3, 3)
     """
-    values = np.asarray(values, dtype=float)
-    out = _axis_rotation(order[0], values[:, 0])
-    for k in range(1, len(order)):
-        out = out @ _axis_rotation(order[k], values[:, k])
+    values = np.radians(np.asarray(values, dtype=float))
+    c, s = np.cos(values), np.sin(values)
+    out = np.zeros(values.shape[:-1] + (3, 3))
+    for i in range(3):
+        out[..., i, i] = 1.0
+    for k, ax in enumerate(order.lower()):
+        _mix(out, "xyz".index(ax), c[..., k], s[..., k])
     return out
+
+
+class _Plan:
+    """What forward kinematics reads of a skeleton for one channel list: the joints grouped
+    by rotation order (with their angle columns), the translation columns, the rest axes
+    and the joints by depth (so each level of the hierarchy is one batched product)."""
+
+    def __init__(self, skel: "Skeleton", channels: Sequence[tuple[str, str]]):
+        col = {c: i for i, c in enumerate(channels)}
+        zero = len(col)  # a column of zeros appended to the frames: dofs the motion lacks
+        n = len(skel.joints)
+        self.n = n
+        self.offsets = np.array([j.offset for j in skel.joints])
+        self.trans_cols: list[tuple[int, int, int]] = []  # (joint, axis, column)
+        groups: dict[str, tuple[list[int], list[list[int]]]] = {}
+        for i, j in enumerate(skel.joints):
+            for d in j.dofs:
+                if d.startswith("t") and (j.name, d) in col:
+                    self.trans_cols.append((i, AXIS_INDEX[d[1]], col[(j.name, d)]))
+            if j.rotation_order:
+                g = groups.setdefault(j.rotation_order, ([], []))
+                g[0].append(i)
+                g[1].append([col.get((j.name, "r" + a), zero) for a in j.rotation_order.lower()])
+        self.groups = [
+            (order, np.array(idx), np.array(cols)) for order, (idx, cols) in groups.items()
+        ]
+        self.fixed = np.array(
+            [i for i, j in enumerate(skel.joints) if not j.rotation_order], dtype=int
+        )
+        axes = np.array([j.axis for j in skel.joints])
+        self.axes = axes
+        # forward kinematics skips the rest axes np.allclose calls the identity; the local
+        # transforms (for exporters) skip exact identities only
+        self.tilted = ~np.all(np.abs(axes - np.eye(3)) <= 1e-8 + 1e-5 * np.eye(3), axis=(1, 2))
+        self.not_eye = ~np.all(axes == np.eye(3), axis=(1, 2))
+        self.levels = _levels(np.array([j.parent for j in skel.joints], dtype=int))
+
+    def local(self, frames: np.ndarray, exact: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Local translations ``(3, J, T)`` and rotations ``(3, 3, J, T)``, components first
+        so that every product below is a few operations on rows of ``T`` values
+        (``exact``: every rest axis that is not exactly the identity is applied)."""
+        T = frames.shape[0]
+        ext = np.concatenate([frames, np.zeros((T, 1))], axis=1).T  # (D + 1, T)
+        trans = np.repeat(self.offsets.T[:, :, None], T, axis=2)
+        for i, a, c in self.trans_cols:
+            trans[a, i] = ext[c]
+        rots = np.zeros((3, 3, self.n, T))
+        for i in range(3):
+            rots[i, i, self.fixed] = 1.0
+        for order, idx, cols in self.groups:
+            ang = np.radians(ext[cols])  # (k, len(order), T)
+            cos, sin = np.cos(ang), np.sin(ang)
+            # axis @ R(channels) @ axis.T: the product starts at the rest axis
+            tilt = (self.not_eye if exact else self.tilted)[idx]
+            a = np.where(tilt[:, None, None], self.axes[idx], np.eye(3)).transpose(1, 2, 0)
+            r = np.repeat(a[..., None], T, axis=3)  # (3, 3, k, T)
+            for k, ax in enumerate(order.lower()):
+                j, m = ("xyz".index(ax) + 1) % 3, ("xyz".index(ax) + 2) % 3
+                c, s_ = cos[:, k], sin[:, k]
+                rj = r[:, j].copy()
+                r[:, j] = rj * c + r[:, m] * s_
+                r[:, m] = r[:, m] * c - rj * s_
+            if tilt.any():
+                r = _mm(r, a.swapaxes(0, 1)[..., None])
+            rots[:, :, idx] = r
+        return trans, rots
+
+    def world(self, trans: np.ndarray, rots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World positions ``(3, J, T)`` and rotations ``(3, 3, J, T)`` from :meth:`local`'s:
+        one batched product per level of the hierarchy."""
+        pos = trans.copy()
+        rot = rots.copy()
+        for idx, par in self.levels:
+            rp = rot[:, :, par]
+            rot[:, :, idx] = _mm(rp, rots[:, :, idx])
+            pos[:, idx] = pos[:, par] + _mv(rp, trans[:, idx])
+        return pos, rot
+
+
+def _mm(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Products of 3x3 matrices stored components first: ``(3, 3, ...)`` each."""
+    return x[:, 0, None] * y[0][None] + x[:, 1, None] * y[1][None] + x[:, 2, None] * y[2][None]
+
+
+def _mv(x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Matrices ``(3, 3, ...)`` times vectors ``(3, ...)``, components first."""
+    return x[:, 0] * v[0] + x[:, 1] * v[1] + x[:, 2] * v[2]
+
+
+#: plans by skeleton and channel list (skeletons and their joints are immutable)
+_PLANS: "weakref.WeakKeyDictionary[Skeleton, dict]" = weakref.WeakKeyDictionary()
+
+
+def _plan(skel: "Skeleton", channels: Sequence[tuple[str, str]]) -> _Plan:
+    """The :class:`_Plan` of ``skel`` for ``channels``, made once."""
+    key = tuple(channels)
+    plans = _PLANS.setdefault(skel, {})
+    plan = plans.get(key)
+    if plan is None:
+        if len(plans) > 16:
+            plans.clear()
+        plan = plans[key] = _Plan(skel, key)
+    return plan
+
+
+def _levels(parents: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(joints, their parents) at each depth below the roots."""
+    parents = np.asarray(parents, dtype=int)
+    depth = np.zeros(parents.size, dtype=int)
+    for i in range(parents.size):
+        j = parents[i]
+        while j >= 0 and depth[i] <= parents.size:
+            depth[i] += 1
+            j = parents[j]
+    return [(np.flatnonzero(depth == d), parents[depth == d]) for d in range(1, depth.max() + 1)]
+
+
+def _world(trans: np.ndarray, rots: np.ndarray, levels) -> tuple[np.ndarray, np.ndarray]:
+    """World positions and rotations from local ones, joints first (``(J, T, ...)``): one
+    batched product per level of the hierarchy."""
+    pos = trans.copy()
+    rot = rots.copy()
+    for idx, par in levels:
+        rp = rot[par]
+        rot[idx] = rp @ rots[idx]
+        pos[idx] = pos[par] + np.einsum("ktab,ktb->kta", rp, trans[idx])
+    return pos, rot
 
 
 def forward_kinematics(
@@ -284,49 +411,51 @@ def forward_kinematics(
     if skel is None:
         raise ParameterError("forward kinematics needs a skeleton; this motion has none")
     frames = np.asarray(motion.frames, dtype=float)
-    T = frames.shape[0]
-    col = {c: i for i, c in enumerate(motion.channels)}
-    n = len(skel.joints)
-    rot = np.empty((n, T, 3, 3))
-    pos = np.empty((n, T, 3))
-    for i, j in enumerate(skel.joints):
-        # translation: offset with translation channels substituted
-        t = np.broadcast_to(j.offset, (T, 3)).copy()
-        for d in j.dofs:
-            if d.startswith("t") and (j.name, d) in col:
-                t[:, AXIS_INDEX[d[1]]] = frames[:, col[(j.name, d)]]
-        if j.rotation_order:
-            vals = np.zeros((T, len(j.rotation_order)))
-            for k, ax in enumerate(j.rotation_order.lower()):
-                c = (j.name, "r" + ax)
-                if c in col:
-                    vals[:, k] = frames[:, col[c]]
-            local = rotation_matrices(vals, j.rotation_order)
-            if not np.allclose(j.axis, np.eye(3)):
-                local = j.axis @ local @ j.axis.T
-        else:
-            local = np.broadcast_to(np.eye(3), (T, 3, 3))
-        if j.parent < 0:
-            rot[i] = local
-            pos[i] = t
-        else:
-            rp = rot[j.parent]
-            rot[i] = rp @ local
-            pos[i] = pos[j.parent] + np.einsum("tab,tb->ta", rp, t)
+    plan = _plan(skel, motion.channels)
+    known = _recall(plan, frames)
+    if known is not None:
+        return known
+    pos, rot = plan.world(*plan.local(frames))
     names = skel.names
     parents = list(skel.parents)
-    extra = []
-    for i, j in enumerate(skel.joints):
-        if j.end_site is not None:
-            extra.append(pos[i] + np.einsum("tab,b->ta", rot[i], j.end_site))
-            names.append(f"{j.name}/end")
-            parents.append(i)
-    allpos = np.concatenate([pos, np.stack(extra)], axis=0) if extra else pos
-    return JointPositions(
-        positions=np.ascontiguousarray(allpos.transpose(1, 0, 2)),
+    ends = [i for i, j in enumerate(skel.joints) if j.end_site is not None]
+    if ends:
+        sites = np.array([skel.joints[i].end_site for i in ends]).T[:, :, None]  # (3, E, 1)
+        pos = np.concatenate([pos, pos[:, ends] + _mv(rot[:, :, ends], sites)], axis=1)
+        names += [f"{skel.joints[i].name}/end" for i in ends]
+        parents += ends
+    out = JointPositions(
+        positions=np.ascontiguousarray(pos.transpose(2, 1, 0)),
         names=names,
         parents=np.asarray(parents, dtype=int),
     )
+    _remember(plan, frames, out)
+    return out
+
+
+#: Recent forward kinematics: ``(plan, frames, positions)``, newest last.  Generating a
+#: motion measures the same frames many times over (contacts, skating, accelerations,
+#: the quality measure, the plausibility checks); a hit is checked value by value.
+_RECENT: list[tuple[_Plan, np.ndarray, JointPositions]] = []
+_RECENT_SIZE = 8
+_RECENT_MAX_VALUES = 2_000_000  # frames larger than this are not kept
+
+
+def _recall(plan: _Plan, frames: np.ndarray) -> JointPositions | None:
+    for i, (p, f, out) in enumerate(_RECENT):
+        if p is plan and f.shape == frames.shape and np.array_equal(f, frames):
+            _RECENT.append(_RECENT.pop(i))
+            return JointPositions(out.positions.copy(), list(out.names), out.parents.copy())
+    return None
+
+
+def _remember(plan: _Plan, frames: np.ndarray, out: JointPositions) -> None:
+    if frames.size > _RECENT_MAX_VALUES:
+        return
+    _RECENT.append(
+        (plan, frames.copy(), JointPositions(out.positions.copy(), list(out.names), out.parents))
+    )
+    del _RECENT[:-_RECENT_SIZE]
 
 
 def rotation_order_from_dofs(dofs: Sequence[str], reverse: bool) -> str:

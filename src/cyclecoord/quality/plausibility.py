@@ -214,13 +214,15 @@ def segment_distances(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.nda
     return np.sqrt(np.einsum("...i,...i->...", diff, diff))
 
 
-def _pair_distances(motion: Motion, bn: Bones) -> np.ndarray:
-    """Distances ``(T, Q)`` of every checked bone pair in every frame."""
+def _pair_distances(motion: Motion, bn: Bones, which: np.ndarray | None = None) -> np.ndarray:
+    """Distances ``(T, Q)`` of every checked bone pair (or of pairs ``which``) in every
+    frame."""
     pos = motion.positions().positions  # (T, P, 3)
     T = pos.shape[0]
-    Q = bn.pairs.shape[0]
+    pairs = bn.pairs if which is None else bn.pairs[which]
+    Q = pairs.shape[0]
     out = np.empty((T, Q))
-    a, b = bn.pairs[:, 0], bn.pairs[:, 1]
+    a, b = pairs[:, 0], pairs[:, 1]
     sa, ea, sb, eb = bn.start[a], bn.end[a], bn.start[b], bn.end[b]
     step = max(1, _CHUNK // max(Q, 1))
     for lo in range(0, T, step):
@@ -590,14 +592,23 @@ def check_plausibility(
     size = motion.skeleton.total_length()  # type: ignore[union-attr]
     names = inter.bones.pair_names()
     ref_min: dict[tuple[str, str], float] = {}
-    for r in references:
+    # the references' closest approach matters for the pairs the motion brings close only
+    wanted = {names[q] for q in np.flatnonzero(inter.flagged.any(axis=0))}
+    wanted |= {(k[1], k[0]) for k in wanted}
+    for r in references if wanted else ():
         if r.skeleton is None:
             continue
         for view in _reference_views(r, motion):
             rb = bones(view)
+            rnames = rb.pair_names()
+            which = np.array([k in wanted for k in rnames], dtype=bool)
+            if not which.any():
+                continue
             rsize = view.skeleton.total_length()  # type: ignore[union-attr]
-            rd = _pair_distances(view, rb).min(axis=0) * (size / rsize if rsize > 0 else 1.0)
-            for key, d in zip(rb.pair_names(), rd):
+            rd = _pair_distances(view, rb, which).min(axis=0) * (
+                size / rsize if rsize > 0 else 1.0
+            )
+            for key, d in zip([k for k, w in zip(rnames, which) if w], rd):
                 ref_min[key] = min(ref_min.get(key, np.inf), float(d))
     contacts = []
     new_mask = np.zeros(inter.flagged.shape[0], dtype=bool)

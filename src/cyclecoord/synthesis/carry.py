@@ -197,7 +197,7 @@ def lock_where_clean(
     """
     from ..quality.contacts import contact_runs, foot_contacts
     from ..quality.legs import find_feet
-    from .footlock import lock_feet
+    from .footlock import pin_feet
 
     try:
         feet = find_feet(motion.skeleton, motion) if feet is None else tuple(feet)
@@ -218,10 +218,10 @@ def lock_where_clean(
     for _ in range(3):
         if not planted.any():
             break
-        trial = lock_feet(motion, replace(contacts, planted=planted), blend=blend, passes=1)
-        after = _accel(trial.motion)
+        trial = pin_feet(motion, replace(contacts, planted=planted), blend=blend)
+        after = _accel(trial)
         bad = (after > limit) & (after > before * 1.05)
-        bad |= _outside(trial.motion.frames, bounds) & ~outside_before
+        bad |= _outside(trial.frames, bounds) & ~outside_before
         bad = np.flatnonzero(bad)
         if not bad.size:
             result = trial
@@ -252,7 +252,7 @@ def lock_where_clean(
     line = f"foot locking: {n_locked} contacts pinned"
     if spans:
         line += f"; not at frames {where} (pinning there made a pop or left the training range)"
-    return LockOutcome(result.motion, n_locked, spans, line)
+    return LockOutcome(result, n_locked, spans, line)
 
 
 #: Degrees a pinned leg's channels may go beyond the training range (as the plausibility

@@ -39,9 +39,9 @@ from ..quality.contacts import (
     foot_contacts,
     foot_skating,
 )
-from ..skeleton import Skeleton, rotation_matrices
+from ..skeleton import Skeleton, _mix
 
-__all__ = ["FootLockResult", "lock_feet"]
+__all__ = ["FootLockResult", "lock_feet", "pin_feet"]
 
 #: Weight of the change of the leg's angles (per radian) relative to target errors (per leg
 #: length): small enough that locks hold to about 1e-3 leg lengths even where the leg is
@@ -312,7 +312,9 @@ def _chain(skel: Skeleton, ankle: int, deepest: int) -> list[int]:
 
 
 class _LegIK:
-    """Forward kinematics of one leg chain as a function of its rotation channels."""
+    """Forward kinematics of one leg chain as a function of its rotation channels, with
+    the exact Jacobian of the foot points (each angle turns the points below its joint
+    about the elementary rotation's axis in the world)."""
 
     def __init__(self, motion: Motion, chain: list[int], points: list[int], world_rot, world_pos):
         skel = motion.skeleton
@@ -321,14 +323,35 @@ class _LegIK:
         self.points = points
         col = {c: i for i, c in enumerate(motion.channels)}
         self.vars: list[tuple[int, int, int]] = []  # (chain position, order position, column)
+        #: per chain joint: its offset, rest axis (None: identity) and (axis index, variable)
+        #: for each rotation channel the motion has (a missing one is 0: no rotation)
+        self.steps: list[tuple[np.ndarray, np.ndarray | None, list[tuple[int, int]]]] = []
         for ci, j in enumerate(chain):
             joint = skel.joints[j]
+            turns = []
             for k, ax in enumerate(joint.rotation_order.lower()):
                 c = col.get((joint.name, "r" + ax))
                 if c is not None:
+                    turns.append(("xyz".index(ax), len(self.vars)))
                     self.vars.append((ci, k, c))
+            rest = None if np.array_equal(joint.axis, np.eye(3)) else joint.axis
+            self.steps.append((joint.offset, rest, turns))
         if not self.vars:
             raise ParameterError("the leg chain has no rotation channels to solve")
+        #: each point: (chain position it hangs from, offset below that joint or None for
+        #: the joint itself) and how many of the chain's joints turn it
+        self.where: list[tuple[int, np.ndarray | None]] = []
+        reach = []
+        for p in points:
+            if p in chain:
+                self.where.append((chain.index(p), None))
+                reach.append(chain.index(p))
+            else:  # a point one bone below the chain (the toe below the foot)
+                ci = chain.index(skel.joints[p].parent)
+                self.where.append((ci, skel.joints[p].offset))
+                reach.append(ci + 1)
+        #: (P, V): variable v moves point p
+        self.moves = np.array([[ci < r for ci, _, _ in self.vars] for r in reach])
         parent = skel.joints[chain[0]].parent
         self.base_rot = world_rot[:, parent]
         self.base_pos = world_pos[:, parent]
@@ -339,83 +362,93 @@ class _LegIK:
 
     def positions(self, q: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """Positions ``(n, P, 3)`` of the foot points for variables ``q`` (n, V) on ``rows``."""
-        skel = self.skel
-        rot = self.base_rot[rows]
-        pos = self.base_pos[rows]
-        out = {}
-        for ci, j in enumerate(self.chain + [None]):
-            if j is None:
-                break
-            joint = skel.joints[j]
-            pos = pos + np.einsum("tab,b->ta", rot, joint.offset)
-            vals = np.zeros((len(rows), len(joint.rotation_order)))
-            for v, (cj, k, c) in enumerate(self.vars):
-                if cj == ci:
-                    vals[:, k] = q[:, v]
-            if joint.rotation_order:
-                local = joint.axis @ rotation_matrices(vals, joint.rotation_order) @ joint.axis.T
-                rot = rot @ local
-            out[j] = (pos, rot)
-        res = []
-        for p in self.points:
-            if p in out:
-                res.append(out[p][0])
-            else:  # a point one bone below the chain (the toe below the foot)
-                pj = skel.joints[p]
-                ppos, prot = out[pj.parent]
-                res.append(ppos + np.einsum("tab,b->ta", prot, pj.offset))
-        return np.stack(res, axis=1)
+        return self.kinematics(q, self.base_rot[rows], self.base_pos[rows])[0]
+
+    def kinematics(self, q: np.ndarray, rot: np.ndarray, pos: np.ndarray, jacobian: bool = False):
+        """Positions ``(n, P, 3)`` of the foot points for variables ``q`` (n, V) below the
+        chain's parent at ``rot`` (n, 3, 3) and ``pos`` (n, 3); with ``jacobian`` also
+        their derivatives ``(n, P, 3, V)`` per degree."""
+        n = q.shape[0]
+        rad = np.radians(q)
+        cos, sin = np.cos(rad), np.sin(rad)
+        pivots, axes, at = [], [], []
+        for offset, rest, turns in self.steps:
+            pos = pos + rot @ offset
+            if turns:  # (no channel: no rotation)
+                m = rot.copy() if rest is None else rot @ rest
+                for axis, v in turns:
+                    if jacobian:  # the elementary rotation's axis in the world
+                        axes.append(m[:, :, axis].copy())
+                        pivots.append(pos)
+                    _mix(m, axis, cos[:, v], sin[:, v])
+                rot = m if rest is None else m @ rest.T
+            at.append((pos, rot))
+        out = np.empty((n, len(self.points), 3))
+        for i, (ci, offset) in enumerate(self.where):
+            jpos, jrot = at[ci]
+            out[:, i] = jpos if offset is None else jpos + jrot @ offset
+        if not jacobian:
+            return out, None
+        J = np.zeros((n, len(self.points), 3, len(self.vars)))
+        deg = np.pi / 180.0
+        for v in range(len(self.vars)):
+            w = axes[v] * deg
+            for i in np.flatnonzero(self.moves[:, v]):
+                d = out[:, i] - pivots[v]  # the axis times the lever arm
+                J[:, i, 0, v] = w[:, 1] * d[:, 2] - w[:, 2] * d[:, 1]
+                J[:, i, 1, v] = w[:, 2] * d[:, 0] - w[:, 0] * d[:, 2]
+                J[:, i, 2, v] = w[:, 0] * d[:, 1] - w[:, 1] * d[:, 0]
+        return out, J
 
 
-def _solve(ik: _LegIK, rows, targets, weights, scale, iterations=_ITERATIONS):
+def _solve(ik, rows, targets, weights, scale, iterations=_ITERATIONS):
     """Levenberg-Marquardt on all ``rows`` at once; returns the new variables (n, V).
 
     Minimises, per frame, ``sum (weights * (p(q) - targets) / scale)^2 +
     (_REGULARISATION * |q - q0| in radians)^2``: the weighted target errors in leg lengths
     and the change of the chain's angles.  Each frame keeps its own damping, raised when a
     step would not lower its cost (steps are only taken downhill, also near a straight
-    knee where the linearisation is poor).
+    knee where the linearisation is poor), and stops once its step is under 1e-6 degrees.
+    The Jacobian is exact (:meth:`_LegIK.kinematics`), from the same forward kinematics
+    pass as the residuals.
     """
     q0 = ik.values()[rows]
     q = q0.copy()
-    reg = _REGULARISATION * np.radians(1.0)  # the variables are in degrees
-    eps = 1e-4
+    reg2 = (_REGULARISATION * np.radians(1.0)) ** 2  # the variables are in degrees
+    base_rot, base_pos = ik.base_rot[rows], ik.base_pos[rows]
+    wt = weights / scale
 
-    def residual(qq, copies: int = 1):
-        """Residuals of ``copies`` stacked sets of variables ``(copies * n, V)`` on ``rows``
-        (one forward-kinematics pass for a whole finite-difference Jacobian)."""
-        p = ik.positions(qq, np.tile(rows, copies)).reshape((copies, len(rows)) + targets.shape[1:])
-        r = ((p - targets) * weights / scale).reshape(copies * len(rows), -1)
-        return np.concatenate([r, reg * (qq - np.tile(q0, (copies, 1)))], axis=1)
-
-    def cost(rr):
-        return np.einsum("ij,ij->i", rr, rr)
+    def evaluate(qq, idx):
+        """Residuals (n, 3P) of the targets, costs (n,) and the residuals' Jacobian
+        (n, 3P, V) on rows ``idx``."""
+        p, J = ik.kinematics(qq, base_rot[idx], base_pos[idx], jacobian=True)
+        r = ((p - targets[idx]) * wt[idx]).reshape(len(idx), -1)
+        J = (J * wt[idx][..., None]).reshape(len(idx), r.shape[1], -1)
+        d = qq - q0[idx]
+        return r, np.einsum("ij,ij->i", r, r) + reg2 * np.einsum("ij,ij->i", d, d), J
 
     n, V = q.shape
     mu = np.full(n, 1e-3)
-    r = residual(q)
-    c = cost(r)
+    r, c, J = evaluate(q, np.arange(n))
+    live = np.arange(n)  # rows still moving
+    eye = np.eye(V)
     for _ in range(iterations):
-        dq = np.repeat(q[None], V, axis=0)  # (V, n, V): variable v nudged in copy v
-        dq[np.arange(V), :, np.arange(V)] += eps
-        J = (residual(dq.reshape(V * n, V), V).reshape(V, n, -1) - r) / eps
-        J = np.moveaxis(J, 0, 2)  # (n, residuals, V)
-        JT = np.swapaxes(J, 1, 2)
-        JTJ = JT @ J
-        diag = np.einsum("nvv->nv", JTJ)
-        A = JTJ.copy()
-        A[:, np.arange(V), np.arange(V)] += mu[:, None] * diag
-        step = np.linalg.solve(A, -(JT @ r[..., None]))[..., 0]
-        trial = q + step
-        r_new = residual(trial)
-        c_new = cost(r_new)
-        better = c_new <= c
-        q = np.where(better[:, None], trial, q)
-        r = np.where(better[:, None], r_new, r)
-        c = np.where(better, c_new, c)
-        mu = np.where(better, mu * 0.3, mu * 10.0)
-        if (np.abs(step).max(axis=1) < 1e-6).all():
+        if live.size == 0:
             break
+        Jl, rl = J[live], r[live]
+        JT = np.swapaxes(Jl, 1, 2)
+        A = JT @ Jl + reg2 * eye
+        g = (JT @ rl[..., None])[..., 0] + reg2 * (q[live] - q0[live])
+        A += mu[live, None, None] * (np.einsum("nvv->nv", A)[:, :, None] * eye)
+        step = np.linalg.solve(A, -g[..., None])[..., 0]
+        trial = q[live] + step
+        r_new, c_new, J_new = evaluate(trial, live)
+        better = c_new <= c[live]
+        take = live[better]
+        q[take], r[take] = trial[better], r_new[better]
+        c[take], J[take] = c_new[better], J_new[better]
+        mu[live] = np.where(better, mu[live] * 0.3, mu[live] * 10.0)
+        live = live[np.abs(step).max(axis=1) >= 1e-6]
     return q
 
 
@@ -423,11 +456,10 @@ def _lock_once(
     motion: Motion, contacts: FootContacts, nb: int, cyclic: bool
 ) -> tuple[Motion, float]:
     """One locking pass: the edited motion and the largest horizontal lock error."""
-    from .._kinematics import global_transforms, local_transforms
+    from .._kinematics import world_transforms
 
     skel = motion.skeleton
-    trans, rots = local_transforms(motion)
-    wpos, wrot = global_transforms(trans, rots, skel.parents)
+    wpos, wrot = world_transforms(motion)
     frames = np.array(motion.frames, dtype=float)
     scale = contacts.leg_length
     worst = 0.0
@@ -530,6 +562,56 @@ def _lock_once(
     return motion.with_frames(frames), worst
 
 
+def pin_feet(
+    motion: Motion, contacts: FootContacts, *, blend: float = 0.1, cyclic: bool = False
+) -> Motion:
+    """:func:`lock_feet`'s motion alone, one pass on ``contacts`` (no skating figures, no
+    joint changes, no fresh contact search): for callers that judge the result their
+    own way (:func:`~cyclecoord.synthesis.carry.lock_where_clean`, latent planting)."""
+    return _pinned(motion, contacts, blend, cyclic, 1, {})[0]
+
+
+def _pinned(motion, contacts, blend, cyclic, passes, contact_options):
+    """The locked motion, the contacts it was given (found when None), the options for
+    finding contacts afresh and the largest lock error."""
+    if not (np.isfinite(blend) and blend >= 0):
+        raise ParameterError(f"blend must be >= 0 seconds, got {blend!r}")
+    if isinstance(passes, bool) or not isinstance(passes, (int, np.integer)) or passes < 1:
+        raise ParameterError(f"passes must be a whole number >= 1, got {passes!r}")
+    feet = contact_options.pop("feet", None)
+    if contacts is None:
+        contacts = foot_contacts(motion, feet=feet, **contact_options)
+    elif feet is not None:
+        raise ParameterError("pass either contacts or feet, not both")
+    else:
+        contact_skeleton(motion)
+    if contacts.n_frames != motion.n_frames:
+        raise ParameterError(
+            f"contacts cover {contacts.n_frames} frames, the motion has {motion.n_frames}"
+        )
+    nb = round(blend * motion.fps)
+    if not contact_options:  # find contacts afresh with the thresholds of the given ones
+        contact_options = {
+            "height": contacts.height_threshold / contacts.leg_length,
+            "speed": (
+                contacts.speed_threshold / contacts.leg_length
+                if np.isfinite(contacts.speed_threshold)
+                else None
+            ),
+            "up": "xyz"[contacts.up],
+        }
+    out, worst = _lock_once(motion, contacts, nb, cyclic)
+    locked = contacts
+    for _ in range(int(passes) - 1):
+        again = foot_contacts(out, contacts.feet, **contact_options)
+        extra = again.planted & ~locked.planted
+        if not (foot_skating(out, again).skating & extra).any():
+            break
+        locked = replace(locked, planted=locked.planted | again.planted)
+        out, worst = _lock_once(out, locked, nb, cyclic)
+    return out, contacts, contact_options, worst
+
+
 def lock_feet(
     motion: Motion,
     contacts: FootContacts | None = None,
@@ -567,41 +649,9 @@ def lock_feet(
     """
     from .._kinematics import local_transforms
 
-    if not (np.isfinite(blend) and blend >= 0):
-        raise ParameterError(f"blend must be >= 0 seconds, got {blend!r}")
-    if isinstance(passes, bool) or not isinstance(passes, (int, np.integer)) or passes < 1:
-        raise ParameterError(f"passes must be a whole number >= 1, got {passes!r}")
-    feet = contact_options.pop("feet", None)
-    if contacts is None:
-        contacts = foot_contacts(motion, feet=feet, **contact_options)
-    elif feet is not None:
-        raise ParameterError("pass either contacts or feet, not both")
-    else:
-        contact_skeleton(motion)
-    if contacts.n_frames != motion.n_frames:
-        raise ParameterError(
-            f"contacts cover {contacts.n_frames} frames, the motion has {motion.n_frames}"
-        )
-    nb = round(blend * motion.fps)
-    if not contact_options:  # find contacts afresh with the thresholds of the given ones
-        contact_options = {
-            "height": contacts.height_threshold / contacts.leg_length,
-            "speed": (
-                contacts.speed_threshold / contacts.leg_length
-                if np.isfinite(contacts.speed_threshold)
-                else None
-            ),
-            "up": "xyz"[contacts.up],
-        }
-    out, worst = _lock_once(motion, contacts, nb, cyclic)
-    locked = contacts
-    for _ in range(int(passes) - 1):
-        again = foot_contacts(out, contacts.feet, **contact_options)
-        extra = again.planted & ~locked.planted
-        if not (foot_skating(out, again).skating & extra).any():
-            break
-        locked = replace(locked, planted=locked.planted | again.planted)
-        out, worst = _lock_once(out, locked, nb, cyclic)
+    out, contacts, contact_options, worst = _pinned(
+        motion, contacts, blend, cyclic, passes, contact_options
+    )
     _, rots = local_transforms(motion)
     _, rots2 = local_transforms(out)
     cosang = (np.einsum("tjab,tjab->tj", rots, rots2) - 1.0) / 2.0

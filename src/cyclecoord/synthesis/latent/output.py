@@ -153,7 +153,7 @@ class OutputMixin:
             return out
         from dataclasses import replace
 
-        from ..footlock import lock_feet
+        from ..footlock import pin_feet
 
         # what the root cannot keep still (two planted feet whose stance the blend
         # changes), a small leg IK pins: contacts inside the spans only
@@ -162,7 +162,7 @@ class OutputMixin:
         contacts = replace(contacts, planted=contacts.planted & span[:, None])
         if not contacts.planted.any():
             return out
-        return lock_feet(out, contacts, blend=LOCK_BLEND, passes=1).motion
+        return pin_feet(out, contacts, blend=LOCK_BLEND)
 
     def hold_mask(self, n_frames: int) -> np.ndarray:
         """(T,) frames an IDLE command made."""
