@@ -23,6 +23,7 @@ in degrees.
 
 from __future__ import annotations
 
+import threading
 import weakref
 from dataclasses import dataclass, field
 from typing import Protocol, Sequence
@@ -433,29 +434,40 @@ def forward_kinematics(
     return out
 
 
-#: Recent forward kinematics: ``(plan, frames, positions)``, newest last.  Generating a
-#: motion measures the same frames many times over (contacts, skating, accelerations,
-#: the quality measure, the plausibility checks); a hit is checked value by value.
-_RECENT: list[tuple[_Plan, np.ndarray, JointPositions]] = []
+#: Recent forward kinematics of each plan (so of each skeleton, and gone with it):
+#: ``(frames, positions)``, newest last.  Generating a motion measures the same frames
+#: many times over (contacts, skating, accelerations, the quality measure, the
+#: plausibility checks); a hit is checked value by value and handed out as a copy.  Only
+#: small motions are kept (at most ``_RECENT_MAX_VALUES`` channel values, about 2 MB with
+#: their positions), so a long-lived process holds a few megabytes at most per skeleton.
+_RECENT: "weakref.WeakKeyDictionary[_Plan, list]" = weakref.WeakKeyDictionary()
+_RECENT_LOCK = threading.Lock()
 _RECENT_SIZE = 8
-_RECENT_MAX_VALUES = 2_000_000  # frames larger than this are not kept
+_RECENT_MAX_VALUES = 100_000
 
 
 def _recall(plan: _Plan, frames: np.ndarray) -> JointPositions | None:
-    for i, (p, f, out) in enumerate(_RECENT):
-        if p is plan and f.shape == frames.shape and np.array_equal(f, frames):
-            _RECENT.append(_RECENT.pop(i))
-            return JointPositions(out.positions.copy(), list(out.names), out.parents.copy())
-    return None
+    if frames.size > _RECENT_MAX_VALUES:
+        return None
+    with _RECENT_LOCK:
+        recent = _RECENT.get(plan, [])
+        for i, (f, out) in enumerate(recent):
+            if f.shape == frames.shape and np.array_equal(f, frames):
+                recent.append(recent.pop(i))
+                break
+        else:
+            return None
+    return JointPositions(out.positions.copy(), list(out.names), out.parents.copy())
 
 
 def _remember(plan: _Plan, frames: np.ndarray, out: JointPositions) -> None:
     if frames.size > _RECENT_MAX_VALUES:
         return
-    _RECENT.append(
-        (plan, frames.copy(), JointPositions(out.positions.copy(), list(out.names), out.parents))
-    )
-    del _RECENT[:-_RECENT_SIZE]
+    kept = (frames.copy(), JointPositions(out.positions.copy(), list(out.names), out.parents))
+    with _RECENT_LOCK:
+        recent = _RECENT.setdefault(plan, [])
+        recent.append(kept)
+        del recent[:-_RECENT_SIZE]
 
 
 def rotation_order_from_dofs(dofs: Sequence[str], reverse: bool) -> str:
