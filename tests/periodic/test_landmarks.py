@@ -317,3 +317,71 @@ def test_a_capture_that_loops_exactly_gets_one_landmark_per_pose():
     assert len(idx_d) == 30 and radius_d == 0.0
     idx, _ = greedy_landmarks(x + np.random.default_rng(0).normal(0, 1e-3, x.shape), 150)
     assert len(idx) == 150  # poses that differ are all candidates
+
+
+def test_memory_guard_estimate_is_estimate_complex_of_what_it_chose():
+    """choose_landmarks's estimate is documented as the one estimate_complex gives for the
+    landmarks it chose (the same sample: n_samples and random_state at their defaults),
+    and the guard shrinks the landmarks until that estimate fits the budget."""
+    x = np.random.default_rng(2).standard_normal((3000, 3))
+    full = estimate_complex(x, 1.0)  # every point
+    limit = estimate_complex(x, 1.0, n_vertices=AUTO_LANDMARKS).bytes / 3
+    n, est, reason = choose_landmarks(x, 1.0, landmarks=None, memory_limit=limit)
+    assert n is not None and 50 < n < AUTO_LANDMARKS and "memory guard" in reason
+    assert est == estimate_complex(x, 1.0, n_vertices=n)
+    assert est.bytes <= limit
+    # the same sample for any vertex count: the edge fraction is the full complex's
+    assert est.edges / (n * (n - 1) / 2) == pytest.approx(full.edges / (3000 * 2999 / 2), rel=1e-12)
+
+
+def test_estimate_complex_known_answers():
+    """Points whose pairs all lie exactly at the threshold (a simplex: e_i + 0.5, every
+    pair sqrt(2) apart) are all linked ("within" includes the threshold): every pair is an
+    edge and every triple a triangle, whatever the sample.  Memory: the dense distance
+    matrix and the edge columns."""
+    from math import comb
+
+    from cyclecoord.periodic._rips import DENSE_BYTES_PER_PAIR
+    from cyclecoord.periodic.landmarks import _BYTES_PER_EDGE, ComplexEstimate
+
+    x = np.eye(6) + 0.5
+    thr = float(np.linalg.norm(x[0] - x[1]))
+    est = estimate_complex(x, thr)
+    assert est == ComplexEstimate(6, comb(6, 2), comb(6, 3),
+                                  DENSE_BYTES_PER_PAIR * 36.0 + _BYTES_PER_EDGE * comb(6, 2))
+    four = estimate_complex(x, thr, n_vertices=4)  # the same fractions on 4 vertices
+    assert (four.n_points, four.edges, four.triangles) == (4, 6, 4)
+    assert estimate_complex(x, 0.99 * thr).edges == 0.0
+    # one point far from two close ones: a third of the pairs is an edge, no triangle (the
+    # sample draws every point alike)
+    three = np.array([[0.0, 0.0], [0.0, 1.0], [50.0, 0.0]])
+    est = estimate_complex(three, 2.0)
+    assert est.edges == pytest.approx(1.0, rel=0.05) and est.triangles == 0.0
+    none = estimate_complex(three, 2.0, n_samples=0)  # no sample, nothing seen
+    assert none.edges == 0.0 and none.triangles == 0.0
+    # too few points for a triangle: nothing estimated
+    assert estimate_complex(three[:2], 2.0) == ComplexEstimate(2, 0.0, 0.0, 0.0)
+
+
+def test_memory_guard_at_the_edge_of_the_budget():
+    """The complete complex is left alone when its distance matrix and every possible edge
+    fit the budget exactly; a byte less and the guard estimates it; three points whose
+    edges do not fit cannot be thinned further (at least 50 landmarks would be needed)."""
+    from math import comb
+
+    from cyclecoord.periodic._rips import DENSE_BYTES_PER_PAIR
+    from cyclecoord.periodic.landmarks import _BYTES_PER_EDGE
+
+    x = np.random.default_rng(3).standard_normal((300, 3))
+    complete = DENSE_BYTES_PER_PAIR * 300.0 * 300 + _BYTES_PER_EDGE * comb(300, 2)
+    assert choose_landmarks(x, 0.5, landmarks=None, memory_limit=complete) == (
+        None, None, "every frame (landmarks off)")
+    n, est, _ = choose_landmarks(x, 0.5, landmarks=None, memory_limit=complete - 1)
+    assert n is None and est == estimate_complex(x, 0.5)  # the sampled estimate fits
+    three = np.eye(3) + 0.5  # every pair linked at the threshold: 3 edges
+    thr = float(np.linalg.norm(three[0] - three[1]))
+    with pytest.raises(cc.ParameterError, match="even 3 landmarks need"):
+        choose_landmarks(three, thr, landmarks=None, memory_limit=DENSE_BYTES_PER_PAIR * 9.0 + 1)
+    # two points: nothing estimated, as estimate_complex says
+    two = three[:2]
+    assert choose_landmarks(two, thr, landmarks=None, memory_limit=1.0)[1] == estimate_complex(two, thr)

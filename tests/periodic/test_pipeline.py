@@ -425,3 +425,33 @@ def test_configured_estimator_gives_its_parameters():
         configured_keywords(None, None, est, {**given, "prime": 59})
     with pytest.raises(cc.ParameterError, match="estimator must be a CircularCoordinates, got str"):
         configured_keywords(None, None, "ripser", given)
+
+
+def test_configured_preprocessor_delay_in_frames_becomes_seconds():
+    """A Preprocessor's delay counts frames, extract's counts seconds: 12 frames at
+    120 fps are 0.1 s (which extract turns back into round(0.1 * 120) = 12 frames)."""
+    from cyclecoord.periodic.results import EXTRACT_CONFIGURED_DEFAULTS, configured_keywords
+
+    given = dict(EXTRACT_CONFIGURED_DEFAULTS)
+    m = cc.datasets.make_periodic_capture(n_frames=50, fps=120.0, random_state=0).motion
+    prep = Preprocessor(delay=12, difference_root=False, normalize=True, pca=3)
+    chosen = configured_keywords(m, prep, None, given)
+    assert chosen == dict(difference_root=False, normalize=True, pca=3, root="body",
+                          delay=pytest.approx(0.1, rel=1e-12), rotations="auto")
+    assert round(chosen["delay"] * m.fps) == 12
+    at_30 = configured_keywords(m.with_frames(m.frames, fps=30.0), Preprocessor(delay=12), None,
+                                given)
+    assert at_30["delay"] == pytest.approx(0.4, rel=1e-12)
+    for none in (None, 0):  # no delay embedding either way
+        assert configured_keywords(m, Preprocessor(delay=none), None, given)["delay"] is None
+    with pytest.raises(cc.ParameterError, match="give delay either as keyword"):
+        configured_keywords(m, prep, None, {**given, "delay": 0.2})
+    # several delays: detect takes them all (seconds), extract takes one
+    assert configured_keywords(m, Preprocessor(delay=[12]), None, given)["delay"] == pytest.approx(0.1)
+    two = configured_keywords(m, Preprocessor(delay=[12, 30]), None, given, several_delays=True)
+    assert two["delay"] == pytest.approx((0.1, 0.25))
+    with pytest.raises(cc.ParameterError, match="takes one delay, the preprocessor has 2"):
+        configured_keywords(m, Preprocessor(delay=[12, 30]), None, given)
+    for bad in (2.5, -3):  # refused as the Preprocessor refuses them, not rounded
+        with pytest.raises(cc.ParameterError, match="whole numbers of frames"):
+            configured_keywords(m, Preprocessor(delay=bad), None, given)

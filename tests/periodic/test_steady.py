@@ -153,6 +153,8 @@ def test_centred_window_stays_inside():
     lo, hi = centred_window(10, 2)
     assert lo.tolist() == [0, 0, 0, 1, 2, 3, 4, 5, 5, 5]
     assert hi.tolist() == [4, 4, 4, 5, 6, 7, 8, 9, 9, 9]
+    lo, hi = centred_window(5, 2)  # exactly as wide as the frames
+    assert lo.tolist() == [0] * 5 and hi.tolist() == [4] * 5
     lo, hi = centred_window(3, 5)  # wider than the frames: all of them
     assert lo.tolist() == [0, 0, 0] and hi.tolist() == [2, 2, 2]
 
@@ -167,3 +169,68 @@ def test_a_two_frame_stretch_at_pace_is_steady():
     assert np.flatnonzero(steady_mask(u, cand, 2.0)).tolist() == [3, 4]
     u[4] = 0.4  # 0.2 turns per period: too slow
     assert not steady_mask(u, cand, 2.0).any()
+
+
+def test_moving_mask_finds_the_motion_between_still_stretches():
+    """3 s still, 6 s of a 1 Hz swing with a 1 s hold in the middle, 3 s still, a 0.5 s
+    burst, still to the end (30 fps): the swing is moving (the hold splits it, a second is
+    more than the half second bridged), the burst is shorter than a second: still."""
+    from cyclecoord.periodic.steady import moving_mask
+
+    fps, t = 30.0, np.arange(540)
+    swing = 20 * np.sin(2 * np.pi * t / 30)
+    s = np.where(((t >= 90) & (t < 270)) | ((t >= 300) & (t < 360)) | ((t >= 450) & (t < 465)),
+                 swing, 0.0)
+    mask = moving_mask(np.c_[s, 0.5 * s, -s], fps)
+    assert mask.shape == (540,)
+    (a0, b0), (a1, b1) = stretches(mask)
+    # the speed's 0.5 s moving average blurs each end by at most 15 / 2 frames
+    for got, want in ((a0, 90), (b0, 270), (a1, 300), (b1, 360)):
+        assert abs(got - want) <= 8, (got, want)
+    assert not mask[400:].any()  # the burst
+    # only the named columns are read: the same answer from them inside wider poses
+    wide = np.c_[np.zeros((540, 2)), s, 0.5 * s, -s, 100 * np.cos(t)]
+    np.testing.assert_array_equal(moving_mask(wide, fps, columns=np.array([2, 3, 4])), mask)
+    # a still take has no moving frame; too short or no joints to judge: all moving
+    assert not moving_mask(np.ones((540, 3)), fps).any()
+    assert not moving_mask(np.ones((3, 3)), fps).any()  # three frames are judged
+    # the level is the take's own: the same motion a hundred times smaller moves alike
+    np.testing.assert_array_equal(moving_mask(np.c_[s, 0.5 * s, -s] / 100, fps), mask)
+    assert moving_mask(np.c_[s, s][:2], fps).all()
+    assert moving_mask(np.zeros((540, 0)), fps).all()
+    assert moving_mask(wide, fps, columns=np.array([], dtype=int)).all()
+
+
+def test_pace_is_read_over_a_whole_period():
+    """A coordinate that stalls 90 % of each cycle and jumps through the turn in the last
+    10 % still turns exactly once over every period-long window: every frame is at pace.
+    A steady pace is kept between 1 / max_pace and max_pace turns a period."""
+    P, t = 100, np.arange(1000)
+    phase = (t % P) / P
+    u = t // P + np.where(phase < 0.9, 0.0, (phase - 0.9) / 0.1)
+    cand = np.ones(t.size, dtype=bool)
+    assert stretches(steady_mask(u, cand, float(P), pace_window=1.0)) == [(0, 1000)]
+    for rate, steady in ((0.6, False), (0.65, True), (1.5, True), (1.7, False)):
+        got = steady_mask(t * rate / P, cand, float(P), pace_window=1.0)
+        assert got.all() if steady else not got.any(), rate
+    # the bounds are kept (exact paces: 128 frames a period, multiples of 1/256 a frame)
+    assert steady_mask(t * 1.5 / 128, cand, 128.0, max_pace=1.5).all()
+    assert steady_mask(t * 0.5 / 128, cand, 128.0, max_pace=2.0).all()
+    # a pace that jumps from 1 to 1.8 turns a period at frame 500: the one-period window
+    # reads 1.6 at frame 525, the two-period one at 550; a frame is at pace when either is
+    u = np.where(t < 500, t / P, 5 + 1.8 * (t - 500) / P)
+    assert stretches(steady_mask(u, cand, float(P))) == [(0, 551)]
+
+
+def test_clean_runs_bridges_short_gaps_then_drops_short_runs():
+    from cyclecoord.periodic.steady import clean_runs
+
+    m = np.array([1, 1, 0, 0, 1, 1, 0, 0, 0, 1, 1, 1, 1, 0, 1], bool)
+    # gaps of 2 bridged (not the 3-frame one); then runs under 4 frames dropped
+    want = np.array([1, 1, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1, 1, 1], bool)
+    np.testing.assert_array_equal(clean_runs(m, min_run=4, max_gap=2), want)
+    assert not clean_runs(m, min_run=7, max_gap=2).any()  # two runs of 6 left: dropped
+    assert clean_runs(m, min_run=7, max_gap=3).all()  # every gap bridged: one run of 15
+    only = np.zeros(15, bool)
+    only[9:13] = True  # nothing bridged: the one run of 4
+    np.testing.assert_array_equal(clean_runs(m, min_run=3, max_gap=0), only)

@@ -185,3 +185,56 @@ def test_clean_closes_short_gaps_inside_and_drops_short_runs():
                     bool)
     np.testing.assert_array_equal(_clean(m, 3), want)
     np.testing.assert_array_equal(_clean(m, 1), m)  # 1 frame: nothing to clean
+
+
+def test_a_foot_held_up_all_take_is_never_planted():
+    """Standing on the right leg, the left thigh held 50 degrees forward all take: the
+    left foot is 2.86 units (0.36 leg) over the floor on every frame.  A point's contact
+    level may lie at most a quarter leg over the floor, so the held foot never reads as
+    down (its own lowest height would make it planted throughout)."""
+    skel = legs_skeleton()
+    m = make_motion(skel, T=120, lift_left=np.ones(120, bool))
+    f = m.frames.copy()
+    f[:, m.channels.index(("lfemur", "rx"))] = -50.0
+    c = foot_contacts(m.with_frames(f))
+    assert c.floor == pytest.approx(0.5) and c.leg_length == pytest.approx(8.0)
+    np.testing.assert_allclose(c.contact_level, [2.5, 2.5, 1.0, 0.5])  # capped at 0.5 + 8 / 4
+    lifted = 9 - 8 * np.cos(np.radians(50))  # hip at 9, leg of 8
+    np.testing.assert_allclose(c.height[:, 0], lifted - 2.5)
+    assert not c.side_planted("left").any() and c.side_planted("right").all()
+
+
+def test_skate_speed_zero_counts_every_moving_planted_foot():
+    """A planted point skates when it moves faster than skate_speed: at 0 a still foot
+    does not, a foot sliding however slowly does (the threshold is not reached by
+    standing still)."""
+    skel = legs_skeleton()
+    still = foot_skating(make_motion(skel), skate_speed=0.0)
+    assert still.skating_frames == 0 and still.skate_threshold == 0.0
+    assert not still.skating.any()
+    creep = foot_skating(make_motion(skel, root_speed=0.05), skate_speed=0.0)
+    assert creep.skating_fraction == 1.0 and creep.skating.all()
+    # at 0.1 leg lengths/s (0.8 units/s here) the same creep is not skating
+    slow = foot_skating(make_motion(skel, root_speed=0.05))
+    assert slow.skating_frames == 0 and slow.skate_threshold == pytest.approx(0.8)
+    assert foot_skating(make_motion(skel, root_speed=0.9)).skating_fraction == 1.0
+
+
+def test_mean_speeds_are_over_planted_frames_only():
+    """Sliding at 2 units/s with the left foot lifted on frames 40-80: every foot's mean
+    speed while planted is 2 (the lift's jumps are not planted frames); with no foot ever
+    planted (a jump) nothing slides: mean speed 0."""
+    from dataclasses import replace
+
+    T = 120
+    lift = np.zeros(T, bool)
+    lift[40:80] = True
+    m = make_motion(legs_skeleton(), T=T, root_speed=2.0, lift_left=lift)
+    c = foot_contacts(m)
+    assert not c.side_planted("left").all() and c.planted.any(axis=0).all()
+    s = foot_skating(m, c)
+    np.testing.assert_allclose(s.foot_mean_speed, 2.0)
+    assert s.mean_speed == pytest.approx(2.0)
+    air = foot_skating(m, replace(c, planted=np.zeros_like(c.planted)))
+    assert air.mean_speed == 0.0 and air.skating_frames == 0
+    assert np.isnan(air.foot_mean_speed).all()

@@ -156,3 +156,34 @@ def test_ratios_against_sources_that_never_move():
                   largest_accel_frame=0)
     q = GeneratedQuality(**values)
     assert all(np.isfinite(q.knee_ratio + q.hip_ratio)) and np.isfinite(q.cadence_ratio)
+
+
+def test_fast_contact_fraction_counts_feet_faster_than_half_a_leg_a_second():
+    """sliding_fraction: the frames on which a foot in contact (height alone) moves faster
+    than FAST_CONTACT = 0.5 leg lengths/s.  Synthetic legs (leg 8 units, 64 fps, every
+    position a multiple of 1/64: exact speeds) slide on the floor at exactly 4 units/s
+    (0.5 leg/s: not faster) for 32 frames, then at 6: half the frames."""
+    from _legs import legs_skeleton, make_motion
+
+    from cyclecoord.quality.generated import FAST_CONTACT
+
+    assert FAST_CONTACT == 0.5
+    skel = legs_skeleton()
+    src = make_motion(skel, T=128, fps=64.0)
+    f = src.frames.copy()
+    for knee in ("ltibia", "rtibia"):  # sources that move their knees (no 0 / 0 figures)
+        f[:, src.channels.index((knee, "rx"))] = 10 * np.sin(2 * np.pi * np.arange(128) / 64)
+    sources = [src.with_frames(f)]
+    at_limit = make_motion(skel, T=64, fps=64.0, root_speed=4.0)
+    q = measure_generated(at_limit, sources)
+    assert all(v == 1.0 for v in q.contact_fraction.values())  # every foot on the floor
+    assert q.sliding_fraction == 0.0
+    f = at_limit.frames.copy()
+    k = np.arange(64)
+    f[:, at_limit.channels.index(("root", "tz"))] = np.where(k < 32, 4.0 * k / 64,
+                                                             2.0 + 6.0 * (k - 32) / 64)
+    q = measure_generated(at_limit.with_frames(f), sources)
+    # frame 31's central difference still reads 4 units/s; frames 32 on read 5 and 6
+    assert q.sliding_fraction == 0.5 and q.to_dict()["fast_contact_fraction"] == 0.5
+    assert measure_generated(make_motion(skel, T=64, fps=64.0, root_speed=4.5),
+                             sources).sliding_fraction == 1.0

@@ -47,6 +47,18 @@ def test_bad_coefficient_orders(args):
         finite_difference_coefficients(*args)
 
 
+def test_the_longest_stencil_is_32_points():
+    """A stencil of 32 points is built (the 31st forward difference: alternating binomial
+    coefficients, exactly); one of 33 is refused."""
+    from math import comb
+
+    c = finite_difference_coefficients(31, 1)
+    np.testing.assert_array_equal(c, [(-1) ** (31 - j) * comb(31, j) for j in range(32)])
+    for derivative, accuracy in ((32, 1), (1, 32), (0, 33)):
+        with pytest.raises(ParameterError, match="stencil of 33 points is too long"):
+            finite_difference_coefficients(derivative, accuracy)
+
+
 # --------------------------------------------------------------------------- jerk
 def test_jerk_exact_on_cubics_and_zero_on_quadratics():
     fps = 120.0

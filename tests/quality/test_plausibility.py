@@ -193,3 +193,38 @@ def test_real_walk_near_contacts_explain_themselves(walk_69_01):
     report = check_plausibility(clip, [clip])
     assert report.clean
     assert any("the inputs come as close" in n for n in report.notes)
+
+
+def test_a_reference_played_on_narrower_hips_explains_the_legs_meeting(walk):
+    """The walk on a skeleton whose hips are half as wide: its legs pass within the
+    clearance of each other on every frame.  The input on its own skeleton never brings
+    them that close, but played on the narrower skeleton (same joints) it does: nothing
+    is new.  A reference on its own skeleton alone would call every frame new."""
+    from dataclasses import replace
+
+    from cyclecoord.quality.plausibility import _reference_views
+    from cyclecoord.skeleton import Skeleton
+
+    walk = walk.window((0, 30))  # the legs meet on every frame: a quarter of the walk
+    sk = walk.skeleton
+    narrow_sk = Skeleton(tuple(
+        replace(j, offset=j.offset * np.array([0.5, 1.0, 1.0])) if j.name in ("lfemur", "rfemur")
+        else j for j in sk.joints), name=sk.name, length_unit=sk.length_unit,
+        source_format=sk.source_format)
+    narrow = cc.Motion(walk.frames, walk.channels, fps=walk.fps, skeleton=narrow_sk)
+    legs = {"lfemur", "ltibia", "rfemur", "rtibia"}
+    met = [c for c in self_intersections(narrow).contacts() if set(c["bones"]) <= legs]
+    assert met and self_intersections(walk).frames.size == 0
+    views = _reference_views(walk, narrow)
+    assert len(views) == 2 and views[0].skeleton is sk and views[1].skeleton is narrow_sk
+    # root translation scaled by the ratio of the skeletons' sizes
+    k = narrow_sk.total_length() / sk.total_length()
+    tx = walk.channel_index("root", "tx")
+    np.testing.assert_allclose(views[1].frames[:, tx], k * walk.frames[:, tx])
+    rest = [i for i, (j, d) in enumerate(walk.channels) if not (j == "root" and d.startswith("t"))]
+    np.testing.assert_array_equal(views[1].frames[:, rest], walk.frames[:, rest])
+    report = check_plausibility(narrow, [walk])
+    assert report.clean and report.new_contact_frames == []
+    assert any("the inputs come as close" in n for n in report.notes)
+    # the same skeleton object: one view, nothing to replay
+    assert len(_reference_views(walk, walk)) == 1

@@ -72,3 +72,52 @@ def test_distances_are_rms_point_distances_even_for_one_point():
     q = pose_quality(m.window((20, 40)), m, [(0, 60)], 20.0)
     assert q.median_cycle_step == pytest.approx(0.01) and q.spread == pytest.approx(0.1)
     assert q.nearest_max == 0.0  # the cycle's poses are captured ones
+
+
+def test_point_jerk_of_a_cubic_and_of_a_circle():
+    """Known third derivatives: points moving as a * t**3 have jerk 6 a at every frame
+    (a cubic's third difference is exact); two points going round circles of radius r,
+    T frames a turn, have third differences of norm r (2 sin(pi / T))**3 each, times
+    fps**3, and the loop's seam reads like any frame (RMS over the points)."""
+    import numpy as np
+
+    from cyclecoord.quality.pose_space import point_jerk
+
+    fps, a = 30.0, 0.7
+    t = np.arange(20) / fps
+    cubic = np.zeros((20, 7))  # rows as root_frame_points gives: 2 points and the root height
+    cubic[:, 0] = a * t ** 3
+    cubic[:, 4] = a * t ** 3
+    j = point_jerk(cubic, fps, cyclic=False)
+    assert j.shape == (17,)
+    # each point's jerk is 6 a along one axis; the RMS over the two points is 6 a
+    np.testing.assert_allclose(j, 6 * a, rtol=1e-6)
+    np.testing.assert_allclose(point_jerk(cubic[:, :1], fps, cyclic=False), 6 * a, rtol=1e-6)
+    T, r = 40, 2.0
+    w = 2 * np.pi * np.arange(T) / T
+    loop = np.zeros((T, 7))
+    loop[:, 0], loop[:, 1] = r * np.cos(w), r * np.sin(w)
+    loop[:, 3], loop[:, 5] = r * np.sin(w), r * np.cos(w)
+    jc = point_jerk(loop, fps, cyclic=True)
+    assert jc.shape == (T,)
+    np.testing.assert_allclose(jc, r * (2 * np.sin(np.pi / T)) ** 3 * fps ** 3, rtol=1e-9)
+
+
+def test_a_two_frame_run_keeps_the_frame_numbers_of_the_runs_after_it():
+    """The one-point rig climbing 0.01 a frame, made from a 2-frame run and frames 10-60:
+    each captured pose's nearest one half a period (10 frames) away or more is 0.1 away,
+    the spread, with the short run in or out."""
+    import numpy as np
+
+    from cyclecoord.motion import Motion
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),))
+    f = np.zeros((60, 6))
+    f[:, 1] = 1 + 0.01 * np.arange(60)
+    m = Motion(f, sk.channels, fps=30, skeleton=sk)
+    cycle = m.window((20, 40))
+    alone = pose_quality(cycle, m, [(10, 60)], 20.0)
+    short = pose_quality(cycle, m, [(0, 2), (5, 6), (10, 60)], 20.0)  # one frame: no step
+    assert alone.spread == pytest.approx(0.1) and short.spread == pytest.approx(0.1)
+    assert short.nearest_max == 0.0

@@ -378,3 +378,47 @@ def test_root_orientation_of_single_turns(order):
     frames = np.array([[r.get(d, 0.0) for _, d in sk.channels] for r in rows])
     hpr = root_orientation(Motion(frames, sk.channels, fps=30, skeleton=sk))
     np.testing.assert_allclose(hpr, [[30, 0, 0], [0, 20, 0], [0, 0, 20], [0, 0, -15]], atol=1e-9)
+
+
+def test_foot_skating_leaves_out_a_foot_swinging_in_the_air():
+    """Heights are read on the up axis (y): the left leg raised 60 to 80 degrees out to the
+    side and swinging there (its feet 5 to 7.6 units over a floor at 0.5, beyond a quarter
+    leg) is never in contact, though its depth (z) stays that of the standing right foot.
+    Standing still the figure is 0; the whole body sliding 2 units/s it is 2, the
+    standing foot's speed, whatever the swinging foot does."""
+    from _legs import legs_skeleton, make_motion
+
+    m = make_motion(legs_skeleton(), T=60, fps=30.0)
+    f = m.frames.copy()
+    f[:, m.channels.index(("lfemur", "rz"))] = 60.0 + 20.0 * np.arange(60) / 60
+    assert foot_skating_speed(m.with_frames(f)) == pytest.approx(0.0, abs=1e-12)
+    f[:, m.channels.index(("root", "tx"))] = 2.0 * np.arange(60) / 30.0
+    assert foot_skating_speed(m.with_frames(f)) == pytest.approx(2.0, rel=1e-12)
+    # the floor is the motion's own: the same 20 units higher reads the same
+    high = f.copy()
+    high[:, m.channels.index(("root", "ty"))] += 20.0
+    assert foot_skating_speed(m.with_frames(high)) == pytest.approx(2.0, rel=1e-12)
+    # three frames are measured, two are too few; feet faster than a leg (10.5 units) a
+    # second are never in contact: 0
+    assert foot_skating_speed(m.with_frames(f[:3])) == pytest.approx(2.0, rel=1e-12)
+    assert np.isnan(foot_skating_speed(m.with_frames(f[:2])))
+    f[:, m.channels.index(("root", "tx"))] = 12.0 * np.arange(60) / 30.0
+    assert foot_skating_speed(m.with_frames(f)) == 0.0
+
+
+def test_leg_range_ratios_keep_a_reference_range_of_exactly_min_leg_range():
+    """Channels whose reference range is below MIN_LEG_RANGE (2 degrees) are left out of
+    the ratios; a range of exactly 2 degrees is not below it and is kept."""
+    from cyclecoord.quality.cycle_quality import MIN_LEG_RANGE
+
+    assert MIN_LEG_RANGE == 2.0
+    n = 40
+    square = np.where(np.arange(n) % 20 < 10, 0.0, 1.0)  # held 10 frames: kept by the median
+    m = _motion({"lfemur.rx": 2.0 * square, "ltibia.rx": 1.5 * square,
+                 "rfemur.rx": 10.0 * square})
+    ref = cycle_quality(m, m)
+    assert ref.leg_ranges == {"lfemur.rx": 2.0, "ltibia.rx": 1.5, "rfemur.rx": 10.0}
+    assert ref.joint_ranges == {"lfemur": 2.0, "ltibia": 1.5, "rfemur": 10.0}
+    q = cycle_quality(m, m, reference=ref)
+    assert q.leg_range_ratios == {"lfemur.rx": 1.0, "rfemur.rx": 1.0}
+    assert q.joint_range_ratios == {"lfemur": 1.0, "rfemur": 1.0}

@@ -22,7 +22,7 @@ from .barcode import (
 from .coordinates import CircularCoordinates
 from .cycle import TypicalCycle
 from .density import PeriodicDensity
-from .preprocess import PreparedData, Preprocessor
+from .preprocess import PreparedData, Preprocessor, _delays
 from .windings import Windings, stretches
 
 __all__ = [
@@ -344,21 +344,33 @@ def configured_keywords(
     given: dict[str, Any],
     defaults: dict[str, Any] = EXTRACT_CONFIGURED_DEFAULTS,
     where: str = "extract()",
+    several_delays: bool = False,
 ) -> dict[str, Any]:
     """Keywords of ``where`` (extract or detect) from configured objects; a keyword changed
     from its default beside the object that carries it is an error.  Only the estimator's
-    parameters named in ``given`` are taken."""
+    parameters named in ``given`` are taken.
+
+    The preprocessor's delays (frames) become seconds at the motion's rate: one delay a
+    number, several (only when ``where`` takes them, ``several_delays``) a tuple."""
     chosen: dict[str, Any] = {}
     if preprocessor is not None:
         if not isinstance(preprocessor, Preprocessor):
             raise ParameterError(
                 f"{where}: preprocessor must be a Preprocessor, got {type(preprocessor).__name__}"
             )
-        lag = preprocessor.delay
         fps = getattr(motion, "fps", None) or 1.0
+        # validated as the preprocessor does (whole frames >= 0; zeros dropped)
+        lags = [] if preprocessor.delay is None else _delays(preprocessor.delay)
+        if len(lags) > 1 and not several_delays:
+            raise ParameterError(
+                f"{where}: takes one delay, the preprocessor has {len(lags)} ({lags} frames)"
+            )
+        seconds = [float(k) / fps for k in lags]
         chosen.update(difference_root=preprocessor.difference_root,
                       normalize=preprocessor.normalize, pca=preprocessor.pca,
-                      root=preprocessor.root, delay=None if not lag else float(lag) / fps,
+                      root=preprocessor.root,
+                      delay=None if not seconds else seconds[0] if len(seconds) == 1
+                      else tuple(seconds),
                       rotations=preprocessor.rotations)
     if estimator is not None:
         if not isinstance(estimator, CircularCoordinates):

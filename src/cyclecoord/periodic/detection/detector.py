@@ -329,7 +329,8 @@ def _from_configured(motion: Motion, options: dict[str, Any]) -> dict[str, Any]:
 
     pre, est = options.pop("preprocessor"), options.pop("estimator")
     given = {k: options[k] for k in _DETECT_CONFIGURED}
-    chosen = configured_keywords(motion, pre, est, given, _DETECT_CONFIGURED, "detect()")
+    chosen = configured_keywords(motion, pre, est, given, _DETECT_CONFIGURED, "detect()",
+                                 several_delays=True)
     return {**options, **chosen}
 
 
