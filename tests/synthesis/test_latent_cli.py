@@ -199,3 +199,23 @@ def test_animate_feet_option_and_script_key(workdir, capsys):
         assert main(["animate", str(script), "-o", str(out), *bad]) == 1
         err = capsys.readouterr().err
         assert "feet: no joint" in err and "nearest" in err and not out.exists()
+
+
+def test_fit_refuses_a_root_without_position_channels(tmp_path, capsys):
+    """A glTF whose skeleton metadata lost the root's ``tx`` dof (fuzz_formats gltf case
+    1002403): the model's root track reads the root's position, and fitting raised a
+    KeyError; now one line naming the file and the missing channel, and no model."""
+    walk = cc.datasets.make_periodic_capture(kind="walk", n_frames=60, random_state=0).motion
+    path = tmp_path / "walk.gltf"
+    cc.save(walk, path)
+    doc = json.loads(path.read_text())
+    dofs = doc["extras"]["cyclecoord"]["skeleton"]["joints"][0]["dofs"]
+    assert dofs[0] == "tx"
+    del dofs[0]
+    path.write_text(json.dumps(doc))
+    out = tmp_path / "m.npz"
+    assert main(["latent", "fit", str(path), "-o", str(out), "--max-iter", "2",
+                 "--no-progress"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "walk.gltf" in err[0] and "no tx channel" in err[0], err
+    assert not out.exists()

@@ -115,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..io import atomic_write
     from .._words import plural
-    from ..synthesis.latent.model import LatentModel
+    from ..synthesis.latent.model import LatentModel, root_position_problem
 
     if args.dims < 1:
         raise ParameterError(f"--dims must be >= 1, got {args.dims}")
@@ -132,6 +132,9 @@ def run(args: argparse.Namespace) -> int:
     for i, text in enumerate(args.takes):
         path, a, b, name = parse_take(text)
         motion = load(path).window((a, b))
+        problem = root_position_problem(motion) if motion.skeleton is not None else None
+        if problem:
+            raise ParameterError(f"{path}: {problem}")
         step = args.step or max(1, int(round(motion.fps / TRAINING_FPS)))
         seg = motion[::step]
         if seg.n_frames < 3:

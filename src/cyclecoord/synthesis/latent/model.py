@@ -62,6 +62,18 @@ class RootTrack:
     tilt: np.ndarray
 
 
+def root_position_problem(motion: Motion) -> str | None:
+    """Why ``motion`` cannot train a latent model's root (its root has no position
+    channel on some axis), or None."""
+    root = motion.skeleton.joints[0].name
+    have = set(motion.channels)
+    missing = [d for d in ("tx", "ty", "tz") if (root, d) not in have]
+    if not missing:
+        return None
+    return (f"a latent model needs the root's position; root {root!r} has no "
+            f"{', '.join(missing)} channel")
+
+
 def root_track(motion: Motion) -> RootTrack:
     """The :class:`RootTrack` of one contiguous capture (y up, CMU facing +z at rest)."""
     from ..align import root_rotation
@@ -169,6 +181,9 @@ class LatentModel:
             raise ParameterError(
                 "a latent model needs motions with a skeleton (forward kinematics)"
             )
+        problem = root_position_problem(first)
+        if problem:  # the root's travel is modelled apart (root_track): it must be there
+            raise ParameterError(f"training segment 0: {problem}")
         for i, m in enumerate(motions):
             if m.channels != first.channels:
                 raise ParameterError(f"training segment {i} has different channels from segment 0")
