@@ -878,3 +878,18 @@ def test_any_skeleton_round_trips_fk(tmp_path: Path, offsets, seed: int) -> None
     for j in skel.joints:
         new = "root" if j.parent < 0 else j.name
         np.testing.assert_allclose(fk1[new], fk0[j.name], atol=1e-8)
+
+
+@pytest.mark.parametrize(
+    "fps, named",
+    [(120.0, False), (120.0 + 0.5e-9, False), (120.0 - 0.5e-9, False), (120.0 + 1.5e-9, True),
+     (120.0 - 1.5e-9, True), (60.0, True), (240.0, True)],
+)
+def test_amc_names_its_rate_unless_it_is_120(tmp_path, fps, named):
+    """AMC has no frame rate: write_amc names the motion's in a header comment (the exact
+    float) unless it is CMU's 120 Hz to within 1e-9 fps (documented in write_amc)."""
+    m = Motion(np.zeros((2, 3)), [("root", "tx"), ("root", "ty"), ("root", "tz")], fps=fps)
+    write_amc(m, tmp_path / "m.amc")
+    lines = (tmp_path / "m.amc").read_text().splitlines()
+    rate_lines = [s for s in lines if s.startswith("# frame rate")]
+    assert rate_lines == ([f"# frame rate {fps!r} fps (cyclecoord)"] if named else [])

@@ -268,3 +268,24 @@ def test_joint_checks_geometry():
         Joint(name="a", parent=-1, offset=[0, 0, 0], axis=np.zeros((3, 3)))
     with pytest.raises(ParameterError, match="rotation matrix"):
         Joint(name="a", parent=-1, offset=[0, 0, 0], axis=np.diag([1.0, 1.0, -1.0]))
+
+
+def test_bvh_hierarchy_past_its_word_limit_names_the_line(tmp_path):
+    """A hierarchy of more than 64 words a supported joint (64 * MAX_JOINTS) without
+    MOTION is refused at the first line read once the words already read exceed that:
+    the error names that line (1-based)."""
+    limit = 64 * MAX_JOINTS
+    per_line = 1000
+    path = tmp_path / "words.bvh"
+    # line 1 is HIERARCHY (1 word), lines 2.. hold 1000 words each
+    full = (limit - 1) // per_line + 1  # word lines that take the count past the limit
+    path.write_text("HIERARCHY\n" + ("x " * per_line + "\n") * (full + 5))
+    with pytest.raises(ParseError, match=f"runs past {limit:,} words") as e:
+        cc.load(path)
+    one_line(e, path)
+    assert e.value.line == full + 2  # the line after HIERARCHY and the `full` word lines
+    # exactly at the limit: still read on (refused later for what the words are)
+    path.write_text("HIERARCHY\n" + "x\n" * (limit - 1) + "x y\n")
+    with pytest.raises(ParseError) as e:
+        cc.load(path)
+    assert "runs past" not in str(e.value)

@@ -154,7 +154,10 @@ def write_amc(
         channels are grouped per joint in the motion's order.
     path : path-like
         Destination ``.amc``; ``:FULLY-SPECIFIED``, ``:DEGREES``, frames numbered from 1,
-        values written with full (round-trip exact) precision.
+        values written with full (round-trip exact) precision.  AMC has no frame rate:
+        a motion's rate is named in a ``# frame rate ... fps (cyclecoord)`` header
+        comment (read back by :func:`cyclecoord.load`) unless it is CMU's 120 Hz to
+        within 1e-9 fps.
     skeleton_path : path-like, optional
         Also write the motion's skeleton there as ASF (see :func:`write_asf`); bone
         names in the AMC match it.
