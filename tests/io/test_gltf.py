@@ -312,3 +312,24 @@ def test_stick_mesh_radius_is_a_hundredth_of_the_bone_length(tmp_path):
     verts, _, _ = _stick_mesh(np.array([[0.0, 0, 0], [0, 0, 2.0]]), [(0, (0, 1))], 1.0)
     assert np.linalg.norm(verts[:4] - [0, 0, 0], axis=1) == pytest.approx([0.5] * 4)
     assert np.linalg.norm(verts[4:] - [0, 0, 2.0], axis=1) == pytest.approx([0.5] * 4)
+
+
+def test_unit_quaternions_are_normalised_within_the_tolerance():
+    """Rotation keys are unit quaternions to within UNIT_TOLERANCE (1e-3) in length, and
+    are divided by their length; longer or shorter ones, or values that are not
+    finite, are refused."""
+    from cyclecoord.io._checked import Invalid
+    from cyclecoord.io.gltf_read import UNIT_TOLERANCE, _unit_quaternions
+
+    assert UNIT_TOLERANCE == 1e-3
+    s = np.sqrt(0.5)
+    q = np.array([[0, 0, 0, 1.0009], [0, 0.9991 * s, 0, 0.9991 * s], [0.5, 0.5, 0.5, 0.5]])
+    np.testing.assert_allclose(
+        _unit_quaternions(q, "x"), [[0, 0, 0, 1], [0, s, 0, s], [0.5, 0.5, 0.5, 0.5]],
+        atol=1e-15,
+    )
+    for bad in ([0, 0, 0, 1.0011], [0, 0, 0, 0.9989], [0, 0, 0, 0], [0, 0, 0, 2.0]):
+        with pytest.raises(Invalid, match="has length"):
+            _unit_quaternions(np.array([[0, 0, 0, 1.0], bad]), "x")
+    with pytest.raises(Invalid, match="quaternion 1 holds .*not finite"):
+        _unit_quaternions(np.array([[0, 0, 0, 1.0], [0, np.nan, 0, 1]]), "x")

@@ -273,8 +273,9 @@ def _accessor(gltf, buffers, index, where: str) -> np.ndarray:
 def _sample(
     times: np.ndarray, values: np.ndarray, interp: str, at: np.ndarray, quat: bool
 ) -> np.ndarray:
-    if interp == "CUBICSPLINE":
-        values = values.reshape(len(times), 3, -1)[:, 1]
+    """``values`` at the key ``times`` sampled at ``at`` by ``interp``, ``"STEP"`` or
+    ``"LINEAR"`` (a CUBICSPLINE sampler's values are taken out of its triples and read as
+    LINEAR by the caller); rotations are renormalised after the linear interpolation."""
     if interp == "STEP":
         k = np.clip(np.searchsorted(times, at + 1e-9, side="right") - 1, 0, len(times) - 1)
         return values[k]
