@@ -69,3 +69,71 @@ def test_matrices_are_row_vector_transforms():
         for k in range(2):
             np.testing.assert_allclose(np.append(p, 1.0) @ m[k],
                                        np.append(rots[k] @ p + trans[k], 1.0), atol=1e-12)
+
+
+def test_time_samples_outside_the_stage_range_are_not_read(walk_69_01, tmp_path):
+    """Only the time codes from startTimeCode to endTimeCode are the motion: a sample
+    after endTimeCode is neither read nor checked (here it is not a unit quaternion)."""
+    out = tmp_path / "w.usda"
+    write_usd(walk_69_01[:6], out)
+    text = out.read_text()
+    a = text.index("quatf[] rotations.timeSamples")
+    b = text.index("5: [(", a) + len("5: [(")
+    end = text.index(")", b)
+    out.write_text(text[:b] + "2, 0, 0, 0" + text[end:])
+    with pytest.raises(ParseError, match="rotations at time code 5"):
+        read_usd(out)
+    out.write_text(out.read_text().replace("endTimeCode = 5", "endTimeCode = 4", 1))
+    back = read_usd(out)
+    assert back.n_frames == 5
+    np.testing.assert_allclose(back.positions().positions,
+                               walk_69_01[:5].positions().positions, atol=1e-3)
+
+
+def test_refusals_hold_back_what_was_printed_meanwhile(capfd):
+    """A USD reader's refusal is its one-line ParseError (a usd-core error or text that
+    is not UTF-8 turned into one): what was printed on standard error while reading
+    (Python's, file descriptor 2's, usd-core's warnings) is not shown; after a read that
+    succeeds, or an error other than a refusal, it is printed as usual."""
+    import os
+    import sys
+
+    from pxr import Tf
+
+    from cyclecoord.io.usd import _refusing
+
+    class PxrError(RuntimeError):
+        pass
+
+    PxrError.__module__ = "pxr.Tf"
+
+    def reader(outcome):
+        def read(path):
+            sys.stderr.write("python says\n")
+            sys.stderr.flush()
+            os.write(2, b"C++ says\n")
+            Tf.Warn("usd-core says")
+            if outcome == "refuse":
+                raise ParseError("bad", str(path))
+            if outcome == "utf8":
+                raise UnicodeDecodeError("utf-8", b"\xff", 0, 1, "invalid start byte")
+            if outcome == "pxr":
+                raise PxrError("Error in 'f' at line 3 in file x.cpp : 'corrupt'")
+            if outcome == "fail":
+                raise KeyError("bug")
+            return 7
+        return _refusing(read)
+
+    capfd.readouterr()
+    for outcome, words in [("refuse", "bad"), ("utf8", "not UTF-8 .invalid start byte at byte 0"),
+                           ("pxr", "not a readable USD file .corrupt.")]:
+        with pytest.raises(ParseError, match=words):
+            reader(outcome)("f.usda")
+        assert capfd.readouterr().err == "", outcome
+    assert reader("succeed")("f.usda") == 7
+    err = capfd.readouterr().err
+    assert err.startswith("python says\nC++ says\n") and "usd-core says" in err
+    with pytest.raises(KeyError):
+        reader("fail")("f.usda")
+    err = capfd.readouterr().err
+    assert err.startswith("python says\nC++ says\n") and "usd-core says" in err

@@ -381,7 +381,8 @@ def _local_transforms(query, times: np.ndarray, path: Path) -> tuple[np.ndarray,
     time code); between samples the translations are interpolated linearly and the
     rotations along the shorter arc, as USD interpolates them.  The authored rotations
     must be finite unit quaternions and every local transform a rotation and a
-    translation (no scale), checked before anything is decomposed.
+    translation (no scale), checked before anything is decomposed.  Samples outside
+    ``times[0] .. times[-1]`` are not part of the motion: neither read nor checked.
     """
     from pxr import Usd, UsdSkel
     from scipy.spatial.transform import Rotation
