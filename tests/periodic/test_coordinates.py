@@ -128,6 +128,10 @@ def test_temporal_metric_zeroes_consecutive_frames():
     d = temporal_distance_matrix(x)
     assert np.all(np.diagonal(d, 1) == 0)
     assert d[0, 2] > 0
+    # Euclidean distances, symmetric, with 0 between consecutive frames (both ways)
+    pts = np.array([[0.0, 0.0], [3.0, 4.0], [6.0, 0.0], [0.0, 8.0]])
+    want = np.array([[0, 0, 6, 8], [0, 0, 0, 5], [6, 0, 0, 0], [8, 5, 0, 0]], float)
+    np.testing.assert_array_equal(temporal_distance_matrix(pts), want)
     est = CircularCoordinates(temporal=True).fit(x)
     assert est.selection_.clear
 

@@ -449,3 +449,40 @@ def test_three_windows_covering_exactly_min_cycles_make_a_motion():
         assert n == motions and len(segments) == motions
         assert np.all(labels == (0 if motions else -1))
         assert all(w.motion == (0 if motions else -1) for w in windows)
+
+
+def test_speed_window_is_odd_and_at_least_three_frames():
+    """detect's ``window`` (seconds) becomes the nearest whole number of frames, made odd
+    (an even count gets one more frame: centred on its frame), at least 3."""
+    from cyclecoord.periodic.detection.detector import _speed_window
+
+    cases = {(1.0, 120.0): 121, (1.0, 30.0): 31, (0.5, 30.0): 15, (1.0, 10.0): 11,
+             (0.1, 30.0): 3, (0.05, 30.0): 3, (0.01, 30.0): 3, (0.0, 30.0): 3, (0.2, 30.0): 7}
+    for (window, fps), want in cases.items():
+        assert _speed_window(window, fps) == want, (window, fps)
+
+
+def test_window_table_progress_bar_only_when_asked(monkeypatch):
+    """``progress=True`` shows a tqdm bar over the windows (after 2 s), ``False`` never;
+    with no window to fit there is no bar either; the bar is cleared when done."""
+    import tqdm
+
+    from cyclecoord.periodic.detection import window_table
+
+    made = []
+
+    class Recorder(tqdm.tqdm):
+        def __init__(self, *args, **kwargs):
+            made.append(kwargs)
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(tqdm, "tqdm", Recorder)
+    t = np.linspace(0, 4 * np.pi, 40)
+    pts = np.column_stack([np.cos(t), np.sin(t)])
+    for progress, lengths, disabled in [(True, (2.0,), False), (False, (2.0,), True),
+                                        (True, (9.0,), True)]:
+        made.clear()
+        wins = window_table(pts, pts, 10.0, lengths=lengths, progress=progress)
+        assert len(wins) == (0 if lengths == (9.0,) else 5)
+        assert [k["disable"] for k in made] == [disabled], (progress, lengths)
+        assert made[0]["delay"] == 2.0 and made[0]["leave"] is False

@@ -33,6 +33,13 @@ METHODS = ("auto", "global", "windows")
 
 
 @one_blas_thread
+
+def _speed_window(window: float, fps: float) -> int:
+    """Frames the coordinate's speed is averaged over for a ``window`` of seconds: the
+    nearest whole number of frames to ``window * fps``, made odd (an even count gets one
+    more frame) so that the window is centred on its frame, and at least 3."""
+    return max(3, int(round(window * fps)) | 1)
+
 def detect(
     motion: Motion,
     frames: tuple[int | None, int | None] | None = None,
@@ -201,7 +208,7 @@ def detect(
     # 1-4. candidate classes, their coordinates, excitation and validation
     cand = candidate_classes(barcode, n_classes, max_classes, min_persistence)
     fps = motion.fps
-    w = max(3, int(round(window * fps)) | 1)
+    w = _speed_window(window, fps)
     v_min = 1.0 / (max_period * fps)
     t0 = time.perf_counter()
     classes = read_classes(
