@@ -455,3 +455,32 @@ def test_configured_preprocessor_delay_in_frames_becomes_seconds():
     for bad in (2.5, -3):  # refused as the Preprocessor refuses them, not rounded
         with pytest.raises(cc.ParameterError, match="whole numbers of frames"):
             configured_keywords(m, Preprocessor(delay=bad), None, given)
+
+
+def test_the_first_fit_reads_the_moving_frames_unless_too_many_or_too_few(monkeypatch):
+    """TakeFit.moving (its docstring): the moving frames, unless they are 95 % of the take
+    or more, or fewer than max(10, 2 * n_neighbors); then, and without steady, every frame.
+    Each bound itself keeps the moving frames."""
+    from cyclecoord.periodic import fitting
+
+    motion = cc.datasets.make_periodic_capture(n_frames=100, period=40.0, random_state=0).motion
+    count = {}
+
+    def mask(poses, fps, columns=None):
+        out = np.zeros(len(poses), dtype=bool)
+        out[5 : 5 + count["n"]] = True
+        return out
+
+    monkeypatch.setattr(fitting, "moving_mask", mask)
+
+    def moving(n, n_neighbors=10, steady=True):
+        count["n"] = n
+        params = dict(delay=None, difference_root=True, normalize=False, pca=None, root="body",
+                      rotations="auto", steady=steady, n_neighbors=n_neighbors)
+        return int(fitting.TakeFit(motion, params, True).moving.sum())
+
+    assert moving(20) == 20 and moving(19) == 100  # 2 * 10 neighbours
+    assert moving(16, n_neighbors=8) == 16 and moving(15, n_neighbors=8) == 100
+    assert moving(10, n_neighbors=3) == 10 and moving(9, n_neighbors=3) == 100  # at least 10
+    assert moving(94) == 94 and moving(95) == 100  # 95 % of 100 frames
+    assert moving(50, steady=False) == 100
