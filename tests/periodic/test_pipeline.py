@@ -484,3 +484,24 @@ def test_the_first_fit_reads_the_moving_frames_unless_too_many_or_too_few(monkey
     assert moving(10, n_neighbors=3) == 10 and moving(9, n_neighbors=3) == 100  # at least 10
     assert moving(94) == 94 and moving(95) == 100  # 95 % of 100 frames
     assert moving(50, steady=False) == 100
+
+
+def test_a_configured_object_alone_is_read_and_checked():
+    """extract reads a configured preprocessor without an estimator, and an estimator
+    without a preprocessor: each alone is checked (a wrong type, a keyword given both
+    ways) before any fitting, and its settings are used."""
+    m = cc.datasets.make_periodic_capture(n_frames=200, period=40.0, random_state=0).motion
+    with pytest.raises(cc.ParameterError, match="preprocessor must be a Preprocessor"):
+        cc.extract(m, preprocessor="body")
+    with pytest.raises(cc.ParameterError, match="give pca either as keyword"):
+        cc.extract(m, pca=3, preprocessor=Preprocessor(pca=5))
+    with pytest.raises(cc.ParameterError, match="estimator must be a CircularCoordinates"):
+        cc.extract(m, estimator=Preprocessor())
+    with pytest.raises(cc.ParameterError, match="give prime either as keyword"):
+        cc.extract(m, prime=59, estimator=cc.CircularCoordinates(prime=53))
+    # alone, each object's settings are the extraction's (the preprocessor's delay None:
+    # no delay embedding), as CycleOptions' are
+    m = cc.datasets.make_periodic_capture(n_frames=240, period=60.0, random_state=0).motion
+    res = cc.extract(m, preprocessor=Preprocessor(pca=5))
+    assert res.parameters["pca"] == 5 and res.parameters["delay"] is None
+    assert cc.extract(m, cycle=cc.CycleOptions(n_samples=50)).parameters["n_samples"] == 50
