@@ -455,3 +455,53 @@ def test_configured_preprocessor_delay_in_frames_becomes_seconds():
     for bad in (2.5, -3):  # refused as the Preprocessor refuses them, not rounded
         with pytest.raises(cc.ParameterError, match="whole numbers of frames"):
             configured_keywords(m, Preprocessor(delay=bad), None, given)
+
+
+def test_the_first_fit_reads_the_moving_frames_unless_too_many_or_too_few(monkeypatch):
+    """TakeFit.moving (its docstring): the moving frames, unless they are 95 % of the take
+    or more, or fewer than max(10, 2 * n_neighbors); then, and without steady, every frame.
+    Each bound itself keeps the moving frames."""
+    from cyclecoord.periodic import fitting
+
+    motion = cc.datasets.make_periodic_capture(n_frames=100, period=40.0, random_state=0).motion
+    count = {}
+
+    def mask(poses, fps, columns=None):
+        out = np.zeros(len(poses), dtype=bool)
+        out[5 : 5 + count["n"]] = True
+        return out
+
+    monkeypatch.setattr(fitting, "moving_mask", mask)
+
+    def moving(n, n_neighbors=10, steady=True):
+        count["n"] = n
+        params = dict(delay=None, difference_root=True, normalize=False, pca=None, root="body",
+                      rotations="auto", steady=steady, n_neighbors=n_neighbors)
+        return int(fitting.TakeFit(motion, params, True).moving.sum())
+
+    assert moving(20) == 20 and moving(19) == 100  # 2 * 10 neighbours
+    assert moving(16, n_neighbors=8) == 16 and moving(15, n_neighbors=8) == 100
+    assert moving(10, n_neighbors=3) == 10 and moving(9, n_neighbors=3) == 100  # at least 10
+    assert moving(94) == 94 and moving(95) == 100  # 95 % of 100 frames
+    assert moving(50, steady=False) == 100
+
+
+def test_a_configured_object_alone_is_read_and_checked():
+    """extract reads a configured preprocessor without an estimator, and an estimator
+    without a preprocessor: each alone is checked (a wrong type, a keyword given both
+    ways) before any fitting, and its settings are used."""
+    m = cc.datasets.make_periodic_capture(n_frames=200, period=40.0, random_state=0).motion
+    with pytest.raises(cc.ParameterError, match="preprocessor must be a Preprocessor"):
+        cc.extract(m, preprocessor="body")
+    with pytest.raises(cc.ParameterError, match="give pca either as keyword"):
+        cc.extract(m, pca=3, preprocessor=Preprocessor(pca=5))
+    with pytest.raises(cc.ParameterError, match="estimator must be a CircularCoordinates"):
+        cc.extract(m, estimator=Preprocessor())
+    with pytest.raises(cc.ParameterError, match="give prime either as keyword"):
+        cc.extract(m, prime=59, estimator=cc.CircularCoordinates(prime=53))
+    # alone, each object's settings are the extraction's (the preprocessor's delay None:
+    # no delay embedding), as CycleOptions' are
+    m = cc.datasets.make_periodic_capture(n_frames=240, period=60.0, random_state=0).motion
+    res = cc.extract(m, preprocessor=Preprocessor(pca=5))
+    assert res.parameters["pca"] == 5 and res.parameters["delay"] is None
+    assert cc.extract(m, cycle=cc.CycleOptions(n_samples=50)).parameters["n_samples"] == 50

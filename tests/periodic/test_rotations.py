@@ -130,3 +130,22 @@ def test_hinge_angles_move_by_whole_turns_into_half_a_turn_of_their_centre():
     out = rmap.to_vectors(np.column_stack([x, x]))
     np.testing.assert_array_equal(out[:, 0], [10.0, 189.5, -169.0, 189.0, -170.0, 20.0, 0.1])
     np.testing.assert_array_equal(out[:, 1], x)  # not a hinge column: copied
+
+
+def test_without_a_skeleton_every_rotation_channel_is_a_hinge():
+    """fit_rotation_map's documentation: without a skeleton (no Euler orders) every
+    rotation channel is a hinge; with it each three-channel joint is a rotation and the
+    others hinges.  Excluded columns (the root) and position channels are neither."""
+    import dataclasses
+
+    m = example_capture().motion
+    root = np.asarray(m.root_channels())
+    rot = [i for i, (j, d) in enumerate(m.channels) if d in ("rx", "ry", "rz") and i not in root]
+    bare = fit_rotation_map(dataclasses.replace(m, skeleton=None), exclude=root)
+    assert bare.groups == ()
+    np.testing.assert_array_equal(bare.hinge_columns, rot)
+    full = fit_rotation_map(m, exclude=root)
+    grouped = sorted(int(c) for g in full.groups for c in g.columns)
+    assert sorted(c for _, cols in three_dof_joints(m) for c in cols) == grouped
+    assert sorted(grouped + full.hinge_columns.tolist()) == rot
+    assert all(len(g.columns) == 3 and sorted(g.order) == ["X", "Y", "Z"] for g in full.groups)

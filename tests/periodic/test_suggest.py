@@ -4,6 +4,8 @@ import json
 import sys
 from pathlib import Path
 
+import pytest
+
 import cyclecoord as cc
 from cyclecoord.cli import main
 from cyclecoord.periodic.suggest import what_would_help
@@ -47,3 +49,46 @@ def test_nothing_is_tried_that_was_already_given(monkeypatch):
     assert [c.get("rotations") for c in calls] == ["rotvec", "rotvec", "rotvec"]
     assert {k for c in calls for k, v in c.items() if v in (False, 3, True)} == {
         "steady", "pca", "normalize"}
+
+
+def test_only_clean_cycles_are_suggested_and_at_most_two(monkeypatch):
+    """what_would_help on stand-in extractions: a refusal or a cycle with a pop or a stray
+    pose is no suggestion, one without a pose-quality figure or with a clean one is; it
+    stops after ``most`` and tries nothing on a capture over MAX_FRAMES frames (that many
+    are still tried)."""
+    from types import SimpleNamespace as NS
+
+    import cyclecoord.periodic.pipeline as pipeline
+    from cyclecoord.periodic import suggest
+
+    clean, pop, stray = NS(pops=[], strays=[]), NS(pops=[3], strays=[]), NS(pops=[], strays=[7])
+    m = cc.datasets.example_capture().motion
+
+    def found(outcomes, most=None):
+        it = iter(outcomes)
+
+        def extract(motion, **kw):
+            q = next(it)
+            if q == "refused":
+                raise cc.errors.NoPeriodicMotionError("refused")
+            return NS(pose_quality=q, period_frames=120, cycles=4.5)
+
+        monkeypatch.setattr(pipeline, "extract", extract)
+        kw = {} if most is None else {"most": most}
+        return [s.option for s in what_would_help(m, {}, **kw)]
+
+    names = [option for option, _ in suggest.ALTERNATIVES]
+    assert found(["refused", pop, stray, clean]) == [names[3]]
+    assert found([None, pop, clean, clean]) == [names[0], names[2]]  # most=2 by default
+    monkeypatch.setattr(pipeline, "extract",
+                        lambda motion, **kw: NS(pose_quality=None, period_frames=120, cycles=4.5))
+    first = what_would_help(m, {}, most=1)[0]
+    assert first.to_dict() == {"option": names[0], "period_frames": 120.0, "cycles": 4.5}
+    with pytest.raises(AttributeError):  # a frozen record
+        first.cycles = 1.0
+    assert found([clean, clean, clean, clean], most=3) == names[:3]
+    assert found([stray, None, "refused", pop], most=1) == [names[1]]
+    monkeypatch.setattr(suggest, "MAX_FRAMES", m.n_frames)
+    assert found([clean] * 4) == names[:2]
+    monkeypatch.setattr(suggest, "MAX_FRAMES", m.n_frames - 1)
+    assert found([clean] * 4) == []

@@ -176,8 +176,10 @@ def test_skating_line(walk_69_01):
 
 
 def test_clean_closes_short_gaps_inside_and_drops_short_runs():
-    """min_frames 3: gaps of 2 and 1 frames between contacts are closed, a 3-frame gap
-    is kept, a gap at either end is not between contacts; a 2-frame contact is dropped."""
+    """Gaps inside shorter than min_frames are closed, then contacts shorter than
+    min_frames dropped; min_frames 1 or less leaves the mask as it is.  min_frames 3: gaps
+    of 2 and 1 frames between contacts are closed, a 3-frame gap is kept, a gap at either
+    end is not between contacts; a 2-frame contact is dropped."""
     from cyclecoord.quality.contacts import _clean
 
     m = np.array([0, 1, 1, 1, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1, 0, 1, 1, 0, 0, 0, 1, 1, 0], bool)
@@ -185,6 +187,11 @@ def test_clean_closes_short_gaps_inside_and_drops_short_runs():
                     bool)
     np.testing.assert_array_equal(_clean(m, 3), want)
     np.testing.assert_array_equal(_clean(m, 1), m)  # 1 frame: nothing to clean
+    # 2 frames: the one-frame gap inside is closed, the one-frame contact dropped, two kept
+    m2 = np.array([1, 0, 1, 1, 0, 0, 1, 0, 0, 1, 1, 0], bool)
+    np.testing.assert_array_equal(_clean(m2, 2),
+                                  np.array([1, 1, 1, 1, 0, 0, 0, 0, 0, 1, 1, 0], bool))
+    np.testing.assert_array_equal(_clean(m, 2), m | (np.arange(m.size) == 16))
 
 
 def test_a_foot_held_up_all_take_is_never_planted():

@@ -187,3 +187,48 @@ def test_fast_contact_fraction_counts_feet_faster_than_half_a_leg_a_second():
     assert q.sliding_fraction == 0.5 and q.to_dict()["fast_contact_fraction"] == 0.5
     assert measure_generated(make_motion(skel, T=64, fps=64.0, root_speed=4.5),
                              sources).sliding_fraction == 1.0
+
+
+def test_cycle_is_the_first_autocorrelation_peak_near_the_highest():
+    """_cycle (the module's cadence): the first peak of the autocorrelation between 0.4 and
+    2.5 s that reaches CYCLE_PEAK of the highest there.  A 1.1 s sine reads 1.1 s; a 0.38 s
+    one (under the window) reads its first peak inside, two cycles (0.76 s), not the
+    window's edge; a weak 2.2 s undertone leaves 1.1 s (its peak is within 85 % of the
+    2.2 s one), a strong one makes it 2.2 s; without a peak the highest lag is taken; a
+    flat or too short signal has none."""
+    from cyclecoord.quality.generated import CYCLE_PEAK, CYCLE_RANGE, _cycle
+
+    assert CYCLE_RANGE == (0.4, 2.5) and CYCLE_PEAK == 0.85
+    fps, t = 100.0, np.arange(600)
+    assert _cycle(np.sin(2 * np.pi * t / 110), fps) == pytest.approx(1.1, abs=0.011)
+    assert _cycle(np.sin(2 * np.pi * t / 38), fps) == pytest.approx(0.76, abs=0.011)
+    weak = np.sin(2 * np.pi * t / 110) + 0.2 * np.sin(2 * np.pi * t / 220)
+    strong = np.sin(2 * np.pi * t / 110) + 0.5 * np.sin(2 * np.pi * t / 220)
+    assert _cycle(weak, fps) == pytest.approx(1.1, abs=0.011)
+    assert _cycle(strong, fps) == pytest.approx(2.2, abs=0.011)
+    # no peak inside the window (a drift: the autocorrelation only falls): its highest lag
+    assert _cycle(np.arange(600.0), fps) == pytest.approx(0.4)
+    assert np.isnan(_cycle(np.full(600, 3.0), fps))
+    assert np.isnan(_cycle(np.sin(2 * np.pi * t[:79] / 20), fps))  # 39 lags: under 0.4 s
+
+
+def test_longest_freeze_is_zero_without_slow_frames():
+    """longest_freeze_s is the longest run of slow frames (pose speed under FREEZE_FRACTION
+    of the sources' median), 0 when there is none; runs over FREEZE_SECONDS are freezes.
+    Synthetic legs at 64 fps whose knees bend at a steady 40 deg/s have no slow frame;
+    holding frame 20 for 32 frames makes steps 20-50 still: one run of 31 frames."""
+    from _legs import legs_skeleton, make_motion
+
+    skel = legs_skeleton()
+    src = make_motion(skel, T=128, fps=64.0)
+    f = src.frames.copy()
+    knees = [src.channels.index((knee, "rx")) for knee in ("ltibia", "rtibia")]
+    f[:, knees] = 10 * np.sin(2 * np.pi * np.arange(128) / 64)[:, None]
+    sources = [src.with_frames(f)]
+    g = src.frames[:96].copy()
+    g[:, knees] = (40.0 * np.arange(96) / 64)[:, None]
+    q = measure_generated(src[:96].with_frames(g), sources)
+    assert q.freezes == [] and q.longest_freeze_s == 0.0
+    g[20:52] = g[20]
+    q = measure_generated(src[:96].with_frames(g), sources)
+    assert q.freezes == [(20, 51)] and q.longest_freeze_s == pytest.approx(31 / 64)

@@ -410,3 +410,30 @@ def test_short_quadruped_pairs_legs_where_they_part_lowest(trotting):
         for label, k in (("front left", "fl"), ("front right", "fr"), ("hind left", "hl"),
                          ("hind right", "hr"))
     ]
+
+
+def test_forward_directions_are_unit_vectors_however_short_the_feet():
+    """_Geometry.forward: where the feet point (ankle to toe, the up axis dropped), one unit
+    vector a frame, on a frame whose feet point almost straight down too (1.5e-12 units
+    forward); a frame on which they point exactly down has none (zeros, not NaN).  With no
+    foot pointing anywhere on most frames, the root's travel; without travel, +z."""
+    from cyclecoord.quality.legs import _Geometry
+
+    geo = object.__new__(_Geometry)
+    geo.up = 1
+    pos = np.zeros((4, 3, 3))  # frames, (root, ankle, toe), xyz
+    pos[:, 1] = [0.0, 1.0, 0.0]
+    pos[:, 2] = [[0.0, 0.0, 3.0], [1.5e-12, 0.0, 0.0], [0.0, 0.0, 0.0], [-2.0, 0.5, 0.0]]
+    geo.pos = pos
+    fwd = geo.forward([(1, 2)])
+    np.testing.assert_allclose(fwd, [[0, 0, 1], [1, 0, 0], [0, 0, 0], [-1, 0, 0]], atol=1e-15)
+    # no foot direction: the root's travel from the first frame to the last, else +z
+    pos[:, 1] = pos[:, 2] = [0.5, 1.0, 0.0]
+    pos[:, 0] = [[1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 0.0, 5.0], [3.0, 0.0, 1.0]]
+    travel = np.array([2.0, 0.0, 1.0]) / np.sqrt(5.0)
+    np.testing.assert_allclose(geo.forward([(1, 2)]), np.tile(travel, (4, 1)), atol=1e-15)
+    geo.pos = pos[[0, 3]]  # two frames travel too
+    np.testing.assert_allclose(geo.forward([(1, 2)]), np.tile(travel, (2, 1)), atol=1e-15)
+    geo.pos = pos
+    pos[:, 0] = [1.0, 0.0, 0.0]
+    np.testing.assert_array_equal(geo.forward([(1, 2)]), np.tile([0.0, 0.0, 1.0], (4, 1)))

@@ -222,3 +222,18 @@ def test_blockwise_figures_equal_whole_array_ones_bit_for_bit(monkeypatch):
     np.testing.assert_array_equal(qm.frame_steps(x), whole_steps)
     with pytest.raises(ParameterError):
         qm.jerk_summary(x[:5], 120.0)
+
+
+def test_cyclic_jerk_summary_is_the_open_one_over_the_loop_continued():
+    """jerk_summary uses the 4th-order formula (a 7-point stencil) with or without
+    ``cyclic``: over a loop it equals the open figure over the loop followed by its first
+    6 frames, i.e. the mean norm of jerk(accuracy=4, cyclic=True); another order differs."""
+    from cyclecoord.quality.metrics import jerk, jerk_summary
+
+    t = np.arange(40) / 40
+    x = np.column_stack([np.sin(2 * np.pi * t), np.cos(6 * np.pi * t), 0.3 * np.sin(10 * np.pi * t)])
+    loop = jerk_summary(x, 30.0, cyclic=True)
+    assert loop == pytest.approx(jerk_summary(np.vstack([x, x[:6]]), 30.0), rel=1e-12)
+    j4 = np.linalg.norm(jerk(x, 30.0, accuracy=4, cyclic=True), axis=1).mean()
+    j5 = np.linalg.norm(jerk(x, 30.0, accuracy=5, cyclic=True), axis=1).mean()
+    assert loop == pytest.approx(j4, rel=1e-12) and abs(j5 / j4 - 1) > 1e-3

@@ -228,3 +228,16 @@ def test_a_reference_played_on_narrower_hips_explains_the_legs_meeting(walk):
     assert any("the inputs come as close" in n for n in report.notes)
     # the same skeleton object: one view, nothing to replay
     assert len(_reference_views(walk, walk)) == 1
+
+
+def test_the_note_names_the_worst_joint_angle(walk):
+    """check_plausibility's joint-range note counts the angles out of range and names the
+    worst excess (joint_range_violations lists it first), not the first channel."""
+    g = np.array(walk.frames)
+    low, high = walk.channel_index("lfemur", "rx"), walk.channel_index("ltibia", "rx")
+    g[10, low] = g[:, low].max() + 8.0  # 3 degrees beyond the 5-degree margin
+    g[20, high] = g[:, high].max() + 25.0  # 20 beyond: the worst
+    rep = check_plausibility(walk.with_frames(g), [walk])
+    note = next(n for n in rep.notes if "joint angles leave" in n)
+    assert note.startswith("2 joint angles leave") and "worst ltibia.rx at" in note
+    assert [v.channel for v in rep.joint_range] == [("ltibia", "rx"), ("lfemur", "rx")]

@@ -134,6 +134,11 @@ class Fit:
 class TakeFit:
     """One extraction's fitting steps on a windowed capture: preparation, the barcode and
     coordinate on some rows, the steady frames.  ``params`` are :func:`extract`'s (checked).
+
+    ``moving`` holds the frames the first fit reads: with ``steady``, the moving frames
+    (:func:`~cyclecoord.periodic.steady.moving_mask`), unless they are 95 % of the take or
+    more (nothing to leave out) or fewer than ``max(10, 2 * n_neighbors)`` (too few to
+    fit on); then, and without ``steady``, every frame.
     """
 
     def __init__(self, motion: Motion, params: dict[str, Any], require_clear: bool) -> None:

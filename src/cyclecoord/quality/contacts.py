@@ -305,7 +305,10 @@ def contact_runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 def _clean(mask: np.ndarray, min_frames: int) -> np.ndarray:
-    """Close gaps and drop runs shorter than ``min_frames`` in a ``(T,)`` mask."""
+    """Close gaps and drop runs shorter than ``min_frames`` in a ``(T,)`` mask.
+
+    Gaps between two runs (not at either end) are closed first, then the runs still
+    shorter are dropped; ``min_frames`` 1 or less leaves the mask as it is."""
     out = mask.copy()
     if min_frames <= 1:
         return out

@@ -406,7 +406,8 @@ class _Geometry:
 
     def forward(self, legs: list[tuple[int, ...]]) -> np.ndarray:
         """Horizontal forward direction per frame ``(T, 3)``: where the feet point (ankle
-        to toe), else the root's travel, else +z."""
+        to toe), else the root's travel, else +z.  Each row is a unit vector, however
+        short the feet's horizontal extent on that frame, or zero where it is none."""
         horiz = [k for k in range(3) if k != self.up]
         T = self.pos.shape[0]
         fwd = np.zeros((T, 3))
