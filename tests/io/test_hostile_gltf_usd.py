@@ -283,3 +283,25 @@ def test_usd_skeleton_value_of_an_unknown_type(usda, attr):
     text = usda.read_text()
     usda.write_text(text.replace(f"matrix4d[] {attr} =", f"matrix0d[] {attr} ="))
     _refused(usda, f"Skeleton.{attr}: a UnregisteredValue value", "Matrix4dArray")
+
+
+def test_an_accessor_in_a_misaligned_buffer_view(glb):
+    # the accessor's own offset is 0, but its view starts 2 bytes into a 4-byte float
+    doc, blob = read_glb(glb)
+    acc = doc["accessors"][_times_accessor(doc)]
+    view = doc["bufferViews"][acc["bufferView"]]
+    start = view.get("byteOffset", 0)
+    data = bytes(blob[start : start + view["byteLength"]])
+    blob += b"\0" * (-len(blob) % 4) + b"\0\0"
+    view["byteOffset"] = len(blob)
+    blob += data
+    write_glb(glb, doc, blob)
+    _refused(glb, "byteOffset", "not a multiple of its 4-byte components")
+
+
+def test_channel_names_of_more_than_a_thousand_characters(glb):
+    doc, blob = read_glb(glb)
+    extras = doc["extras"]["cyclecoord"]
+    extras["channels"][0][0] = "j" * 1001
+    write_glb(glb, doc, blob)
+    _refused(glb, "channels[0]", "1,001 characters; at most 1,000")
