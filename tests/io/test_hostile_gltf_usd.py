@@ -305,3 +305,26 @@ def test_channel_names_of_more_than_a_thousand_characters(glb):
     extras["channels"][0][0] = "j" * 1001
     write_glb(glb, doc, blob)
     _refused(glb, "channels[0]", "1,001 characters; at most 1,000")
+
+
+def test_usd_time_codes_far_from_zero(usda):
+    # the frame count is endTimeCode - startTimeCode + 1, wherever the range starts
+    text = usda.read_text().replace("endTimeCode = 19", "endTimeCode = 9000019", 1)
+    usda.write_text(text.replace("startTimeCode = 0", "startTimeCode = 9000000", 1))
+    m = cc.load(usda)
+    assert m.n_frames == 20 and np.isfinite(m.frames).all()
+
+
+def test_usd_animation_values_without_its_joints():
+    # an animation that names no joints has 0 of them: any translation is one too many
+    pytest.importorskip("pxr")
+    from pxr import Gf, Usd, UsdSkel, Vt
+
+    from cyclecoord.io.usd import _check_component_sizes
+
+    stage = Usd.Stage.CreateInMemory()
+    anim = UsdSkel.Animation.Define(stage, "/Anim")
+    assert anim.GetJointsAttr().Get() is None
+    anim.GetTranslationsAttr().Set(Vt.Vec3fArray([Gf.Vec3f(0, 0, 0)]), Usd.TimeCode(0))
+    with pytest.raises(ParseError, match="1 values for the animation's 0 joints"):
+        _check_component_sizes(anim, np.array([0]), "x.usda")
