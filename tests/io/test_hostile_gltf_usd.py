@@ -328,3 +328,24 @@ def test_usd_animation_values_without_its_joints():
     anim.GetTranslationsAttr().Set(Vt.Vec3fArray([Gf.Vec3f(0, 0, 0)]), Usd.TimeCode(0))
     with pytest.raises(ParseError, match="1 values for the animation's 0 joints"):
         _check_component_sizes(anim, np.array([0]), "x.usda")
+
+
+def test_gltf_of_exactly_max_frames_is_not_refused_for_its_frame_count(glb):
+    # at 1 fps a last key at 9,999,999 s makes MAX_FRAMES (10 million) frames: the most
+    # supported, so only the (here small) memory limit refuses it; one second more is
+    # refused for its frame count
+    from cyclecoord.io._limits import MAX_FRAMES, memory_limit
+
+    doc, blob = read_glb(glb)
+    view = doc["bufferViews"][doc["accessors"][_times_accessor(doc)]["bufferView"]]
+    start = view.get("byteOffset", 0)
+    times = np.frombuffer(bytes(blob[start : start + view["byteLength"]]), "<f4").copy()
+    del doc["extras"]["cyclecoord"]["frames"]
+    doc["extras"]["cyclecoord"]["fps"] = 1.0
+    for last, words in [(MAX_FRAMES - 1, ["10,000,000 frames of", "memory"]),
+                        (MAX_FRAMES, ["at most 10,000,000 are supported"])]:
+        times[-1] = last
+        blob[start : start + times.nbytes] = times.astype("<f4").tobytes()
+        write_glb(glb, doc, blob)
+        with memory_limit(1_000_000):
+            _refused(glb, *words)
