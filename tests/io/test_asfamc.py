@@ -893,3 +893,41 @@ def test_amc_names_its_rate_unless_it_is_120(tmp_path, fps, named):
     lines = (tmp_path / "m.amc").read_text().splitlines()
     rate_lines = [s for s in lines if s.startswith("# frame rate")]
     assert rate_lines == ([f"# frame rate {fps!r} fps (cyclecoord)"] if named else [])
+
+
+def test_bone_axis_without_letters_means_xyz(tmp_path: Path) -> None:
+    plain = MINI_ASF.replace("axis 10 -20 30 XYZ", "axis 10 -20 30")
+    assert plain != MINI_ASF
+    a = read_asf(put(tmp_path, "a.asf", MINI_ASF))
+    b = read_asf(put(tmp_path, "b.asf", plain))
+    assert_same_skeleton(a, b)
+
+
+def test_numbers_up_to_the_largest_magnitude_are_read() -> None:
+    from cyclecoord.io._acclaim import parse_number
+    from cyclecoord.io._limits import MAX_MAGNITUDE
+
+    assert parse_number(repr(MAX_MAGNITUDE), "x.asf", 1, "length") == MAX_MAGNITUDE
+    assert parse_number(repr(-MAX_MAGNITUDE), "x.asf", 1, "length") == -MAX_MAGNITUDE
+    with pytest.raises(ParseError, match="beyond the largest supported magnitude"):
+        parse_number(repr(MAX_MAGNITUDE * (1 + 1e-15)), "x.asf", 1, "length")
+
+
+def test_helper_bone_names_count_up_past_taken_ones() -> None:
+    # a helper bone is "<parent>_to_<child>", then _2, _3... while that name is taken
+    from cyclecoord.io._acclaim import asf_layout
+
+    skel = Skeleton(
+        joints=(
+            Joint("Hips", -1, [0, 0, 0], ("rx",), "X"),
+            Joint("Spine", 0, [0, 10, 0], ("rx",), "X"),
+            Joint("Head", 1, [0, 20, 1], ("rx",), "X"),
+            Joint("Arm", 1, [5, 15, 0], ("rx",), "X"),
+            Joint("Spine_to_Head", 0, [1, 0, 0], ("rx",), "X"),
+            Joint("Spine_to_Head_2", 0, [2, 0, 0], ("rx",), "X"),
+        ),
+        name="taken",
+    )
+    names = [b.asf_name for b in asf_layout(skel)]
+    assert len(set(names)) == len(names)
+    assert "Spine_to_Head_3" in names and "Spine_to_Arm" in names

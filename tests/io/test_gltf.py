@@ -213,14 +213,12 @@ def _foreign(tmp_path, m):
     return gltf
 
 
-def test_cubic_spline_samplers_read_their_values_not_tangents(tmp_path):
-    """A CUBICSPLINE sampler holds (in-tangent, value, out-tangent) per key; the reader
-    takes the values (between keys it interpolates linearly, as for LINEAR)."""
+def _cubic(tmp_path, m, in_tangent=7.0, out_tangent=-5.0):
+    """``m`` as a foreign glTF whose samplers are CUBICSPLINE, tangents value + offset."""
     import base64
 
     import pygltflib
 
-    m = _arm()
     gltf = _foreign(tmp_path, m)
     blob = bytearray()
     for s in gltf.animations[0].samplers:
@@ -231,7 +229,7 @@ def test_cubic_spline_samplers_read_their_values_not_tangents(tmp_path):
         start = (view.byteOffset or 0) + (acc.byteOffset or 0)
         v = np.frombuffer(data, np.float32, acc.count * ncomp, start).reshape(-1, ncomp)
         # tangents far from the values (a reader taking them would be far off)
-        keys = np.stack([v + 7.0, v, v - 5.0], axis=1).astype(np.float32)
+        keys = np.stack([v + in_tangent, v, v + out_tangent], axis=1).astype(np.float32)
         gltf.bufferViews.append(pygltflib.BufferView(buffer=len(gltf.buffers),
                                                      byteOffset=len(blob),
                                                      byteLength=keys.nbytes))
@@ -244,9 +242,23 @@ def test_cubic_spline_samplers_read_their_values_not_tangents(tmp_path):
     uri = "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode()
     gltf.buffers.append(pygltflib.Buffer(byteLength=len(blob), uri=uri))
     (tmp_path / "cubic.gltf").write_text(gltf.gltf_to_json())
-    back = read_gltf(tmp_path / "cubic.gltf")
+    return tmp_path / "cubic.gltf"
+
+
+def test_cubic_spline_samplers_read_their_values_not_tangents(tmp_path):
+    """A CUBICSPLINE sampler holds (in-tangent, value, out-tangent) per key; the reader
+    takes the values (between keys it interpolates linearly, as for LINEAR)."""
+    m = _arm()
+    back = read_gltf(_cubic(tmp_path, m))
     assert back.n_frames == m.n_frames
     assert np.abs(back.positions().positions[:, :3] - m.positions().positions).max() < 1e-5
+
+
+@pytest.mark.parametrize("in_tangent, out_tangent", [(np.nan, -5.0), (7.0, np.inf)])
+def test_cubic_spline_tangents_must_be_finite(tmp_path, in_tangent, out_tangent):
+    path = _cubic(tmp_path, _arm(), in_tangent, out_tangent)
+    with pytest.raises(ParseError, match="tangents that are not finite"):
+        read_gltf(path)
 
 
 def test_identity_matrix_beside_trs_is_no_matrix(tmp_path):

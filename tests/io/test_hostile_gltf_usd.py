@@ -283,3 +283,69 @@ def test_usd_skeleton_value_of_an_unknown_type(usda, attr):
     text = usda.read_text()
     usda.write_text(text.replace(f"matrix4d[] {attr} =", f"matrix0d[] {attr} ="))
     _refused(usda, f"Skeleton.{attr}: a UnregisteredValue value", "Matrix4dArray")
+
+
+def test_an_accessor_in_a_misaligned_buffer_view(glb):
+    # the accessor's own offset is 0, but its view starts 2 bytes into a 4-byte float
+    doc, blob = read_glb(glb)
+    acc = doc["accessors"][_times_accessor(doc)]
+    view = doc["bufferViews"][acc["bufferView"]]
+    start = view.get("byteOffset", 0)
+    data = bytes(blob[start : start + view["byteLength"]])
+    blob += b"\0" * (-len(blob) % 4) + b"\0\0"
+    view["byteOffset"] = len(blob)
+    blob += data
+    write_glb(glb, doc, blob)
+    _refused(glb, "byteOffset", "not a multiple of its 4-byte components")
+
+
+def test_channel_names_of_more_than_a_thousand_characters(glb):
+    doc, blob = read_glb(glb)
+    extras = doc["extras"]["cyclecoord"]
+    extras["channels"][0][0] = "j" * 1001
+    write_glb(glb, doc, blob)
+    _refused(glb, "channels[0]", "1,001 characters; at most 1,000")
+
+
+def test_usd_time_codes_far_from_zero(usda):
+    # the frame count is endTimeCode - startTimeCode + 1, wherever the range starts
+    text = usda.read_text().replace("endTimeCode = 19", "endTimeCode = 9000019", 1)
+    usda.write_text(text.replace("startTimeCode = 0", "startTimeCode = 9000000", 1))
+    m = cc.load(usda)
+    assert m.n_frames == 20 and np.isfinite(m.frames).all()
+
+
+def test_usd_animation_values_without_its_joints():
+    # an animation that names no joints has 0 of them: any translation is one too many
+    pytest.importorskip("pxr")
+    from pxr import Gf, Usd, UsdSkel, Vt
+
+    from cyclecoord.io.usd import _check_component_sizes
+
+    stage = Usd.Stage.CreateInMemory()
+    anim = UsdSkel.Animation.Define(stage, "/Anim")
+    assert anim.GetJointsAttr().Get() is None
+    anim.GetTranslationsAttr().Set(Vt.Vec3fArray([Gf.Vec3f(0, 0, 0)]), Usd.TimeCode(0))
+    with pytest.raises(ParseError, match="1 values for the animation's 0 joints"):
+        _check_component_sizes(anim, np.array([0]), "x.usda")
+
+
+def test_gltf_of_exactly_max_frames_is_not_refused_for_its_frame_count(glb):
+    # at 1 fps a last key at 9,999,999 s makes MAX_FRAMES (10 million) frames: the most
+    # supported, so only the (here small) memory limit refuses it; one second more is
+    # refused for its frame count
+    from cyclecoord.io._limits import MAX_FRAMES, memory_limit
+
+    doc, blob = read_glb(glb)
+    view = doc["bufferViews"][doc["accessors"][_times_accessor(doc)]["bufferView"]]
+    start = view.get("byteOffset", 0)
+    times = np.frombuffer(bytes(blob[start : start + view["byteLength"]]), "<f4").copy()
+    del doc["extras"]["cyclecoord"]["frames"]
+    doc["extras"]["cyclecoord"]["fps"] = 1.0
+    for last, words in [(MAX_FRAMES - 1, ["10,000,000 frames of", "memory"]),
+                        (MAX_FRAMES, ["at most 10,000,000 are supported"])]:
+        times[-1] = last
+        blob[start : start + times.nbytes] = times.astype("<f4").tobytes()
+        write_glb(glb, doc, blob)
+        with memory_limit(1_000_000):
+            _refused(glb, *words)

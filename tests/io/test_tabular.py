@@ -232,3 +232,22 @@ def test_csv_missing_and_empty(tmp_path):
     (tmp_path / "header.csv").write_text("a.tx,a.ty\n")
     with pytest.raises(ParseError, match="no frames"):  # as every reader: no frames, no capture
         read_csv(tmp_path / "header.csv")
+
+
+def test_csv_ignores_the_skeleton_it_does_not_store(tmp_path):
+    # the skeleton is not written, so one no skeleton file would take does not stop a CSV
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("rx",), "X"), Joint("far", 0, [1e12, 0, 0], ("ry",), "Y")))
+    m = Motion(np.zeros((3, 2)), sk.channels, fps=30.0, skeleton=sk)
+    with pytest.raises(ParameterError, match="skeleton"):
+        write_npz(m, tmp_path / "m.npz")
+    write_csv(m, tmp_path / "m.csv")
+    back = read_csv(tmp_path / "m.csv")
+    assert back.channels == m.channels and np.array_equal(back.frames, m.frames)
+
+
+def test_csv_joint_names_with_dots_read_back(tmp_path):
+    # the header splits at the last dot: joint "a.b.c" with dof "rx" is "a.b.c.rx"
+    m = Motion(np.arange(6.0).reshape(3, 2), [("a.b.c", "rx"), ("hips", "ty")], fps=30.0)
+    write_csv(m, tmp_path / "m.csv")
+    back = read_csv(tmp_path / "m.csv")
+    assert back.channels == m.channels and np.array_equal(back.frames, m.frames)

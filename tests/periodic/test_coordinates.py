@@ -312,3 +312,18 @@ def test_coordinates_stay_below_one():
 
     out = orient_with_time(np.array([0.3, np.nextafter(0.3, 0.0), 0.5, 0.7]))
     assert out.max() < 1.0 and out[1] == 0.0
+
+
+def test_extend_coordinate_point_in_one_ball_takes_that_center_value():
+    # a point inside the ball of one center only (not the first) gets that center's value;
+    # one in no ball, its nearest center's (the docstring's `covered`)
+    from cyclecoord.periodic._cochain import extend_coordinate
+
+    centers = np.array([[0.0, 0.0], [10.0, 0.0], [0.0, 10.0]])
+    theta = np.array([0.1, 0.6, 0.85])
+    pts = np.array([[10.5, 0.0], [0.0, 9.7], [0.2, 0.0], [8.0, 1.0]])
+    out, covered = extend_coordinate(
+        pts, centers, theta, np.zeros((0, 2), int), np.zeros(0), radius=1.0
+    )
+    np.testing.assert_allclose(out, [0.6, 0.85, 0.1, 0.6], atol=1e-12)
+    assert covered.tolist() == [True, True, True, False]

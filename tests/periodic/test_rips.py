@@ -50,3 +50,30 @@ def test_sparse_matches_ripser():
     want = ripser.ripser(mat, maxdim=1, thresh=1.5, coeff=47, do_cocycles=True, distance_matrix=True)
     c = mat.tocoo()
     _same(sparse_rips_cohomology(c.row, c.col, c.data, 300, 1.5, 47), want)
+
+
+def test_long_h0_counts_h0_bars_not_h1_bars():
+    from cyclecoord.periodic.barcode import Barcode
+
+    bc = Barcode(
+        h0=np.array([[0.0, 0.1], [0.0, 1.0], [0.0, np.inf]]),
+        h1=np.array([[0.2, 0.3]]),
+        cocycles=[np.zeros((0, 3), int)],
+        threshold=2.0,
+        prime=47,
+        n_points=3,
+    )
+    # H0 lengths 0.1, 1 and 2 (the infinite bar capped at the threshold); the H1 bar is 0.1
+    assert bc.long_h0(0.5) == 2
+    assert bc.long_h0(0.05) == 3
+    assert bc.long_h0(1.5) == 1
+
+
+@pytest.mark.parametrize("scale", [0.0, -1.0, np.inf, np.nan])
+def test_compute_barcode_refuses_a_max_scale_that_is_not_positive(scale):
+    from cyclecoord.errors import ParameterError
+    from cyclecoord.periodic.barcode import compute_barcode
+
+    x = np.random.default_rng(0).normal(size=(10, 2))
+    with pytest.raises(ParameterError, match="max scale must be a positive number"):
+        compute_barcode(x, max_scale=scale)

@@ -176,6 +176,18 @@ def test_typical_amplitude_windows_start_at_every_frame_for_short_cycles():
     np.testing.assert_array_equal(typical_amplitude(cycle, phase[:3], poses[:3], spike=1), cycle)
 
 
+def test_typical_amplitude_first_window_starts_at_the_run_start():
+    """A phased run exactly one period long has one window, the one starting at its first
+    frame: its range (1.3 times the cycle's, plateaus a running median keeps) sets a gain
+    of 1.3 about the cycle's mean."""
+    from cyclecoord.periodic.clip import typical_amplitude
+
+    cycle = np.repeat([1.0, -1.0], 8)[:, None]
+    poses = 1.3 * cycle
+    out = typical_amplitude(cycle, np.zeros(16), poses, spike=3)
+    np.testing.assert_allclose(out, 1.3 * cycle)
+
+
 def test_typical_amplitude_never_narrows_nor_widens_a_glitch():
     """Three channels of a 12-frame cycle against a capture of four repetitions of a
     plateaued pattern (range 3; a running median of 3 frames keeps it): a channel 1.2x

@@ -15,6 +15,7 @@ Conventions (see :mod:`cyclecoord.skeleton` for the shared skeleton model):
   matrix is ``Rz @ Ry @ Rx`` and the intrinsic ``rotation_order`` is ``"ZYX"`` (CMU's
   mocapPlayer convention).  ``axis a b c XYZ`` pairs each angle with the letter at the
   same position and also applies the first letter first: ``C = Rz(c) @ Ry(b) @ Rx(a)``.
+  A bone's ``axis a b c`` without letters means ``XYZ``.
   The root ``orientation`` is read the same way with the root ``axis`` letters.
 * Angles are degrees unless the ASF says ``:units angle rad`` or the AMC says
   ``:RADIANS``; skeletons and motions always hold degrees.  An AMC with neither

@@ -561,10 +561,12 @@ def read_gltf(path: str | os.PathLike[str]) -> Motion:
     ParseError
         One line naming the file and the entry (``accessors[3].count``,
         ``nodes[5].children``, ``extras.cyclecoord.fps``, ...): indices or byte ranges out
-        of bounds, a node graph with a cycle or too deep, key times that are not finite
-        or do not increase, more frames than ``MAX_FRAMES`` or than the
-        memory limit allows, rotations that are not unit quaternions, extras of the wrong
-        types.
+        of bounds, accessors not aligned to their components (the accessor's and its
+        buffer view's byte offsets together), a node graph with a cycle or too deep, key
+        times that are not finite or do not increase, more frames than ``MAX_FRAMES`` or
+        than the memory limit allows, rotations that are not unit quaternions, spline
+        tangents (in or out) that are not finite, node or channel names longer than 1,000
+        characters, extras of the wrong types.
     """
     from ._checked import Invalid
 

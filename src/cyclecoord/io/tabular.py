@@ -420,7 +420,8 @@ def write_csv(motion: Motion, path: str | os.PathLike[str]) -> None:
     """Save the frames as CSV: ``# fps=...`` comment, ``joint.dof`` header, one row per frame.
 
     Values are written with :func:`repr`, so they read back exactly.  The skeleton is
-    not stored (save it as ASF/BVH, or use :func:`write_npz`).
+    not stored (save it as ASF/BVH, or use :func:`write_npz`), nor checked.
+    The header names split at the last dot, so joint names may hold dots.
 
     Parameters
     ----------
