@@ -486,3 +486,31 @@ def test_window_table_progress_bar_only_when_asked(monkeypatch):
         assert len(wins) == (0 if lengths == (9.0,) else 5)
         assert [k["disable"] for k in made] == [disabled], (progress, lengths)
         assert made[0]["delay"] == 2.0 and made[0]["leave"] is False
+
+
+def test_dilate_by_zero_frames_leaves_the_mask_alone():
+    from cyclecoord.periodic.detection.windows import _dilate
+
+    mask = np.zeros(12, dtype=bool)
+    mask[5] = True
+    assert np.array_equal(_dilate(mask, 0), mask)
+    assert np.flatnonzero(_dilate(mask, 2)).tolist() == [3, 4, 5, 6, 7]
+
+
+def test_binned_cycle_interpolates_empty_bins_linearly_around_the_circle():
+    from cyclecoord.periodic.detection.windows import binned_cycle
+
+    # Bins 0 and 3 of 4 are filled (poses 1 and 4); bins 1 and 2 lie 1/3 and 2/3 of the way.
+    out = binned_cycle(np.array([0.1, 0.8]), np.array([[1.0], [4.0]]), bins=4)
+    assert np.allclose(out[:, 0], [1.0, 2.0, 3.0, 4.0])
+
+
+def test_window_table_windows_stay_inside_the_capture():
+    """Windows of 10 frames stepped by 2 over 21 frames start at 0, 2, ..., 10 and the last
+    one ends at the last frame; none runs past it."""
+    from cyclecoord.periodic.detection import window_table
+
+    t = np.arange(21)
+    pts = np.column_stack([np.cos(2 * np.pi * t / 5), np.sin(2 * np.pi * t / 5)])
+    wins = window_table(pts, pts, 5.0, lengths=(2.0,), progress=False)
+    assert [(w.start, w.stop) for w in wins] == [(a, a + 10) for a in (0, 2, 4, 6, 8, 10, 11)]

@@ -385,3 +385,11 @@ def test_memory_guard_at_the_edge_of_the_budget():
     # two points: nothing estimated, as estimate_complex says
     two = three[:2]
     assert choose_landmarks(two, thr, landmarks=None, memory_limit=1.0)[1] == estimate_complex(two, thr)
+
+
+def test_summary_period_is_frame_steps_per_cycle():
+    """101 frames winding 4 times: 100 steps over 4 cycles, a period of 25 frames."""
+    model = object.__new__(PhaseModel)
+    model.phase = lambda motion: (np.arange(101) / 25.0) % 1.0
+    s = model.summary(None)
+    assert s["cycles"] == pytest.approx(4.0) and s["period_frames"] == pytest.approx(25.0)

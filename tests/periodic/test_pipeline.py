@@ -505,3 +505,13 @@ def test_a_configured_object_alone_is_read_and_checked():
     res = cc.extract(m, preprocessor=Preprocessor(pca=5))
     assert res.parameters["pca"] == 5 and res.parameters["delay"] is None
     assert cc.extract(m, cycle=cc.CycleOptions(n_samples=50)).parameters["n_samples"] == 50
+
+
+def test_rows_of_is_a_view_for_one_contiguous_run():
+    from cyclecoord.periodic.fitting import rows_of
+
+    x = np.arange(20.0).reshape(10, 2)
+    run = rows_of(x, np.arange(3, 7))
+    assert np.array_equal(run, x[3:7]) and np.shares_memory(run, x)
+    gap = rows_of(x, np.array([1, 2, 5]))
+    assert np.array_equal(gap, x[[1, 2, 5]]) and not np.shares_memory(gap, x)
