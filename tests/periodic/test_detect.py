@@ -514,3 +514,20 @@ def test_window_table_windows_stay_inside_the_capture():
     pts = np.column_stack([np.cos(2 * np.pi * t / 5), np.sin(2 * np.pi * t / 5)])
     wins = window_table(pts, pts, 5.0, lengths=(2.0,), progress=False)
     assert [(w.start, w.stop) for w in wins] == [(a, a + 10) for a in (0, 2, 4, 6, 8, 10, 11)]
+
+
+def test_a_segment_starting_one_frame_in_has_a_boundary_there():
+    """Only frames 0 and n_frames are not boundaries: a start at frame 1 is one, 1 frame
+    from the capture's first frame."""
+    segs = [Segment(1, 10, 0, (0,), 1, 2, 1.5, 1, 10), Segment(10, 20, 1, (1,), 1, 2, 1.5, 1, 10)]
+    assert boundary_errors(segs, [(0, 10, "a"), (10, 20, "b")], 20) == [0, 1, 0]
+
+
+def test_candidate_classes_take_a_bar_of_exactly_the_clear_ratio():
+    from cyclecoord.periodic.barcode import CLEAR_RATIO, Barcode
+    from cyclecoord.periodic.detection.classes import candidate_classes
+
+    h1 = np.array([[1.0, 3.0], [2.0, 2.0 * CLEAR_RATIO], [2.0, 2.9]])  # ratios 3, 1.5, 1.45
+    bc = Barcode(h0=np.zeros((0, 2)), h1=h1, cocycles=[None] * 3, threshold=10.0, prime=47,
+                 n_points=10)
+    assert candidate_classes(bc, None, 5, 0.1) == [0, 1]
