@@ -531,3 +531,23 @@ def test_candidate_classes_take_a_bar_of_exactly_the_clear_ratio():
     bc = Barcode(h0=np.zeros((0, 2)), h1=h1, cocycles=[None] * 3, threshold=10.0, prime=47,
                  n_points=10)
     assert candidate_classes(bc, None, 5, 0.1) == [0, 1]
+
+
+def test_drop_unsteady_labels_a_pause_minus_one():
+    """Joints still for a second in the middle of a segment: those frames become -1 and
+    the segment splits around them."""
+    from cyclecoord.motion import Motion
+    from cyclecoord.periodic.detection._segments import drop_unsteady
+
+    T = 150
+    t = np.arange(T, dtype=float)
+    t[60:90] = 60.0  # still from frame 60 to 89
+    t[90:] -= 30.0
+    ang = 2 * np.pi * t / 30
+    joints = 30.0 * np.column_stack([np.sin(ang), np.cos(ang)])
+    motion = Motion(joints, [("a", "rx"), ("b", "rx")], fps=30.0)
+    seg = Segment(0, T, 0, (0,), 1.0, 2.0, 1.5, 4.0, 30.0)
+    labels, out = drop_unsteady(np.zeros(T, int), [seg], joints, motion, min_run=10)
+    assert set(labels.tolist()) == {0, -1}
+    assert np.all(labels[65:85] == -1) and np.all(labels[:50] == 0) and np.all(labels[100:] == 0)
+    assert len(out) == 2
