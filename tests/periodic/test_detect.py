@@ -551,3 +551,18 @@ def test_drop_unsteady_labels_a_pause_minus_one():
     assert set(labels.tolist()) == {0, -1}
     assert np.all(labels[65:85] == -1) and np.all(labels[:50] == 0) and np.all(labels[100:] == 0)
     assert len(out) == 2
+
+
+def test_motion_cycles_take_each_motions_longest_segment(chain):
+    """A short extra piece of motion 0 at the end of the capture does not replace its
+    longest segment as the one the cycle is taken from."""
+    import dataclasses
+
+    _, res, _ = chain
+    T = res.motion.n_frames
+    longest = max((sg for sg in res.segments if sg.motion == 0), key=lambda sg: sg.stop - sg.start)
+    assert longest.stop - longest.start > 20
+    extra = dataclasses.replace(longest, start=T - 20, stop=T)
+    res2 = dataclasses.replace(res, segments=[*res.segments, extra])
+    got = [c for c in motion_cycles(res2) if c.motion == 0]
+    assert [(c.start, c.stop) for c in got] == [(longest.start, longest.stop)]
