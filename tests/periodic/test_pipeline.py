@@ -515,3 +515,15 @@ def test_rows_of_is_a_view_for_one_contiguous_run():
     assert np.array_equal(run, x[3:7]) and np.shares_memory(run, x)
     gap = rows_of(x, np.array([1, 2, 5]))
     assert np.array_equal(gap, x[[1, 2, 5]]) and not np.shares_memory(gap, x)
+
+
+def test_a_long_takes_cycle_is_averaged_from_its_middle_frames(monkeypatch):
+    """Over MAX_CYCLE_FRAMES phased frames only the middle ones are averaged; with the
+    limit lowered to two periods a steady 600-frame walk still gives its 120-frame cycle."""
+    import cyclecoord.periodic.clip as clip
+
+    cap = cc.datasets.make_periodic_capture(n_frames=600, period=120.0, noise=0.5, random_state=0)
+    monkeypatch.setattr(clip, "MAX_CYCLE_FRAMES", 240)
+    res = cc.extract(cap.motion)
+    assert abs(res.cycle.n_frames - 120) <= 6  # the period within 5 %
+    assert np.all(np.isfinite(res.cycle.frames))
