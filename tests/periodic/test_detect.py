@@ -566,3 +566,22 @@ def test_motion_cycles_take_each_motions_longest_segment(chain):
     res2 = dataclasses.replace(res, segments=[*res.segments, extra])
     got = [c for c in motion_cycles(res2) if c.motion == 0]
     assert [(c.start, c.stop) for c in got] == [(longest.start, longest.stop)]
+
+
+def test_detect_defaults_beside_a_configured_estimator_are_no_conflict():
+    """detect's own default keywords beside an estimator give way to its settings; a
+    keyword changed from its default beside it is an error."""
+    import inspect
+
+    from cyclecoord.errors import ParameterError
+    from cyclecoord.periodic.coordinates import CircularCoordinates
+    from cyclecoord.periodic.detection.detector import _from_configured
+
+    m = cc.datasets.make_periodic_capture(n_frames=100, period=50, random_state=0).motion
+    defaults = {k: p.default for k, p in inspect.signature(detect).parameters.items()
+                if p.default is not inspect.Parameter.empty}
+    est = CircularCoordinates(scale_fraction=0.5)
+    chosen = _from_configured(m, {**defaults, "estimator": est})
+    assert chosen["scale_fraction"] == 0.5
+    with pytest.raises(ParameterError):
+        _from_configured(m, {**defaults, "estimator": est, "scale_fraction": 0.7})
