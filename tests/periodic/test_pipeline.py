@@ -527,3 +527,18 @@ def test_a_long_takes_cycle_is_averaged_from_its_middle_frames(monkeypatch):
     res = cc.extract(cap.motion)
     assert abs(res.cycle.n_frames - 120) <= 6  # the period within 5 %
     assert np.all(np.isfinite(res.cycle.frames))
+
+
+def test_not_clear_reason_names_what_falls_short():
+    from types import SimpleNamespace
+
+    from cyclecoord.periodic.barcode import CLEAR_GAP, CLEAR_RATIO
+    from cyclecoord.periodic.fitting import not_clear_reason
+
+    bc = SimpleNamespace(threshold=2.0)
+    short = SimpleNamespace(index=0, birth=1.0, death=1.2, ratio=CLEAR_RATIO / 2, gap=2 * CLEAR_GAP)
+    why = not_clear_reason(short, bc)
+    assert "death/birth" in why and "persistence" not in why
+    low = SimpleNamespace(index=1, birth=0.1, death=0.5, ratio=5.0, gap=2 * CLEAR_GAP)
+    why = not_clear_reason(low, bc)
+    assert "persistence under" in why and "death/birth" not in why and "H1 bar #1" in why
