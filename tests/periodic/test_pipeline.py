@@ -542,3 +542,13 @@ def test_not_clear_reason_names_what_falls_short():
     low = SimpleNamespace(index=1, birth=0.1, death=0.5, ratio=5.0, gap=2 * CLEAR_GAP)
     why = not_clear_reason(low, bc)
     assert "persistence under" in why and "death/birth" not in why and "H1 bar #1" in why
+
+
+def test_a_landmark_fit_reports_its_class_birth_on_every_frame():
+    """On landmarks the report carries the class's birth on all the frames as well
+    (``selection.full_birth``), which is no later than the landmarks' birth; 400 frames
+    are first read on 150 landmarks and fitted again on 100."""
+    cap = cc.datasets.make_periodic_capture(n_frames=400, period=60.0, random_state=0)
+    res = cc.extract(cap.motion, landmarks=100)
+    fb = res.selection.full_birth
+    assert fb is not None and 0 < fb <= res.selection.birth + 1e-12
