@@ -431,3 +431,14 @@ def test_heldout_times_interpolate_from_the_neighbours_left_out():
     # four frames are the fewest read from neighbours with exclude=0
     np.testing.assert_allclose(_heldout_times(theta[[0, 1, 3, 6]], identity),
                                [0.93, 0.045, 0.185, 0.17], atol=1e-12)
+
+
+def test_select_bandwidth_needs_two_exclude_plus_two_frames():
+    """With ``exclude=1`` four frames are enough (each keeps one frame to predict it from);
+    three are refused."""
+    theta = np.arange(4) / 4.0
+    poses = np.cos(2 * np.pi * theta)[:, None]
+    sel = select_bandwidth(theta, poses, 4.0, k=1, exclude=1, candidates=[0.5, 1.0])
+    assert np.isfinite(sel.bandwidth) and np.all(np.isfinite(sel.cv_error))
+    with pytest.raises(ParameterError, match="too few"):
+        select_bandwidth(theta[:3], poses[:3], 4.0, k=1, exclude=1, candidates=[0.5, 1.0])

@@ -486,3 +486,102 @@ def test_window_table_progress_bar_only_when_asked(monkeypatch):
         assert len(wins) == (0 if lengths == (9.0,) else 5)
         assert [k["disable"] for k in made] == [disabled], (progress, lengths)
         assert made[0]["delay"] == 2.0 and made[0]["leave"] is False
+
+
+def test_dilate_by_zero_frames_leaves_the_mask_alone():
+    from cyclecoord.periodic.detection.windows import _dilate
+
+    mask = np.zeros(12, dtype=bool)
+    mask[5] = True
+    assert np.array_equal(_dilate(mask, 0), mask)
+    assert np.flatnonzero(_dilate(mask, 2)).tolist() == [3, 4, 5, 6, 7]
+
+
+def test_binned_cycle_interpolates_empty_bins_linearly_around_the_circle():
+    from cyclecoord.periodic.detection.windows import binned_cycle
+
+    # Bins 0 and 3 of 4 are filled (poses 1 and 4); bins 1 and 2 lie 1/3 and 2/3 of the way.
+    out = binned_cycle(np.array([0.1, 0.8]), np.array([[1.0], [4.0]]), bins=4)
+    assert np.allclose(out[:, 0], [1.0, 2.0, 3.0, 4.0])
+
+
+def test_window_table_windows_stay_inside_the_capture():
+    """Windows of 10 frames stepped by 2 over 21 frames start at 0, 2, ..., 10 and the last
+    one ends at the last frame; none runs past it."""
+    from cyclecoord.periodic.detection import window_table
+
+    t = np.arange(21)
+    pts = np.column_stack([np.cos(2 * np.pi * t / 5), np.sin(2 * np.pi * t / 5)])
+    wins = window_table(pts, pts, 5.0, lengths=(2.0,), progress=False)
+    assert [(w.start, w.stop) for w in wins] == [(a, a + 10) for a in (0, 2, 4, 6, 8, 10, 11)]
+
+
+def test_a_segment_starting_one_frame_in_has_a_boundary_there():
+    """Only frames 0 and n_frames are not boundaries: a start at frame 1 is one, 1 frame
+    from the capture's first frame."""
+    segs = [Segment(1, 10, 0, (0,), 1, 2, 1.5, 1, 10), Segment(10, 20, 1, (1,), 1, 2, 1.5, 1, 10)]
+    assert boundary_errors(segs, [(0, 10, "a"), (10, 20, "b")], 20) == [0, 1, 0]
+
+
+def test_candidate_classes_take_a_bar_of_exactly_the_clear_ratio():
+    from cyclecoord.periodic.barcode import CLEAR_RATIO, Barcode
+    from cyclecoord.periodic.detection.classes import candidate_classes
+
+    h1 = np.array([[1.0, 3.0], [2.0, 2.0 * CLEAR_RATIO], [2.0, 2.9]])  # ratios 3, 1.5, 1.45
+    bc = Barcode(h0=np.zeros((0, 2)), h1=h1, cocycles=[None] * 3, threshold=10.0, prime=47,
+                 n_points=10)
+    assert candidate_classes(bc, None, 5, 0.1) == [0, 1]
+
+
+def test_drop_unsteady_labels_a_pause_minus_one():
+    """Joints still for a second in the middle of a segment: those frames become -1 and
+    the segment splits around them."""
+    from cyclecoord.motion import Motion
+    from cyclecoord.periodic.detection._segments import drop_unsteady
+
+    T = 150
+    t = np.arange(T, dtype=float)
+    t[60:90] = 60.0  # still from frame 60 to 89
+    t[90:] -= 30.0
+    ang = 2 * np.pi * t / 30
+    joints = 30.0 * np.column_stack([np.sin(ang), np.cos(ang)])
+    motion = Motion(joints, [("a", "rx"), ("b", "rx")], fps=30.0)
+    seg = Segment(0, T, 0, (0,), 1.0, 2.0, 1.5, 4.0, 30.0)
+    labels, out = drop_unsteady(np.zeros(T, int), [seg], joints, motion, min_run=10)
+    assert set(labels.tolist()) == {0, -1}
+    assert np.all(labels[65:85] == -1) and np.all(labels[:50] == 0) and np.all(labels[100:] == 0)
+    assert len(out) == 2
+
+
+def test_motion_cycles_take_each_motions_longest_segment(chain):
+    """A short extra piece of motion 0 at the end of the capture does not replace its
+    longest segment as the one the cycle is taken from."""
+    import dataclasses
+
+    _, res, _ = chain
+    T = res.motion.n_frames
+    longest = max((sg for sg in res.segments if sg.motion == 0), key=lambda sg: sg.stop - sg.start)
+    assert longest.stop - longest.start > 20
+    extra = dataclasses.replace(longest, start=T - 20, stop=T)
+    res2 = dataclasses.replace(res, segments=[*res.segments, extra])
+    got = [c for c in motion_cycles(res2) if c.motion == 0]
+    assert [(c.start, c.stop) for c in got] == [(longest.start, longest.stop)]
+
+
+def test_detect_defaults_beside_a_configured_estimator_are_no_conflict():
+    """detect's own default keywords beside an estimator give way to its settings; a
+    keyword changed from its default beside it is an error."""
+    import inspect
+
+    from cyclecoord.errors import ParameterError
+    from cyclecoord.periodic.coordinates import CircularCoordinates
+    from cyclecoord.periodic.detection.detector import _from_configured
+
+    m = cc.datasets.make_periodic_capture(n_frames=100, period=50, random_state=0).motion
+    defaults = {k: p.default for k, p in inspect.signature(detect).parameters.items()
+                if p.default is not inspect.Parameter.empty}
+    est = CircularCoordinates(scale_fraction=0.5)
+    chosen = _from_configured(m, {**defaults, "estimator": est})
+    assert chosen["scale_fraction"] == 0.5
+    with pytest.raises(ParameterError):
+        _from_configured(m, {**defaults, "estimator": est, "scale_fraction": 0.7})

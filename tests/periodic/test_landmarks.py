@@ -385,3 +385,20 @@ def test_memory_guard_at_the_edge_of_the_budget():
     # two points: nothing estimated, as estimate_complex says
     two = three[:2]
     assert choose_landmarks(two, thr, landmarks=None, memory_limit=1.0)[1] == estimate_complex(two, thr)
+
+
+def test_summary_period_is_frame_steps_per_cycle():
+    """101 frames winding 4 times: 100 steps over 4 cycles, a period of 25 frames."""
+    model = object.__new__(PhaseModel)
+    model.phase = lambda motion: (np.arange(101) / 25.0) % 1.0
+    s = model.summary(None)
+    assert s["cycles"] == pytest.approx(4.0) and s["period_frames"] == pytest.approx(25.0)
+
+
+def test_run_bytes_counts_float64_words_per_frame():
+    """Past the EM's 20,000 values, a frame of K=10 points and D=12 channels adds
+    8 bytes x (3 copies x 12 values + 16 words) = 416 bytes."""
+    from cyclecoord.periodic.landmarks import run_bytes
+
+    assert run_bytes(30_001, 10, 12) - run_bytes(30_000, 10, 12) == pytest.approx(416.0)
+    assert run_bytes(30_001, 12) - run_bytes(30_000, 12) == pytest.approx(416.0)

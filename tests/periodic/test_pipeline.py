@@ -505,3 +505,50 @@ def test_a_configured_object_alone_is_read_and_checked():
     res = cc.extract(m, preprocessor=Preprocessor(pca=5))
     assert res.parameters["pca"] == 5 and res.parameters["delay"] is None
     assert cc.extract(m, cycle=cc.CycleOptions(n_samples=50)).parameters["n_samples"] == 50
+
+
+def test_rows_of_is_a_view_for_one_contiguous_run():
+    from cyclecoord.periodic.fitting import rows_of
+
+    x = np.arange(20.0).reshape(10, 2)
+    run = rows_of(x, np.arange(3, 7))
+    assert np.array_equal(run, x[3:7]) and np.shares_memory(run, x)
+    gap = rows_of(x, np.array([1, 2, 5]))
+    assert np.array_equal(gap, x[[1, 2, 5]]) and not np.shares_memory(gap, x)
+
+
+def test_a_long_takes_cycle_is_averaged_from_its_middle_frames(monkeypatch):
+    """Over MAX_CYCLE_FRAMES phased frames only the middle ones are averaged; with the
+    limit lowered to two periods a steady 600-frame walk still gives its 120-frame cycle."""
+    import cyclecoord.periodic.clip as clip
+
+    cap = cc.datasets.make_periodic_capture(n_frames=600, period=120.0, noise=0.5, random_state=0)
+    monkeypatch.setattr(clip, "MAX_CYCLE_FRAMES", 240)
+    res = cc.extract(cap.motion)
+    assert abs(res.cycle.n_frames - 120) <= 6  # the period within 5 %
+    assert np.all(np.isfinite(res.cycle.frames))
+
+
+def test_not_clear_reason_names_what_falls_short():
+    from types import SimpleNamespace
+
+    from cyclecoord.periodic.barcode import CLEAR_GAP, CLEAR_RATIO
+    from cyclecoord.periodic.fitting import not_clear_reason
+
+    bc = SimpleNamespace(threshold=2.0)
+    short = SimpleNamespace(index=0, birth=1.0, death=1.2, ratio=CLEAR_RATIO / 2, gap=2 * CLEAR_GAP)
+    why = not_clear_reason(short, bc)
+    assert "death/birth" in why and "persistence" not in why
+    low = SimpleNamespace(index=1, birth=0.1, death=0.5, ratio=5.0, gap=2 * CLEAR_GAP)
+    why = not_clear_reason(low, bc)
+    assert "persistence under" in why and "death/birth" not in why and "H1 bar #1" in why
+
+
+def test_a_landmark_fit_reports_its_class_birth_on_every_frame():
+    """On landmarks the report carries the class's birth on all the frames as well
+    (``selection.full_birth``), which is no later than the landmarks' birth; 400 frames
+    are first read on 150 landmarks and fitted again on 100."""
+    cap = cc.datasets.make_periodic_capture(n_frames=400, period=60.0, random_state=0)
+    res = cc.extract(cap.motion, landmarks=100)
+    fb = res.selection.full_birth
+    assert fb is not None and 0 < fb <= res.selection.birth + 1e-12

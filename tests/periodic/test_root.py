@@ -89,3 +89,10 @@ def test_planted_ground_without_contacts_keeps_the_clips_own_steps():
     layout = root_layout(clip)
     ground = planted_ground(clip, layout, ("lfoot", "ltoes", "rfoot", "rtoes"), np.zeros((clip.n_frames, 4)))
     np.testing.assert_allclose(ground, clip.frames[:, [layout.column("tx"), layout.column("tz")]], atol=1e-9)
+
+
+def test_decompose_root_has_the_seven_documented_columns(walk):
+    layout = root_layout(walk)
+    x = decompose_root(walk.frames[:5], layout)
+    assert x.shape == (5, 7)
+    np.testing.assert_allclose(x[:, 0], walk.frames[:5, layout.column("ty")])

@@ -234,3 +234,12 @@ def test_clean_runs_bridges_short_gaps_then_drops_short_runs():
     only = np.zeros(15, bool)
     only[9:13] = True  # nothing bridged: the one run of 4
     np.testing.assert_array_equal(clean_runs(m, min_run=3, max_gap=0), only)
+
+
+def test_steady_turning_keeps_a_turn_of_exactly_max_curve():
+    """A heading turning 1 degree a frame turns 20 degrees over a 20-frame period."""
+    from cyclecoord.periodic.steady import steady_turning
+
+    heading = np.arange(100.0)
+    assert steady_turning(heading, 20.0, max_curve=20.0).all()
+    assert not steady_turning(heading, 20.0, max_curve=19.5).any()

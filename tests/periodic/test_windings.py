@@ -260,3 +260,20 @@ def test_hold_weights_give_a_held_stretch_one_vote():
     w = hold_weights(ph)
     np.testing.assert_allclose(w, [1, 1 / 3, 1 / 3, 1 / 3, 1, 0, 0.5, 0.5, 1])
     assert hold_weights(np.full(4, np.nan)).sum() == 0
+
+
+def test_register_moves_a_phase_at_most_the_band_and_at_least_one_sample():
+    """A band of 0.02 cycle is one sample of a 50-sample cycle, and a band of a quarter
+    sample is rounded up to one: in one round each frame goes to one of the three samples
+    about the one nearest its given phase, within 1.5 samples of that phase, even where
+    the given phase is warped by 2 samples."""
+    from cyclecoord.periodic.registration import register
+
+    t = np.arange(200)
+    true = t / 50.0
+    poses = np.column_stack([np.cos(2 * np.pi * true), np.sin(2 * np.pi * true)])
+    given = np.mod(true + 0.04 * np.sin(2 * np.pi * t / 37), 1.0)
+    for band in (0.02, 0.005):
+        out = register(given, poses, [(0, 200)], n_samples=50, width=0.02, n_iter=1, band=band)
+        moved = np.abs(np.mod(out - given + 0.5, 1.0) - 0.5) * 50
+        assert moved.max() <= 1.5 + 1e-9 and moved.max() > 1.0

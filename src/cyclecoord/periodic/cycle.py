@@ -347,7 +347,8 @@ def select_bandwidth(
         within one standard error of the least.
     exclude : int, default 0
         Frames on each side of ``i`` (in time) left out with it; 0 is plain
-        leave-one-out.
+        leave-one-out.  Needs at least ``2 * exclude + 2`` frames, so that every frame
+        keeps one other frame to be predicted from.
     max_validation : int, default 2000
         At most this many validation frames, evenly spaced in time.
     chunk_elements : int, default 4,000,000

@@ -92,6 +92,8 @@ def first_clear(
 
 
 def not_clear_reason(sel: BarSelection, barcode: Barcode) -> str:
+    """Why a bar does not stand clear: its death/birth ratio and its gap to the next bar
+    when they fall short, otherwise (neither does) its persistence against the threshold."""
     why = []
     if sel.ratio < CLEAR_RATIO:
         why.append(f"death/birth {sel.ratio:.2f} < {CLEAR_RATIO}")

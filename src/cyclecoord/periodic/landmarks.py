@@ -73,6 +73,10 @@ def run_bytes(n_frames: int, n_dims: int, n_channels: int | None = None) -> floa
         Dimensions ``K`` of the analysed points.
     n_channels : int, optional
         Channels ``D`` of the poses the cycle is averaged from (default ``K``).
+
+    Each frame counts three float64 copies of its ``max(K, D)`` values and 16 float64
+    words, ``8 * (3 * max(K, D) + 16)`` bytes; the density's EM work grows with the
+    frames up to 20,000 and 40 MiB of bounded scratch is added once.
     """
     d = n_dims if n_channels is None else n_channels
     per_frame = 8.0 * (_COPIES_PER_VALUE * max(n_dims, d) + _WORDS_PER_FRAME)

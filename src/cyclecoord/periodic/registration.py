@@ -138,7 +138,8 @@ def register(
     n_iter : int
         Rounds of alignment and averaging.
     band : float
-        How far (in cycles) a frame's phase may move from the one it has.
+        How far (in cycles) a frame's phase may move from the one it has, per round:
+        ``round(band * n_samples)`` samples, at least one.
     penalty : float
         Cost of a frame that holds or skips a sample, as a fraction of the median
         pose-to-cycle distance.

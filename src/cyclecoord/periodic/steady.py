@@ -219,7 +219,8 @@ def steady_turning(
         around it and the turns over the periods centred half a period before and after
         (a frame whose window reaches into a turn's start or end).
     max_curve : float
-        Largest turn over the period around a frame, degrees.
+        Largest turn over the period around a frame, degrees (a turn of
+        exactly ``max_curve`` is steady).
 
     Returns
     -------
