@@ -234,3 +234,17 @@ def test_clean_runs_bridges_short_gaps_then_drops_short_runs():
     only = np.zeros(15, bool)
     only[9:13] = True  # nothing bridged: the one run of 4
     np.testing.assert_array_equal(clean_runs(m, min_run=3, max_gap=0), only)
+
+
+def test_gaps_of_a_quarter_period_are_bridged():
+    """Period 100: a 25-frame gap (frames whose recurrence distance is over the limit)
+    inside a steady stretch is bridged, a 26-frame one is not."""
+    t = np.arange(1000)
+    u = t / 100.0
+    cand = np.ones(1000, bool)
+    for gap, bridged in ((25, True), (26, False)):
+        r = np.ones(1000)
+        r[500 : 500 + gap] = 10.0
+        got = steady_mask(u, cand, 100.0, recurrence_distance=r)
+        assert got.all() == bridged, gap
+        assert got[:500].all() and got[500 + gap :].all()
