@@ -248,3 +248,27 @@ def test_hold_weights_give_a_held_stretch_one_vote():
     w = hold_weights(ph)
     np.testing.assert_allclose(w, [1, 1 / 3, 1 / 3, 1 / 3, 1, 0, 0.5, 0.5, 1])
     assert hold_weights(np.full(4, np.nan)).sum() == 0
+
+
+def test_anchors_exactly_min_anchor_gap_apart_are_kept():
+    """Only anchors *closer* than min_anchor_gap are dropped: a coordinate turning evenly
+    (1/64 a frame, exact) is equally sharp at every level, and 8 levels 1/8 apart with a
+    gap of 0.125 all stay anchors."""
+    u = np.arange(640) / 64.0
+    w = complete_windings(u, [(0, 640)], n_levels=8, min_anchor_gap=0.125)
+    assert sorted(w.anchors.tolist()) == list(range(8))
+    w = complete_windings(u, [(0, 640)], n_levels=8, min_anchor_gap=0.2)
+    assert len(w.anchors) == 4
+
+
+def test_retime_reads_only_the_fraction_of_a_runs_first_frame():
+    """Each run is re-unwrapped from its own first frame: whole turns added to the
+    coordinate (2^40 of them, exactly representable with it) leave the phase unchanged."""
+    period = 100.0
+    u = staircase(700, period)
+    u = np.round(u * 4096) / 4096  # on the grid of 2^-12 that 2^40 + u keeps exactly
+    w = complete_windings(u, [(0, 700)])
+    shifted = u + 2.0**40
+    assert np.array_equal(shifted - 2.0**40, u)
+    np.testing.assert_array_equal(retime(shifted, [(0, 700)], complete_windings(shifted, [(0, 700)])),
+                                  retime(u, [(0, 700)], w))
