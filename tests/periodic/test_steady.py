@@ -243,3 +243,17 @@ def test_steady_turning_keeps_a_turn_of_exactly_max_curve():
     heading = np.arange(100.0)
     assert steady_turning(heading, 20.0, max_curve=20.0).all()
     assert not steady_turning(heading, 20.0, max_curve=19.5).any()
+
+
+def test_gaps_of_a_quarter_period_are_bridged():
+    """Period 100: a 25-frame gap (frames whose recurrence distance is over the limit)
+    inside a steady stretch is bridged, a 26-frame one is not."""
+    t = np.arange(1000)
+    u = t / 100.0
+    cand = np.ones(1000, bool)
+    for gap, bridged in ((25, True), (26, False)):
+        r = np.ones(1000)
+        r[500 : 500 + gap] = 10.0
+        got = steady_mask(u, cand, 100.0, recurrence_distance=r)
+        assert got.all() == bridged, gap
+        assert got[:500].all() and got[500 + gap :].all()

@@ -277,3 +277,27 @@ def test_register_moves_a_phase_at_most_the_band_and_at_least_one_sample():
         out = register(given, poses, [(0, 200)], n_samples=50, width=0.02, n_iter=1, band=band)
         moved = np.abs(np.mod(out - given + 0.5, 1.0) - 0.5) * 50
         assert moved.max() <= 1.5 + 1e-9 and moved.max() > 1.0
+
+
+def test_anchors_exactly_min_anchor_gap_apart_are_kept():
+    """Only anchors *closer* than min_anchor_gap are dropped: a coordinate turning evenly
+    (1/64 a frame, exact) is equally sharp at every level, and 8 levels 1/8 apart with a
+    gap of 0.125 all stay anchors."""
+    u = np.arange(640) / 64.0
+    w = complete_windings(u, [(0, 640)], n_levels=8, min_anchor_gap=0.125)
+    assert sorted(w.anchors.tolist()) == list(range(8))
+    w = complete_windings(u, [(0, 640)], n_levels=8, min_anchor_gap=0.2)
+    assert len(w.anchors) == 4
+
+
+def test_retime_reads_only_the_fraction_of_a_runs_first_frame():
+    """Each run is re-unwrapped from its own first frame: whole turns added to the
+    coordinate (2^40 of them, exactly representable with it) leave the phase unchanged."""
+    period = 100.0
+    u = staircase(700, period)
+    u = np.round(u * 4096) / 4096  # on the grid of 2^-12 that 2^40 + u keeps exactly
+    w = complete_windings(u, [(0, 700)])
+    shifted = u + 2.0**40
+    assert np.array_equal(shifted - 2.0**40, u)
+    np.testing.assert_array_equal(retime(shifted, [(0, 700)], complete_windings(shifted, [(0, 700)])),
+                                  retime(u, [(0, 700)], w))

@@ -245,3 +245,23 @@ def test_mean_speeds_are_over_planted_frames_only():
     air = foot_skating(m, replace(c, planted=np.zeros_like(c.planted)))
     assert air.mean_speed == 0.0 and air.skating_frames == 0
     assert np.isnan(air.foot_mean_speed).all()
+
+
+def test_two_frames_are_enough_one_is_not():
+    """Documented: at least 2 frames; two frames of standing still are planted."""
+    m = make_motion(legs_skeleton(), T=2)
+    assert foot_contacts(m).planted.all()
+    with pytest.raises(ParameterError, match="at least 2 frames"):
+        foot_contacts(make_motion(legs_skeleton(), T=1))
+
+
+def test_min_duration_is_in_seconds():
+    """A lift of 4 frames at 120 fps (about 0.05 s with the frames central differences
+    add) is a gap under min_duration = 0.2 s (24 frames), closed; under 0.01 s (1 frame)
+    it stays."""
+    lift = np.zeros(240, bool)
+    lift[100:104] = True
+    m = make_motion(legs_skeleton(), T=240, fps=120.0, lift_left=lift)
+    assert foot_contacts(m, min_duration=0.2).side_planted("left").all()
+    short = foot_contacts(m, min_duration=0.01).side_planted("left")
+    assert not short[100:104].any() and short[:98].all() and short[106:].all()

@@ -232,3 +232,39 @@ def test_longest_freeze_is_zero_without_slow_frames():
     g[20:52] = g[20]
     q = measure_generated(src[:96].with_frames(g), sources)
     assert q.freezes == [(20, 51)] and q.longest_freeze_s == pytest.approx(31 / 64)
+
+
+def test_a_motion_at_a_twentieth_of_the_sources_pose_speed_is_one_freeze():
+    """Slow frames are those under FREEZE_FRACTION (10 %) of the sources' median pose speed.
+    Synthetic legs at 64 fps: sources bend the knees 10 deg at 1 Hz; a motion bending them
+    the same way at 1/20 Hz moves at most 1/20 of the sources' fastest, under 10 % of
+    their median (about 0.7 of the fastest) on every frame: one freeze of the whole take."""
+    from _legs import legs_skeleton, make_motion
+
+    skel = legs_skeleton()
+    src = make_motion(skel, T=128, fps=64.0)
+    f = src.frames.copy()
+    knees = [src.channels.index((knee, "rx")) for knee in ("ltibia", "rtibia")]
+    f[:, knees] = 10 * np.sin(2 * np.pi * np.arange(128) / 64)[:, None]
+    sources = [src.with_frames(f)]
+    g = src.frames[:96].copy()
+    g[:, knees] = 10 * np.sin(2 * np.pi * np.arange(96) / (64 * 20))[:, None]
+    q = measure_generated(src[:96].with_frames(g), sources)
+    assert q.freezes == [(0, 96)] and q.longest_freeze_s == pytest.approx(96 / 64)
+
+
+def test_sources_are_resampled_by_a_whole_step_within_five_percent():
+    """125 fps to 30: every 4th frame gives 31.25 fps, within 5 % of 30 (1.5): taken.
+    100 fps to 30: every 3rd gives 33.3, 3.3 off: the source is kept as it is."""
+    from _legs import legs_skeleton, make_motion
+
+    from cyclecoord.quality.generated import _resampled
+
+    skel = legs_skeleton()
+    m = make_motion(skel, T=120, fps=125.0)
+    r = _resampled(m, 30.0)
+    assert r.fps == 31.25 and r.n_frames == 30
+    np.testing.assert_array_equal(r.frames, m.frames[::4])
+    m = make_motion(skel, T=120, fps=100.0)
+    assert _resampled(m, 30.0) is m
+    assert _resampled(m, 100.0) is m  # a step of 1: nothing to do

@@ -223,6 +223,16 @@ def test_no_feet_message_lists_candidates_and_the_option():
         find_legs(arm)
     text = str(err.value)
     assert "--feet LEFT,RIGHT" in text and "j2" in text and "foot joints" in text
+    assert "e.g. --feet LEFT,RIGHT;" in text  # one end joint: no pair to suggest
+
+
+def test_no_feet_message_suggests_the_two_lowest_end_joints():
+    """With two or more end joints and no legs found, the example is the two lowest."""
+    arms = Skeleton((Joint("j0", -1, [0, 0, 0]), Joint("j1", 0, [1, 1, 0]), Joint("j2", 1, [0, 1, 0]),
+                     Joint("j3", 0, [-1, 1, 0]), Joint("j4", 3, [0, 3, 0])))
+    with pytest.raises(ParameterError) as err:
+        find_legs(arms)
+    assert "e.g. --feet j2,j4;" in str(err.value)
 
 
 # ------------------------------------------------------------------ quadrupeds
@@ -437,3 +447,24 @@ def test_forward_directions_are_unit_vectors_however_short_the_feet():
     geo.pos = pos
     pos[:, 0] = [1.0, 0.0, 0.0]
     np.testing.assert_array_equal(geo.forward([(1, 2)]), np.tile([0.0, 0.0, 1.0], (4, 1)))
+    pos[:, 0] = 0.0
+    pos[-1, 0] = [1e-9, 0.0, 0.0]  # a travel of exactly 1e-9 units is none too
+    assert np.linalg.norm(pos[-1, 0] - pos[0, 0]) == 1e-9
+    np.testing.assert_array_equal(geo.forward([(1, 2)]), np.tile([0.0, 0.0, 1.0], (4, 1)))
+
+
+def test_grounded_bounds_are_inclusive():
+    """_Geometry.grounded: an end whose median height is at most 0.3 of the body height and
+    whose 5 % low is at most _GROUND_LOW = 0.1 of it reaches the ground, both bounds included
+    (body height 10: a low of exactly 1.0 counts, 1.0 + 1 ulp does not)."""
+    from cyclecoord.quality.legs import _GROUND_LOW, _Geometry
+
+    assert _GROUND_LOW * 10.0 == 1.0
+    geo = object.__new__(_Geometry)
+    geo.height = 10.0
+    geo.ends = [0]
+    geo.median = np.array([3.0])
+    geo.low = np.array([1.0])
+    assert geo.grounded() == [0]
+    geo.low = np.array([np.nextafter(1.0, 2.0)])
+    assert geo.grounded() == []

@@ -241,3 +241,20 @@ def test_the_note_names_the_worst_joint_angle(walk):
     note = next(n for n in rep.notes if "joint angles leave" in n)
     assert note.startswith("2 joint angles leave") and "worst ltibia.rx at" in note
     assert [v.channel for v in rep.joint_range] == [("ltibia", "rx"), ("lfemur", "rx")]
+
+
+def test_a_zero_length_link_away_from_the_origin_is_one_node():
+    """A child at its parent's place (offset 0) is one node with it, wherever it is."""
+    from cyclecoord.motion import Motion
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    skel = Skeleton((
+        Joint("root", -1, [0.0, 0.0, 0.0]),
+        Joint("a", 0, [2.0, 0.0, 0.0]),
+        Joint("a_twist", 1, [0.0, 0.0, 0.0]),  # zero-length link at (2, 0, 0)
+        Joint("b", 2, [0.0, 2.0, 0.0]),
+        Joint("c", 1, [0.0, 0.0, 2.0]),
+    ))
+    bn = bones(Motion(np.zeros((1, 0)), (), skeleton=skel))
+    assert len(bn.names) == 3  # root-a, a-b (through a_twist), a-c: no bone of length 0
+    assert np.all(bn.start != bn.end)

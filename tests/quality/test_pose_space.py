@@ -121,3 +121,38 @@ def test_a_two_frame_run_keeps_the_frame_numbers_of_the_runs_after_it():
     short = pose_quality(cycle, m, [(0, 2), (5, 6), (10, 60)], 20.0)  # one frame: no step
     assert alone.spread == pytest.approx(0.1) and short.spread == pytest.approx(0.1)
     assert short.nearest_max == 0.0
+
+
+def test_cycle_figures_lengths_are_in_metres(extracted):
+    """Steps and jerk scale with the rig's metres per unit; the loop closure has no unit."""
+    from dataclasses import replace
+
+    from cyclecoord.quality.pose_space import cycle_figures
+    from cyclecoord.rig import describe_rig
+
+    cycle = extracted.cycle
+    rig = describe_rig(cycle)
+    a = cycle_figures(cycle, rig)
+    b = cycle_figures(cycle, replace(rig, metres_per_unit=2.0 * rig.metres_per_unit))
+    for k in ("jerk", "largest_step", "median_step"):
+        assert getattr(b, k) == pytest.approx(2.0 * getattr(a, k), rel=1e-12), k
+    assert b.loop_closure == pytest.approx(a.loop_closure, rel=1e-12)
+    assert 0 < a.median_step <= a.largest_step
+
+
+def test_capture_jerk_from_runs_of_five_frames(extracted):
+    """The capture's jerk needs runs of at least 5 frames (the open 5-point stencil): a run
+    of exactly 5 has one (that run's jerk, in metres), runs of 4 have none (NaN)."""
+    import numpy as np
+
+    from cyclecoord.quality.pose_space import _jerk, root_frame_points
+    from cyclecoord.rig import describe_rig
+
+    res = extracted
+    a = res.used_frames[0][0]
+    rig = describe_rig(res.motion)
+    q = pose_quality(res.cycle, res.motion, [(a, a + 5)], res.period_frames)
+    pts = root_frame_points(res.motion.window((a, a + 5)), rig)
+    assert q.capture_jerk == pytest.approx(_jerk(pts, res.motion.fps, False) * rig.metres_per_unit)
+    assert np.isfinite(q.capture_jerk) and q.capture_jerk > 0
+    assert np.isnan(pose_quality(res.cycle, res.motion, [(a, a + 4)], res.period_frames).capture_jerk)

@@ -422,3 +422,22 @@ def test_leg_range_ratios_keep_a_reference_range_of_exactly_min_leg_range():
     q = cycle_quality(m, m, reference=ref)
     assert q.leg_range_ratios == {"lfemur.rx": 1.0, "rfemur.rx": 1.0}
     assert q.joint_range_ratios == {"lfemur": 1.0, "rfemur": 1.0}
+
+
+def test_autocorrelation_period_takes_a_peak_at_the_first_lag_searched(monkeypatch):
+    """A peak exactly at min_lag is a local maximum like any other (the lags examined run
+    one past each end).  Joint angles cos(2 pi t / 32) + 0.7 cos(2 pi t / 64) at 64 fps,
+    lags 0.5-63/64 s (32-63 frames): the autocorrelation peaks at 32 (normalised about
+    (1 - 0.49) / 1.49 = 0.34, over min_correlation) and rises again only towards 64,
+    outside the range: the period is lag 32, refined by at most half a frame (the slower
+    component tilts the parabola towards shorter lags)."""
+    import types
+
+    from cyclecoord.quality import reference
+
+    t = np.arange(640)
+    x = (np.cos(2 * np.pi * t / 32) + 0.7 * np.cos(2 * np.pi * t / 64))[:, None]
+    monkeypatch.setattr(reference, "joint_angles", lambda motion: x.copy())
+    take = types.SimpleNamespace(fps=64.0)
+    p = autocorrelation_period(take, min_lag=0.5, max_lag=63 / 64)
+    assert 31.5 <= p <= 32.5

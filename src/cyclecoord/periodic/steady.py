@@ -296,6 +296,8 @@ def steady_mask(
     Returns
     -------
     ndarray of bool, shape (T,)
+        Gaps of at most a quarter period (rounded) between steady frames are bridged,
+        then steady runs under a period (rounded) are dropped (:func:`clean_runs`).
     """
     cand = np.asarray(candidates, dtype=bool)
     ok = cand.copy()

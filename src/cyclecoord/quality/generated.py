@@ -273,7 +273,11 @@ class SourceFigures:
 def source_figures(
     sources: Sequence[Motion], fps: float, feet: Sequence[str] | None = None
 ) -> SourceFigures:
-    """The figures of the source captures, resampled to ``fps`` (a whole-number step)."""
+    """The figures of the source captures, resampled to ``fps`` (a whole-number step).
+
+    A source is taken every ``k = round(source fps / fps)`` frames when ``k > 1`` and its
+    rate then lands within 5 % of ``fps``; otherwise it is used at its own rate.
+    """
     from ..rig import metres_per_unit
 
     if not sources:
@@ -518,7 +522,7 @@ def measure_generated(
         The generated motion (any rig with two legs; a quadruped's first two legs).
     sources : sequence of Motion
         The source captures (training takes, the cycles' captures); resampled to the
-        motion's rate by a whole-number step.
+        motion's rate by a whole-number step when that lands within 5 % of it.
     feet : sequence of str, optional
         Foot points; default found (:func:`~cyclecoord.quality.legs.find_legs`).
     hold : ndarray of bool, shape (T,), optional

@@ -370,7 +370,8 @@ class _Geometry:
 
     def grounded(self, median: float = _GROUND_MEDIAN) -> list[int]:
         """Ends that reach the ground, lowest first, one per foot (of two ends parting low,
-        the lower)."""
+        the lower).  An end reaches it when its median height is at most ``median`` and its
+        5 % low at most :data:`_GROUND_LOW` of the body height (both bounds included)."""
         H = self.height
         cand = [
             e for e in self.ends
@@ -407,7 +408,8 @@ class _Geometry:
     def forward(self, legs: list[tuple[int, ...]]) -> np.ndarray:
         """Horizontal forward direction per frame ``(T, 3)``: where the feet point (ankle
         to toe), else the root's travel, else +z.  Each row is a unit vector, however
-        short the feet's horizontal extent on that frame, or zero where it is none."""
+        short the feet's horizontal extent on that frame, or zero where it is none.  A
+        median extent, or a travel, of at most 1e-9 units is none."""
         horiz = [k for k in range(3) if k != self.up]
         T = self.pos.shape[0]
         fwd = np.zeros((T, 3))
