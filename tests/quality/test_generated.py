@@ -212,19 +212,24 @@ def test_cycle_is_the_first_autocorrelation_peak_near_the_highest():
     assert np.isnan(_cycle(np.sin(2 * np.pi * t[:79] / 20), fps))  # 39 lags: under 0.4 s
 
 
+def _knee_sources():
+    """Synthetic legs at 64 fps (128 frames) and, as sources, the same legs bending both
+    knees 10 deg at 1 Hz: (motion, knee columns, [sources])."""
+    from _legs import legs_skeleton, make_motion
+
+    src = make_motion(legs_skeleton(), T=128, fps=64.0)
+    f = src.frames.copy()
+    knees = [src.channels.index((knee, "rx")) for knee in ("ltibia", "rtibia")]
+    f[:, knees] = 10 * np.sin(2 * np.pi * np.arange(128) / 64)[:, None]
+    return src, knees, [src.with_frames(f)]
+
+
 def test_longest_freeze_is_zero_without_slow_frames():
     """longest_freeze_s is the longest run of slow frames (pose speed under FREEZE_FRACTION
     of the sources' median), 0 when there is none; runs over FREEZE_SECONDS are freezes.
     Synthetic legs at 64 fps whose knees bend at a steady 40 deg/s have no slow frame;
     holding frame 20 for 32 frames makes steps 20-50 still: one run of 31 frames."""
-    from _legs import legs_skeleton, make_motion
-
-    skel = legs_skeleton()
-    src = make_motion(skel, T=128, fps=64.0)
-    f = src.frames.copy()
-    knees = [src.channels.index((knee, "rx")) for knee in ("ltibia", "rtibia")]
-    f[:, knees] = 10 * np.sin(2 * np.pi * np.arange(128) / 64)[:, None]
-    sources = [src.with_frames(f)]
+    src, knees, sources = _knee_sources()
     g = src.frames[:96].copy()
     g[:, knees] = (40.0 * np.arange(96) / 64)[:, None]
     q = measure_generated(src[:96].with_frames(g), sources)
@@ -239,14 +244,7 @@ def test_a_motion_at_a_twentieth_of_the_sources_pose_speed_is_one_freeze():
     Synthetic legs at 64 fps: sources bend the knees 10 deg at 1 Hz; a motion bending them
     the same way at 1/20 Hz moves at most 1/20 of the sources' fastest, under 10 % of
     their median (about 0.7 of the fastest) on every frame: one freeze of the whole take."""
-    from _legs import legs_skeleton, make_motion
-
-    skel = legs_skeleton()
-    src = make_motion(skel, T=128, fps=64.0)
-    f = src.frames.copy()
-    knees = [src.channels.index((knee, "rx")) for knee in ("ltibia", "rtibia")]
-    f[:, knees] = 10 * np.sin(2 * np.pi * np.arange(128) / 64)[:, None]
-    sources = [src.with_frames(f)]
+    src, knees, sources = _knee_sources()
     g = src.frames[:96].copy()
     g[:, knees] = 10 * np.sin(2 * np.pi * np.arange(96) / (64 * 20))[:, None]
     q = measure_generated(src[:96].with_frames(g), sources)
