@@ -7,11 +7,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.ndimage import gaussian_filter1d
 
 import cyclecoord as cc
 from cyclecoord.errors import ParameterError
 from cyclecoord.quality.generated import measure_generated
 from cyclecoord.synthesis.latent import LatentModel, Synthesizer
+from cyclecoord.synthesis.latent.particle import ParticleParams
 from cyclecoord.synthesis.latent.script import training_takes
 
 
@@ -64,15 +66,71 @@ def test_every_training_frame_has_a_gait_phase(models):
         assert np.all(np.diff(g.phase[g.rows(0)]) > 0)
 
 
-@pytest.mark.parametrize("part, commands", [("walk", range(0, 10)), ("run", range(11, 21))])
-def test_cadence_ranges_and_pops_match_the_training_takes(models, made, part, commands):
+# largest accel measured at the commit that smoothed the particle's path: walk 0.70, run
+# 1.15 (1.12 and 1.32 unsmoothed); the limits are those times 1.3
+@pytest.mark.parametrize(
+    "part, commands, accel", [("walk", range(0, 10), 0.91), ("run", range(11, 21), 1.5)]
+)
+def test_cadence_ranges_and_pops_match_the_training_takes(models, made, part, commands, accel):
     syn, motion = made
     a, b = _span(syn, commands)
     q = measure_generated(motion[a:b], training_takes(models, [part]))
     assert abs(q.cadence_ratio - 1) <= 0.10  # the issue: runs stepped at 1.0 s against 0.68
     assert min(q.knee_ratio) >= 0.9 and min(q.hip_ratio) >= 0.9
-    assert q.largest_accel <= 1.5
+    assert q.largest_accel <= accel
     assert q.longest_freeze_s <= 0.2
+
+
+def _chain(models, smooth):
+    """Four MOVEs ahead in the walk, a TRANSITION to the run, two MOVEs; no planting."""
+    syn = Synthesizer(models, fps=30, seed=0, plant="off", lock=False,
+                      params=ParticleParams(smooth=smooth))
+    syn.start("walk", {"frame": 0})
+    for _ in range(4):
+        syn.command += 1
+        syn.move({"ahead": 0.3}, stop=False)
+    syn.command += 1
+    syn.transition("run", blend=0.4)
+    for _ in range(2):
+        syn.command += 1
+        syn.move({"ahead": 0.3}, stop=False)
+    return syn, syn.motion()
+
+
+def test_the_particle_path_is_smoothed_before_it_is_posed(models):
+    raw_syn, raw = _chain(models, 0.0)
+    syn, smooth = _chain(models, 1.0 / 30)
+    cols = [raw.channel_index(*c) for c in models["walk"].channels_]
+    # the particle itself is the same; only the posing differs
+    np.testing.assert_array_equal(raw_syn.latent_path()[0][1], syn.latent_path()[0][1])
+    # smooth=0: every frame is its chunk's own pose
+    np.testing.assert_allclose(
+        raw.frames[:, cols], np.concatenate([c.angles for c in raw_syn.chunks]), atol=1e-9
+    )
+    # the MOVE chain: the pose of its latent path smoothed by a Gaussian of one frame
+    a, b = _span(syn, range(0, 4))
+    X = np.concatenate([c.X for c in syn.chunks if c.command < 4])
+    assert X.shape[0] == b - a
+    Xs = gaussian_filter1d(X, 1.0, axis=0, mode="nearest")
+    want = syn._clip("walk", models["walk"].pose(Xs), count=False)
+    # ... up to the last three frames, where it fades back to the frame the blend starts from
+    np.testing.assert_allclose(smooth.frames[a : b - 3][:, cols], want[: b - a - 3], atol=1e-9)
+    assert not np.allclose(smooth.frames[a : b - 3][:, cols], raw.frames[a : b - 3][:, cols])
+    np.testing.assert_allclose(smooth.frames[b - 1][cols], raw.frames[b - 1][cols], atol=1e-9)
+    # the blend is kept as it was, and the run's MOVEs fade in from its last frame
+    t0, t1 = _span(syn, [4])
+    np.testing.assert_allclose(smooth.frames[t0:t1][:, cols], raw.frames[t0:t1][:, cols], atol=1e-9)
+    np.testing.assert_allclose(smooth.frames[t1][cols], raw.frames[t1][cols], atol=1e-9)
+    # what it is for: the joints' largest acceleration in the chain drops (measured 0.85x)
+    acc = [np.abs(np.diff(m.frames[a:b][:, cols], 2, axis=0)).max() for m in (raw, smooth)]
+    assert acc[1] < 0.9 * acc[0]
+
+
+def test_path_smoothing_is_a_checked_particle_parameter():
+    assert ParticleParams().smooth == pytest.approx(1.0 / 30)
+    assert ParticleParams().replace(smooth=0).smooth == 0
+    with pytest.raises(ParameterError, match="smooth must be positive"):
+        ParticleParams(smooth=-0.1)
 
 
 def test_move_chain_flows_through_its_waypoints(made):

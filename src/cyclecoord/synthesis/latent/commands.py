@@ -132,6 +132,9 @@ class _Chunk:
     angles: np.ndarray
     root: dict[str, np.ndarray]
     command: int
+    #: the angles and root are the model's pose of X (a particle's path), not a blend or a
+    #: played capture: :meth:`OutputMixin.motion` may pose a smoothed X instead
+    particle: bool = False
 
 
 @dataclass
@@ -331,12 +334,12 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         t0, c0 = time.perf_counter(), time.process_time()
         self.reserve(path.shape[0] - 1)
         X, V = simulate(m, path, self.x, self.v, self.fps, params, self.force, self.t, ride)
-        self._emit(self.current, X, m.pose(X), self._root(m, X))
+        self._emit(self.current, X, m.pose(X), self._root(m, X), particle=True)
         self.sim_seconds += time.perf_counter() - t0
         self.sim_cpu_seconds += time.process_time() - c0
         self.x, self.v = X[-1], V[-1]
 
-    def _clip(self, name: str, angles: np.ndarray) -> np.ndarray:
+    def _clip(self, name: str, angles: np.ndarray, count: bool = True) -> np.ndarray:
         """Joint limits: angles beyond the training range of model ``name`` are eased
         back towards it, never past :data:`LIMIT_MARGIN` of the range beyond it
         (``hi + m tanh((a - hi) / m)``: slope 1 at the limit and rising, so a joint
@@ -347,15 +350,16 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         mg = np.maximum(LIMIT_MARGIN * (hi - lo), 1e-6)
         clipped = np.where(angles > hi, hi + mg * np.tanh((angles - hi) / mg), angles)
         clipped = np.where(clipped < lo, lo - mg * np.tanh((lo - clipped) / mg), clipped)
-        over = np.abs(clipped - angles)
-        self.clamped["values"] += int((over > 1e-9).sum())
-        self.clamped["max_deg"] = max(self.clamped["max_deg"], float(over.max(initial=0.0)))
+        if count:
+            over = np.abs(clipped - angles)
+            self.clamped["values"] += int((over > 1e-9).sum())
+            self.clamped["max_deg"] = max(self.clamped["max_deg"], float(over.max(initial=0.0)))
         return clipped
 
-    def _emit(self, name, X, angles, root, clip: bool = True) -> None:
+    def _emit(self, name, X, angles, root, clip: bool = True, particle: bool = False) -> None:
         if clip:
             angles = self._clip(name, angles)
-        self.chunks.append(_Chunk(name, X, angles, root, self.command))
+        self.chunks.append(_Chunk(name, X, angles, root, self.command, particle))
         self.t += X.shape[0] / self.fps
 
     @staticmethod

@@ -39,9 +39,7 @@ class OutputMixin:
         if not self.chunks:
             raise ParameterError("the script made no frames")
         first = self.models[self.chunks[0].model]
-        angles = np.concatenate([c.angles for c in self.chunks])
-        keys = ("height", "velocity", "turn", "tilt")
-        root = {k: np.concatenate([c.root[k] for c in self.chunks]) for k in keys}
+        angles, root = self._posed()
         T = angles.shape[0]
         theta = np.concatenate([[0.0], np.cumsum(root["turn"][:-1]) / self.fps])
         head = heading_matrix(theta)
@@ -76,6 +74,62 @@ class OutputMixin:
             source="synthetic:latent",
         )
         return self._plant_feet(motion)
+
+    def _posed(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """Every frame's joint angles ``(T, C)`` and root motion, the particle's path
+        smoothed.
+
+        Each run of consecutive particle chunks of one model (MOVEs, IDLEs) is posed again
+        from its latent path smoothed by a Gaussian of ``params.smooth`` seconds
+        (:class:`~.particle.ParticleParams`). Where the run meets a blend or a played
+        capture the smoothing fades out over three widths, so the run's first and last
+        frames stay those the blend or the capture joins. Blends and played captures are
+        kept. The joint-limit easing counted in the report is the unsmoothed path's.
+        """
+        from scipy.ndimage import gaussian_filter1d
+
+        keys = ("height", "velocity", "turn", "tilt")
+        chunks = self.chunks
+        angles = [c.angles for c in chunks]
+        roots = [c.root for c in chunks]
+        sigma = self.params.smooth * self.fps
+        i = 0
+        while i < len(chunks):
+            if not chunks[i].particle:
+                i += 1
+                continue
+            j = i
+            while (
+                j + 1 < len(chunks)
+                and chunks[j + 1].particle
+                and chunks[j + 1].model == chunks[i].model
+            ):
+                j += 1
+            X = np.concatenate([c.X for c in chunks[i : j + 1]])
+            if sigma <= 0 or X.shape[0] < 3:
+                i = j + 1
+                continue
+            k = np.arange(X.shape[0], dtype=float)
+            fade = max(3.0 * sigma, 1.0)
+            u = np.ones_like(k)
+            if i > 0:  # joins the chunk before: its first frame kept
+                u = np.minimum(u, k / fade)
+            if j + 1 < len(chunks):  # and the chunk after: its last frame kept
+                u = np.minimum(u, (k[-1] - k) / fade)
+            u = np.clip(u, 0.0, 1.0)
+            w = u * u * (3.0 - 2.0 * u)
+            Xs = X + w[:, None] * (gaussian_filter1d(X, sigma, axis=0, mode="nearest") - X)
+            m = self.models[chunks[i].model]
+            A = self._clip(chunks[i].model, m.pose(Xs), count=False)
+            R = self._root(m, Xs)
+            edges = np.cumsum([0] + [c.X.shape[0] for c in chunks[i : j + 1]])
+            for n, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
+                angles[i + n] = A[a:b]
+                roots[i + n] = {key: R[key][a:b] for key in keys}
+            i = j + 1
+        return np.concatenate(angles), {
+            key: np.concatenate([r[key] for r in roots]) for key in keys
+        }
 
     def plant_spans(self, n_frames: int) -> np.ndarray:
         """How much of each step's root travel ``(T - 1,)``, in ``[0, 1]``, :meth:`motion`
