@@ -383,3 +383,49 @@ def test_crossval_prints_the_papers_row_for_its_set_and_a_longer_horizon(walks):
     assert fold["frames"] == 3 * walks[0].n_frames
     assert {"longest_freeze_s", "support_slip", "error_f_deg"} <= set(fold)
     assert cv.to_report()["long_horizon"] == cv.long
+
+
+def test_synth_on_a_static_root_rig_is_the_same_walk_written_back_in_that_rig(walks):
+    """A static ``joint_Root`` above travelling hips, 6 channels on every joint (the Bandai
+    layout): the graph is built in the analysis rig and its output written back in the
+    takes' own rig, the same motion as on the plain rig (issue 24 on any rig). Before,
+    the hips' heading was a joint angle of the pose space and their travel was not the
+    root's: the measure read the feet 4 m under the floor and the root still."""
+    from _rigs import static_root
+
+    from cyclecoord.conventions import to_bvh_convention
+    from cyclecoord.quality.generated import measure_generated
+
+    walks = [to_bvh_convention(w, "ZXY") for w in walks]
+    turn = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])  # 90 deg about y
+    bandai = [static_root(w, turn, [5.0, 0.0, -3.0], True) for w in walks]
+    bandai = [b.with_frames(b.frames, fps=w.fps) for b, w in zip(bandai, walks)]
+    plain = MotionGraphSynth(dims=2).fit(walks).generate(90, 0, 10).motion
+    gen = MotionGraphSynth(dims=2).fit(bandai).generate(90, 0, 10).motion
+    assert gen.channels == bandai[0].channels and gen.skeleton.names == bandai[0].skeleton.names
+    # the static root stays where it was; the same body poses as on the plain rig
+    root = [gen.channel_index("joint_Root", d) for d in ("tx", "ty", "tz")]
+    np.testing.assert_allclose(gen.frames[:, root], [[5.0, 0.0, -3.0]] * 90, atol=1e-9)
+    for c in walks[0].channels[6:]:
+        np.testing.assert_allclose(
+            gen.frames[:, gen.channel_index(*c)], plain.frames[:, plain.channel_index(*c)],
+            atol=1e-6,
+        )
+    # world positions: the plain walk turned and shifted as the static root turns it
+    p_gen, p_plain = gen.positions().positions[:, 1:], plain.positions().positions
+    np.testing.assert_allclose(p_gen, p_plain @ turn.T + [5.0, 0.0, -3.0], atol=1e-6)
+    a, b = measure_generated(gen, bandai), measure_generated(plain, walks)
+    for key in ("support_slip", "largest_accel", "root_speed", "source_root_speed"):
+        assert getattr(a, key) == pytest.approx(getattr(b, key), rel=1e-6, abs=1e-9), key
+
+
+def test_synth_refuses_takes_whose_rigs_read_differently(walks):
+    from _rigs import static_root
+
+    from cyclecoord.conventions import to_bvh_convention
+
+    walks = [to_bvh_convention(w, "ZXY") for w in walks]
+    other = static_root(walks[1], np.eye(3), [0.0, 0.0, 0.0], True)
+    with pytest.raises(ParameterError, match="differ"):
+        MotionGraphSynth(dims=2).fit([static_root(walks[0], np.eye(3), [0, 0, 0], False),
+                                      other])

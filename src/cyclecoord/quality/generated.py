@@ -278,11 +278,11 @@ def source_figures(
     A source is taken every ``k = round(source fps / fps)`` frames when ``k > 1`` and its
     rate then lands within 5 % of ``fps``; otherwise it is used at its own rate.
     """
-    from ..rig import metres_per_unit
+    from ..rig import analysis_motion, metres_per_unit
 
     if not sources:
         raise ParameterError("the measure of generated motion needs the source captures")
-    srcs = [_resampled(s, fps) for s in sources]
+    srcs = [_resampled(analysis_motion(s), fps) for s in sources]
     rig = _rig(srcs[0], feet)
     kins = [_kin(s, rig) for s in srcs]
     floors = [foot_contacts(s, rig.feet).floor for s in srcs]
@@ -536,7 +536,10 @@ def measure_generated(
     """
     if motion.n_frames < 3:
         raise ParameterError(f"the measure needs at least 3 frames, got {motion.n_frames}")
+    from ..rig import analysis_motion
+
     ref = reference if reference is not None else source_figures(sources or [], motion.fps, feet)
+    motion = analysis_motion(motion)
     rig = _rig(motion, feet)
     kin = _kin(motion, rig)
     m = ref.metres

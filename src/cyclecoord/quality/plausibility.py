@@ -587,6 +587,11 @@ def check_plausibility(
     -------
     PlausibilityReport
     """
+    from ..rig import analysis_motion
+
+    # in the analysis rig: a static root at the origin is no bone to the travelling hips
+    motion = analysis_motion(motion)
+    references = [analysis_motion(r) for r in references]
     inter = self_intersections(motion, threshold)
     thr = inter.threshold
     size = motion.skeleton.total_length()  # type: ignore[union-attr]

@@ -30,7 +30,7 @@ from .describe import (
     parse_units,
     rig_summary,
 )
-from .normalize import RigAdapter, normalize_rig
+from .normalize import RigAdapter, analysis_motion, normalize_rig
 
 __all__ = [
     "CMU_UNIT",
@@ -41,6 +41,7 @@ __all__ = [
     "Units",
     "describe_rig",
     "metres_per_unit",
+    "analysis_motion",
     "normalize_rig",
     "parse_units",
     "rig_summary",

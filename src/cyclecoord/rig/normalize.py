@@ -20,7 +20,7 @@ from ..motion import Motion
 from ..skeleton import AXIS_INDEX, Joint, Skeleton
 from .describe import Z_TO_Y, RigInfo, _skeleton_of, describe_rig
 
-__all__ = ["RigAdapter", "normalize_rig"]
+__all__ = ["RigAdapter", "analysis_motion", "normalize_rig"]
 
 
 # ------------------------------------------------------------------ normalising
@@ -433,3 +433,16 @@ def _replace_joint(joint: Joint, **changes) -> Joint:
     }
     fields.update(changes)
     return Joint(**fields)
+
+
+def analysis_motion(motion: Motion) -> Motion:
+    """The motion as the measures see it: :func:`normalize_rig` with every frame kept.
+
+    The travelling joint is the root and Y is up, so a static root with moving hips (the
+    Bandai rig) or a Z-up capture is measured like any other: no bone from a fixed
+    origin to the hips, no travel among the pose's points. A motion without a skeleton,
+    or one that needs no change, is returned as it is.
+    """
+    if motion.skeleton is None:
+        return motion
+    return normalize_rig(motion, drop_reference=False)[0]

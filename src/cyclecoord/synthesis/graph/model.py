@@ -8,7 +8,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -133,8 +133,9 @@ class MotionGraphSynth:
             raise ParameterError(
                 f"unknown integrator {self.integrator!r}; choose from {', '.join(INTEGRATORS)}"
             )
-        self.takes_ = check_takes(takes, minimum=2)
-        self.names_ = [take_name(m, i) for i, m in enumerate(self.takes_)]
+        raw = check_takes(takes, minimum=2)
+        self.names_ = [take_name(m, i) for i, m in enumerate(raw)]
+        self.takes_, self.rig_ = _analysis_takes(raw)
         self.dims_ = auto_dims(self.takes_) if self.dims == "auto" else int(self.dims)
         self.space_ = PoseSpace(self.dims_).fit(self.takes_)
         self.floor_, self.accel_limit_ = _ground(self.takes_) if self.carry else (None, None)
@@ -160,7 +161,8 @@ class MotionGraphSynth:
                 )
             motion, name = self.takes_[int(start)], self.names_[int(start)]
         elif isinstance(start, Motion):
-            motion, name = start, take_name(start)
+            name = take_name(start)
+            motion = _analysis_takes([start])[0][0] if self.rig_ is not None else start
             check_takes([self.takes_[0], motion], minimum=2)
         else:
             raise ParameterError(
@@ -253,6 +255,8 @@ class MotionGraphSynth:
                 )
                 out = locked.motion
                 notes.append(locked.line)
+        if self.rig_ is not None:  # back in the takes' own rig
+            out = self.rig_.restore(out)
         out = out.with_frames(
             out.frames,
             metadata={
@@ -266,6 +270,29 @@ class MotionGraphSynth:
             start={"take": name, "frame": f, "latent": x0.tolist()},
             notes=notes,
         )
+
+
+def _analysis_takes(takes: Sequence[Motion]) -> tuple[list[Motion], Any]:
+    """The takes in their analysis rig (:func:`cyclecoord.rig.normalize_rig`, every frame
+    kept, so frame numbers stay the takes'), and the first take's adapter that writes a
+    generated motion back in their rig (None when nothing changed).
+
+    A static root with travelling hips (the Bandai rig) otherwise left the hips' heading
+    among the joint angles of the pose space and their travel out of the root's.
+    """
+    from ...rig import normalize_rig
+
+    out = [normalize_rig(m, drop_reference=False) for m in takes]
+    adapter = out[0][1]
+    for i, (m, a) in enumerate(out[1:], 1):
+        if a.changes() != adapter.changes() or m.channels != out[0][0].channels:
+            raise ParameterError(
+                f"{take_name(takes[i], i)}: its rig reads differently from "
+                f"{take_name(takes[0], 0)}'s ({'; '.join(a.changes()) or 'nothing to change'} "
+                f"against {'; '.join(adapter.changes()) or 'nothing to change'}); train on "
+                "takes of one rig"
+            )
+    return [m for m, _ in out], (None if adapter.identity else adapter)
 
 
 def _parse(method: str) -> tuple[str, bool, bool, bool]:
