@@ -174,13 +174,19 @@ class LatentModel:
             Also find the gait phase of every training frame (:meth:`gait`; a segment
             without a cycle gets none), which MOVEs ``ahead`` and in-step TRANSITIONs use.
         """
+        from ...rig import analysis_motion
+
         if not motions:
             raise ParameterError("a latent model needs at least one training segment")
-        first = motions[0]
-        if first.skeleton is None:
+        if any(m.skeleton is None for m in motions):
             raise ParameterError(
                 "a latent model needs motions with a skeleton (forward kinematics)"
             )
+        # the analysis rig (every frame kept): the travelling joint is the root and Y is
+        # up, so a static root with moving hips (the Bandai rig) does not put the hips'
+        # travel among the modelled angles; the model and what it makes use that rig
+        motions = [analysis_motion(m) for m in motions]
+        first = motions[0]
         problem = root_position_problem(first)
         if problem:  # the root's travel is modelled apart (root_track): it must be there
             raise ParameterError(f"training segment 0: {problem}")
@@ -209,6 +215,7 @@ class LatentModel:
         if len(self.segment_names_) != len(motions):
             raise ParameterError(f"{len(self.segment_names_)} names for {len(motions)} segments")
         self.frames_ = np.concatenate([m.frames for m in motions])
+        self._centres = None  # angle_centres() of these frames
         self.segments_ = np.concatenate([np.full(m.n_frames, i) for i, m in enumerate(motions)])
         self.times_ = np.concatenate([np.arange(m.n_frames) / m.fps for m in motions])
         tracks = [root_track(m) for m in motions]
@@ -268,10 +275,36 @@ class LatentModel:
 
     # -------------------------------------------------------------- mappings
     def angles(self, frames: np.ndarray) -> np.ndarray:
-        """The modelled joint-angle columns of full frames ``(T, D)``."""
+        """The modelled joint-angle columns of full frames ``(T, D)``, each on the branch
+        within 180 degrees of its centre (:meth:`angle_centres`)."""
         modelled = set(self.channels_)
         cols = [i for i, c in enumerate(self.all_channels_) if c in modelled]
-        return np.asarray(frames, dtype=float)[:, cols]
+        x = np.asarray(frames, dtype=float)[:, cols]
+        c = self.angle_centres()
+        # whole turns only, and only where needed: a value on the branch keeps its bits
+        return np.where(np.abs(x - c) > 180.0, x - 360.0 * np.round((x - c) / 360.0), x)
+
+    def angle_centres(self) -> np.ndarray:
+        """``(C,)`` degrees: each modelled channel's branch centre, its circular mean over
+        the training frames rounded to a multiple of 180.
+
+        An angle near +-180 (the Bandai rig's thighs) wraps from one end to the other in
+        the capture; modelled as written, the PCA and the GP saw 360-degree jumps and
+        the model made poses of averages of -179 and 179.  Centred, the channel is
+        continuous; rounded, the centre is the same for every model of a rig (a walk's
+        and a run's thighs), so their poses blend.  Channels whose mean is within 90
+        degrees of 0 (every CMU channel) keep their values.
+        """
+        c = getattr(self, "_centres", None)
+        if c is None or c.shape != (len(self.channels_),):
+            from ...periodic.rotations import circular_mean_degrees
+
+            modelled = set(self.channels_)
+            cols = [i for i, ch in enumerate(self.all_channels_) if ch in modelled]
+            mean = circular_mean_degrees(np.asarray(self.frames_, dtype=float)[:, cols])
+            c = 180.0 * np.round(mean / 180.0)
+            self._centres = c
+        return c
 
     def kernel(self, X: np.ndarray) -> np.ndarray:
         """``k(x)`` for latent points ``(T, q)``: ``(T, N)``."""
