@@ -258,11 +258,11 @@ def find_bridges(
     check_compatible(m1, m2, f"bridging {names[0]!r} to {names[1]!r}: ")
     if threshold is None:
         threshold = DEFAULT_THRESHOLD * m1.skeleton_.total_length()
-    pose1 = m1.pose(m1.X_)
+    pose1 = m1.to_channels(m1.pose(m1.X_))  # the rig's channels: each model has its chart
     n1 = pose1.shape[0]
     XS, _ = project(
         m2,
-        m2.pca_coordinates(pose1),
+        m2.pca_coordinates(m2.to_model(pose1)),
         n_starts=n_starts,
         random_state=random_state,
         every_start=True,
@@ -272,7 +272,7 @@ def find_bridges(
     S = XS.shape[1]
     flat = XS.reshape(n1 * S, -1)
     d_all = pose_distance(
-        m1.skeleton_, m1.channels_, np.repeat(pose1, S, axis=0), m2.pose(flat)
+        m1.skeleton_, m1.channels_, np.repeat(pose1, S, axis=0), m2.to_channels(m2.pose(flat))
     ).reshape(n1, S)
     raw = d_all.min(axis=1)
     raw_points = XS[np.arange(n1), np.argmin(d_all, axis=1)]

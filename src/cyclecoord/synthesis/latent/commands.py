@@ -356,6 +356,13 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             self.clamped["max_deg"] = max(self.clamped["max_deg"], float(over.max(initial=0.0)))
         return clipped
 
+    def _into(self, src: str, to: str, angles: np.ndarray) -> np.ndarray:
+        """Model ``src``'s angles ``(T, C)`` in model ``to``'s chart: the same rotations
+        (:meth:`~.model.LatentModel.chart`), so a blend mixes like with like."""
+        if src == to:
+            return angles
+        return self.models[to].to_model(self.models[src].to_channels(angles))
+
     def _emit(self, name, X, angles, root, clip: bool = True, particle: bool = False) -> None:
         if clip:
             angles = self._clip(name, angles)

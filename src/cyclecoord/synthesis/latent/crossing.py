@@ -164,7 +164,7 @@ class CrossingMixin:
         frame of model ``name`` (units/s^2)."""
         if name not in self._acc:
             m = self.models[name]
-            pts = pose_points(m.angles(m.frames_), m.channels_, m.skeleton_)
+            pts = pose_points(m.to_channels(m.angles(m.frames_)), m.channels_, m.skeleton_)
             acc = [
                 np.linalg.norm(np.diff(pts[m.segments_ == s], 2, axis=0), axis=2).max(axis=1)
                 for s in np.unique(m.segments_)
@@ -180,7 +180,9 @@ class CrossingMixin:
         a joint by ``D`` peaks at ``5.78 D / T^2``)."""
         m1, m2 = self.models[src], self.models[to]
         p = pose_points(
-            np.vstack([m1.pose(x1[None]), m2.pose(x2[None])]), m1.channels_, m1.skeleton_
+            np.vstack([m1.to_channels(m1.pose(x1[None])), m2.to_channels(m2.pose(x2[None]))]),
+            m1.channels_,
+            m1.skeleton_,
         )
         D = float(np.linalg.norm(p[1] - p[0], axis=1).max())
         budget = BLEND_ACCELERATION * min(self._acc99(src), self._acc99(to))
@@ -290,7 +292,9 @@ class CrossingMixin:
         }
         # each model's pose is clipped to its own range before the blend, so the frames
         # after the blend continue without a jump
-        blended = (1 - w) * self._clip(src, m1.pose(X1)) + w * self._clip(to, m2.pose(X2))
+        blended = (1 - w) * self._into(src, to, self._clip(src, m1.pose(X1))) + w * self._clip(
+            to, m2.pose(X2)
+        )
         self._emit(to, X2, blended, root, clip=False)
         self.events.append(
             {

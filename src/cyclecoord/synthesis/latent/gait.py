@@ -109,7 +109,9 @@ def _anchor(model, rows: np.ndarray, phase: np.ndarray, leg_points: tuple[str, s
     """Phase at which the first ankle is furthest ahead of the second (cycles)."""
     names = list(model.skeleton_.names)
     a, b = (names.index(n) for n in leg_points)
-    pts = pose_points(model.angles(model.frames_[rows]), model.channels_, model.skeleton_)
+    pts = pose_points(
+        model.to_channels(model.angles(model.frames_[rows])), model.channels_, model.skeleton_
+    )
     d = pts[:, a] - pts[:, b]
     d = d - d.mean(axis=0)
     _, _, vt = np.linalg.svd(d, full_matrices=False)

@@ -52,6 +52,7 @@ def influence_weights(
     channels: Sequence[tuple[str, str]],
     skeleton: Skeleton,
     steps: Sequence[int] = STEPS,
+    to_channels=None,
 ) -> np.ndarray:
     """The weight ``w_i`` of every joint-angle channel (Eq. 3).
 
@@ -63,6 +64,10 @@ def influence_weights(
     skeleton : Skeleton
     steps : sequence of int
         Multiples ``n`` of the channel's standard deviation.
+    to_channels : callable, optional
+        Maps angles ``(T, C)`` to the channel values forward kinematics reads (a latent
+        model's chart, :meth:`~.model.LatentModel.to_channels`); default the angles are
+        the channels.
 
     Returns
     -------
@@ -82,7 +87,7 @@ def influence_weights(
     for i in range(n_ch):
         rows = 1 + i * steps_arr.size + np.arange(steps_arr.size)
         probes[rows, i] += steps_arr * sd[i]
-    pts = pose_points(probes, channels, skeleton)
+    pts = pose_points(probes if to_channels is None else to_channels(probes), channels, skeleton)
     moved = np.linalg.norm((pts[1:] - pts[0]).reshape(n_ch, steps_arr.size, -1), axis=2)
     delta = np.abs(steps_arr)[None, :] * sd[:, None]  # |n sigma_i|, (C, S)
     denom = (delta**2).sum(axis=1)

@@ -215,7 +215,7 @@ class LatentModel:
         if len(self.segment_names_) != len(motions):
             raise ParameterError(f"{len(self.segment_names_)} names for {len(motions)} segments")
         self.frames_ = np.concatenate([m.frames for m in motions])
-        self._centres = None  # angle_centres() of these frames
+        self._centres = self._chart = None  # angle_centres() and chart() of these frames
         self.segments_ = np.concatenate([np.full(m.n_frames, i) for i, m in enumerate(motions)])
         self.times_ = np.concatenate([np.arange(m.n_frames) / m.fps for m in motions])
         tracks = [root_track(m) for m in motions]
@@ -227,7 +227,9 @@ class LatentModel:
         )
         angles = self.angles(self.frames_)
         self.mean_ = angles.mean(axis=0)
-        self.weights_ = influence_weights(angles, self.channels_, self.skeleton_)
+        self.weights_ = influence_weights(
+            angles, self.channels_, self.skeleton_, to_channels=self.to_channels
+        )
         Z = (angles - self.mean_) * self.weights_
         _, S, Vt = np.linalg.svd(Z, full_matrices=False)
         if not S.size or not S[0] > 1e-12:  # nothing to learn (and a log of zero variance)
@@ -275,14 +277,111 @@ class LatentModel:
 
     # -------------------------------------------------------------- mappings
     def angles(self, frames: np.ndarray) -> np.ndarray:
-        """The modelled joint-angle columns of full frames ``(T, D)``, each on the branch
-        within 180 degrees of its centre (:meth:`angle_centres`)."""
+        """The model's angles ``(T, C)`` of full frames ``(T, D)``: the modelled channels,
+        each on the branch within 180 degrees of its centre (:meth:`angle_centres`), the
+        joints of :meth:`chart` re-expressed about their mean rotation."""
         modelled = set(self.channels_)
         cols = [i for i, c in enumerate(self.all_channels_) if c in modelled]
-        x = np.asarray(frames, dtype=float)[:, cols]
+        return self.to_model(np.asarray(frames, dtype=float)[:, cols])
+
+    def _centred(self, x: np.ndarray) -> np.ndarray:
         c = self.angle_centres()
         # whole turns only, and only where needed: a value on the branch keeps its bits
         return np.where(np.abs(x - c) > 180.0, x - 360.0 * np.round((x - c) / 360.0), x)
+
+    def chart(self) -> tuple:
+        """The joints modelled about their mean rotation: ``(columns, order, mean)`` per
+        joint, ``columns`` its three channels (of :attr:`channels_`) in Euler order.
+
+        A joint whose Euler channels wrap, flip or come near gimbal lock in the training
+        frames (:func:`~cyclecoord.periodic.rotations.euler_is_safe`; the Bandai rig's
+        thighs at +-180 and its spine at 88 degrees of the middle angle) is modelled as
+        the Euler angles of ``mean^T R``, a rotation within a few tens of degrees of the
+        identity, whose angles are continuous and far from gimbal lock; as written, a GP
+        mean between two frames of one pose written two ways twisted the spine (the
+        Bandai walk-run script's head accelerated 18.7x the training 99th percentile).
+        The model's angles (:meth:`angles`, :meth:`pose`) are in this chart;
+        :meth:`to_channels` gives the rig's channels back.  Empty on every CMU take we
+        hold: their channels are modelled as written.
+        """
+        ch = getattr(self, "_chart", None)
+        if ch is None:
+            ch = self._chart = self._fit_chart()
+        return ch
+
+    def _fit_chart(self) -> tuple:
+        import warnings
+
+        from scipy.spatial.transform import Rotation
+
+        from ...periodic.rotations import euler_is_safe
+
+        modelled = set(self.channels_)
+        cols = [i for i, c in enumerate(self.all_channels_) if c in modelled]
+        x = self._centred(np.asarray(self.frames_, dtype=float)[:, cols])
+        by_joint: dict[str, dict[str, int]] = {}
+        for k, (j, d) in enumerate(self.channels_):
+            if d in ("rx", "ry", "rz"):
+                by_joint.setdefault(j, {})[d[1]] = k
+        out = []
+        for j, c in by_joint.items():
+            order = self.skeleton_[j].rotation_order.upper()
+            if len(c) != 3 or sorted(order) != ["X", "Y", "Z"]:
+                continue
+            idx = np.array([c[a.lower()] for a in order], dtype=int)
+            if euler_is_safe(x[:, idx]):
+                continue
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message=".*[Gg]imbal.*")
+                mean = Rotation.from_euler(order, x[:, idx], degrees=True).mean()
+            out.append((idx, order, mean.as_matrix()))
+        return tuple(out)
+
+    def to_model(self, values: np.ndarray) -> np.ndarray:
+        """Channel values ``(T, C)`` of :attr:`channels_` (degrees) in the model's chart."""
+        import warnings
+
+        from scipy.spatial.transform import Rotation
+
+        x = self._centred(np.atleast_2d(np.asarray(values, dtype=float)))
+        for idx, order, mean in self.chart():
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message=".*[Gg]imbal.*")
+                R = Rotation.from_euler(order, x[:, idx], degrees=True)
+                x[:, idx] = (Rotation.from_matrix(mean).inv() * R).as_euler(order, degrees=True)
+        return x
+
+    def to_channels(self, angles: np.ndarray, continuous: bool = False) -> np.ndarray:
+        """The model's angles ``(T, C)`` as the rig's channel values (degrees).
+
+        Parameters
+        ----------
+        angles : ndarray, shape (T, C)
+        continuous : bool, default False
+            Each charted joint's Euler angles continuous over the rows, starting nearest
+            the first training frame (for a motion); otherwise each row on its own
+            (any valid angles: enough for forward kinematics).
+        """
+        from scipy.spatial.transform import Rotation
+
+        from ...conventions import continuous_euler
+
+        a = np.array(np.atleast_2d(angles), dtype=float)
+        if not self.chart():
+            return a
+        for idx, order, mean in self.chart():
+            R = Rotation.from_matrix(mean) * Rotation.from_euler(order, a[:, idx], degrees=True)
+            if continuous:
+                near = self._centred(self._channels0()[None])[0, idx]
+                a[:, idx] = continuous_euler(R.as_matrix()[:, None], order, near)[:, 0]
+            else:
+                a[:, idx] = R.as_euler(order, degrees=True)
+        return a
+
+    def _channels0(self) -> np.ndarray:
+        modelled = set(self.channels_)
+        cols = [i for i, c in enumerate(self.all_channels_) if c in modelled]
+        return np.asarray(self.frames_[0], dtype=float)[cols]
 
     def angle_centres(self) -> np.ndarray:
         """``(C,)`` degrees: each modelled channel's branch centre, its circular mean over
@@ -303,6 +402,7 @@ class LatentModel:
             cols = [i for i, ch in enumerate(self.all_channels_) if ch in modelled]
             mean = circular_mean_degrees(np.asarray(self.frames_, dtype=float)[:, cols])
             c = 180.0 * np.round(mean / 180.0)
+            c[c <= -180.0] += 360.0  # one name for the half turn: 180, never -180
             self._centres = c
         return c
 

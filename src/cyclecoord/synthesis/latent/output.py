@@ -127,9 +127,38 @@ class OutputMixin:
                 angles[i + n] = A[a:b]
                 roots[i + n] = {key: R[key][a:b] for key in keys}
             i = j + 1
-        return np.concatenate(angles), {
+        # each chunk's angles are in its model's chart: the rig's channels, continuous
+        angles = [self.models[c.model].to_channels(a) for c, a in zip(chunks, angles)]
+        return self._continuous(np.concatenate(angles)), {
             key: np.concatenate([r[key] for r in roots]) for key in keys
         }
+
+    def _continuous(self, angles: np.ndarray) -> np.ndarray:
+        """The Euler channels ``(T, C)`` of every joint a model charts about its mean
+        rotation made continuous over the frames (the first nearest the first model's
+        first training frame); the other channels as they are."""
+        import warnings
+
+        from scipy.spatial.transform import Rotation
+
+        from ...conventions import continuous_euler
+
+        first = self.models[self.chunks[0].model]
+        joints = {}
+        for name in dict.fromkeys(c.model for c in self.chunks):
+            for idx, order, _ in self.models[name].chart():
+                joints[tuple(int(i) for i in idx)] = order
+        if not joints:
+            return angles
+        out = np.array(angles, dtype=float)
+        start = first._centred(first._channels0()[None])[0]
+        for idx, order in joints.items():
+            cols = list(idx)
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message=".*[Gg]imbal.*")
+                R = Rotation.from_euler(order, out[:, cols], degrees=True).as_matrix()
+            out[:, cols] = continuous_euler(R[:, None], order, start[cols])[:, 0]
+        return out
 
     def plant_spans(self, n_frames: int) -> np.ndarray:
         """How much of each step's root travel ``(T - 1,)``, in ``[0, 1]``, :meth:`motion`

@@ -157,7 +157,9 @@ class GaitMixin:
             + w.reshape((-1,) + (1,) * (r1[k].ndim - 1)) * r2[k]
             for k in r1
         }
-        blended = (1 - wc) * self._clip(src, m1.pose(Xa)) + wc * self._clip(to, m2.pose(Xb))
+        blended = (1 - wc) * self._into(src, to, self._clip(src, m1.pose(Xa))) + wc * self._clip(
+            to, m2.pose(Xb)
+        )
         self._emit(to, Xb, blended, root, clip=False)
         c = self.crossings_threshold(src)
         self.events.append(
@@ -186,7 +188,11 @@ class GaitMixin:
 def _better(best, cand, m1, m2, x):
     """The nearer in pose of ``best`` ((segment, phase, point), distance) and ``cand``."""
     seg, u, x2 = cand
-    p = pose_points(np.vstack([m1.pose(x[None]), m2.pose(x2[None])]), m1.channels_, m1.skeleton_)
+    p = pose_points(
+        np.vstack([m1.to_channels(m1.pose(x[None])), m2.to_channels(m2.pose(x2[None]))]),
+        m1.channels_,
+        m1.skeleton_,
+    )
     d = float(np.sqrt(((p[0] - p[1]) ** 2).sum(-1).mean()))
     if best is None or d < best[1]:
         return (seg, u, x2), d
