@@ -219,3 +219,23 @@ def test_fit_refuses_a_root_without_position_channels(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "walk.gltf" in err[0] and "no tx channel" in err[0], err
     assert not out.exists()
+
+
+def test_fit_says_the_rig_and_the_joints_it_models_about_their_mean(tmp_path, capsys):
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from _rigs import BANDAI, bandai
+
+    bandai(2)  # skips without the shared data
+    out = tmp_path / "walk.npz"
+    assert main(["latent", "fit", str(BANDAI[2]), "-o", str(out), "--max-iter", "20",
+                 "--no-progress", "--report", str(tmp_path / "r.json")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("rig: Bandai-style rig: static root joint_Root, Hips travels")
+    assert "static root joint_Root folded into Hips" in lines[0]
+    assert lines[1].endswith("gimbal lock in the takes): Spine")
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert report["joints_about_their_mean_rotation"] == ["Spine"]
+    model = cc.synthesis.latent.LatentModel.load(out)
+    assert model.skeleton_.joints[0].name == "Hips"  # the analysis rig

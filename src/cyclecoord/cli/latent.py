@@ -128,11 +128,24 @@ def run(args: argparse.Namespace) -> int:
         folder = target.parent if str(target.parent) else Path(".")
         if not folder.is_dir():
             raise ParameterError(f"{target}: folder {folder} does not exist")
+    from ..rig import analysis_motion, describe_rig, normalize_rig
+
     segments, names = [], []
+    rig_lines: list[str] = []
     for i, text in enumerate(args.takes):
         path, a, b, name = parse_take(text)
         motion = load(path).window((a, b))
-        problem = root_position_problem(motion) if motion.skeleton is not None else None
+        if i == 0 and motion.skeleton is not None:
+            info = describe_rig(motion)
+            changes = normalize_rig(motion, info, drop_reference=False)[1].changes()
+            rig_lines.append(
+                f"rig: {info.summary()}"
+                + (f" (modelled with {'; '.join(changes)}; what the model makes uses that rig)"
+                   if changes else "")
+            )
+        problem = (
+            root_position_problem(analysis_motion(motion)) if motion.skeleton is not None else None
+        )
         if problem:
             raise ParameterError(f"{path}: {problem}")
         step = args.step or max(1, int(round(motion.fps / TRAINING_FPS)))
@@ -165,6 +178,14 @@ def run(args: argparse.Namespace) -> int:
         if args.report:
             with atomic_write(staged.file(args.report)) as fh:
                 json.dump(summary, fh, indent=2)
+    charted = summary["joints_about_their_mean_rotation"]
+    if charted:
+        rig_lines.append(
+            "modelled about their mean rotation (Euler channels that wrap or come near "
+            f"gimbal lock in the takes): {', '.join(charted)}"
+        )
+    for line in rig_lines:
+        print(line)
     print(
         f"{out}: {summary['frames']} frames in {plural(len(names), 'segment')}, "
         f"{plural(summary['pca_components'], 'PCA component')} "

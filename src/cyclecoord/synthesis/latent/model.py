@@ -482,6 +482,9 @@ class LatentModel:
             "lengthscale": self.gp_.lengthscale_,
             "white_variance": self.gp_.noise_,
             "latent_speed_per_s": self.speed_,
+            "joints_about_their_mean_rotation": [
+                self.channels_[idx[0]][0] for idx, _, _ in self.chart()
+            ],
         }
 
     def training_motion(self) -> Motion:
