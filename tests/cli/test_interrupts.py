@@ -222,3 +222,56 @@ def test_feet_interrupted_before_the_report_keeps_the_motion(walk300, tmp_path, 
     code = main(["feet", str(walk300), "-o", str(out), "--report", str(report)])
     assert code == 130, capsys.readouterr().err
     assert _listing(tmp_path) == before
+
+
+def test_ctrl_c_while_the_console_script_loads_the_commands_is_one_line(monkeypatch, capsys):
+    """The console script's entry point imports the command line (numpy, scipy, every
+    reader: about a second) inside its own guard: a Ctrl-C there is the one line and exit
+    130, not Python's KeyboardInterrupt traceback."""
+    import importlib.abc
+
+    from cyclecoord._console import main as console
+
+    class CtrlC(importlib.abc.MetaPathFinder):
+        def find_spec(self, name, path=None, target=None):
+            if name == "cyclecoord.cli.main":
+                raise KeyboardInterrupt
+            return None
+
+    monkeypatch.delitem(sys.modules, "cyclecoord.cli.main")
+    monkeypatch.setattr(sys, "meta_path", [CtrlC(), *sys.meta_path])
+    assert console() == 130
+    assert capsys.readouterr().err == "cyclecoord: interrupted\n"
+
+
+def test_a_real_ctrl_c_while_the_console_script_loads_is_held_to_the_end(monkeypatch, capsys):
+    """A SIGINT that arrives in the middle of the imports (numpy turned one into an
+    ImportError) is held until they end, then reported as the one line."""
+    import importlib.abc
+    import signal
+
+    from cyclecoord._console import main as console
+
+    seen = []
+
+    class CtrlC(importlib.abc.MetaPathFinder):
+        def find_spec(self, name, path=None, target=None):
+            if name == "cyclecoord.cli.main" and not seen:
+                seen.append(name)
+                signal.raise_signal(signal.SIGINT)  # delivered now, the import goes on
+            return None
+
+    monkeypatch.delitem(sys.modules, "cyclecoord.cli.main")
+    monkeypatch.setattr(sys, "meta_path", [CtrlC(), *sys.meta_path])
+    assert console() == 130
+    assert seen and "cyclecoord.cli.main" in sys.modules  # the import itself completed
+    assert capsys.readouterr().err == "cyclecoord: interrupted\n"
+
+
+def test_the_console_script_runs_the_command_line(monkeypatch, capsys):
+    from cyclecoord._console import main as console
+
+    monkeypatch.setattr(sys, "argv", ["cyclecoord", "--version"])
+    with pytest.raises(SystemExit) as exc:  # argparse's --version exits itself
+        console()
+    assert exc.value.code == 0 and capsys.readouterr().out.startswith("cyclecoord ")
