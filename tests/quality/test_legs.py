@@ -468,3 +468,373 @@ def test_grounded_bounds_are_inclusive():
     assert geo.grounded() == [0]
     geo.low = np.array([np.nextafter(1.0, 2.0)])
     assert geo.grounded() == []
+
+
+# ------------------------------------------------------------------ helpers, known answers
+def rest_biped(shin_r: float = 4.0, heel: float | None = None) -> Skeleton:
+    """Joints j0..j9 in a rest pose, y up, toes forward (+z), left at +x: j0 the pelvis at
+    the origin; j1-j4 the left leg (hip [1, -1, 0], knee and ankle 4 down each, toe 0.5
+    down and 1 forward, its end site 0.5 further); j5-j8 the right leg (shin ``shin_r``);
+    j9 a head 3 up (end site 1 up).  ``heel``: a j10 under the left ankle at that height
+    below it (0.4 back)."""
+    j = [Joint("j0", -1, [0, 0, 0], ("tx", "ty", "tz"), "")]
+    for x, shin in ((1.0, 4.0), (-1.0, shin_r)):
+        b = len(j)
+        j += [Joint(f"j{b}", 0, [x, -1.0, 0]), Joint(f"j{b + 1}", b, [0, -4.0, 0]),
+              Joint(f"j{b + 2}", b + 1, [0, -shin, 0]),
+              Joint(f"j{b + 3}", b + 2, [0, -0.5, 1.0], end_site=[0, 0, 0.5])]
+    j.append(Joint("j9", 0, [0, 3.0, 0], end_site=[0, 1.0, 0]))
+    if heel is not None:
+        j.append(Joint("j10", 3, [0, -heel, -0.4]))
+    return Skeleton(tuple(j))
+
+
+def test_legs_feet_sides_labels_and_describe():
+    legs = cc.quality.legs.Legs(
+        (cc.quality.legs.Leg("front left", "left", "front", ("a", "b")),
+         cc.quality.legs.Leg("leg 2", "?", None, ("c",))), "given")
+    assert legs.feet == ("a", "b", "c")
+    assert legs.sides == ("left", "left", "?")
+    assert legs.labels == ("front left", "front left", "leg 2")
+    assert legs.describe() == "feet by given: front left a+b, leg 2 c"
+
+
+def test_nearest_joints_case_count_and_cutoff():
+    """difflib's ratio 2 M / (|a| + |b|): "abcd" and "abxxxx" share 2 of 10 letters (0.4,
+    over the cutoff 0.3), "abcd" and "axxxxx" 1 of 10 (0.2, under it)."""
+    from cyclecoord.quality.legs import nearest_joints
+
+    names = ["LFoot", "lfoot1", "lfoot2", "lfoot3", "lfoot4", "lfoot5", "abxxxx", "axxxxx"]
+    skel = Skeleton(tuple(Joint(n, i - 1, [0, 1, 0]) for i, n in enumerate(names)))
+    five = nearest_joints(skel, "LFOOT")  # original case, the five closest by default
+    assert len(five) == 5 and five[0] == "LFoot" and set(five) < set(names[:6])
+    two = nearest_joints(skel, "lfoot", n=2)
+    assert len(two) == 2 and two[0] == "LFoot"
+    assert nearest_joints(skel, "ABCD") == ["abxxxx"]
+    assert nearest_joints(skel, "qqqq") == []
+
+
+def test_check_feet_contract():
+    from cyclecoord.quality.legs import check_feet, feet_names
+
+    skel = rest_biped()
+    assert check_feet(skel, ["j4", "j8"]) == ("j4", "j8")
+    assert feet_names(skel, ["j4", "j8"]) == ("j4", "j8")
+    assert feet_names(skel, "j3:j4,j7:j8") == ("j3", "j4", "j7", "j8")
+    with pytest.raises(ParameterError, match="at least one"):
+        check_feet(skel, [])
+    with pytest.raises(ParameterError, match="twice"):
+        check_feet(skel, ["j4", "j8", "j4"])
+    with pytest.raises(ParameterError, match=r"no joint 'j44' in skeleton \(unnamed\) \(10 joints\)"):
+        check_feet(skel, ["j44"])
+    with pytest.raises(ParameterError, match="twice"):  # a sequence is not split at ':'
+        feet_names(skel, ["j4", "j4"])
+
+
+def test_resolve_feet_empty_halves_and_four_legs():
+    skel = rest_biped()
+    with pytest.raises(ParameterError, match="an empty name"):
+        resolve_feet(skel, "j4,,j8")
+    with pytest.raises(ParameterError, match="an empty name"):
+        resolve_feet(skel, ["j4", ""])
+    # one half a joint: the message names the other half; neither: the whole item
+    with pytest.raises(ParameterError, match="no joint 'zz'"):
+        resolve_feet(skel, "j3:zz,j8")
+    with pytest.raises(ParameterError, match="no joint 'zz'"):
+        resolve_feet(skel, "zz:j4,j8")
+    with pytest.raises(ParameterError, match="no joint 'yy:zz'"):
+        resolve_feet(skel, "yy:zz,j8")
+    with pytest.raises(ParameterError, match="3 legs"):
+        resolve_feet(skel, "j4,j8,j9")
+    with pytest.raises(ParameterError, match="1 legs"):
+        resolve_feet(skel, "j3:j4")
+    # four chains are a quadruped's four legs
+    names = quadruped_names("anonymous")
+    quad = quadruped_skeleton(names)
+    four = [names[f"{k}_toe"] for k in ("fl", "fr", "hl")] + [names["hr_ankle"]]
+    assert resolve_feet(quad, ",".join(four)) == tuple(four)
+    # the leg's points are checked like any (a joint named twice)
+    with pytest.raises(ParameterError, match="twice"):
+        resolve_feet(skel, "j3:j4,j4")
+
+
+def test_group_joins_points_on_one_chain_and_sorts_them_down():
+    from cyclecoord.quality.legs import _group
+
+    skel = rest_biped()
+    assert _group(skel, ("j4", "j7", "j2", "j9")) == [["j2", "j4"], ["j7"], ["j9"]]
+    assert _group(skel, ("j8", "j6", "j5", "j4")) == [["j5", "j6", "j8"], ["j4"]]
+
+
+def test_ordered_front_unnamed_hind_then_left_right_unknown():
+    from cyclecoord.quality.legs import Leg, _ordered
+
+    legs = [Leg("x", s, limb, ()) for limb in ("hind", None, "front") for s in ("?", "right", "left")]
+    got = [(g.limb, g.side) for g in _ordered(legs)]
+    assert got == [(limb, s) for limb in ("front", None, "hind") for s in ("left", "right", "?")]
+
+
+def test_named_legs_toe_alone_and_toe_not_below_the_ankle():
+    """A leg named by its toe alone gives the toe; an ankle whose named toe hangs elsewhere
+    gives the ankle alone."""
+    names = {"j3": "lfoot", "j4": "j4", "j8": "rtoes", "j7": "j7", "j10": "ltoes"}
+    skel = rest_biped(heel=0.5)
+    skel = Skeleton(tuple(replace(j, name=names.get(j.name, j.name)) for j in skel.joints))
+    skel = Skeleton(tuple(replace(j, parent=0) if j.name == "ltoes" else j for j in skel.joints))
+    legs = find_legs(skel)
+    assert legs.method == "names"
+    assert [(g.label, g.points) for g in legs.legs] == [("left", ("lfoot",)),
+                                                        ("right", ("rtoes",))]
+
+
+def test_find_legs_up_axis():
+    """The same body with its up axis y turned to x (and to z) gives the same feet."""
+    skel = rest_biped()
+    assert find_legs(skel).feet == ("j3", "j4", "j7", "j8")
+    for up, perm in (("x", [1, 0, 2]), ("z", [0, 2, 1])):
+        turned = Skeleton(tuple(
+            replace(j, offset=j.offset[perm],
+                    end_site=None if j.end_site is None else j.end_site[perm])
+            for j in skel.joints))
+        legs = find_legs(turned, up=up)
+        assert set(legs.feet) == {"j3", "j4", "j7", "j8"}, up
+        assert legs.method == "geometry"
+    with pytest.raises(ParameterError, match="up axis must be one of x, y, z, got 'w'"):
+        find_legs(skel, up="w")
+
+
+def test_geometry_of_the_rest_pose_by_hand():
+    """rest_biped's rest pose summed bone by bone: floor at the toes (y -9.5), heights above
+    it, body height 12.5 (the head joint at 3; end sites count for lows, not for the
+    height), bone lengths the offsets' norms."""
+    from cyclecoord.quality.legs import _Geometry
+
+    geo = _Geometry(rest_biped(), None, "y")
+    assert geo.in_motion is False
+    expected = [[0, 0, 0], [1, -1, 0], [1, -5, 0], [1, -9, 0], [1, -9.5, 1],
+                [-1, -1, 0], [-1, -5, 0], [-1, -9, 0], [-1, -9.5, 1], [0, 3, 0]]
+    np.testing.assert_array_equal(geo.pos, [expected])
+    assert geo.ends == [4, 8, 9]
+    assert geo.floor == -9.5
+    np.testing.assert_array_equal(geo.median, [9.5, 8.5, 4.5, 0.5, 0, 8.5, 4.5, 0.5, 0, 12.5])
+    np.testing.assert_array_equal(geo.low, geo.median)
+    assert geo.height == 12.5 and geo.usable
+    s2, s125 = np.sqrt(2.0), np.sqrt(1.25)
+    np.testing.assert_allclose(geo.bone, [0, s2, 4, 4, s125, s2, 4, 4, s125, 3], rtol=1e-15)
+    assert geo.chain(4) == [0, 1, 2, 3, 4] and geo.chain(0) == [0]
+    assert geo.part(4, 8) == 0 and geo.part(3, 4) == 3 and geo.part(4, 3) == 3
+    assert geo.part(4, 4) == 4 and geo.part(2, 9) == 0
+    assert geo.length(0, 4) == pytest.approx(s2 + 8 + s125, rel=1e-15)
+    assert geo.length(2, 4) == pytest.approx(4 + s125, rel=1e-15)
+    assert geo.length(4, 4) == 0.0
+    np.testing.assert_allclose(geo.mean_position(0, 4), [[1, -24.5 / 4, 0.25]], rtol=1e-15)
+    np.testing.assert_allclose(geo.mean_position(3, 4), [[1, -9.5, 1]], rtol=1e-15)
+    assert geo.grounded() == [4, 8]
+    assert geo.foot_points(0, 4) == (3, 4)  # the shin (4) is over a quarter of 10.5
+    assert geo.candidates() == ["j4 (0)", "j8 (0)", "j9 (12.5)"]
+    assert geo.candidates(1) == ["j4 (0)"]
+
+
+def test_geometry_end_sites_lower_the_lows_each_its_own():
+    """Each joint's low is itself or its own end site, whichever is lower: toe end sites
+    0.5 and 0.25 down put the floor at -10 and the right toe at 0.25; the head's end site
+    above it leaves the head at its joint (3, 13 above the floor)."""
+    from cyclecoord.quality.legs import _Geometry
+
+    skel = rest_biped()
+    ends = {"j4": [0, -0.5, 0.5], "j8": [0, -0.25, 0.5]}
+    skel = Skeleton(tuple(replace(j, end_site=ends.get(j.name, j.end_site)) for j in skel.joints))
+    geo = _Geometry(skel, None, "y")
+    assert geo.floor == -10.0
+    np.testing.assert_array_equal(geo.median[[3, 4, 7, 8, 9]], [1.0, 0.0, 1.0, 0.25, 13.0])
+    assert geo.height == 13.0
+
+
+def _standing(skel: Skeleton, heights) -> Motion:
+    """``skel`` (root dofs tx ty tz only) with its root at these heights, one a frame."""
+    frames = np.zeros((len(heights), 3))
+    frames[:, 1] = heights
+    return Motion(frames, skel.channels, fps=30.0, skeleton=skel)
+
+
+def test_geometry_in_motion_quantiles_and_frame_step():
+    """The root at heights 0, 1, ..., 100: the toes' per-frame lows k - 9.5 put the floor
+    at their 5 % quantile (5 - 9.5 = -4.5), a toe's median at 50 - 9.5 + 4.5 = 45 and its
+    5 % low at 0, the body height at the head's median 53 + 4.5."""
+    from cyclecoord.quality.legs import _Geometry
+
+    skel = rest_biped()
+    geo = _Geometry(skel, _standing(skel, np.arange(101.0)), "y")
+    assert geo.in_motion is True and geo.pos.shape == (101, 10, 3)
+    assert geo.floor == pytest.approx(-4.5, abs=1e-12)
+    assert geo.median[4] == pytest.approx(45.0, abs=1e-12)
+    assert geo.low[4] == pytest.approx(0.0, abs=1e-12)
+    assert geo.low[9] == pytest.approx(12.5, abs=1e-12)
+    assert geo.height == pytest.approx(57.5, abs=1e-12)
+    # at most 400 frames: a step of ceil(T / 400)
+    for T, used in ((400, 400), (401, 201), (1200, 400), (1201, 301)):
+        geo = _Geometry(skel, _standing(skel, np.zeros(T)), "y")
+        assert geo.pos.shape[0] == used, T
+    # a motion with a NaN is not used: the rest pose instead
+    h = np.zeros(5)
+    h[2] = np.nan
+    geo = _Geometry(skel, _standing(skel, h), "y")
+    assert geo.in_motion is False and geo.pos.shape[0] == 1
+
+
+def test_grounded_keeps_the_lower_of_two_ends_parting_low():
+    """A heel under the left ankle (a second end of that leg): of the toe and the heel only
+    the lower is a foot, as they part at the ankle (0.5 above the floor, under 0.3 of the
+    body height); the right toe parts from either at the pelvis and stays."""
+    from cyclecoord.quality.legs import _Geometry
+
+    geo = _Geometry(rest_biped(heel=0.4), None, "y")  # heel at -9.4, over the toe
+    assert geo.ends == [4, 8, 9, 10]
+    assert geo.grounded() == [4, 8]
+    geo = _Geometry(rest_biped(heel=0.6), None, "y")  # heel at -9.6: the floor
+    assert geo.median[10] == 0.0 and geo.median[4] == pytest.approx(0.1)
+    assert geo.grounded() == [10, 8]
+    # lowest first, whatever the order of the ends
+    geo = _Geometry(rest_biped(shin_r=3.8), None, "y")
+    assert geo.grounded() == [4, 8]
+    geo = _Geometry(rest_biped(shin_r=4.2), None, "y")
+    assert geo.grounded() == [8, 4]
+
+
+def test_grounded_median_bound_and_its_argument():
+    """Median height at most 0.3 of the body height by default, or the bound given (both
+    included): 3.0 of 10 passes 0.3, not 0.15; 1.5 passes 0.15."""
+    from cyclecoord.quality.legs import _GROUND_MEDIAN, _Geometry
+
+    assert _GROUND_MEDIAN * 10.0 == 3.0
+    geo = object.__new__(_Geometry)
+    geo.height = 10.0
+    geo.ends = [0]
+    geo.low = np.array([0.0])
+    geo.median = np.array([3.0])
+    assert geo.grounded() == [0]
+    assert geo.grounded(0.15) == []
+    geo.median = np.array([np.nextafter(3.0, 4.0)])
+    assert geo.grounded() == []
+    geo.median = np.array([1.5])
+    assert geo.grounded(0.15) == [0]
+
+
+def _two_legs(la: float, lb: float) -> Skeleton:
+    """j0 with a leg j1 [1, 0, 0] -> j2 (la - 1 down) and j3 [-1, 0, 0] -> j4 (lb - 1 down),
+    and a head j5 10 up."""
+    return Skeleton((
+        Joint("j0", -1, [0, 0, 0]), Joint("j1", 0, [1.0, 0, 0]), Joint("j2", 1, [0, 1 - la, 0]),
+        Joint("j3", 0, [-1.0, 0, 0]), Joint("j4", 3, [0, 1 - lb, 0]), Joint("j5", 0, [0, 10, 0]),
+    ))
+
+
+def test_pair_score_closed_form_and_bounds():
+    """(median_a + median_b) / height + |la - lb| / max(la, lb), None when the legs differ
+    by more than 0.3 of the longer one or part at most 0.3 of the height up."""
+    from cyclecoord.quality.legs import _Geometry
+
+    # legs 10 and 7: a spread of exactly 0.3 is alike; the floor at -9, height 19
+    geo = _Geometry(_two_legs(10.0, 7.0), None, "y")
+    assert geo.height == 19.0
+    assert geo.pair_score(2, 4) == pytest.approx(3.0 / 19.0 + 0.3, rel=1e-15)
+    assert geo.pair_score(4, 2) == pytest.approx(3.0 / 19.0 + 0.3, rel=1e-15)
+    geo = _Geometry(_two_legs(10.0, 6.99), None, "y")
+    assert geo.pair_score(2, 4) is None
+    # rest_biped with a right shin of 3: lengths sqrt 2 + 8 + sqrt 1.25 and 1 less
+    geo = _Geometry(rest_biped(shin_r=3.0), None, "y")
+    la = np.sqrt(2.0) + 8 + np.sqrt(1.25)
+    assert geo.pair_score(4, 8) == pytest.approx(1.0 / 12.5 + 1.0 / la, rel=1e-14)
+    assert geo.pair_score(4, 9) is None  # a head of 3 beside a leg of 10.5
+    # parting at the ankle (0.5 above the floor): not two legs
+    geo = _Geometry(rest_biped(heel=0.4), None, "y")
+    assert geo.pair_score(4, 10) is None
+
+
+def test_pair_score_part_height_and_zero_length_bounds():
+    from cyclecoord.quality.legs import _PART_HEIGHT, _Geometry
+
+    assert _PART_HEIGHT * 10.0 == 3.0
+    geo = object.__new__(_Geometry)
+    geo.skeleton = Skeleton((Joint("j0", -1, [0, 0, 0]), Joint("j1", 0, [0, -2, 0]),
+                             Joint("j2", 0, [0, -2, 0])))
+    geo.height = 10.0
+    geo.bone = np.array([0.0, 2.0, 2.0])
+    geo.median = np.array([3.0, 0.5, 1.5])
+    assert geo.pair_score(1, 2) is None  # parting exactly 0.3 up is too low
+    geo.median[0] = np.nextafter(3.0, 4.0)
+    assert geo.pair_score(1, 2) == pytest.approx(0.2, rel=1e-15)
+    geo.bone[:] = 0.0  # legs of no length are none
+    assert geo.pair_score(1, 2) is None
+
+
+def test_foot_points_shin_fraction_edges():
+    """The ankle is the first joint up from the end whose bone is at least a quarter of the
+    leg (exactly a quarter counts), else the joint just below where the leg parts."""
+    from cyclecoord.quality.legs import _SHIN_FRACTION, _Geometry
+
+    assert _SHIN_FRACTION == 0.25
+
+    def chain(*drops):
+        joints = [Joint("j0", -1, [0, 0, 0])]
+        joints += [Joint(f"j{k + 1}", k, [0, -d, 0]) for k, d in enumerate(drops)]
+        return _Geometry(Skeleton(tuple(joints)), None, "y")
+
+    assert chain(4.0, 2.0, 2.0).foot_points(0, 3) == (3,)  # 2 of 8: an ankle, no toe
+    assert chain(4.0, 2.0, 1.99).foot_points(0, 3) == (2, 3)  # 1.99 of 7.99: a toe
+    assert chain(1.0, 1.0, 1.0, 1.0, 1.0).foot_points(0, 5) == (1, 2)  # all short
+    assert chain(1.0, 1.0, 1.0, 1.0, 1.0).foot_points(2, 5) == (5,)  # 1 of 3 from j2
+
+
+def test_usable_upright_left_ahead_by_hand():
+    from cyclecoord.quality.legs import _Geometry
+
+    flat = Skeleton((Joint("j0", -1, [0, 0, 0]), Joint("j1", 0, [1, 0, 0]),
+                     Joint("j2", 0, [-1, 0, 0])))
+    geo = _Geometry(flat, None, "y")
+    assert geo.height == 0.0 and not geo.usable
+    with pytest.raises(ParameterError, match="no foot joints"):
+        find_legs(flat)
+    geo.height = np.inf
+    assert not geo.usable
+    geo.height = 1e-300
+    assert geo.usable
+    # upright: the leg's top over its end by more than half the leg's length (> 0)
+    geo = object.__new__(_Geometry)
+    geo.skeleton = Skeleton((Joint("j0", -1, [0, 0, 0]), Joint("j1", 0, [0, -4, 0]),
+                             Joint("j2", 0, [0, 0, 0])))
+    geo.bone = np.array([0.0, 4.0, 0.0])
+    geo.median = np.array([2.0, 0.0, 1.0])
+    assert not geo.upright([(0, 1)])  # 2 over, half of 4: not more
+    geo.median[0] = 2.5
+    assert geo.upright([(0, 1)])
+    assert not geo.upright([(0, 1), (0, 2)])  # a leg of no length
+    # left = up x forward: with y up and +z forward, left is +x; the median frame decides
+    geo.up = 1
+    fwd = np.tile([0.0, 0.0, 1.0], (3, 1))
+    a = np.array([[1.0, 0, 0], [1.0, 0, 0], [-1.0, 0, 0]])
+    b = np.zeros((3, 3))
+    assert geo.left_of(a, b, fwd) and not geo.left_of(b, a, fwd)
+    assert not geo.left_of(b, b, fwd)  # on the line: not left
+    assert not geo.ahead_of(a, b, fwd)
+    assert geo.ahead_of(a[:, [2, 1, 0]], b, fwd) and not geo.ahead_of(b, b, fwd)
+    geo.up = 2  # z up, +x forward: left is +y
+    fwd = np.tile([1.0, 0.0, 0.0], (3, 1))
+    assert geo.left_of(np.tile([0.0, 1.0, 0.0], (3, 1)), b, fwd)
+    assert not geo.left_of(np.tile([0.0, -1.0, 0.0], (3, 1)), b, fwd)
+
+
+def test_forward_feet_of_exactly_1e9_units_are_none():
+    """A median foot extent of exactly 1e-9 units is none: the root's travel decides."""
+    from cyclecoord.quality.legs import _Geometry
+
+    geo = object.__new__(_Geometry)
+    geo.up = 1
+    pos = np.zeros((3, 3, 3))
+    pos[:, 1] = [0.0, 1.0, 0.0]
+    pos[:, 2] = [1e-9, 0.0, 0.0]
+    pos[-1, 0] = [0.0, 0.0, -2.0]
+    geo.pos = pos
+    np.testing.assert_array_equal(geo.forward([(1, 2)]), np.tile([0.0, 0.0, -1.0], (3, 1)))
+    pos[:, 2] = [2e-9, 0.0, 0.0]
+    np.testing.assert_allclose(geo.forward([(1, 2)]), np.tile([1.0, 0.0, 0.0], (3, 1)))
