@@ -838,3 +838,63 @@ def test_forward_feet_of_exactly_1e9_units_are_none():
     np.testing.assert_array_equal(geo.forward([(1, 2)]), np.tile([0.0, 0.0, -1.0], (3, 1)))
     pos[:, 2] = [2e-9, 0.0, 0.0]
     np.testing.assert_allclose(geo.forward([(1, 2)]), np.tile([1.0, 0.0, 0.0], (3, 1)))
+
+
+def _renamed(skel: Skeleton, names: dict) -> Skeleton:
+    return Skeleton(tuple(replace(j, name=names.get(j.name, j.name)) for j in skel.joints))
+
+
+def test_legs_of_feet_sides_from_names_before_geometry():
+    """Sides come from the first named joint on each leg's chain, even against the
+    geometry (hips named the other way round); without names, from the geometry."""
+    skel = rest_biped()
+    legs = legs_of_feet(skel, "j7:j8,j3:j4")
+    assert legs.method == "given"
+    assert [(g.label, g.side, g.limb, g.points) for g in legs.legs] == [
+        ("right", "right", None, ("j7", "j8")), ("left", "left", None, ("j3", "j4"))]
+    swapped = _renamed(skel, {"j1": "rhipjoint", "j5": "lhipjoint"})
+    legs = legs_of_feet(swapped, ("j4", "j8"))
+    assert legs.sides == ("right", "left")
+    legs = legs_of_feet(_renamed(skel, {"j3": "rfoot"}), ("j4", "j8"))  # one side named
+    assert legs.sides == ("left", "right")  # the geometry decides both
+
+
+def test_legs_of_feet_labels_without_sides_and_twice_the_same():
+    """A leg without a side is "leg k" (k from 1, in the order given); a label met twice
+    gets its leg's number too; neither 2 nor 4 legs: no geometry is tried."""
+    skel = rest_biped()
+    legs = legs_of_feet(skel, ["j4", "j8", "j9"])
+    assert [g.label for g in legs.legs] == ["leg 1", "leg 2", "leg 3"]
+    assert legs.sides == ("?", "?", "?")
+    named = _renamed(skel, {"j3": "lfoot", "j7": "lhand"})
+    legs = legs_of_feet(named, ["lfoot", "lhand", "j9"])
+    assert [g.label for g in legs.legs] == ["left", "left 2", "leg 3"]
+    assert legs.sides == ("left", "left", "?")
+    # two legs on a flat body (no height): no geometry either
+    flat = Skeleton((Joint("j0", -1, [0, 0, 0]), Joint("j1", 0, [1, 0, 0]),
+                     Joint("j2", 0, [-1, 0, 0])))
+    legs = legs_of_feet(flat, ["j1", "j2"])
+    assert [(g.label, g.side) for g in legs.legs] == [("leg 1", "?"), ("leg 2", "?")]
+
+
+def _splayed() -> Skeleton:
+    """rest_biped with the legs reaching forward from the hips (knee and ankle 1 down and
+    4 forward each): they drop 3.5 over a length of about 10.8, not hanging down."""
+    j = [Joint("j0", -1, [0, 0, 0], ("tx", "ty", "tz"), "")]
+    for x in (1.0, -1.0):
+        b = len(j)
+        j += [Joint(f"j{b}", 0, [x, -1.0, 0]), Joint(f"j{b + 1}", b, [0, -1.0, 4.0]),
+              Joint(f"j{b + 2}", b + 1, [0, -1.0, 4.0]),
+              Joint(f"j{b + 3}", b + 2, [0, -0.5, 1.0], end_site=[0, 0, 0.5])]
+    j.append(Joint("j9", 0, [0, 3.0, 0], end_site=[0, 1.0, 0]))
+    return Skeleton(tuple(j))
+
+
+def test_geometry_legs_must_hang_down_in_the_rest_pose_only():
+    """A rest pose whose legs do not hang down (Bandai's lie along the floor) gives no legs;
+    in a motion the same pose does (the motion shows where the feet are)."""
+    skel = _splayed()
+    with pytest.raises(ParameterError, match="no foot joints"):
+        find_legs(skel)
+    legs = find_legs(skel, _standing(skel, np.zeros(3)))
+    assert legs.method == "geometry" and legs.feet == ("j3", "j4", "j7", "j8")
