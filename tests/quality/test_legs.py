@@ -898,3 +898,101 @@ def test_geometry_legs_must_hang_down_in_the_rest_pose_only():
         find_legs(skel)
     legs = find_legs(skel, _standing(skel, np.zeros(3)))
     assert legs.method == "geometry" and legs.feet == ("j3", "j4", "j7", "j8")
+
+
+def test_leg_results_are_frozen_and_hashable():
+    from dataclasses import FrozenInstanceError
+
+    from cyclecoord.quality.legs import Leg, Legs
+
+    leg = Leg("left", "left", None, ("a",))
+    legs = Legs((leg,), "names")
+    assert len({leg, Leg("left", "left", None, ("a",))}) == 1 and hash(legs) == hash(
+        Legs((Leg("left", "left", None, ("a",)),), "names"))
+    with pytest.raises(FrozenInstanceError):
+        leg.side = "right"
+    with pytest.raises(FrozenInstanceError):
+        legs.method = "given"
+
+
+def test_ancestors_reach_the_root_and_the_root_groups_with_its_chain():
+    from cyclecoord.quality.legs import _ancestors, _group
+
+    skel = rest_biped()
+    assert _ancestors(skel, 4) == ["j3", "j2", "j1", "j0"] and _ancestors(skel, 0) == []
+    assert _group(skel, ("j4", "j0")) == [["j0", "j4"]]
+    # ANKLE:TOE with the root as the ankle: the toe is below it, and so is every joint
+    with pytest.raises(ParameterError, match="1 legs"):
+        resolve_feet(skel, "j0:j4,j8")
+
+
+def test_geometry_of_an_empty_motion_is_the_rest_pose_and_the_root_is_no_end():
+    from cyclecoord.quality.legs import _Geometry
+
+    skel = rest_biped()
+    geo = _Geometry(skel, _standing(skel, np.zeros(0)), "y")
+    assert geo.in_motion is False and geo.pos.shape == (1, 10, 3)
+    # a root whose only child is a prop is no end: ends are never the root
+    lone = Skeleton((Joint("j0", -1, [0, 0, 0]), Joint("Prop1", 0, [0, -1, 0])))
+    assert _Geometry(lone, None, "y").ends == []
+
+
+def test_legs_too_unlike_to_pair_give_no_legs():
+    """Two ends on the floor 9 below the root, one leg 10 long and one 17 (its hip 8 out
+    to the side): 7 apart, over 0.3 of 17, so no pair and no legs."""
+    skel = Skeleton((Joint("j0", -1, [0, 0, 0]), Joint("j1", 0, [8.0, 0, 0]),
+                     Joint("j2", 1, [0, -9.0, 0]), Joint("j3", 0, [-1.0, 0, 0]),
+                     Joint("j4", 3, [0, -9.0, 0]), Joint("j5", 0, [0, 5.0, 0])))
+    with pytest.raises(ParameterError, match="no foot joints"):
+        find_legs(skel)
+    ok = Skeleton(tuple(replace(j, offset=[4.0, 0, 0]) if j.name == "j1" else j
+                        for j in skel.joints))  # 13 and 10: 3 apart, within 0.3 of 13
+    assert find_legs(ok).feet == ("j2", "j4")
+
+
+def test_four_ends_of_which_only_one_pair_is_alike_give_two_legs():
+    """The quadruped at rest with its hind right hip 8 out to the side (that leg 17 long
+    from the pelvis, the hind left 10.6): no two pairs are both alike, so the pair that is
+    (the front legs, parting at the chest, alike exactly) are the two legs."""
+    names = quadruped_names("anonymous")
+    skel = quadruped_skeleton(names)
+    wide = Skeleton(tuple(replace(j, offset=[-8.0, 0, 0]) if j.name == names["hr_hip"] else j
+                          for j in skel.joints))
+    legs = find_legs(wide)
+    assert legs.method == "geometry"
+    assert legs.feet == (names["fl_ankle"], names["fl_toe"], names["fr_ankle"], names["fr_toe"])
+    assert legs.sides == ("left", "left", "right", "right")
+
+
+def test_extra_legs_need_a_motion_and_a_right_leg_of_one_point():
+    """A dog rig named like a person gets its front legs from a motion, never from its rest
+    pose alone; the named legs' chains are checked from the left leg's first point to the
+    right leg's last, a right leg of its ankle alone included."""
+    names = quadruped_names("human")
+    dog = quadruped_skeleton(names)
+    assert find_legs(dog).method == "names"
+    motion = trot(dog, names)
+    assert find_legs(dog, motion).method == "names and geometry"
+    bare = {names["hr_toe"]: "j99"}
+    dog1 = _renamed(dog, bare)
+    motion1 = Motion(motion.frames, tuple((bare.get(a, a), d) for a, d in motion.channels),
+                     fps=motion.fps, skeleton=dog1)
+    legs = find_legs(dog1, motion1)
+    assert legs.method == "names and geometry"
+    assert [(g.label, g.points) for g in legs.legs][-1] == ("hind right", ("RightFoot",))
+
+
+@pytest.mark.parametrize("heading", [0.0, 180.0])
+def test_extra_legs_front_or_hind_whichever_way_the_dog_trots(heading):
+    """Front and hind come from where the legs are along the way the feet point, far
+    from the origin too (a trot of 16 units either way, 100 units behind the origin)."""
+    names = quadruped_names("human")
+    dog = quadruped_skeleton(names)
+    motion = trot(dog, names, heading_deg=heading)
+    frames = motion.frames.copy()
+    frames[:, motion.channel_index(names["pelvis"], "tz")] -= 100.0 * np.cos(np.radians(heading))
+    legs = find_legs(dog, motion.with_frames(frames))
+    assert legs.method == "names and geometry"
+    assert [(g.label, g.points[0]) for g in legs.legs] == [
+        ("front left", "LeftHand"), ("front right", "RightHand"),
+        ("hind left", "LeftFoot"), ("hind right", "RightFoot")]
