@@ -707,3 +707,37 @@ def test_autocorrelation_period_first_strong_peak_and_min_correlation():
     assert autocorrelation_period(four, strong=0.95) == pytest.approx(20, abs=0.05)
     assert autocorrelation_period(four, min_correlation=0.95) == pytest.approx(20, abs=0.05)
     assert autocorrelation_period(four, min_correlation=0.85) == pytest.approx(10, abs=0.05)
+
+
+def test_average_cycle_heading_unwrapped_and_roots_without_heading():
+    """A turn in place crossing 180 degrees (170, 175, 180, -175: +5 a frame) averages as a
+    steady turn from the first heading; a root without ry averages its translation
+    relative to each piece's start, unturned; a root without tx/tz as it is."""
+    rows = np.zeros((9, 6))
+    rows[:, 4] = [170.0, 175.0, 180.0, -175.0, 10.0, 15.0, 20.0, 25.0, 25.0]
+    rows[:, 0] = [0, 0, 0, 0, 50, 51, 52, 53, 53]
+    m = _motion({"a.rx": np.zeros(9)}, root=rows)
+    avg = average_cycle(m, [0, 4, 8], 4)
+    np.testing.assert_allclose(avg.frames[:, 4], [170, 175, 180, 185])
+    # the first piece stands; the second moves 1 a frame along world x, which its first
+    # heading (10) turns into local (cos 10, sin 10); the mean is half that, turned into
+    # the first piece's heading (170)
+    a = np.radians(10.0)
+    local = np.array([np.cos(a), np.sin(a)]) * np.arange(4)[:, None] / 2  # (dx, dz) local
+    b = np.radians(170.0)
+    np.testing.assert_allclose(avg.frames[:, 0], np.cos(b) * local[:, 0] + np.sin(b) * local[:, 1],
+                               atol=1e-12)
+    np.testing.assert_allclose(avg.frames[:, 2], -np.sin(b) * local[:, 0] + np.cos(b) * local[:, 1],
+                               atol=1e-12)
+    # no heading channel: translations relative to each piece's start, not turned
+    flat = cc.Motion(np.column_stack([rows[:, 0], rows[:, 2] + 3.0, np.arange(9.0)]),
+                     [("root", "tx"), ("root", "tz"), ("a", "rx")], fps=10.0)
+    avg = average_cycle(flat, [0, 4, 8], 4)
+    np.testing.assert_allclose(avg.frames[:, 0], np.arange(4) / 2)
+    np.testing.assert_allclose(avg.frames[:, 1], 3.0)
+    np.testing.assert_allclose(avg.frames[:, 2], [2, 3, 4, 5])
+    # only tx: no relative translation (both tx and tz are needed)
+    onlyx = cc.Motion(np.column_stack([rows[:, 0], np.arange(9.0)]),
+                      [("root", "tx"), ("a", "rx")], fps=10.0)
+    np.testing.assert_allclose(average_cycle(onlyx, [0, 4, 8], 4).frames[:, 0],
+                               [25, 25.5, 26, 26.5])
