@@ -524,3 +524,106 @@ def test_penetration_pops_units_and_notes():
     # never under the floor: a penetration of 0, not negative
     q = measure_generated(src[:96], reference=ref)
     assert q.penetration_m == 0.0 and q.penetration_fraction == 0.0
+
+
+def test_angle_of_parallel_vectors_rounding_over_one():
+    """(0.54, 0.21, 0.36) against 3 times itself: the cosine rounds to 1 + 2^-52; clipped,
+    the angle is 0, not NaN."""
+    from cyclecoord.quality.generated import _angle
+
+    u = np.array([0.54, 0.21, 0.36])
+    assert _angle(u, 3 * u) == 0.0
+
+
+def test_cycle_first_peak_at_the_window_start_and_rising_windows():
+    """At 100 fps the window starts at lag 40: a 0.41 s sine peaks at the window's second
+    lag (0.41, not its second peak 0.82); 200 samples cap the window at lag 100, where a
+    1.1 s sine still rises: no peak inside, the highest lag (99: 0.99 s) is taken."""
+    from cyclecoord.quality.generated import _cycle
+
+    t = np.arange(600)
+    assert _cycle(np.sin(2 * np.pi * t / 41), 100.0) == pytest.approx(0.41)
+    assert _cycle(np.sin(2 * np.pi * t[:200] / 110), 100.0) == pytest.approx(0.99)
+
+
+def test_contact_band_is_three_hundredths_of_the_leg():
+    """Contact from height alone: within CONTACT_HEIGHT = 0.03 leg lengths (0.24 units for
+    legs of 8) of each point's own low level.  The legs raised 0.23 on the second half of
+    the take stay in contact; raised 0.25 they leave it on that half."""
+    from cyclecoord.quality.generated import CONTACT_HEIGHT
+
+    assert CONTACT_HEIGHT == 0.03
+    src, knees, sources = _knee_sources()
+    ty = src.channels.index(("root", "ty"))
+    for lift, fraction in ((0.23, 1.0), (0.25, 0.5)):
+        g = src.frames[:96].copy()
+        g[48:, ty] += lift
+        q = measure_generated(src[:96].with_frames(g), sources)
+        assert q.contact_fraction == dict.fromkeys(("lfoot", "ltoes", "rfoot", "rtoes"),
+                                                   fraction), lift
+
+
+def test_rig_and_source_figures_are_frozen():
+    from dataclasses import FrozenInstanceError
+
+    from cyclecoord.quality.generated import _rig, source_figures
+
+    src, knees, sources = _knee_sources()
+    ref = source_figures(sources, 64.0)
+    with pytest.raises(FrozenInstanceError):
+        ref.floor = 0.0
+    with pytest.raises(FrozenInstanceError):
+        _rig(src, None).trunk = 1
+
+
+def test_rig_of_three_or_four_legs_uses_the_first_two():
+    from _legs import legs_skeleton, make_motion
+    from _walkers import quadruped_names, quadruped_skeleton, trot
+
+    from cyclecoord.quality.generated import _rig
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    names = quadruped_names("dog")
+    skel = quadruped_skeleton(names)
+    rig = _rig(trot(skel, names), None)
+    assert len(rig.legs.legs) == 4
+    assert [skel.names[i] for i in rig.ankles] == [names["fl_ankle"], names["fr_ankle"]]
+    assert len(rig.feet) == 8  # the feet are all the legs'
+    # three legs given (the third a spine joint on the root, no knee): the first two
+    base = legs_skeleton()
+    skel = Skeleton(base.joints + (Joint("LowerBack", 0, [0, 2.0, 0]),))
+    rig = _rig(make_motion(skel, T=8), ("lfoot", "rfoot", "LowerBack"))
+    assert len(rig.legs.legs) == 3 and rig.ankles == [3, 7] and rig.hips == [1, 5]
+
+
+def test_kin_removes_the_heading_and_measures_hips_from_the_trunk():
+    """_kin: positions relative to the root with the heading (the hips' left-right line)
+    turned to +x, so a body spinning in place has one local pose; the hip angle is the
+    thigh against the trunk's downward line, 0 for legs hanging straight under an upright
+    trunk wherever the body stands (or against -y without a trunk)."""
+    from _legs import legs_skeleton
+
+    from cyclecoord.motion import Motion
+    from cyclecoord.quality.generated import _kin, _rig
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    base = legs_skeleton()
+    for spine in ((), ("LowerBack", "Spine")):
+        joints = list(base.joints)
+        for k, name in enumerate(spine):
+            joints.append(Joint(name, 0 if k == 0 else len(joints) - 1, [0, 2.0, 0]))
+        skel = Skeleton(tuple(joints))
+        ch = skel.channels
+        f = np.zeros((5, len(ch)))
+        f[:, ch.index(("root", "tx"))] = 100.0
+        f[:, ch.index(("root", "ty"))] = 10.0
+        f[:, ch.index(("root", "ry"))] = [0.0, 30.0, 90.0, 200.0, -45.0]
+        m = Motion(f, ch, fps=10.0, skeleton=skel)
+        kin = _kin(m, _rig(m, None))
+        np.testing.assert_allclose(kin.local, np.broadcast_to(kin.local[0], kin.local.shape),
+                                   atol=1e-9)
+        np.testing.assert_allclose(kin.local[0, 1], [1.0, -1.0, 0.0], atol=1e-12)  # lfemur
+        np.testing.assert_allclose(kin.local[0, 5], [-1.0, -1.0, 0.0], atol=1e-12)
+        np.testing.assert_allclose(kin.hip, 0.0, atol=1e-6)
+        np.testing.assert_allclose(kin.knee, 0.0, atol=1e-6)
+        np.testing.assert_allclose(kin.pose_speed(), 0.0, atol=1e-8)
