@@ -627,3 +627,40 @@ def test_kin_removes_the_heading_and_measures_hips_from_the_trunk():
         np.testing.assert_allclose(kin.hip, 0.0, atol=1e-6)
         np.testing.assert_allclose(kin.knee, 0.0, atol=1e-6)
         np.testing.assert_allclose(kin.pose_speed(), 0.0, atol=1e-8)
+
+
+def test_summary_says_more_only_past_four_freezes():
+    four = _quality(freezes=[(0, 20), (30, 50), (60, 80), (90, 110)]).summary()[3]
+    assert four.endswith("frames 0-20, 30-50, 60-80, 90-110")
+
+
+def test_sliding_feet_slip_in_units_and_leg_lengths_and_knee_p99():
+    """Standing legs slid forward at 4 units/s (64 fps, positions multiples of 1/16): the
+    lowest foot points (the toes) move 4 units/s, half a leg of 8 a second, times the
+    sources' metres per unit; the knees held bent 30 and 10 deg give those p99 flexions."""
+    from _legs import legs_skeleton, make_motion
+
+    from cyclecoord.quality.generated import source_figures
+
+    src, knees, sources = _knee_sources()
+    ref = source_figures(sources, 64.0)
+    m = make_motion(legs_skeleton(), T=64, fps=64.0, root_speed=4.0)
+    f = m.frames.copy()
+    f[:, knees[0]] = 30.0
+    f[:, knees[1]] = -10.0
+    q = measure_generated(m.with_frames(f), reference=ref)
+    assert q.support_slip == pytest.approx(4.0 * ref.metres, rel=1e-9)
+    assert q.support_slip_legs == pytest.approx(0.5, rel=1e-9)
+    assert q.knee_p99 == pytest.approx((30.0, 10.0), abs=1e-6)
+    assert q.knee_range == pytest.approx((0.0, 0.0), abs=1e-6)
+
+
+@pytest.mark.filterwarnings("ignore:invalid value encountered:RuntimeWarning")  # pops 0 / 0
+def test_still_sources_make_no_frame_a_freeze():
+    """Slow is strictly under a tenth of the sources' median pose speed: sources that never
+    move (median 0) leave a still motion without freezes."""
+    from _legs import legs_skeleton, make_motion
+
+    still = make_motion(legs_skeleton(), T=64, fps=64.0)
+    q = measure_generated(still, [still])
+    assert q.freezes == [] and q.longest_freeze_s == 0.0
