@@ -655,6 +655,8 @@ def test_average_cycle_coordinate_or_wraps_and_length():
     assert average_cycle(m, phase, 4).metadata["pieces"] == [(4.0, 8.0)]
     nine = np.array([0.0, 4.0, 8.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0])  # T values, not in [0, 1)
     assert average_cycle(m, nine, 4).metadata["pieces"] == [(0.0, 1.0), (1.0, 4.0), (4.0, 8.0)]
+    halves = np.array([0.0, 0.5, 1.0, 1.5, 1.5, 1.5, 1.5, 1.5, 1.5])  # 1.0 and 1.5 >= 1
+    assert average_cycle(m, halves, 2).metadata["pieces"] == [(0.0, 0.5), (0.5, 1.0), (1.0, 1.5)]
     for bad in (1, 2.5, 0):
         with pytest.raises(ParameterError, match="integer >= 2"):
             average_cycle(m, [0, 4, 8], bad)
