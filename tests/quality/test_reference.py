@@ -743,3 +743,16 @@ def test_average_cycle_heading_unwrapped_and_roots_without_heading():
                       [("root", "tx"), ("a", "rx")], fps=10.0)
     np.testing.assert_allclose(average_cycle(onlyx, [0, 4, 8], 4).frames[:, 0],
                                [25, 25.5, 26, 26.5])
+
+
+def test_autocorrelation_period_first_lag_and_a_unit_energy_take():
+    """The lags start at min_lag (0.5 s: lag 5 at 10 fps, with lag 4 only as its left
+    neighbour): a 0.4 s cosine reads its second peak, 8.  A square wave of +-1/8 and
+    period 8 over 64 frames has energy exactly 1 (and every overlap's product under 1):
+    its period is still 8."""
+    four = _cosines(200, (10, 4))
+    assert autocorrelation_period(four, min_lag=0.5) == pytest.approx(8, abs=0.05)
+    square = np.where(np.arange(64) % 8 < 4, 0.125, -0.125)
+    assert float(np.sum(square**2)) == 1.0 and square.mean() == 0.0
+    m = _motion({"lfemur.rx": square})
+    assert autocorrelation_period(m) == pytest.approx(8, abs=0.1)
