@@ -288,6 +288,8 @@ def test_jerk_rows_and_the_cyclic_wrap_by_hand():
     assert jerk_summary(y, 2.0) == pytest.approx(48.0, rel=1e-9)
     with pytest.raises(ParameterError, match="fps"):
         jerk_summary(y, 0.0)
+    with pytest.raises(ParameterError, match="accuracy 4 needs at least 7 frames, got 6"):
+        jerk_summary(y[:6], 1.0)
 
 
 def test_frame_steps_and_largest_steps_by_hand():
