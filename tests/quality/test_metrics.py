@@ -363,3 +363,12 @@ def test_monotonicity_by_hand():
     # residuals phase - theta: 0, 0, -0.1, 0.05, 0: arc -0.1 .. 0.05, centre -0.025
     assert res.offset == pytest.approx(0.975) and res.max_abs_error_after_alignment == pytest.approx(0.075)
     assert res.mean_abs_error_after_alignment == pytest.approx((0.025 * 3 + 0.075 + 0.075) / 5)
+
+
+def test_phase_agreement_is_frozen():
+    from dataclasses import FrozenInstanceError
+
+    res = monotonicity(np.array([0.0, 0.1, 0.2]), np.array([0.0, 0.1, 0.2]))
+    with pytest.raises(FrozenInstanceError):
+        res.orientation = -1
+    assert hash(res) == hash(monotonicity(np.array([0.0, 0.1, 0.2]), np.array([0.0, 0.1, 0.2])))
