@@ -664,3 +664,18 @@ def test_still_sources_make_no_frame_a_freeze():
     still = make_motion(legs_skeleton(), T=64, fps=64.0)
     q = measure_generated(still, [still])
     assert q.freezes == [] and q.longest_freeze_s == 0.0
+
+
+def test_resampling_tolerance_is_strictly_under_five_percent():
+    """42 fps to 20: every 2nd frame gives 21, exactly 5 % (1.0) off: kept as it is; 41
+    fps gives 20.5: taken."""
+    from _legs import legs_skeleton, make_motion
+
+    from cyclecoord.quality.generated import _resampled
+
+    skel = legs_skeleton()
+    m = make_motion(skel, T=40, fps=42.0)
+    assert 42.0 / 2 - 20.0 == 0.05 * 20.0
+    assert _resampled(m, 20.0) is m
+    r = _resampled(make_motion(skel, T=40, fps=41.0), 20.0)
+    assert r.fps == 20.5 and r.n_frames == 20
