@@ -996,3 +996,22 @@ def test_extra_legs_front_or_hind_whichever_way_the_dog_trots(heading):
     assert [(g.label, g.points[0]) for g in legs.legs] == [
         ("front left", "LeftHand"), ("front right", "RightHand"),
         ("hind left", "LeftFoot"), ("hind right", "RightFoot")]
+
+
+def test_no_feet_message_without_end_joints():
+    lone = Skeleton((Joint("j0", -1, [0, 0, 0]),))
+    with pytest.raises(ParameterError, match=r"e\.g\. --feet LEFT,RIGHT; lowest end joints "
+                                             r"\(height above the floor\): none$"):
+        find_legs(lone)
+
+
+def test_given_quadruped_feet_in_the_rest_pose():
+    """Four given legs in any order: paired where their chains part lowest (front legs at
+    the chest, hind legs at the pelvis), sides and front/hind from the rest pose."""
+    names = quadruped_names("anonymous")
+    skel = quadruped_skeleton(names)
+    given = (names["hl_toe"], names["fr_ankle"], names["hr_ankle"], names["fl_toe"])
+    legs = legs_of_feet(skel, given)
+    assert [g.label for g in legs.legs] == ["hind left", "front right", "hind right",
+                                            "front left"]
+    assert legs.method == "given" and legs.feet == given
