@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -316,8 +318,10 @@ def test_distance_to_cycle_single_point_and_repeated_frames():
     np.testing.assert_allclose(distance_to_cycle([[3.0, 4.0], [0.0, 0.0]], [[0.0, 0.0]]),
                                [5.0, 0.0])
     seg = [[0.0, 0.0], [0.0, 0.0], [4.0, 0.0]]
-    np.testing.assert_allclose(distance_to_cycle([[2.0, 3.0], [-1.0, 0.0], [5.0, 0.0]], seg),
-                               [3.0, 1.0, 1.0], atol=1e-12)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no division by the zero-length segment
+        got = distance_to_cycle([[2.0, 3.0], [-1.0, 0.0], [5.0, 0.0]], seg)
+    np.testing.assert_allclose(got, [3.0, 1.0, 1.0], atol=1e-12)
     np.testing.assert_allclose(distance_to_cycle([2.0, -1.0], [0.0, 4.0]), [0.0, 1.0])
 
 
