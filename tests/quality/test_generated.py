@@ -304,6 +304,7 @@ def test_feet_word_bounds_and_ratios():
     z = _quality(support_slip=1e-9, cycle_s=2e-9, root_speed=3e-9, knee_range=(4e-9, 0.0))
     assert (z.slip_ratio, z.cadence_ratio, z.root_ratio) == pytest.approx((1.0, 2.0, 3.0))
     assert z.knee_ratio == pytest.approx((4.0, 0.0))
+    assert _quality(hip_range=(4e-9, 1e-9)).hip_ratio == pytest.approx((4.0, 1.0))
 
 
 def test_to_dict_and_summary_lines():
@@ -679,3 +680,19 @@ def test_resampling_tolerance_is_strictly_under_five_percent():
     assert _resampled(m, 20.0) is m
     r = _resampled(make_motion(skel, T=40, fps=41.0), 20.0)
     assert r.fps == 20.5 and r.n_frames == 20
+
+
+def test_source_penetration_is_the_fraction_of_frames_under_the_floor():
+    """Sources dipping 1 unit on 2 of their 128 frames (too few to move the floor, a low
+    quantile): their lowest point goes about 0.7 units under it, over 0.02 m (0.35
+    units), on those 2 frames (the floor moves by 0.002)."""
+    from cyclecoord.quality.generated import source_figures
+
+    src, knees, sources = _knee_sources()
+    f = sources[0].frames.copy()
+    ty = src.channels.index(("root", "ty"))
+    f[[40, 90], ty] -= 1.0
+    ref = source_figures([sources[0].with_frames(f)], 64.0)
+    assert ref.floor == pytest.approx(source_figures(sources, 64.0).floor, abs=0.01)
+    assert ref.penetration == 2 / 128
+    assert source_figures(sources, 64.0).penetration == 0.0
