@@ -766,6 +766,8 @@ def test_pair_score_part_height_and_zero_length_bounds():
     assert geo.pair_score(1, 2) == pytest.approx(0.2, rel=1e-15)
     geo.bone[:] = 0.0  # legs of no length are none
     assert geo.pair_score(1, 2) is None
+    geo.bone[1:] = 0.5  # short legs are legs: (0.5 + 1.5) / 10
+    assert geo.pair_score(1, 2) == pytest.approx(0.2, rel=1e-15)
 
 
 def test_foot_points_shin_fraction_edges():
@@ -808,6 +810,9 @@ def test_usable_upright_left_ahead_by_hand():
     assert not geo.upright([(0, 1)])  # 2 over, half of 4: not more
     geo.median[0] = 2.5
     assert geo.upright([(0, 1)])
+    geo.median[1] = 0.5  # the drop is 2.0 again, from higher up
+    assert not geo.upright([(0, 1)])
+    geo.median[1] = 0.0
     assert not geo.upright([(0, 1), (0, 2)])  # a leg of no length
     # left = up x forward: with y up and +z forward, left is +x; the median frame decides
     geo.up = 1
@@ -1015,3 +1020,20 @@ def test_given_quadruped_feet_in_the_rest_pose():
     assert [g.label for g in legs.legs] == ["hind left", "front right", "hind right",
                                             "front left"]
     assert legs.method == "given" and legs.feet == given
+
+
+def test_grounded_keeps_ends_parting_strictly_over_0_3_of_the_height():
+    """Of two ends on the floor, the second is another foot only when their chains part
+    over 0.3 of the body height (exactly 0.3: the same foot)."""
+    from cyclecoord.quality.legs import _Geometry
+
+    geo = object.__new__(_Geometry)
+    geo.skeleton = Skeleton((Joint("j0", -1, [0, 0, 0]), Joint("j1", 0, [1, -3, 0]),
+                             Joint("j2", 0, [-1, -3, 0])))
+    geo.height = 10.0
+    geo.ends = [1, 2]
+    geo.low = np.zeros(3)
+    geo.median = np.array([3.0, 0.0, 0.1])
+    assert geo.grounded() == [1]
+    geo.median[0] = np.nextafter(3.0, 4.0)
+    assert geo.grounded() == [1, 2]
