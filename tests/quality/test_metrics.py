@@ -376,3 +376,12 @@ def test_phase_agreement_is_frozen():
     with pytest.raises(FrozenInstanceError):
         res.orientation = -1
     assert hash(res) == hash(monotonicity(np.array([0.0, 0.1, 0.2]), np.array([0.0, 0.1, 0.2])))
+
+
+def test_distance_to_a_small_cycle_scales():
+    """The square of side 2 and its points scaled by 1/100 (segments of length 0.02):
+    distances scale by 1/100 too, the segments' interiors counted however short."""
+    square = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
+    pts = np.array([[1.0, 1.0], [3.0, 3.0], [1.0, -0.5], [1.0, 0.0], [2.0, 1.3]])
+    np.testing.assert_allclose(distance_to_cycle(pts / 100, square / 100),
+                               [0.01, np.sqrt(2) / 100, 0.005, 0.0, 0.0], atol=1e-15)
