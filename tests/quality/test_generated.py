@@ -652,6 +652,8 @@ def test_sliding_feet_slip_in_units_and_leg_lengths_and_knee_p99():
     q = measure_generated(m.with_frames(f), reference=ref)
     assert q.support_slip == pytest.approx(4.0 * ref.metres, rel=1e-9)
     assert q.support_slip_legs == pytest.approx(0.5, rel=1e-9)
+    # every foot point is on the floor, moving 4 units/s: so is the median one in contact
+    assert q.contact_slide == pytest.approx(4.0 * ref.metres, rel=1e-9)
     assert q.knee_p99 == pytest.approx((30.0, 10.0), abs=1e-6)
     assert q.knee_range == pytest.approx((0.0, 0.0), abs=1e-6)
 
