@@ -550,6 +550,10 @@ def test_best_loop_cut_equals_brute_force(seed):
         assert cut.period_frames == period and type(cut.period_frames) is float
         assert cut.n_frames == want[2] - want[1] == cut.clip.n_frames
         np.testing.assert_array_equal(cut.clip.frames, m.frames[want[1] : want[2]])
+    # the default tolerance, 0.15: a period of 6 frames allows 6 alone (5.1 to 6.9)
+    want, _ = _brute_loop_cut(x, 6.0, 0.15, np.ones(T, bool))
+    cut = best_loop_cut(m, 6.0)
+    assert (cut.start, cut.stop) == (want[1], want[2]) and cut.n_frames == 6
 
 
 def test_best_loop_cut_arguments_and_no_fit():
@@ -657,6 +661,8 @@ def test_average_cycle_coordinate_or_wraps_and_length():
     assert average_cycle(m, nine, 4).metadata["pieces"] == [(0.0, 1.0), (1.0, 4.0), (4.0, 8.0)]
     halves = np.array([0.0, 0.5, 1.0, 1.5, 1.5, 1.5, 1.5, 1.5, 1.5])  # 1.0 and 1.5 >= 1
     assert average_cycle(m, halves, 2).metadata["pieces"] == [(0.0, 0.5), (0.5, 1.0), (1.0, 1.5)]
+    ones = np.array([0.0, 0.5, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0])  # 1.0 is not in [0, 1)
+    assert average_cycle(m, ones, 2).metadata["pieces"] == [(0.0, 0.5), (0.5, 1.0)]
     for bad in (1, 2.5, 0):
         with pytest.raises(ParameterError, match="integer >= 2"):
             average_cycle(m, [0, 4, 8], bad)
