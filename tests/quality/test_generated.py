@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cyclecoord.errors import ParameterError
 from cyclecoord.io import load, save
 from cyclecoord.quality.contacts import foot_skating
 from cyclecoord.quality.generated import measure_generated
@@ -312,3 +313,434 @@ def test_plausibility_has_no_bone_from_a_static_root_to_the_hips():
         r = check_plausibility(m, [m])
         assert not any("joint_Root" in c["bones"] for c in r.contacts), BANDAI[k].name
         assert not r.new_contact_frames
+
+
+# ------------------------------------------------------------ helpers, known answers
+def _quality(**values):
+    """A GeneratedQuality with every figure 0 but those given."""
+    from dataclasses import MISSING, fields
+
+    from cyclecoord.quality.generated import GeneratedQuality
+
+    required = [f for f in fields(GeneratedQuality)
+                if f.default is MISSING and f.default_factory is MISSING]
+    base = {f.name: 0.0 for f in required}
+    base.update(frames=10, feet=("lfoot", "rfoot"), contact_fraction={}, freezes=[],
+                knee_range=(1.0, 1.0), hip_range=(1.0, 1.0), largest_step_frame=0,
+                largest_accel_frame=0)
+    base.update(values)
+    return GeneratedQuality(**base)
+
+
+def test_feet_word_bounds_and_ratios():
+    """Slip up to 1.5x the sources' is planted, up to 4x slipping (both included), beyond
+    gliding; a ratio's denominator is at least 1e-9."""
+    from cyclecoord.quality.generated import GLIDING_RATIO, PLANTED_RATIO
+
+    assert (PLANTED_RATIO, GLIDING_RATIO) == (1.5, 4.0)
+    word = lambda slip: _quality(support_slip=slip, source_support_slip=2.0).feet_word  # noqa: E731
+    assert [word(s) for s in (3.0, np.nextafter(3.0, 4.0), 8.0, np.nextafter(8.0, 9.0))] == [
+        "planted", "slipping", "slipping", "gliding"]
+    q = _quality(support_slip=3.0, source_support_slip=2.0, knee_range=(30.0, 45.0),
+                 source_knee_range=60.0, hip_range=(10.0, 20.0), source_hip_range=40.0,
+                 cycle_s=1.2, source_cycle_s=1.0, root_speed=1.5, source_root_speed=1.0)
+    assert q.slip_ratio == 1.5
+    assert q.knee_ratio == (0.5, 0.75) and q.hip_ratio == (0.25, 0.5)
+    assert q.cadence_ratio == pytest.approx(1.2) and q.root_ratio == 1.5
+    z = _quality(support_slip=1e-9, cycle_s=2e-9, root_speed=3e-9, knee_range=(4e-9, 0.0))
+    assert (z.slip_ratio, z.cadence_ratio, z.root_ratio) == pytest.approx((1.0, 2.0, 3.0))
+    assert z.knee_ratio == pytest.approx((4.0, 0.0))
+    assert _quality(hip_range=(4e-9, 1e-9)).hip_ratio == pytest.approx((4.0, 1.0))
+
+
+def test_to_dict_and_summary_lines():
+    q = _quality(support_slip=0.5, source_support_slip=0.25, cycle_s=float("nan"),
+                 freezes=[(1, 9), (12, 20), (30, 40), (50, 60), (70, 80)], held_frames=3,
+                 notes=["a note"], knee_p99=(80.0, 81.0))
+    d = q.to_dict()
+    assert d["feet_verdict"] == "slipping" and d["support_slip_ratio"] == 2.0
+    assert d["cycle_s"] is None and d["cadence_ratio"] is None
+    assert d["freezes"][0] == [1, 9] and d["held_frames"] == 3 and d["knee_p99_deg"] == [80, 81]
+    lines = q.summary()
+    assert lines[0] == q.headline() and lines[-1] == "  a note"
+    assert "frames 1-9, 12-20, 30-40, 50-60 and 1 more; 3 held frames asked for" in lines[3]
+    assert _quality().summary()[3] == "  freezes: none"
+    assert _quality(held_frames=2).summary()[3] == "  freezes: none (2 held frames asked for)"
+
+
+def test_angle_by_hand():
+    from cyclecoord.quality.generated import _angle
+
+    u = np.array([[1.0, 0, 0], [1.0, 0, 0], [2.0, 0, 0], [1.0, 1.0, 0], [0.0, 0, 0]])
+    v = np.array([[0.0, 3, 0], [5.0, 0, 0], [-1.0, 0, 0], [1.0, 0, 0], [1.0, 0, 0]])
+    np.testing.assert_allclose(_angle(u, v), [90, 0, 180, 45, 90], atol=1e-6)
+
+
+def _kin_of(local=None, pos=None, fps=10.0):
+    from cyclecoord.quality.generated import _Kin
+
+    local = pos if local is None else local
+    pos = local if pos is None else pos
+    return _Kin(fps=fps, pos=pos, local=local, knee=np.zeros((len(pos), 2)),
+                hip=np.zeros((len(pos), 2)))
+
+
+def test_kin_pose_speed_accel_and_root_speed_by_hand():
+    """Two joints, one moving 1 unit a frame along x (then 1 + 2 t at frame 3), the other
+    still: RMS speed sqrt(1 / 2) unit a frame, times fps; the largest acceleration the
+    second difference times fps^2; the root's horizontal speed over 0.5 s (5 frames at
+    10 fps, rounded; 1 at 1 fps, never more than the take)."""
+    T = 6
+    local = np.zeros((T, 2, 3))
+    local[:, 0, 0] = [0.0, 1.0, 2.0, 3.0, 5.0, 7.0]
+    local[:, 1, 1] = 4.0  # height: still
+    kin = _kin_of(local)
+    assert kin.n == 6
+    np.testing.assert_allclose(kin.pose_speed(), 10 * np.sqrt([0.5, 0.5, 0.5, 2.0, 2.0]))
+    np.testing.assert_allclose(kin.accel(), [0, 0, 100, 0])
+    pos = np.zeros((12, 1, 3))
+    pos[:, 0, 0] = 3.0 * np.arange(12)  # 3 units a frame along x, 4 along z
+    pos[:, 0, 2] = 4.0 * np.arange(12)
+    pos[:, 0, 1] = np.arange(12) ** 2  # height does not count
+    speed = _kin_of(pos=pos, fps=10.0).root_speed()
+    assert speed.shape == (7,)
+    np.testing.assert_allclose(speed, 50.0)
+    assert _kin_of(pos=pos, fps=3.0).root_speed().shape == (10,)  # round(1.5) = 2
+    assert _kin_of(pos=pos, fps=1.0).root_speed().shape == (11,)  # round(0.5) = 0: 1
+    np.testing.assert_allclose(_kin_of(pos=pos[:4], fps=10.0).root_speed(), [50.0])  # k = 3
+
+
+def test_support_is_the_lowest_foot_points_horizontal_speed():
+    """Central differences of the foot point lowest on the middle frame: (p[t+1] -
+    p[t-1]) fps / 2, heights left out."""
+    from cyclecoord.quality.generated import _Rig, _support
+
+    pos = np.zeros((4, 3, 3))
+    pos[:, 1] = [[0, 1, 0], [1, 0, 0], [3, 2, 0], [6, 0, 0]]  # foot A
+    pos[:, 2] = [[0, 0.5, 0], [0, 0.5, 4], [0, 1, 8], [0, 0, 8]]  # foot B
+    rig = _Rig(legs=None, feet=("a", "b"), foot_cols=[1, 2], hips=[], knees=[], ankles=[],
+               trunk=None, leg_length=1.0)
+    # frame 1: A lowest (0), moving 3 in x over two frames; frame 2: B (1 < 2), 4 in z
+    np.testing.assert_allclose(_support(_kin_of(pos=pos, fps=10.0), rig), [15.0, 20.0])
+
+
+def test_ranges_and_lowest_by_hand():
+    from cyclecoord.quality.generated import _Rig, _lowest, _ranges
+
+    a = np.column_stack([np.arange(101.0), 2 * np.arange(101.0)])
+    np.testing.assert_allclose(_ranges(a), [98, 196])  # p99 - p1 of 0..100
+    pos = np.zeros((2, 4, 3))
+    pos[:, :, 1] = [[5, 1, 2, 0.5], [5, 1, 0.2, 3]]
+    kin = _kin_of(pos=pos)
+    kin.names = ["root", "foot", "other/end", "foot/end"]
+    kin.parents = [-1, 0, 0, 1]
+    rig = _Rig(legs=None, feet=("foot",), foot_cols=[1], hips=[], knees=[], ankles=[],
+               trunk=None, leg_length=1.0)
+    # the foot's own end site counts, not another joint's
+    np.testing.assert_allclose(_lowest(kin, rig), [0.5, 1.0])
+
+
+def test_source_figures_root_speed_and_cycle_at():
+    """The sources' cycle at a speed: linear between the takes sorted by speed, flat beyond,
+    takes without a cycle (NaN) left out; NaN when none has one."""
+    from cyclecoord.quality.generated import SourceFigures
+
+    def figures(speeds, cycles):
+        return SourceFigures(*([0.0] * 10), take_speed=np.array(speeds),
+                             take_cycle=np.array(cycles), penetration=0.0, contact_slide=0.0)
+
+    s = figures([3.0, 1.0, 2.0, 5.0], [1.0, 2.0, np.nan, 0.5])
+    assert s.root_speed == 2.5
+    assert s.cycle_at(2.0) == 1.5 and s.cycle_at(0.0) == 2.0 and s.cycle_at(9.0) == 0.5
+    assert s.cycle_at(4.0) == 0.75
+    assert np.isnan(figures([1.0], [np.nan]).cycle_at(1.0))
+
+
+def test_rig_joints_of_two_legs():
+    """legs_skeleton: ankles lfoot (3) and rfoot (7), their knees (2, 6) and hips (1, 5);
+    no spine named: no trunk; the leg 4 + 4 long.  A leg whose knee would be the root has
+    no hip."""
+    from _legs import legs_skeleton, make_motion
+
+    from cyclecoord.errors import ParameterError
+    from cyclecoord.motion import Motion
+    from cyclecoord.quality.generated import _rig
+
+    m = make_motion(legs_skeleton(), T=8)
+    rig = _rig(m, None)
+    assert (rig.ankles, rig.knees, rig.hips, rig.trunk) == ([3, 7], [2, 6], [1, 5], None)
+    assert rig.feet == ("lfoot", "ltoes", "rfoot", "rtoes") and rig.foot_cols == [3, 4, 7, 8]
+    assert rig.leg_length == 8.0
+    rig = _rig(m, ("ltoes", "rtoes"))  # toes given: their parent is the ankle
+    assert (rig.ankles, rig.knees, rig.hips) == ([4, 8], [3, 7], [2, 6])
+    rig = _rig(m, ("ltibia", "rtibia"))  # the hip may be the root
+    assert (rig.ankles, rig.knees, rig.hips) == ([2, 6], [1, 5], [0, 0])
+    with pytest.raises(ParameterError, match="no knee and hip above lfemur"):
+        _rig(m, ("lfemur", "rfemur"))  # the knee would be the root
+    with pytest.raises(ParameterError, match="needs a skeleton"):
+        _rig(Motion(m.frames, m.channels, fps=m.fps), None)
+
+
+def test_rig_trunk_is_the_second_spine_joint():
+    from _legs import legs_skeleton, make_motion
+
+    from cyclecoord.quality.generated import _rig
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    base = legs_skeleton()
+    for spine, trunk in (((), None), (("LowerBack",), 9), (("LowerBack", "Spine", "Spine1"), 10)):
+        joints = list(base.joints)
+        for k, name in enumerate(spine):
+            joints.append(Joint(name, 0 if k == 0 else len(joints) - 1, [0, 2.0, 0]))
+        m = make_motion(Skeleton(tuple(joints)), T=8)
+        assert _rig(m, None).trunk == trunk, spine
+
+
+def _bending(src, knees):
+    """The synthetic legs bending both knees at a steady 40 deg/s for 96 frames."""
+    g = src.frames[:96].copy()
+    g[:, knees] = (40.0 * np.arange(96) / 64)[:, None]
+    return g
+
+
+def test_freeze_runs_longer_than_freeze_seconds_and_at_the_end():
+    """At 64 fps FREEZE_SECONDS = 0.2 s is 12.8 frames: a still run of 13 frames is a
+    freeze, one of 12 only the longest run; a still end runs to the last frame (the last
+    frame copies the last step's flag); held frames split a run."""
+    from cyclecoord.quality.generated import FREEZE_FRACTION, FREEZE_SECONDS
+
+    assert (FREEZE_FRACTION, FREEZE_SECONDS) == (0.1, 0.2)
+    src, knees, sources = _knee_sources()
+    ref = None
+    for still, freezes in ((14, [(20, 33)]), (13, [])):
+        g = _bending(src, knees)
+        g[20 : 20 + still] = g[20]  # still - 1 still steps, flagged on their first frame
+        q = measure_generated(src[:96].with_frames(g), sources)
+        assert q.freezes == freezes and q.longest_freeze_s == pytest.approx((still - 1) / 64)
+        ref = q
+    assert ref.held_frames == 0
+    g = _bending(src, knees)
+    g[80:] = g[80]
+    assert measure_generated(src[:96].with_frames(g), sources).freezes == [(80, 96)]
+    hold = np.zeros(96, dtype=bool)
+    hold[86] = True
+    q = measure_generated(src[:96].with_frames(g), sources, hold=hold)
+    assert q.freezes == [] and q.longest_freeze_s == pytest.approx(9 / 64) and q.held_frames == 1
+    with pytest.raises(ParameterError, match=r"one flag per frame \(96\)"):
+        measure_generated(src[:96].with_frames(g), sources, hold=hold[:95])
+
+
+def test_measure_needs_three_frames_and_sources():
+    src, knees, sources = _knee_sources()
+    with pytest.raises(ParameterError, match="at least 3 frames, got 2"):
+        measure_generated(src[:2], sources)
+    assert measure_generated(src[:3], sources).frames == 3
+    with pytest.raises(ParameterError, match="needs the source captures"):
+        measure_generated(src[:10], [])
+
+
+def test_penetration_pops_units_and_notes():
+    """The lowest foot point (the toes' end sites) stands at 0.5 (hip 9, knee 5, ankle 1, toe
+    0.5), over the sources' floor (0.31: their knees bend).  Lowered 0.8 on frames 40-49 and
+    0.5 on 50-59 it goes 0.61 and 0.31 under it: the deepest 0.61 units, and only the
+    first 10 frames deeper than 0.02 m (0.35 units at 0.056 m a unit); a knee jumping 10 deg at frame 60 makes the largest
+    pose step the step 59-60 and the largest acceleration frame 59's (the first of the
+    two equal second differences, 58-60 and 59-61: frame 59 and 60; the first wins)."""
+    from cyclecoord.quality.generated import PENETRATION_M, source_figures
+
+    assert PENETRATION_M == 0.02
+    src, knees, sources = _knee_sources()
+    g = src.frames[:96].copy()
+    ty = src.channels.index(("root", "ty"))
+    g[40:50, ty] -= 0.8
+    g[50:60, ty] -= 0.5
+    g[60:, knees[0]] += 10.0
+    ref = source_figures(sources, 64.0)
+    m = ref.metres
+    assert 0.3 < ref.floor < 0.32 and 0.35 < PENETRATION_M / m < 0.36
+    q = measure_generated(src[:96].with_frames(g), reference=ref)
+    assert q.penetration_m == pytest.approx((ref.floor + 0.3) * m, rel=1e-9)
+    assert q.penetration_fraction == pytest.approx(10 / 96)
+    assert q.leg_length_m == pytest.approx(8.0 * m) and q.feet == ("lfoot", "ltoes", "rfoot",
+                                                                   "rtoes")
+    assert q.largest_step_frame == 59 and q.largest_accel_frame == 59
+    assert q.notes == []
+    # sources at another rate than the motion's: said in a note
+    q = measure_generated(src[:96:2].with_frames(g[::2], fps=32.0), reference=ref)
+    assert q.notes == ["sources measured at 64 fps, the motion at 32"]
+    # never under the floor: a penetration of 0, not negative
+    q = measure_generated(src[:96], reference=ref)
+    assert q.penetration_m == 0.0 and q.penetration_fraction == 0.0
+
+
+def test_angle_of_parallel_vectors_rounding_over_one():
+    """(0.54, 0.21, 0.36) against 3 times itself: the cosine rounds to 1 + 2^-52; clipped,
+    the angle is 0, not NaN."""
+    from cyclecoord.quality.generated import _angle
+
+    u = np.array([0.54, 0.21, 0.36])
+    assert _angle(u, 3 * u) == 0.0
+
+
+def test_cycle_first_peak_at_the_window_start_and_rising_windows():
+    """At 100 fps the window starts at lag 40: a 0.41 s sine peaks at the window's second
+    lag (0.41, not its second peak 0.82); 200 samples cap the window at lag 100, where a
+    1.1 s sine still rises: no peak inside, the highest lag (99: 0.99 s) is taken."""
+    from cyclecoord.quality.generated import _cycle
+
+    t = np.arange(600)
+    assert _cycle(np.sin(2 * np.pi * t / 41), 100.0) == pytest.approx(0.41)
+    assert _cycle(np.sin(2 * np.pi * t[:200] / 110), 100.0) == pytest.approx(0.99)
+
+
+def test_contact_band_is_three_hundredths_of_the_leg():
+    """Contact from height alone: within CONTACT_HEIGHT = 0.03 leg lengths (0.24 units for
+    legs of 8) of each point's own low level.  The legs raised 0.23 on the second half of
+    the take stay in contact; raised 0.25 they leave it on that half."""
+    from cyclecoord.quality.generated import CONTACT_HEIGHT
+
+    assert CONTACT_HEIGHT == 0.03
+    src, knees, sources = _knee_sources()
+    ty = src.channels.index(("root", "ty"))
+    for lift, fraction in ((0.23, 1.0), (0.25, 0.5)):
+        g = src.frames[:96].copy()
+        g[48:, ty] += lift
+        q = measure_generated(src[:96].with_frames(g), sources)
+        assert q.contact_fraction == dict.fromkeys(("lfoot", "ltoes", "rfoot", "rtoes"),
+                                                   fraction), lift
+
+
+def test_rig_and_source_figures_are_frozen():
+    from dataclasses import FrozenInstanceError
+
+    from cyclecoord.quality.generated import _rig, source_figures
+
+    src, knees, sources = _knee_sources()
+    ref = source_figures(sources, 64.0)
+    with pytest.raises(FrozenInstanceError):
+        ref.floor = 0.0
+    with pytest.raises(FrozenInstanceError):
+        _rig(src, None).trunk = 1
+
+
+def test_rig_of_three_or_four_legs_uses_the_first_two():
+    from _legs import legs_skeleton, make_motion
+    from _walkers import quadruped_names, quadruped_skeleton, trot
+
+    from cyclecoord.quality.generated import _rig
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    names = quadruped_names("dog")
+    skel = quadruped_skeleton(names)
+    rig = _rig(trot(skel, names), None)
+    assert len(rig.legs.legs) == 4
+    assert [skel.names[i] for i in rig.ankles] == [names["fl_ankle"], names["fr_ankle"]]
+    assert len(rig.feet) == 8  # the feet are all the legs'
+    # three legs given (the third a spine joint on the root, no knee): the first two
+    base = legs_skeleton()
+    skel = Skeleton(base.joints + (Joint("LowerBack", 0, [0, 2.0, 0]),))
+    rig = _rig(make_motion(skel, T=8), ("lfoot", "rfoot", "LowerBack"))
+    assert len(rig.legs.legs) == 3 and rig.ankles == [3, 7] and rig.hips == [1, 5]
+
+
+def test_kin_removes_the_heading_and_measures_hips_from_the_trunk():
+    """_kin: positions relative to the root with the heading (the hips' left-right line)
+    turned to +x, so a body spinning in place has one local pose; the hip angle is the
+    thigh against the trunk's downward line, 0 for legs hanging straight under an upright
+    trunk wherever the body stands (or against -y without a trunk)."""
+    from _legs import legs_skeleton
+
+    from cyclecoord.motion import Motion
+    from cyclecoord.quality.generated import _kin, _rig
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    base = legs_skeleton()
+    for spine in ((), ("LowerBack", "Spine")):
+        joints = list(base.joints)
+        for k, name in enumerate(spine):
+            joints.append(Joint(name, 0 if k == 0 else len(joints) - 1, [0, 2.0, 0]))
+        skel = Skeleton(tuple(joints))
+        ch = skel.channels
+        f = np.zeros((5, len(ch)))
+        f[:, ch.index(("root", "tx"))] = 100.0
+        f[:, ch.index(("root", "ty"))] = 10.0
+        f[:, ch.index(("root", "ry"))] = [0.0, 30.0, 90.0, 200.0, -45.0]
+        m = Motion(f, ch, fps=10.0, skeleton=skel)
+        kin = _kin(m, _rig(m, None))
+        np.testing.assert_allclose(kin.local, np.broadcast_to(kin.local[0], kin.local.shape),
+                                   atol=1e-9)
+        np.testing.assert_allclose(kin.local[0, 1], [1.0, -1.0, 0.0], atol=1e-12)  # lfemur
+        np.testing.assert_allclose(kin.local[0, 5], [-1.0, -1.0, 0.0], atol=1e-12)
+        np.testing.assert_allclose(kin.hip, 0.0, atol=1e-6)
+        np.testing.assert_allclose(kin.knee, 0.0, atol=1e-6)
+        np.testing.assert_allclose(kin.pose_speed(), 0.0, atol=1e-8)
+
+
+def test_summary_says_more_only_past_four_freezes():
+    four = _quality(freezes=[(0, 20), (30, 50), (60, 80), (90, 110)]).summary()[3]
+    assert four.endswith("frames 0-20, 30-50, 60-80, 90-110")
+
+
+def test_sliding_feet_slip_in_units_and_leg_lengths_and_knee_p99():
+    """Standing legs slid forward at 4 units/s (64 fps, positions multiples of 1/16): the
+    lowest foot points (the toes) move 4 units/s, half a leg of 8 a second, times the
+    sources' metres per unit; the knees held bent 30 and 10 deg give those p99 flexions."""
+    from _legs import legs_skeleton, make_motion
+
+    from cyclecoord.quality.generated import source_figures
+
+    src, knees, sources = _knee_sources()
+    ref = source_figures(sources, 64.0)
+    m = make_motion(legs_skeleton(), T=64, fps=64.0, root_speed=4.0)
+    f = m.frames.copy()
+    f[:, knees[0]] = 30.0
+    f[:, knees[1]] = -10.0
+    q = measure_generated(m.with_frames(f), reference=ref)
+    assert q.support_slip == pytest.approx(4.0 * ref.metres, rel=1e-9)
+    assert q.support_slip_legs == pytest.approx(0.5, rel=1e-9)
+    # every foot point is on the floor, moving 4 units/s: so is the median one in contact
+    assert q.contact_slide == pytest.approx(4.0 * ref.metres, rel=1e-9)
+    assert q.knee_p99 == pytest.approx((30.0, 10.0), abs=1e-6)
+    assert q.knee_range == pytest.approx((0.0, 0.0), abs=1e-6)
+
+
+@pytest.mark.filterwarnings("ignore:invalid value encountered:RuntimeWarning")  # pops 0 / 0
+def test_still_sources_make_no_frame_a_freeze():
+    """Slow is strictly under a tenth of the sources' median pose speed: sources that never
+    move (median 0) leave a still motion without freezes."""
+    from _legs import legs_skeleton, make_motion
+
+    still = make_motion(legs_skeleton(), T=64, fps=64.0)
+    q = measure_generated(still, [still])
+    assert q.freezes == [] and q.longest_freeze_s == 0.0
+
+
+def test_resampling_tolerance_is_strictly_under_five_percent():
+    """42 fps to 20: every 2nd frame gives 21, exactly 5 % (1.0) off: kept as it is; 41
+    fps gives 20.5: taken."""
+    from _legs import legs_skeleton, make_motion
+
+    from cyclecoord.quality.generated import _resampled
+
+    skel = legs_skeleton()
+    m = make_motion(skel, T=40, fps=42.0)
+    assert 42.0 / 2 - 20.0 == 0.05 * 20.0
+    assert _resampled(m, 20.0) is m
+    r = _resampled(make_motion(skel, T=40, fps=41.0), 20.0)
+    assert r.fps == 20.5 and r.n_frames == 20
+
+
+def test_source_penetration_is_the_fraction_of_frames_under_the_floor():
+    """Sources dipping 1 unit on 2 of their 128 frames (too few to move the floor, a low
+    quantile): their lowest point goes about 0.7 units under it, over 0.02 m (0.35
+    units), on those 2 frames (the floor moves by 0.002)."""
+    from cyclecoord.quality.generated import source_figures
+
+    src, knees, sources = _knee_sources()
+    f = sources[0].frames.copy()
+    ty = src.channels.index(("root", "ty"))
+    f[[40, 90], ty] -= 1.0
+    ref = source_figures([sources[0].with_frames(f)], 64.0)
+    assert ref.floor == pytest.approx(source_figures(sources, 64.0).floor, abs=0.01)
+    assert ref.penetration == 2 / 128
+    assert source_figures(sources, 64.0).penetration == 0.0

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -237,3 +239,149 @@ def test_cyclic_jerk_summary_is_the_open_one_over_the_loop_continued():
     j4 = np.linalg.norm(jerk(x, 30.0, accuracy=4, cyclic=True), axis=1).mean()
     j5 = np.linalg.norm(jerk(x, 30.0, accuracy=5, cyclic=True), axis=1).mean()
     assert loop == pytest.approx(j4, rel=1e-12) and abs(j5 / j4 - 1) > 1e-3
+
+
+# ------------------------------------------------------------ helpers, known answers
+def test_argument_checks():
+    from cyclecoord.quality.metrics import _check_fps, _check_int, _frames_array
+
+    assert _frames_array([1.0, 2.0], "x").shape == (2, 1)
+    assert _frames_array([[1, 2]], "x").dtype == float
+    with pytest.raises(ParameterError, match="x must be an array of numbers"):
+        _frames_array(["a"], "x")
+    with pytest.raises(ParameterError, match=r"x must be a \(T, D\) array, got shape \(1, 1, 1\)"):
+        _frames_array(np.zeros((1, 1, 1)), "x")
+    with pytest.raises(ParameterError, match="NaN or infinite"):
+        _frames_array([0.0, np.inf], "x")
+    assert _check_int(np.int64(3), "n", 3) == 3 and type(_check_int(np.int64(3), "n", 3)) is int
+    for bad in (2, True, 3.0, "3"):
+        with pytest.raises(ParameterError, match="n must be an integer >= 3"):
+            _check_int(bad, "n", 3)
+    assert _check_fps(np.float32(0.5)) == 0.5 and _check_fps(30) == 30.0
+    for bad in (0, -1.0, np.inf, np.nan, True, "30"):
+        with pytest.raises(ParameterError, match="fps must be a positive number"):
+            _check_fps(bad)
+
+
+def test_coefficients_of_order_zero_and_as_floats():
+    """The 0th derivative to accuracy 3 is the point itself; the 2nd to accuracy 1 the
+    classic 1, -2, 1 (Fornberg's table)."""
+    np.testing.assert_array_equal(finite_difference_coefficients(0, 3), [1, 0, 0])
+    np.testing.assert_array_equal(finite_difference_coefficients(2, 1), [1, -2, 1])
+    np.testing.assert_allclose(finite_difference_coefficients(2, 2), [2, -5, 4, -1])
+
+
+def test_jerk_rows_and_the_cyclic_wrap_by_hand():
+    """accuracy 1 at 1 fps: jerk[t] = -x[t] + 3 x[t+1] - 3 x[t+2] + x[t+3]; cyclic, the
+    frames after the last are the first ones again; at 2 fps 8 times that."""
+    x = np.array([0.0, 1.0, 0.0, 0.0, 2.0])
+    np.testing.assert_allclose(jerk(x, 1.0, accuracy=1), [[3], [1]])
+    np.testing.assert_allclose(jerk(x, 2.0, accuracy=1), [[24], [8]])
+    loop = np.array([-x[t] + 3 * x[(t + 1) % 5] - 3 * x[(t + 2) % 5] + x[(t + 3) % 5]
+                     for t in range(5)])
+    np.testing.assert_allclose(jerk(x, 1.0, accuracy=1, cyclic=True)[:, 0], loop)
+    assert jerk(x[:4], 1.0, accuracy=1).shape == (1, 1)
+    with pytest.raises(ParameterError, match="accuracy 2 needs at least 5 frames, got 4"):
+        jerk(x[:4], 1.0, accuracy=2)
+    assert jerk(x, 1.0, accuracy=2, cyclic=True).shape == (5, 1)
+    # the summary: the mean of the rows' norms, 4th order (7 points), open or looped
+    y = np.column_stack([np.arange(9.0) ** 3, np.zeros(9)])  # jerk 6 everywhere
+    assert jerk_summary(y, 1.0) == pytest.approx(6.0, rel=1e-9)
+    assert jerk_summary(y, 2.0) == pytest.approx(48.0, rel=1e-9)
+    with pytest.raises(ParameterError, match="fps"):
+        jerk_summary(y, 0.0)
+    with pytest.raises(ParameterError, match="accuracy 4 needs at least 7 frames, got 6"):
+        jerk_summary(y[:6], 1.0)
+
+
+def test_frame_steps_and_largest_steps_by_hand():
+    from cyclecoord.quality.metrics import frame_steps, largest_steps
+
+    x = np.array([[0.0, 0.0], [3.0, 4.0], [3.0, 4.0], [3.0, 5.0]])
+    np.testing.assert_array_equal(frame_steps(x), [5.0, 0.0, 1.0])
+    assert frame_steps(x[:1]).shape == (0,) and frame_steps(np.zeros((0, 2))).shape == (0,)
+    # the cycle's steps go round the loop: the seam (3, 5) -> (0, 0) is the largest
+    cyc, p99 = largest_steps(x, x)
+    assert cyc == pytest.approx(np.sqrt(34.0))
+    assert p99 == pytest.approx(np.percentile([5.0, 0.0, 1.0], 99))
+    # masked frames: only steps between two consecutive frames in the mask
+    assert largest_steps(x, x, [False, True, True, True])[1] == pytest.approx(
+        np.percentile([0.0, 1.0], 99))
+    assert largest_steps(x, x, [True, False, True, True])[1] == 1.0
+    cyc, p99 = largest_steps(np.zeros((0, 2)), x, [True, False, True, False])
+    assert np.isnan(cyc) and np.isnan(p99)
+
+
+def test_distance_to_cycle_single_point_and_repeated_frames():
+    """A cycle of one point: distances to it; a repeated frame (a segment of no length)
+    is a point too."""
+    np.testing.assert_allclose(distance_to_cycle([[3.0, 4.0], [0.0, 0.0]], [[0.0, 0.0]]),
+                               [5.0, 0.0])
+    seg = [[0.0, 0.0], [0.0, 0.0], [4.0, 0.0]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no division by the zero-length segment
+        got = distance_to_cycle([[2.0, 3.0], [-1.0, 0.0], [5.0, 0.0]], seg)
+    np.testing.assert_allclose(got, [3.0, 1.0, 1.0], atol=1e-12)
+    np.testing.assert_allclose(distance_to_cycle([2.0, -1.0], [0.0, 4.0]), [0.0, 1.0])
+
+
+def test_loop_closure_by_hand():
+    # steps 1, 1, 2: median 1; the seam (3, 0) -> (0, 0) is 3
+    assert loop_closure([[0.0, 0], [1, 0], [2, 0], [3, 0]]) == 1.5 * 2
+    assert loop_closure([[0.0], [1.0], [1.0], [1.0]]) == np.inf
+    assert loop_closure([[0.0], [0.0]]) == 1.0
+    assert loop_closure([[0.0], [2.0]]) == 1.0  # one step, there and back
+
+
+def test_wrap_half_and_minimax_offset():
+    from cyclecoord.quality.metrics import _minimax_offset, _wrap_half
+
+    np.testing.assert_allclose(_wrap_half(np.array([0.5, -0.5, 0.7, -0.7, 0.0, 1.2])),
+                               [0.5, 0.5, -0.3, 0.3, 0.0, 0.2], atol=1e-15)
+    # residuals 0.9, 0.1, 0.2 on the circle: the shortest arc holding them runs 0.9 -> 0.2
+    # (0.3 long), centred at 0.05
+    c, half = _minimax_offset(np.array([0.1, -0.1, 1.2]))
+    assert c == pytest.approx(0.05) and half == pytest.approx(0.15)
+    c, half = _minimax_offset(np.array([0.3, 0.3]))
+    assert c == pytest.approx(0.3) and half == 0.0
+    c, half = _minimax_offset(np.array([0.2, 0.4]))
+    assert c == pytest.approx(0.3) and half == pytest.approx(0.1)
+
+
+def test_monotonicity_by_hand():
+    """theta = 0.2 - phase: reflected, offset 0.2 (phase = 0.2 - theta); a true phase that
+    never moves gives no monotone fraction; a tie between the orientations keeps +1."""
+    phase = np.array([0.0, 0.1, 0.2, 0.3])
+    res = monotonicity(np.mod(0.2 - phase, 1.0), phase)
+    assert res.orientation == -1 and res.offset == pytest.approx(0.2)
+    assert res.fraction_monotone == 1.0 and res.max_abs_error_after_alignment < 1e-12
+    still = monotonicity(np.array([0.1, 0.3]), np.array([0.5, 0.5]))
+    assert np.isnan(still.fraction_monotone) and still.orientation == 1
+    assert still.max_abs_error_after_alignment == pytest.approx(0.1)
+    assert still.mean_abs_error_after_alignment == pytest.approx(0.1)
+    # one step back of four: 3 / 4 monotone; errors after the best offset by hand
+    theta = np.array([0.0, 0.1, 0.3, 0.25, 0.4])
+    ph = np.array([0.0, 0.1, 0.2, 0.3, 0.4])
+    res = monotonicity(theta, ph)
+    assert res.orientation == 1 and res.fraction_monotone == 0.75
+    # residuals phase - theta: 0, 0, -0.1, 0.05, 0: arc -0.1 .. 0.05, centre -0.025
+    assert res.offset == pytest.approx(0.975) and res.max_abs_error_after_alignment == pytest.approx(0.075)
+    assert res.mean_abs_error_after_alignment == pytest.approx((0.025 * 3 + 0.075 + 0.075) / 5)
+
+
+def test_phase_agreement_is_frozen():
+    from dataclasses import FrozenInstanceError
+
+    res = monotonicity(np.array([0.0, 0.1, 0.2]), np.array([0.0, 0.1, 0.2]))
+    with pytest.raises(FrozenInstanceError):
+        res.orientation = -1
+    assert hash(res) == hash(monotonicity(np.array([0.0, 0.1, 0.2]), np.array([0.0, 0.1, 0.2])))
+
+
+def test_distance_to_a_small_cycle_scales():
+    """The square of side 2 and its points scaled by 1/100 (segments of length 0.02):
+    distances scale by 1/100 too, the segments' interiors counted however short."""
+    square = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
+    pts = np.array([[1.0, 1.0], [3.0, 3.0], [1.0, -0.5], [1.0, 0.0], [2.0, 1.3]])
+    np.testing.assert_allclose(distance_to_cycle(pts / 100, square / 100),
+                               [0.01, np.sqrt(2) / 100, 0.005, 0.0, 0.0], atol=1e-15)

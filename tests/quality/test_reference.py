@@ -441,3 +441,324 @@ def test_autocorrelation_period_takes_a_peak_at_the_first_lag_searched(monkeypat
     take = types.SimpleNamespace(fps=64.0)
     p = autocorrelation_period(take, min_lag=0.5, max_lag=63 / 64)
     assert 31.5 <= p <= 32.5
+
+
+# ------------------------------------------------------------ helpers, known answers
+def test_joint_columns_with_and_without_a_root():
+    from cyclecoord.quality.reference import joint_columns
+
+    m = _motion({"lfemur.rx": [0.0, 1.0], "lfemur.tx": [2.0, 3.0]})
+    np.testing.assert_array_equal(joint_columns(m), [6, 7])
+    bare = cc.Motion(np.zeros((2, 3)), [("a", "rx"), ("b", "rx"), ("b", "ry")], fps=10.0)
+    np.testing.assert_array_equal(joint_columns(bare), [0, 1, 2])
+
+
+def test_joint_angles_unwrap_rotations_only_and_two_frames():
+    """Rotation channels (dof r...) are unwrapped from two frames on; a translation channel
+    of a joint is left as stored; ``like`` shifts rotations by whole turns towards it."""
+    m = _motion({"a.rx": [170.0, -170.0], "a.tx": [170.0, -170.0]})
+    np.testing.assert_allclose(joint_angles(m), [[170, 170], [190, -170]])
+    # means 180 and 0: like 500 is 320 from the first (one turn up), 100 from the second's 0
+    # (no turn: translations never move)
+    np.testing.assert_allclose(joint_angles(m, like=np.array([500.0, 500.0])),
+                               [[530, 170], [550, -170]])
+    # (-200 - 180) / 360 = -1.06 rounds to one turn down; (-10 - 180) / 360 = -0.53 too
+    np.testing.assert_allclose(joint_angles(m, like=np.array([-200.0, 0.0])),
+                               [[-190, 170], [-170, -170]])
+    np.testing.assert_allclose(joint_angles(m, like=np.array([-10.0, 0.0])),
+                               [[-190, 170], [-170, -170]])
+    # (10 - 180) / 360 = -0.47: no turn
+    np.testing.assert_allclose(joint_angles(m, like=np.array([10.0, 0.0])),
+                               [[170, 170], [190, -170]])
+    with pytest.raises(ParameterError, match="like must have 2 values"):
+        joint_angles(m, like=np.zeros(3))
+    one = _motion({"a.rx": [-170.0]})
+    np.testing.assert_allclose(joint_angles(one), [[-170.0]])
+
+
+def test_median_step_and_its_mask():
+    from cyclecoord.quality.reference import median_step
+
+    x = np.array([[0.0, 0.0], [3.0, 4.0], [3.0, 4.0], [6.0, 8.0], [6.0, 9.0]])  # 5, 0, 5, 1
+    assert median_step(x) == 3.0  # the mean of the middle two of 0, 1, 5, 5
+    assert median_step(x, [True, True, False, True, True]) == 3.0  # steps 5 and 1
+    assert median_step(x, [False, True, True, False, False]) == 0.0  # step 1 -> 2 only
+    assert median_step(x, [True, False, True, False, True]) != median_step(x, None)
+    assert np.isnan(median_step(x, [True, False, True, False, True]))  # no two in a row
+    assert np.isnan(median_step(x[:1]))
+
+
+def test_used_mask_half_open_ranges_and_bounds():
+    from cyclecoord.quality.reference import used_mask
+
+    np.testing.assert_array_equal(used_mask(3, None), [True, True, True])
+    np.testing.assert_array_equal(used_mask(6, [[1, 3], [4, 5]]),
+                                  [False, True, True, False, True, False])
+    np.testing.assert_array_equal(used_mask(4, [(0, 4)]), [True] * 4)
+    np.testing.assert_array_equal(used_mask(4, [[3, 4]]), [False, False, False, True])
+    for bad in ([-1, 2], [2, 2], [3, 2], [0, 5]):
+        with pytest.raises(ParameterError, match="not inside the motion's 4 frames"):
+            used_mask(4, [bad])
+
+
+def _brute_loop_cut(x, period, tol, mask):
+    """Every cut by loops: lengths n from ceil(period (1 - tol)) (at least 2) to
+    floor(period (1 + tol)), shorter than the take; the cut's mean step at least the take's
+    median step; frames i..j in the mask; the smallest |x[j] - x[i]|, the first found on
+    ties (shortest, then earliest)."""
+    T = len(x)
+    steps = [float(np.linalg.norm(x[t + 1] - x[t])) for t in range(T - 1)]
+    med = float(np.median(steps))
+    best = None
+    for n in range(max(2, int(np.ceil(period * (1 - tol)))), int(np.floor(period * (1 + tol))) + 1):
+        for i in range(T - n):
+            j = i + n
+            if sum(steps[i:j]) / n < med or not all(mask[i : j + 1]):
+                continue
+            d = float(np.linalg.norm(x[j] - x[i]))
+            if best is None or d < best[0]:
+                best = (d, i, j)
+    return best, med
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_best_loop_cut_equals_brute_force(seed):
+    rng = np.random.default_rng(seed)
+    T = 40
+    t = np.arange(T)
+    a = 30 * np.sin(2 * np.pi * t / 9.0) + rng.normal(0, 3, T)
+    b = 20 * np.cos(2 * np.pi * t / 9.0) + rng.normal(0, 3, T)
+    a[:6] = a[6]  # a still start
+    m = _motion({"lfemur.rx": a, "ltibia.rx": b})
+    x = joint_angles(m)
+    for period, tol, used in ((9.0, 0.15, None), (9.4, 0.3, [[0, 20], [22, 40]]),
+                              (2.0, 0.0, None), (33.0, 0.1, None), (38.0, 0.1, None)):
+        mask = np.ones(T, bool)
+        if used is not None:
+            mask[:] = False
+            for s, e in used:
+                mask[s:e] = True
+        want, med = _brute_loop_cut(x, period, tol, mask)
+        if want is None:
+            with pytest.raises(ParameterError, match="no loop cut"):
+                best_loop_cut(m, period, tol, used)
+            continue
+        cut = best_loop_cut(m, period, tol, used)
+        assert (cut.start, cut.stop) == (want[1], want[2]), (period, tol)
+        assert cut.distance == pytest.approx(want[0], rel=1e-12)
+        assert cut.median_step == pytest.approx(med, rel=1e-12)
+        assert cut.period_frames == period and type(cut.period_frames) is float
+        assert cut.n_frames == want[2] - want[1] == cut.clip.n_frames
+        np.testing.assert_array_equal(cut.clip.frames, m.frames[want[1] : want[2]])
+    # the default tolerance, 0.15: a period of 6 frames allows 6 alone (5.1 to 6.9)
+    want, _ = _brute_loop_cut(x, 6.0, 0.15, np.ones(T, bool))
+    cut = best_loop_cut(m, 6.0)
+    assert (cut.start, cut.stop) == (want[1], want[2]) and cut.n_frames == 6
+
+
+def test_best_loop_cut_arguments_and_no_fit():
+    t = np.arange(12)
+    m = _motion({"lfemur.rx": 10 * np.sin(2 * np.pi * t / 4)})
+    with pytest.raises(ParameterError, match=">= 2"):
+        best_loop_cut(m, 1.99)
+    assert best_loop_cut(m, 2.0, 0.0).n_frames == 2
+    with pytest.raises(ParameterError, match=r"tolerance must be in \[0, 1\)"):
+        best_loop_cut(m, 4.0, 1.0)
+    with pytest.raises(ParameterError, match="tolerance"):
+        best_loop_cut(m, 4.0, -0.01)
+    assert best_loop_cut(m, 4.0, 0.0).n_frames == 4
+    # 11 frames at most between the first and the last of 12: a period of 12 fits none
+    with pytest.raises(ParameterError, match=r"no loop cut of 12-12 frames .*\(12 frames, 12 used\)"):
+        best_loop_cut(m, 12.0, 0.0)
+    assert best_loop_cut(m, 11.0, 0.0).n_frames == 11
+
+
+def test_wrap_times_interpolate_and_offset_runs():
+    """0.6, 0.9, then 0.2 (1.2 unwrapped): the turn ends a third of the way from frame 1 to
+    frame 2; a run after a NaN counts its frames from the take's start; levels from the
+    first whole number reached to the last."""
+    (w,) = wrap_times(np.array([0.6, 0.9, 0.2, 0.5]))
+    np.testing.assert_allclose(w, [1 + 1 / 3], rtol=1e-14)
+    runs = wrap_times(np.array([np.nan, np.nan, 0.6, 0.9, 0.2, 0.5, np.nan, 0.0, 0.5]))
+    assert len(runs) == 2
+    np.testing.assert_allclose(runs[0], [3 + 1 / 3], rtol=1e-14)
+    np.testing.assert_array_equal(runs[1], [7.0])  # starts on a wrap
+    (w,) = wrap_times(np.array([0.5, 0.75, 0.0, 0.25, 0.5, 0.75, 0.0]))  # on frames exactly
+    np.testing.assert_allclose(w, [2.0, 6.0], rtol=1e-14)
+    (w,) = wrap_times(np.array([0.1, 0.4, 0.7]))  # no turn completed
+    assert w.size == 0 and w.dtype == float
+    assert wrap_times(np.array([np.nan, np.nan])) == []
+    with pytest.raises(ParameterError, match="one value per frame"):
+        wrap_times(np.zeros((3, 2)))
+
+
+def test_sample_and_rot_y_by_hand():
+    from cyclecoord.quality.reference import _rot_y, _sample
+
+    x = np.array([[0.0, 10.0], [1.0, 20.0], [3.0, 40.0]])
+    np.testing.assert_allclose(_sample(x, np.array([0.0, 0.25, 1.5, 2.0])),
+                               [[0, 10], [0.25, 12.5], [2, 30], [3, 40]])
+    # +90 degrees about y takes +x to -z and +z to +x
+    dx, dz = _rot_y(np.array([1.0, 0.0]), np.array([0.0, 1.0]), 90.0)
+    np.testing.assert_allclose(dx, [0, 1], atol=1e-15)
+    np.testing.assert_allclose(dz, [-1, 0], atol=1e-15)
+
+
+def _walk_pieces(headings, starts, heights, n=4):
+    """A root walking one unit a frame straight ahead (local +x, world (cos h, -sin h) in x, z)
+    for ``n`` frames per piece, each piece its own heading, start and height; a joint
+    channel counting frames."""
+    rows = []
+    for h, (x0, z0), y in zip(headings, starts, heights):
+        a = np.radians(h)
+        for k in range(n):
+            rows.append([x0 + k * np.cos(a), y, z0 - k * np.sin(a), 5.0, h, -5.0])
+    rows.append(rows[-1])
+    root = np.array(rows)
+    return _motion({"lfemur.rx": np.arange(len(rows), dtype=float)}, root=root)
+
+
+def test_average_cycle_root_relative_to_each_piece_by_hand():
+    """Two pieces of 4 frames walking straight ahead at headings 30 and 120 from different
+    places: the average walks straight ahead from the first piece's start at its heading;
+    height averaged (1 and 3: 2); the joint channel's frames 0-3 and 4-7 average to 2-5."""
+    m = _walk_pieces([30.0, 120.0], [(5.0, 2.0), (7.0, -3.0)], [1.0, 3.0])
+    avg = average_cycle(m, [0, 4, 8], 4)
+    k = np.arange(4)
+    a = np.radians(30.0)
+    np.testing.assert_allclose(avg.frames[:, 0], 5 + k * np.cos(a), atol=1e-12)
+    np.testing.assert_allclose(avg.frames[:, 2], 2 - k * np.sin(a), atol=1e-12)
+    np.testing.assert_allclose(avg.frames[:, 1], 2.0)
+    np.testing.assert_allclose(avg.frames[:, [3, 4, 5]], np.tile([5.0, 30.0, -5.0], (4, 1)),
+                               atol=1e-12)
+    np.testing.assert_allclose(avg.frames[:, 6], [2, 3, 4, 5])
+    assert avg.metadata["pieces"] == [(0.0, 4.0), (4.0, 8.0)]
+    assert avg.start_frame == 0 and avg.source.startswith("average cycle of")
+    # the wraps sorted first; a piece must end by the last frame (8 of 9 frames)
+    assert average_cycle(m, [8, 0, 4], 4).metadata["pieces"] == [(0.0, 4.0), (4.0, 8.0)]
+    short = m[:8]
+    assert average_cycle(short, [0, 4, 8], 4).metadata["pieces"] == [(0.0, 4.0)]
+    assert average_cycle(m, [-1, 0, 0, 4], 4).metadata["pieces"] == [(0.0, 4.0)]
+
+
+def test_average_cycle_resamples_fractional_pieces():
+    """Piece (0.5, 4.5) in 2 frames: times 0.5 and 2.5; piece (4.5, 6.5): 4.5 and 5.5."""
+    m = _motion({"lfemur.rx": np.arange(9.0) ** 2})
+    avg = average_cycle(m, [0.5, 4.5, 6.5], 2)
+    lin = lambda t: np.interp(t, np.arange(9.0), np.arange(9.0) ** 2)  # noqa: E731
+    np.testing.assert_allclose(avg.frames[:, 6], [(lin(0.5) + lin(4.5)) / 2,
+                                                 (lin(2.5) + lin(5.5)) / 2])
+
+
+def test_average_cycle_coordinate_or_wraps_and_length():
+    """An array of one value in [0, 1) per frame is a coordinate; other arrays are wraps."""
+    m = _motion({"lfemur.rx": np.arange(9.0)})
+    phase = np.mod(np.arange(9) / 4.0, 1.0)  # wraps at 0, 4, 8
+    assert average_cycle(m, phase, 4).metadata["pieces"] == [(0.0, 4.0), (4.0, 8.0)]
+    phase[3] = np.nan  # the first piece spans a NaN: dropped; the run 4..8 gives one
+    assert average_cycle(m, phase, 4).metadata["pieces"] == [(4.0, 8.0)]
+    nine = np.array([0.0, 4.0, 8.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0])  # T values, not in [0, 1)
+    assert average_cycle(m, nine, 4).metadata["pieces"] == [(0.0, 1.0), (1.0, 4.0), (4.0, 8.0)]
+    halves = np.array([0.0, 0.5, 1.0, 1.5, 1.5, 1.5, 1.5, 1.5, 1.5])  # 1.0 and 1.5 >= 1
+    assert average_cycle(m, halves, 2).metadata["pieces"] == [(0.0, 0.5), (0.5, 1.0), (1.0, 1.5)]
+    ones = np.array([0.0, 0.5, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0])  # 1.0 is not in [0, 1)
+    assert average_cycle(m, ones, 2).metadata["pieces"] == [(0.0, 0.5), (0.5, 1.0)]
+    for bad in (1, 2.5, 0):
+        with pytest.raises(ParameterError, match="integer >= 2"):
+            average_cycle(m, [0, 4, 8], bad)
+    assert average_cycle(m, [0, 4, 8], 2.0).n_frames == 2
+    with pytest.raises(ParameterError, match="wrap at least twice"):
+        average_cycle(m, [0, 9], 4)
+
+
+def _cosines(T: int, *terms) -> cc.Motion:
+    """One joint channel, a sum of ``(amplitude, period in frames)`` cosines, at 10 fps."""
+    t = np.arange(T)
+    return _motion({"lfemur.rx": sum(a * np.cos(2 * np.pi * t / p) for a, p in terms)})
+
+
+def test_autocorrelation_period_lag_bounds():
+    """At 10 fps the lags searched are 0.3-3 s (3-30 frames), and at most 80 % of the
+    longest used range: a cosine of 40 frames (4 s) is found only when max_lag allows
+    it and 40 <= 0.8 T (no lag past hi + 0.5 is returned); one of 4 frames (0.4 s) only
+    when min_lag is under 0.4 s; the search needs at least two lags beyond its first
+    (hi - lo >= 2); a constant take has no period."""
+    assert np.isnan(autocorrelation_period(_cosines(200, (10, 40))))
+    forty = autocorrelation_period(_cosines(200, (10, 40)), max_lag=6.0)
+    assert forty == pytest.approx(40, abs=0.05)
+    forty = autocorrelation_period(_cosines(50, (10, 40)), max_lag=10.0)
+    assert forty == pytest.approx(40, abs=0.1)
+    # 0.8 of 49 frames is 39: no lag past 39 and a half (the parabola's half frame)
+    assert autocorrelation_period(_cosines(49, (10, 40)), max_lag=10.0) <= 39.5
+    used = [[0, 50], [60, 109]]  # the longest range 50 frames: 0.8 of it is 40
+    assert autocorrelation_period(_cosines(110, (10, 40)), used, max_lag=10.0) == pytest.approx(
+        40, abs=0.05)
+    assert autocorrelation_period(_cosines(110, (10, 40)), [[0, 49], [60, 109]],
+                                  max_lag=10.0) <= 39.5
+    four = _cosines(200, (10, 4))
+    assert autocorrelation_period(four) == pytest.approx(4, abs=0.05)
+    assert autocorrelation_period(four, min_lag=0.6) == pytest.approx(8, abs=0.05)
+    assert autocorrelation_period(four, max_lag=0.5) == pytest.approx(4, abs=0.05)  # lags 3-5
+    assert np.isnan(autocorrelation_period(four, max_lag=0.4))  # lags 3-4
+    assert np.isnan(autocorrelation_period(_motion({"lfemur.rx": np.full(200, 7.0)})))
+
+
+def test_autocorrelation_period_first_strong_peak_and_min_correlation():
+    """cos(2 pi t / 20) + c cos(2 pi t / 10) autocorrelates as (cos(2 pi L / 20) + c^2
+    cos(2 pi L / 10)) / (1 + c^2): peaks at lag 10, (c^2 - 1) / (c^2 + 1) of the one at
+    20.  c = 2: 0.6 of it, under 0.8 (strong): the period is 20; c = 4: 0.88, so 10,
+    (0.9 on the biased curve: its sums hold 390 and 380 pairs), unless ``strong`` is 0.95 or the peak's correlation 0.88 is under ``min_correlation``."""
+    two = _cosines(400, (1, 20), (2, 10))
+    assert autocorrelation_period(two) == pytest.approx(20, abs=0.05)
+    four = _cosines(400, (1, 20), (4, 10))
+    assert autocorrelation_period(four) == pytest.approx(10, abs=0.05)
+    assert autocorrelation_period(four, strong=0.95) == pytest.approx(20, abs=0.05)
+    assert autocorrelation_period(four, min_correlation=0.95) == pytest.approx(20, abs=0.05)
+    assert autocorrelation_period(four, min_correlation=0.85) == pytest.approx(10, abs=0.05)
+
+
+def test_average_cycle_heading_unwrapped_and_roots_without_heading():
+    """A turn in place crossing 180 degrees (170, 175, 180, -175: +5 a frame) averages as a
+    steady turn from the first heading; a root without ry averages its translation
+    relative to each piece's start, unturned; a root without tx/tz as it is."""
+    rows = np.zeros((9, 6))
+    rows[:, 4] = [170.0, 175.0, 180.0, -175.0, 10.0, 15.0, 20.0, 25.0, 25.0]
+    rows[:, 0] = [0, 0, 0, 0, 50, 51, 52, 53, 53]
+    m = _motion({"a.rx": np.zeros(9)}, root=rows)
+    avg = average_cycle(m, [0, 4, 8], 4)
+    np.testing.assert_allclose(avg.frames[:, 4], [170, 175, 180, 185])
+    # the first piece stands; the second moves 1 a frame along world x, which its first
+    # heading (10) turns into local (cos 10, sin 10); the mean is half that, turned into
+    # the first piece's heading (170)
+    a = np.radians(10.0)
+    local = np.array([np.cos(a), np.sin(a)]) * np.arange(4)[:, None] / 2  # (dx, dz) local
+    b = np.radians(170.0)
+    np.testing.assert_allclose(avg.frames[:, 0], np.cos(b) * local[:, 0] + np.sin(b) * local[:, 1],
+                               atol=1e-12)
+    np.testing.assert_allclose(avg.frames[:, 2], -np.sin(b) * local[:, 0] + np.cos(b) * local[:, 1],
+                               atol=1e-12)
+    # no heading channel: translations relative to each piece's start, not turned
+    flat = cc.Motion(np.column_stack([rows[:, 0], rows[:, 2] + 3.0, np.arange(9.0)]),
+                     [("root", "tx"), ("root", "tz"), ("a", "rx")], fps=10.0)
+    avg = average_cycle(flat, [0, 4, 8], 4)
+    np.testing.assert_allclose(avg.frames[:, 0], np.arange(4) / 2)
+    np.testing.assert_allclose(avg.frames[:, 1], 3.0)
+    np.testing.assert_allclose(avg.frames[:, 2], [2, 3, 4, 5])
+    # only tx: no relative translation (both tx and tz are needed)
+    onlyx = cc.Motion(np.column_stack([rows[:, 0], np.arange(9.0)]),
+                      [("root", "tx"), ("a", "rx")], fps=10.0)
+    np.testing.assert_allclose(average_cycle(onlyx, [0, 4, 8], 4).frames[:, 0],
+                               [25, 25.5, 26, 26.5])
+
+
+def test_autocorrelation_period_first_lag_and_a_unit_energy_take():
+    """The lags start at min_lag (0.5 s: lag 5 at 10 fps, with lag 4 only as its left
+    neighbour): a 0.4 s cosine reads its second peak, 8.  A square wave of +-1/8 and
+    period 8 over 64 frames has energy exactly 1 (and every overlap's product under 1):
+    its period is still 8."""
+    four = _cosines(200, (10, 4))
+    assert autocorrelation_period(four, min_lag=0.5) == pytest.approx(8, abs=0.05)
+    square = np.where(np.arange(64) % 8 < 4, 0.125, -0.125)
+    assert float(np.sum(square**2)) == 1.0 and square.mean() == 0.0
+    m = _motion({"lfemur.rx": square})
+    assert autocorrelation_period(m) == pytest.approx(8, abs=0.1)

@@ -261,8 +261,8 @@ def wrap_times(coordinate: np.ndarray) -> list[np.ndarray]:
             if k == 0:  # the run starts exactly on a wrap
                 times.append(float(a))
                 continue
-            prev = env[k - 1]
-            f = (level - prev) / (env[k] - prev) if env[k] > prev else 1.0
+            prev = env[k - 1]  # < level <= env[k]: k is the first frame reaching the level
+            f = (level - prev) / (env[k] - prev)
             times.append(a + k - 1 + f)
         out.append(np.asarray(times, dtype=float))
     return out
