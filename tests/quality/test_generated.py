@@ -704,15 +704,26 @@ def test_sliding_feet_slip_in_units_and_leg_lengths_and_knee_p99():
     assert q.knee_range == pytest.approx((0.0, 0.0), abs=1e-6)
 
 
-@pytest.mark.filterwarnings("ignore:invalid value encountered:RuntimeWarning")  # pops 0 / 0
 def test_still_sources_make_no_frame_a_freeze():
     """Slow is strictly under a tenth of the sources' median pose speed: sources that never
-    move (median 0) leave a still motion without freezes."""
+    move (median 0) leave a still motion without freezes, and without pops (0 / 0 was a
+    NaN with a RuntimeWarning); any motion against them pops infinitely."""
+    import warnings
+
     from _legs import legs_skeleton, make_motion
 
     still = make_motion(legs_skeleton(), T=64, fps=64.0)
-    q = measure_generated(still, [still])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        q = measure_generated(still, [still])
     assert q.freezes == [] and q.longest_freeze_s == 0.0
+    assert q.largest_step == 0.0 and q.largest_accel == 0.0
+    frames = np.array(still.frames)
+    frames[32:, :] += 1.0  # one jump
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        q = measure_generated(still.with_frames(frames), [still])
+    assert q.largest_step == np.inf and q.largest_accel == np.inf
 
 
 def test_resampling_tolerance_is_strictly_under_five_percent():

@@ -230,6 +230,14 @@ def _ranges(a: np.ndarray) -> np.ndarray:
     return hi - lo
 
 
+def _over(value: float, reference: float) -> float:
+    """``value / reference`` for a pop figure: 0 when neither moves (sources that never
+    move and a motion that does not either), infinite when only the motion does."""
+    if reference > 0:
+        return value / reference
+    return 0.0 if value <= 0 else float("inf")
+
+
 def _resampled(source: Motion, fps: float) -> Motion:
     k = int(round(source.fps / fps))
     if k > 1 and abs(source.fps / k - fps) < 0.05 * fps:
@@ -591,9 +599,9 @@ def measure_generated(
         source_hip_range=ref.hip_range,
         cycle_s=cycle,
         source_cycle_s=ref.cycle_at(rs),
-        largest_step=float(ps.max() / ref.step_p99),
+        largest_step=_over(float(ps.max()), ref.step_p99),
         largest_step_frame=int(ps.argmax()),
-        largest_accel=float(acc.max() / ref.accel_p99),
+        largest_accel=_over(float(acc.max()), ref.accel_p99),
         largest_accel_frame=int(acc.argmax()) + 1,
         root_speed=rs * m,
         source_root_speed=ref.root_speed * m,
