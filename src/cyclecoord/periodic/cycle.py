@@ -176,8 +176,9 @@ def knn_centroids(
     if weighting == "mean":
         return neighbours.mean(axis=1)
 
-    gap = np.abs(ext[ext_idx] - phases[:, None])
-    dist = np.minimum(gap, 1.0 - gap)
+    # already circular: the chosen run has the least reach, at most the k-th nearest
+    # frame's circular distance (<= 0.5), so no |ext - phase| in it exceeds 0.5
+    dist = np.abs(ext[ext_idx] - phases[:, None])
     if bandwidth is None:
         bandwidth = float(np.median(dist.max(axis=1)))
     if bandwidth <= 0.0:  # every neighbour sits exactly on its phase
@@ -422,7 +423,7 @@ def _candidate_widths(
         lo = min(k / (T * np.sqrt(2.0 * np.pi)) * period, 0.5)
         hi = period / 8.0 if max_width is None else _positive_float(max_width, "max_width")
         widths = (
-            np.geomspace(lo, hi, n_candidates) if hi > lo and n_candidates > 1 else np.array([lo])
+            np.geomspace(lo, hi, n_candidates) if hi > lo else np.array([lo])  # n = 1: [lo] too
         )
     else:
         widths = _finite_array(candidates, "candidates", 1)
