@@ -638,9 +638,37 @@ def test_select_bandwidth_validates_on_evenly_spaced_frames():
     np.testing.assert_allclose(one.cv_error, brute_force_cv(theta, theta, poses, widths, 10.0, 0, [0])[0],
                                rtol=1e-5)
     np.testing.assert_array_equal(one.cv_se, 0.0)
+    # with one validation frame "1se" is "min": the least error, with no margin
+    assert select_bandwidth(theta, poses, 10.0, candidates=widths, max_validation=1, rule="1se").bandwidth == \
+        widths[np.argmin(one.cv_error)]
+    # two validation frames (0 and 39) have a standard error (ddof 1) like any number of them
+    two = select_bandwidth(theta, poses, 10.0, candidates=widths, max_validation=2)
+    err = brute_force_cv(theta, theta, poses, widths, 10.0, 0, [0, 39])
+    assert two.n_validation == 2
+    np.testing.assert_allclose(two.cv_se, err.std(axis=0, ddof=1) / np.sqrt(2), rtol=1e-4)
+    assert np.all(two.cv_se > 0)
     for bad in (0, 2.5, True):
         with pytest.raises(ParameterError):
             select_bandwidth(theta, poses, 10.0, candidates=widths, max_validation=bad)
+
+
+def test_select_bandwidth_validates_on_at_most_2000_frames_by_default():
+    """2,001 frames: 2,000 of them, evenly spaced, are predicted (one width, to stay fast)."""
+    theta = np.mod(np.arange(2001) / 50.0, 1.0)
+    poses = np.sin(2 * np.pi * theta)[:, None]
+    assert select_bandwidth(theta, poses, 50.0, candidates=[1.0]).n_validation == 2000
+
+
+def test_results_compare_by_identity_and_hash():
+    """The results hold arrays: they compare by identity (never element-wise) and can be
+    kept in sets and as dict keys."""
+    theta, poses = _cv_data()
+    a = select_bandwidth(theta, poses, 10.0, candidates=[1.0])
+    b = select_bandwidth(theta, poses, 10.0, candidates=[1.0])
+    assert a == a and a != b and len({a, b, a}) == 2
+    cyc = typical_cycle(theta, poses, 10, n_samples=20, k=3)
+    assert cyc == cyc and cyc != typical_cycle(theta, poses, 10, n_samples=20, k=3)
+    assert len({cyc, cyc}) == 1
 
 
 def test_select_bandwidth_one_standard_error_rule_takes_the_widest_within_it():
@@ -835,6 +863,15 @@ def test_typical_cycle_limits(small_motion):
         args = {"period_frames": 40, **ok, **kwargs}
         with pytest.raises(ParameterError):
             typical_cycle(theta, poses, **args)
+
+
+def test_typical_cycle_random_state_defaults_to_zero(small_motion):
+    """The package's one default seed, 0: random sampling without a seed draws as with 0."""
+    theta, poses, density = small_motion
+    kw = dict(density=density, n_samples=30, k=3, sampling="random")
+    default = typical_cycle(theta, poses, 40, **kw).sample_phases
+    np.testing.assert_array_equal(default, typical_cycle(theta, poses, 40, random_state=0, **kw).sample_phases)
+    assert not np.array_equal(default, typical_cycle(theta, poses, 40, random_state=1, **kw).sample_phases)
 
 
 def test_typical_cycle_is_frozen(small_motion):
