@@ -287,3 +287,93 @@ def test_cluster_windows_by_relative_cycle_distance():
     assert len(W._cluster_windows([w1, w2, w3], 0.9)) == 1
     assert W._cluster_windows([w1, off], 0.5) == [[w1]]
     assert W._cluster_windows([off], 0.5) == []
+
+
+# ------------------------------------------------------------- windowed_motions
+def _two_motions():
+    """96 frames: 48 round circle A (16 frames a turn, radius 10), then 48 round circle B
+    (centred 100 away); each window's cycle is its circle's 16 frames, so every frame lies
+    on its own motion's cycle (distance 0) and 10 radii from the other's."""
+    ang = 2 * np.pi * np.arange(16) / 16
+    a = 10 * np.column_stack([np.cos(ang), np.sin(ang)])
+    b = a + [100.0, 0.0]
+    poses = np.concatenate([a[np.arange(48) % 16], b[np.arange(48) % 16]])
+
+    def win(start, cycle, birth, death, scale):
+        return WindowInfo(start=start, stop=start + 32, step=1, birth=birth, death=death, threshold=9.0,
+                          scale=scale, clear=True, cycles=2.0, steadiness=1.0, period_frames=16.0,
+                          looping=True, cycle=cycle)
+
+    wins = [win(0, a, 0.1, 1.0, 0.5), win(16, a, 0.3, 2.0, 0.7), win(48, b, 0.2, 3.0, 0.4),
+            win(64, b, 0.4, 5.0, 0.6)]
+    return poses, wins
+
+
+def test_windowed_motions_from_windows_alone():
+    """Two groups of alike windows, one on each circle: frames 0-47 are motion 0 and 48-95
+    motion 1; each segment's period is its stretch's autocorrelation period (16), its turns
+    48 / 16 = 3, its birth, death and scale the medians over the windows inside it."""
+    poses, wins = _two_motions()
+    labels, segments, n = W.windowed_motions(wins, [], np.full(96, -1), 0, poses, window=4, min_cycles=1.5,
+                                             similarity=0.5, merge_overlap=0.5)
+    assert n == 2
+    np.testing.assert_array_equal(labels, [0] * 48 + [1] * 48)
+    assert [w.motion for w in wins] == [0, 0, 1, 1]
+    got = [(s.start, s.stop, s.motion, s.classes, s.cycles, s.period_frames) for s in segments]
+    assert got == [(0, 48, 0, (), 3.0, 16.0), (48, 96, 1, (), 3.0, 16.0)]
+    assert [(s.birth, s.death, s.scale) for s in segments] == [(0.2, 1.5, 0.6), (pytest.approx(0.3), 4.0, 0.5)]
+    # two windows of 2 turns each hold fewer than min_cycles = 2.5 turns: no motion at all
+    poses, wins = _two_motions()
+    labels, segments, n = W.windowed_motions(wins, [], np.full(96, -1), 0, poses, window=4, min_cycles=2.5,
+                                             similarity=0.5, merge_overlap=0.5)
+    assert n == 0 and segments == [] and np.all(labels == -1) and all(w.motion == -1 for w in wins)
+
+
+def test_windowed_motions_join_windows_to_the_global_motion_they_overlap():
+    """A global class excites frames 0-47 (circle A, three turns of its coordinate): the
+    windows on A cover exactly those frames (share 1 > merge_overlap 0.5) and join its
+    motion, whose segment then reads turns and period from the class's coordinate and its
+    birth, death and scale from the class; the windows on B make motion 1.  With
+    merge_overlap = 1 (a share must exceed it) the A windows stay apart, label nothing
+    (the global labels win on frames 0-47) and keep no motion."""
+    from cyclecoord.periodic.detection.result import DetectedClass
+
+    for overlap, joined in ((0.5, True), (1.0, False)):
+        poses, wins = _two_motions()
+        mask = np.arange(96) < 48
+        coord = np.where(mask, np.mod(np.arange(96) / 16, 1.0), 0.0)
+        cls = DetectedClass(index=3, birth=0.25, death=7.0, scale=0.8, coordinate=coord, speed=np.zeros(96),
+                            consistency=np.ones(96), mask=mask, motion=0)
+        glob = np.where(mask, 0, -1)
+        labels, segments, n = W.windowed_motions(wins, [cls], glob, 1, poses, window=4, min_cycles=1.5,
+                                                 similarity=0.5, merge_overlap=overlap)
+        assert n == 2 and cls.motion == 0
+        np.testing.assert_array_equal(labels, [0] * 48 + [1] * 48)
+        assert [w.motion for w in wins] == ([0, 0, 1, 1] if joined else [-1, -1, 1, 1])
+        first = segments[0]
+        assert (first.start, first.stop, first.motion, first.classes) == (0, 48, 0, (3,))
+        assert (first.birth, first.death, first.scale) == (0.25, 7.0, 0.8)
+        assert first.period_frames == pytest.approx(16.0) and first.cycles == pytest.approx(47 / 16)
+        assert (segments[1].start, segments[1].stop, segments[1].classes) == (48, 96, ())
+
+
+@pytest.mark.parametrize("r, labelled", [(1.9, True), (2.1, False)])
+def test_windowed_motions_leave_frames_beyond_none_cost_unlabelled(r, labelled):
+    """One window on a 16-gon of radius 10, every 16th frame of it at distance 1 from the
+    polygon (radially out from a vertex) but the last two at distance r: its typical
+    distance is the median, 1.  Frames 48-79 at distance r cost r a frame against
+    NONE_COST = 2 for "nothing periodic": at 2.1 the 32 frames save 3.2 by switching, more
+    than the one switch costs (window / 2 = 2), and go unlabelled; at 1.9 they stay."""
+    assert W.NONE_COST == 2.0
+    ang = 2 * np.pi * np.arange(16) / 16
+    cycle = 10 * np.column_stack([np.cos(ang), np.sin(ang)])
+    radius = np.where(np.arange(80) < 48, 11.0, 10.0 + r)
+    poses = (cycle[np.arange(80) % 16] / 10.0) * radius[:, None]
+    w = WindowInfo(start=0, stop=80, step=16, birth=0.1, death=1.0, threshold=9.0, scale=0.5, clear=True,
+                   cycles=5.0, steadiness=1.0, period_frames=16.0, looping=True, cycle=cycle)
+    assert W._typical_distance(poses[0:80:16], cycle) == pytest.approx(1.0)
+    labels, segments, n = W.windowed_motions([w], [], np.full(80, -1), 0, poses, window=4, min_cycles=1.5,
+                                             similarity=0.5, merge_overlap=0.5)
+    assert n == 1
+    np.testing.assert_array_equal(labels, [0] * 48 + [0 if labelled else -1] * 32)
+    assert [(s.start, s.stop) for s in segments] == [(0, 80 if labelled else 48)]
