@@ -210,20 +210,23 @@ def test_window_table_plans_the_windows(monkeypatch):
     """100 frames at 10 fps.  2 s: 20 frames stepped by max(0.5, 2 / 8) s = 5 frames, from
     0 to 75 and a last one ending at frame 100 (start 80); 6 s: 60 frames stepped by
     round(7.5) = 8 frames, 0 to 40 (which already ends at the last frame); 0.9 s (9 frames)
-    and 11 s (110) are skipped, 1 s (10 frames) is kept.  At most 7 points a window: every
-    ceil(20 / 7) = 3rd frame of 20, every 9th of 60, every 2nd of 10."""
+    and 11 s (110) are skipped, 1 s (10 frames) and 10 s (all 100) are kept.  At most 7
+    points a window: every ceil(20 / 7) = 3rd frame of 20, every 9th of 60, every 2nd of
+    10, every 15th of 100."""
     calls = []
     monkeypatch.setattr(W, "_fit_window", _fake_fit(calls, lambda s: 2.0))
     pts = np.column_stack([np.arange(100.0), np.zeros(100)])
-    wins = W.window_table(pts, pts, 10.0, lengths=(2.0, 6.0, 0.9, 11.0, 1.0), max_points=7, prime=5,
+    wins = W.window_table(pts, pts, 10.0, lengths=(2.0, 6.0, 0.9, 11.0, 1.0, 10.0), max_points=7, prime=5,
                           scale_fraction=0.7, progress=False)
     want = [(a, a + 20, 3) for a in list(range(0, 76, 5)) + [80]]
     want += [(a, a + 60, 9) for a in range(0, 41, 8)]
     want += [(a, a + 10, 2) for a in list(range(0, 91, 5))]
+    want += [(0, 100, 15)]
     assert [(w.start, w.stop, w.step) for w in wins] == want
     assert [c[0] for c in calls] == [a for a, _, _ in want]
     assert calls[0][1:] == ([0, 3, 6, 9, 12, 15, 18], 5, 0.7)
-    assert calls[-1][1] == list(range(90, 100, 2))
+    assert calls[-2][1] == list(range(90, 100, 2))
+    assert calls[-1][1] == list(range(0, 100, 15))
 
 
 def test_window_table_loops_on_enough_steady_turns(monkeypatch):
