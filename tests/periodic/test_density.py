@@ -460,3 +460,35 @@ def test_as_generator():
     for bad in (-1, 1.5, "3", np.random.RandomState(0)):
         with pytest.raises(ParameterError):
             as_generator(bad)
+
+
+def test_cdf_stays_within_its_turn_just_below_each_integer():
+    """cdf(x + n) = n + (mass on [0, x]), which is at most n + 1: the phases just below 1
+    (where summing the pieces can round to 1 + 2e-16) give at most 1, so the cdf does not
+    step down into the next turn, where cdf(1) = 1 exactly."""
+    u = np.nextafter(1.0, 0.0) - np.arange(50) * 1.1e-16
+    for n_components in (3, 30):  # fits whose raw sum rounds above 1 there
+        d = PeriodicDensity(n_components=n_components).fit(draw(200, seed=1))
+        assert d._cdf_unit(u).max() > 1.0  # the rounding the bound is for
+        assert d.cdf(u).max() <= 1.0 and float(d.cdf(1.0)) == 1.0
+        assert d.cdf(u + 2.0).max() <= 3.0 and np.all(d.cdf(u - 1.0) <= 0.0)
+
+
+def test_sample_wraps_a_draw_rounding_to_one_onto_zero():
+    """A normal draw landing a hair below 0 (mean + std z = -1e-17) is 1.0 after mod 1 in
+    floating point; the phases are in [0, 1), so it comes back as 0.0.  The draw is set with
+    a Generator whose standard normal values are chosen."""
+    d = PeriodicDensity(n_components=1, n_copies=1).fit(np.array([0.1, 0.2, 0.3]))
+    mu, sd = float(d.means_[0]), float(d.stds_[0])
+    z = -mu / sd
+    while mu + sd * z >= 0.0:  # the largest z whose value is below 0
+        z = np.nextafter(z, -np.inf)
+    assert np.mod(mu + sd * z, 1.0) == 1.0
+
+    class Chosen(np.random.Generator):
+        def standard_normal(self, size=None, *args, **kwargs):
+            return np.array([z, 0.0, 1.0])[:size]
+
+    s = d.sample(3, random_state=Chosen(np.random.PCG64(0)))
+    np.testing.assert_allclose(s, np.sort([0.0, mu, mu + sd]), rtol=1e-12)
+    assert s[0] == 0.0
