@@ -492,3 +492,26 @@ def test_sample_wraps_a_draw_rounding_to_one_onto_zero():
     s = d.sample(3, random_state=Chosen(np.random.PCG64(0)))
     np.testing.assert_allclose(s, np.sort([0.0, mu, mu + sd]), rtol=1e-12)
     assert s[0] == 0.0
+
+
+def test_em_from_an_equal_count_start_that_is_already_a_fixed_point():
+    """Values 0..5 in two components: the start's equal-count runs {0, 1, 2} and {3, 4, 5}
+    have means 1 and 4, whose midpoint 2.5 separates them, so k-means stops there at once
+    (a start of other runs, e.g. {1, 2, 3} first, ends at {0..3} | {4, 5} instead)."""
+    from cyclecoord.periodic.density import _em_1d
+
+    weights, means, var, _, _ = _em_1d(np.arange(6.0), 2, 0, 1e-5)
+    np.testing.assert_allclose(weights, [0.5, 0.5], rtol=1e-12)
+    np.testing.assert_allclose(means, [1.0, 4.0], rtol=1e-12)
+    np.testing.assert_allclose(var, [2 / 3 + 1e-5] * 2, rtol=1e-12)
+
+
+def test_em_weights_sum_to_one():
+    """Five values in five components (each its own): the weights are normalised to sum to
+    1 to rounding, although each component's count carries a 1e-15 guard against 0."""
+    from cyclecoord.periodic.density import _em_1d
+
+    for x in (np.arange(5.0), np.array([0.1, 0.4, 0.45, 0.8])):
+        weights = _em_1d(x, x.size, 100, 1e-5)[0]
+        np.testing.assert_allclose(weights, 1.0 / x.size, rtol=1e-12)
+        assert abs(weights.sum() - 1.0) < 1e-15
