@@ -380,3 +380,27 @@ def test_windowed_motions_leave_frames_beyond_none_cost_unlabelled(r, labelled):
     assert n == 1
     np.testing.assert_array_equal(labels, [0] * 48 + [0 if labelled else -1] * 32)
     assert [(s.start, s.stop) for s in segments] == [(0, 80 if labelled else 48)]
+
+
+def test_windowed_segment_period_from_the_windows_holding_min_cycles():
+    """A segment without a class takes its period from the median frames-per-turn of the
+    windows inside it that turn at least ``min_cycles`` times (exactly 1.5 counts), refined
+    by the stretch's autocorrelation -- which a still stretch cannot refine, so the
+    median of 13 and 14 stands: 40 frames are 40 / 13.5 turns.  With no window holding
+    min_cycles every window inside counts: the median of 13, 20 and 14."""
+    poses = np.zeros((40, 2))
+    cycle = np.zeros((16, 2))
+
+    def win(a, turns, period):
+        return WindowInfo(start=a, stop=a + 20, step=1, birth=0.1, death=1.0, threshold=2.0, scale=0.5,
+                          clear=True, cycles=turns, steadiness=1.0, period_frames=period, looping=True,
+                          cycle=cycle)
+
+    for min_cycles, period in ((1.5, 13.5), (1.6, 14.0)):
+        wins = [win(0, 1.5, 13.0), win(10, 1.0, 20.0), win(20, 1.5, 14.0)]
+        labels, segments, n = W.windowed_motions(wins, [], np.full(40, -1), 0, poses, window=4,
+                                                 min_cycles=min_cycles, similarity=0.5, merge_overlap=0.5)
+        assert n == 1 and np.all(labels == 0)
+        ((seg,),) = [segments]
+        assert (seg.start, seg.stop, seg.period_frames) == (0, 40, period)
+        assert seg.cycles == pytest.approx(40 / period)
