@@ -515,3 +515,11 @@ def test_em_weights_sum_to_one():
         weights = _em_1d(x, x.size, 100, 1e-5)[0]
         np.testing.assert_allclose(weights, 1.0 / x.size, rtol=1e-12)
         assert abs(weights.sum() - 1.0) < 1e-15
+
+
+def test_max_samples_defaults_to_20000():
+    """20,001 values are fitted on 20,000 of them by default, 20,000 on all (one component and
+    one EM step: only the count is looked at here)."""
+    theta = np.linspace(0.0, 1.0, 20001, endpoint=False)
+    assert PeriodicDensity(n_components=1, max_iter=1).fit(theta).n_samples_ == 20000
+    assert PeriodicDensity(n_components=1, max_iter=1).fit(theta[:20000]).n_samples_ == 20000
