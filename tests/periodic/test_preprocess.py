@@ -365,3 +365,9 @@ def test_fit_then_transform_equals_fit_transform():
     off = Preprocessor(difference_root=False).fit_transform(make(f))
     assert off.root_columns.size == 0
     np.testing.assert_allclose(off.poses[:, :6], f[:, :6])
+
+
+def test_one_principal_component_is_allowed():
+    f = np.random.default_rng(3).standard_normal((20, 8))
+    out = Preprocessor(difference_root=False, pca=1, rotations="euler").fit_transform(make(f))
+    assert out.points.shape == (20, 1)

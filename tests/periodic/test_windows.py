@@ -404,3 +404,14 @@ def test_windowed_segment_period_from_the_windows_holding_min_cycles():
         ((seg,),) = [segments]
         assert (seg.start, seg.stop, seg.period_frames) == (0, 40, period)
         assert seg.cycles == pytest.approx(40 / period)
+
+
+def test_window_table_defaults_and_a_hop_of_one_frame(monkeypatch):
+    """By default windows of 2, 4 and 6 s; at 1 fps a 10 s window steps by
+    round(max(0.5, 10 / 8)) = 1 frame."""
+    monkeypatch.setattr(W, "_fit_window", _fake_fit([], lambda s: 2.0))
+    pts = np.column_stack([np.arange(100.0), np.zeros(100)])
+    wins = W.window_table(pts, pts, 10.0, progress=False)
+    assert sorted({w.stop - w.start for w in wins}) == [20, 40, 60]
+    slow = W.window_table(pts[:14], pts[:14], 1.0, lengths=(10.0,), progress=False)
+    assert [w.start for w in slow] == [0, 1, 2, 3, 4]
