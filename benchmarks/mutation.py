@@ -80,8 +80,8 @@ TESTS: dict[str, list[str]] = {
     P + "suggest.py": [T + "periodic/test_suggest.py"],
     P + "windings.py": PIPE,
     **{P + "detection/" + m: [T + "periodic/test_detect.py"]
-       for m in ("_segments.py", "classes.py", "cycles.py", "detector.py", "result.py", "scoring.py",
-                 "windows.py")},
+       for m in ("_segments.py", "classes.py", "cycles.py", "detector.py", "result.py", "scoring.py")},
+    P + "detection/windows.py": [T + "periodic/test_windows.py", T + "periodic/test_detect.py"],
     Q + "contacts.py": [T + "quality/test_contacts.py"],
     Q + "cycle_quality.py": [T + "quality/test_reference.py", T + "quality/test_cycle_figures.py"],
     Q + "generated.py": [T + "quality/test_generated.py"],

@@ -270,3 +270,256 @@ def test_em_with_a_k_means_run_left_empty_stays_finite():
     np.testing.assert_allclose(weights, [6 / 7, 1 / 7, 0.0], atol=1e-12)
     np.testing.assert_allclose(means[:2], [0.0, 1.0], atol=1e-12)
     np.testing.assert_allclose(var, 1e-5, rtol=1e-9)
+
+
+# ------------------------------------------------- known answers, helper by helper
+def brute_force_lloyd(x, k):
+    """1-D k-means by plain Lloyd steps from equal-count runs of the sorted values (the
+    documented start): assign each value to its nearest mean (ties to the lower), re-average."""
+    x = np.sort(x)
+    bounds = np.round(np.linspace(0, x.size, k + 1)).astype(int)
+    label = np.repeat(np.arange(k), np.diff(bounds))
+    for _ in range(1000):
+        means = np.array([x[label == j].mean() for j in range(k)])
+        new = np.argmin(np.abs(x[:, None] - means[None, :]), axis=1)
+        if np.array_equal(new, label):
+            break
+        label = new
+    return np.array([np.mean(label == j) for j in range(k)]), means, np.array([x[label == j].var() for j in range(k)])
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 5])
+def test_em_starts_from_the_k_means_of_equal_count_runs(k):
+    """With max_iter=0 no EM step runs: the start itself is returned -- the k-means
+    clusters' shares, means and (population) variances plus reg_covar."""
+    from cyclecoord.periodic.density import _em_1d
+
+    x = draw(200, seed=k)
+    weights, means, var, converged, n_iter = _em_1d(x, k, 0, 1e-5)
+    w, m, v = brute_force_lloyd(x, k)
+    np.testing.assert_allclose(weights, w, rtol=1e-12)
+    np.testing.assert_allclose(means, m, rtol=1e-10)
+    np.testing.assert_allclose(var, v + 1e-5, rtol=1e-8)
+    assert (converged, n_iter) == (False, 0)
+
+
+def test_em_stops_at_the_first_log_likelihood_change_below_tol():
+    """EM's iteration j measures the mean log-likelihood L_j of the parameters left by
+    j - 1 iterations (recomputed here with scipy from ``_em_1d(..., max_iter=j - 1)``) and
+    stops at the first j with |L_j - L_(j-1)| < tol, 3e-4 by default."""
+    from scipy.stats import norm
+
+    from cyclecoord.periodic.density import _em_1d
+
+    x = draw(300, seed=1)  # four components take 30 steps to settle to 3e-4
+
+    def loglik(j):
+        w, m, v, _, _ = _em_1d(x, 4, j, 1e-5)
+        return np.mean(np.log(norm.pdf(x[:, None], m[None, :], np.sqrt(v)[None, :]) @ w))
+
+    n_iter = _em_1d(x, 4, 100, 1e-5)[4]
+    steps = np.abs(np.diff([-np.inf] + [loglik(j) for j in range(n_iter)]))
+    assert np.all(steps[:-1] >= 3e-4) and steps[-1] < 3e-4
+    assert n_iter >= 4  # several steps: the test is not about the first ones only
+    # a looser tolerance stops at the first step below it
+    loose = _em_1d(x, 4, 100, 1e-5, tol=1e-2)[4]
+    assert loose == 1 + np.flatnonzero(steps < 1e-2)[0] and loose < n_iter
+
+
+@pytest.mark.parametrize("n_copies", [1, 3, 5])
+def test_one_component_fit_is_the_moments_of_the_tiled_copies(n_copies):
+    """One component over n tiled copies (shifts -h..h, h = (n - 1) / 2): its mean is the
+    data's (mod 1) and its variance the data's plus the shifts' (n^2 - 1) / 12 plus
+    reg_covar; EM is at its fixed point from the start, so it stops at step 2."""
+    theta = 0.2 + 0.3 * np.random.default_rng(0).random(50)
+    d = PeriodicDensity(n_components=1, n_copies=n_copies, reg_covar=2e-5).fit(theta + 3.0)
+    assert d.n_components_ == 1 and d.n_samples_ == 50
+    np.testing.assert_allclose(d.weights_, [1.0])
+    np.testing.assert_allclose(d.means_, [theta.mean()], rtol=1e-12)
+    np.testing.assert_allclose(d.stds_**2, [theta.var() + (n_copies**2 - 1) / 12 + 2e-5], rtol=1e-10)
+    assert d.converged_ is True and d.n_iter_ == 2
+
+
+def wrapped_mixture(d, x):
+    """pdf and cdf on [0, 1] of the mixture wrapped onto the circle, summing 201 shifts."""
+    s = np.arange(-100, 101)[None, None, :]
+    loc = d.means_[None, :, None] + s
+    sd = d.stds_[None, :, None]
+    z = (np.asarray(x, dtype=float)[:, None, None] - loc) / sd
+    pdf = (np.exp(-0.5 * z**2) / (sd * np.sqrt(2 * np.pi)) * d.weights_[None, :, None]).sum(axis=(1, 2))
+    from scipy.special import ndtr
+
+    cdf = ((ndtr(z) - ndtr(-loc / sd)) * d.weights_[None, :, None]).sum(axis=(1, 2))
+    return pdf, cdf
+
+
+@pytest.mark.parametrize("n_copies, n_components", [(1, 1), (3, 1), (1, 4), (3, 30)])
+def test_pdf_and_cdf_are_the_wrapped_mixture(n_copies, n_components):
+    """The density is sum over integers s of the mixture at x + s, exactly periodic; summed
+    here over 201 shifts (every component's copies within 8 deviations of [0, 1) are what
+    the fit keeps: the rest weigh < 1e-15)."""
+    d = PeriodicDensity(n_components=n_components, n_copies=n_copies).fit(draw(300, seed=2))
+    x = np.linspace(0.0, 1.0, 41)
+    pdf, cdf = wrapped_mixture(d, x)
+    np.testing.assert_allclose(d.pdf(x), pdf, rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(d.cdf(x), cdf, rtol=1e-12, atol=1e-15)
+    # lifted: cdf(x + n) = cdf(x) + n, for negative turns too; the pdf is periodic
+    np.testing.assert_allclose(d.cdf(x[:-1] - 2.0), cdf[:-1] - 2.0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(d.cdf(x[:-1] + 5.0), cdf[:-1] + 5.0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(d.pdf(x - 3.0), pdf, rtol=1e-12, atol=1e-14)
+
+
+def test_evaluation_keeps_the_input_shape():
+    d = PeriodicDensity(n_components=2).fit(draw(100, seed=1))
+    grid = np.linspace(0.1, 0.9, 6).reshape(2, 3)
+    for f in (d.pdf, d.cdf, d.ppf):
+        assert f(grid).shape == (2, 3)
+        assert np.ndim(f(0.25)) == 0
+        np.testing.assert_allclose(f(grid).ravel(), f(grid.ravel()))
+    assert float(d.cdf(0.0)) == 0.0 and float(d.cdf(1.0)) == 1.0 and float(d.cdf(-1.0)) == -1.0
+
+
+def test_ppf_inverts_the_cdf_of_a_known_single_gaussian():
+    """One wide component (n_copies=1): the cdf has the closed form of the wrapped normal;
+    ppf(q) solves cdf(x) = q to 1e-9 and ppf(0) = 0, ppf(1) = 1, ppf(q + n) = ppf(q) + n."""
+    d = PeriodicDensity(n_components=1, n_copies=1).fit(draw(300, seed=3))
+    q = np.linspace(0.0, 1.0, 101)
+    x = d.ppf(q)
+    np.testing.assert_allclose(wrapped_mixture(d, x)[1], q, atol=1e-9)
+    assert x[0] == 0.0 and x[-1] == 1.0
+    np.testing.assert_allclose(d.ppf(q[:-1] + 2.0), x[:-1] + 2.0, atol=1e-12)
+    np.testing.assert_allclose(d.ppf(q[1:] - 1.0), x[1:] - 1.0, atol=1e-12)
+    np.testing.assert_allclose(d.quantiles(1), d.ppf([0.5]))
+    np.testing.assert_allclose(d.quantiles(4), d.ppf([0.125, 0.375, 0.625, 0.875]))
+
+
+def test_sample_draws_components_by_weight():
+    """Two narrow clusters at 0.2 (30 %) and 0.7 (70 %): the draws fall near each in those
+    shares (binomial: 4 standard deviations of 0.005 at n = 8000), wrap into [0, 1) and are
+    sorted; the same seed gives the same draws, one draw is an array of one."""
+    theta = np.concatenate([0.2 + 0.01 * np.linspace(-1, 1, 30), 0.7 + 0.01 * np.linspace(-1, 1, 70)])
+    d = PeriodicDensity(n_components=2, n_copies=1).fit(theta)
+    s = d.sample(8000, random_state=1)
+    assert s.shape == (8000,) and np.all(np.diff(s) >= 0) and np.all((s >= 0) & (s < 1))
+    assert abs(np.mean(np.abs(s - 0.2) < 0.1) - 0.3) < 0.02
+    assert abs(np.mean(np.abs(s - 0.7) < 0.1) - 0.7) < 0.02
+    # the spread is the component's: about 0.0058 (the cluster's) for the first
+    assert np.std(s[np.abs(s - 0.2) < 0.1]) == pytest.approx(np.sqrt(theta[:30].var() + 1e-5), rel=0.1)
+    assert d.sample(1, random_state=0).shape == (1,)
+    # a component at the seam wraps: draws on both sides of 0, none at 1
+    seam = PeriodicDensity(n_components=1, n_copies=1).fit(np.array([0.99, 0.995, 1.005, 1.01]))
+    w = seam.sample(2000, random_state=2)
+    assert np.all((w >= 0) & (w < 1)) and np.any(w < 0.01) and np.any(w > 0.99)
+
+
+def test_parameter_boundaries_are_accepted():
+    theta = draw(60, seed=0)
+    assert PeriodicDensity(n_components=1, max_iter=1, n_copies=1, max_samples=2).fit(theta).n_samples_ == 2
+    assert PeriodicDensity(max_samples=None).fit(theta).n_samples_ == 60
+    assert PeriodicDensity(max_samples=60).fit(theta).n_samples_ == 60
+    assert PeriodicDensity(max_samples=59).fit(theta).n_samples_ == 59
+    assert PeriodicDensity(reg_covar=1e-300).fit(theta).n_components_ == 30
+    for bad in ({"n_components": True}, {"n_copies": 0}, {"n_copies": 4}, {"max_iter": 0},
+                {"reg_covar": -1e-5}, {"reg_covar": float("inf")}, {"reg_covar": True}, {"reg_covar": "1e-5"},
+                {"max_samples": 0}, {"n_components": 2.0}):
+        with pytest.raises(ParameterError):
+            PeriodicDensity(**bad).fit(theta)
+    d = PeriodicDensity().fit(theta)
+    for bad in (0, True, 2.5):
+        with pytest.raises(ParameterError):
+            d.sample(bad)
+        with pytest.raises(ParameterError):
+            d.quantiles(bad)
+    for f in (d.pdf, d.cdf, d.ppf):
+        with pytest.raises(ParameterError):
+            f([0.1, np.inf])
+        with pytest.raises(ParameterError):
+            f(["a"])
+    for f in (lambda u: u.cdf(0.5), lambda u: u.ppf(0.5), lambda u: u.sample(3), lambda u: u.quantiles(3)):
+        with pytest.raises(ParameterError, match="not fitted"):
+            f(PeriodicDensity())
+
+
+def test_components_are_capped_at_the_distinct_values():
+    """Seven values, five of them distinct (after mod 1): five components at most."""
+    theta = np.array([0.1, 2.5, 0.3, 0.3, 0.5, 0.7, 0.9])
+    assert PeriodicDensity().fit(theta).n_components_ == 5
+    assert PeriodicDensity(n_components=4).fit(theta).n_components_ == 4
+    assert PeriodicDensity(n_components=5).fit(theta).n_components_ == 5
+
+
+def test_as_generator():
+    from cyclecoord.periodic.density import as_generator
+
+    g = np.random.default_rng(3)
+    assert as_generator(g) is g
+    assert as_generator(7).random() == np.random.default_rng(7).random()
+    assert as_generator(np.int64(7)).random() == np.random.default_rng(7).random()
+    assert as_generator(0).random() == np.random.default_rng(0).random()
+    assert isinstance(as_generator(None), np.random.Generator)
+    for bad in (-1, 1.5, "3", np.random.RandomState(0)):
+        with pytest.raises(ParameterError):
+            as_generator(bad)
+
+
+def test_cdf_stays_within_its_turn_just_below_each_integer():
+    """cdf(x + n) = n + (mass on [0, x]), which is at most n + 1: the phases just below 1
+    (where summing the pieces can round to 1 + 2e-16) give at most 1, so the cdf does not
+    step down into the next turn, where cdf(1) = 1 exactly."""
+    u = np.nextafter(1.0, 0.0) - np.arange(50) * 1.1e-16
+    for n_components in (3, 30):  # fits whose raw sum rounds above 1 there
+        d = PeriodicDensity(n_components=n_components).fit(draw(200, seed=1))
+        assert d._cdf_unit(u).max() > 1.0  # the rounding the bound is for
+        assert d.cdf(u).max() <= 1.0 and float(d.cdf(1.0)) == 1.0
+        assert d.cdf(u + 2.0).max() <= 3.0 and np.all(d.cdf(u - 1.0) <= 0.0)
+
+
+def test_sample_wraps_a_draw_rounding_to_one_onto_zero():
+    """A normal draw landing a hair below 0 (mean + std z = -1e-17) is 1.0 after mod 1 in
+    floating point; the phases are in [0, 1), so it comes back as 0.0.  The draw is set with
+    a Generator whose standard normal values are chosen."""
+    d = PeriodicDensity(n_components=1, n_copies=1).fit(np.array([0.1, 0.2, 0.3]))
+    mu, sd = float(d.means_[0]), float(d.stds_[0])
+    z = -mu / sd
+    while mu + sd * z >= 0.0:  # the largest z whose value is below 0
+        z = np.nextafter(z, -np.inf)
+    assert np.mod(mu + sd * z, 1.0) == 1.0
+
+    class Chosen(np.random.Generator):
+        def standard_normal(self, size=None, *args, **kwargs):
+            return np.array([z, 0.0, 1.0])[:size]
+
+    s = d.sample(3, random_state=Chosen(np.random.PCG64(0)))
+    np.testing.assert_allclose(s, np.sort([0.0, mu, mu + sd]), rtol=1e-12)
+    assert s[0] == 0.0
+
+
+def test_em_from_an_equal_count_start_that_is_already_a_fixed_point():
+    """Values 0..5 in two components: the start's equal-count runs {0, 1, 2} and {3, 4, 5}
+    have means 1 and 4, whose midpoint 2.5 separates them, so k-means stops there at once
+    (a start of other runs, e.g. {1, 2, 3} first, ends at {0..3} | {4, 5} instead)."""
+    from cyclecoord.periodic.density import _em_1d
+
+    weights, means, var, _, _ = _em_1d(np.arange(6.0), 2, 0, 1e-5)
+    np.testing.assert_allclose(weights, [0.5, 0.5], rtol=1e-12)
+    np.testing.assert_allclose(means, [1.0, 4.0], rtol=1e-12)
+    np.testing.assert_allclose(var, [2 / 3 + 1e-5] * 2, rtol=1e-12)
+
+
+def test_em_weights_sum_to_one():
+    """Five values in five components (each its own): the weights are normalised to sum to
+    1 to rounding, although each component's count carries a 1e-15 guard against 0."""
+    from cyclecoord.periodic.density import _em_1d
+
+    for x in (np.arange(5.0), np.array([0.1, 0.4, 0.45, 0.8])):
+        weights = _em_1d(x, x.size, 100, 1e-5)[0]
+        np.testing.assert_allclose(weights, 1.0 / x.size, rtol=1e-12)
+        assert abs(weights.sum() - 1.0) < 1e-15
+
+
+def test_max_samples_defaults_to_20000():
+    """20,001 values are fitted on 20,000 of them by default, 20,000 on all (one component and
+    one EM step: only the count is looked at here)."""
+    theta = np.linspace(0.0, 1.0, 20001, endpoint=False)
+    assert PeriodicDensity(n_components=1, max_iter=1).fit(theta).n_samples_ == 20000
+    assert PeriodicDensity(n_components=1, max_iter=1).fit(theta[:20000]).n_samples_ == 20000

@@ -176,8 +176,9 @@ def knn_centroids(
     if weighting == "mean":
         return neighbours.mean(axis=1)
 
-    gap = np.abs(ext[ext_idx] - phases[:, None])
-    dist = np.minimum(gap, 1.0 - gap)
+    # already circular: the chosen run has the least reach, at most the k-th nearest
+    # frame's circular distance (<= 0.5), so no |ext - phase| in it exceeds 0.5
+    dist = np.abs(ext[ext_idx] - phases[:, None])
     if bandwidth is None:
         bandwidth = float(np.median(dist.max(axis=1)))
     if bandwidth <= 0.0:  # every neighbour sits exactly on its phase
@@ -422,7 +423,7 @@ def _candidate_widths(
         lo = min(k / (T * np.sqrt(2.0 * np.pi)) * period, 0.5)
         hi = period / 8.0 if max_width is None else _positive_float(max_width, "max_width")
         widths = (
-            np.geomspace(lo, hi, n_candidates) if hi > lo and n_candidates > 1 else np.array([lo])
+            np.geomspace(lo, hi, n_candidates) if hi > lo else np.array([lo])  # n = 1: [lo] too
         )
     else:
         widths = _finite_array(candidates, "candidates", 1)
@@ -513,12 +514,10 @@ def resample_cyclic(curve: np.ndarray, n_out: int, times: np.ndarray | None = No
     ext_t = np.concatenate([[t[-1] - 1.0], t, [t[0] + 1.0]])
     ext_c = np.concatenate([c[-1:], c, c[:1]], axis=0)
     query = np.arange(n_out) / n_out
-    lo = np.searchsorted(ext_t, query, side="right") - 1  # ext_t[lo] <= q < ext_t[lo + 1]
-    lo = np.clip(lo, 0, ext_t.size - 2)
-    span = ext_t[lo + 1] - ext_t[lo]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        w = np.where(span > 0, (query - ext_t[lo]) / span, 0.0)
-    w = np.clip(w, 0.0, 1.0)[:, None]
+    # t is in [0, 1), so ext_t[0] = t[-1] - 1 < 0 <= query < 1 <= t[0] + 1 = ext_t[-1]: lo is
+    # in [0, ext_t.size - 2] with ext_t[lo] <= q < ext_t[lo + 1], so w is in [0, 1)
+    lo = np.searchsorted(ext_t, query, side="right") - 1
+    w = ((query - ext_t[lo]) / (ext_t[lo + 1] - ext_t[lo]))[:, None]
     return ext_c[lo] * (1.0 - w) + ext_c[lo + 1] * w
 
 

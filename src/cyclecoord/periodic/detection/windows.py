@@ -69,8 +69,8 @@ def binned_cycle(theta: np.ndarray, poses: np.ndarray, bins: int = CYCLE_BINS) -
             break
         nxt = have[np.argmin((have - k) % bins)]
         prv = have[np.argmin((k - have) % bins)]
-        dn, dp = (nxt - k) % bins, (k - prv) % bins
-        out[k] = out[prv] if dn + dp == 0 else (out[prv] * dn + out[nxt] * dp) / (dn + dp)
+        dn, dp = (nxt - k) % bins, (k - prv) % bins  # both >= 1: bin k is empty, they are not
+        out[k] = (out[prv] * dn + out[nxt] * dp) / (dn + dp)
     return out
 
 
