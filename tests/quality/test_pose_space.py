@@ -156,3 +156,217 @@ def test_capture_jerk_from_runs_of_five_frames(extracted):
     assert q.capture_jerk == pytest.approx(_jerk(pts, res.motion.fps, False) * rig.metres_per_unit)
     assert np.isfinite(q.capture_jerk) and q.capture_jerk > 0
     assert np.isnan(pose_quality(res.cycle, res.motion, [(a, a + 4)], res.period_frames).capture_jerk)
+
+
+# ------------------------------------------------------------------ known answers, by hand
+def _root_only(y, fps=30):
+    """A rig of one point (the root) at heights ``y``: its root-frame points are 0, 0, 0
+    and y, so every step and jerk is read off ``y`` by hand."""
+    import numpy as np
+
+    from cyclecoord.motion import Motion
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),))
+    f = np.zeros((len(y), 6))
+    f[:, 1] = y
+    return Motion(f, sk.channels, fps=fps, skeleton=sk)
+
+
+def _unit_rig(motion, metres=1.0):
+    from dataclasses import replace
+
+    from cyclecoord.rig import describe_rig
+
+    return replace(describe_rig(motion), metres_per_unit=metres)
+
+
+def test_root_frame_points_remove_travel_and_heading_but_keep_lean():
+    """Root, an arm 1 along x, a zero-length twist under it (with a zero end site) and a
+    leg 2 down with an end site 1 further: the twist and its end site sit on the arm and
+    are left out, so 4 points (12 columns) and the root's height.  Moving the root, or
+    turning it 90 degrees about the vertical, changes nothing; rolling it 90 degrees about
+    z (a lean) turns the arm to +y and the leg to +x; 30 degrees about x tilts the leg."""
+    import numpy as np
+
+    from cyclecoord.motion import Motion
+    from cyclecoord.quality.pose_space import _distinct_points, root_frame_points
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
+                   Joint("arm", 0, [1.0, 0, 0], ("rx",), "X"),
+                   Joint("twist", 1, [0, 0, 0], ("rx",), "X", end_site=np.zeros(3)),
+                   Joint("leg", 0, [0, -2.0, 0], ("rx",), "X", end_site=np.array([0, -1.0, 0]))))
+    ch = list(sk.channels)
+    f = np.zeros((4, len(ch)))
+    f[:, 0] = [0, 5, 10, 15]  # travelling along x
+    f[:, 1] = 3.0
+    f[1, ch.index(("root", "ry"))] = 90.0
+    f[2, ch.index(("root", "rz"))] = 90.0
+    f[3, ch.index(("root", "rx"))] = 30.0
+    m = Motion(f, sk.channels, fps=30, skeleton=sk)
+    names = m.positions().names
+    assert names == ["root", "arm", "twist", "leg", "twist/end", "leg/end"]
+    assert _distinct_points(sk, names) == [0, 1, 3, 5]
+    got = root_frame_points(m)
+    c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
+    want = np.array([
+        [0, 0, 0, 1, 0, 0, 0, -2, 0, 0, -3, 0, 3],
+        [0, 0, 0, 1, 0, 0, 0, -2, 0, 0, -3, 0, 3],
+        [0, 0, 0, 0, 1, 0, 2, 0, 0, 3, 0, 0, 3],
+        [0, 0, 0, 1, 0, 0, 0, -2 * c, -2 * s, 0, -3 * c, -3 * s, 3],
+    ])
+    np.testing.assert_allclose(got, want, atol=1e-12)
+    # named points only, in the order given (the root always first)
+    np.testing.assert_allclose(root_frame_points(m, names=["leg/end", "arm"])[3],
+                               [0, 0, 0, 0, -3 * c, -3 * s, 1, 0, 0, 3], atol=1e-12)
+
+
+def test_seam_is_the_last_step_over_the_median():
+    import numpy as np
+
+    from cyclecoord.quality.pose_space import _seam
+
+    assert _seam(np.array([1.0, 2.0, 1.0, 3.0])) == 2.0  # median 1.5
+    assert _seam(np.array([0.0, 0.0, 0.0])) == 1.0  # nothing moves: a clean loop
+    assert _seam(np.array([0.0, 0.0, 0.0, 1.0])) == np.inf  # only the seam moves
+
+
+def test_cycle_figures_of_five_frames_by_hand():
+    """Heights 1, 1.01 ... 1.04 looped: four steps of 0.01 and a seam of 0.04 (loop
+    closure 4); the loop's third differences (from 1.02, 1.03, 1.04 leading in) are
+    -0.05, 0.1, -0.05, 0, 0: mean 0.04, times 30^3 = 1080 units/s^3.  In metres at 0.5 m
+    a unit every length halves."""
+    import numpy as np
+
+    from cyclecoord.quality.pose_space import cycle_figures
+
+    cyc = _root_only(1 + 0.01 * np.arange(5))
+    f = cycle_figures(cyc, _unit_rig(cyc))
+    assert f.loop_closure == pytest.approx(4.0)
+    assert f.largest_step == pytest.approx(0.04) and f.median_step == pytest.approx(0.01)
+    assert f.jerk == pytest.approx(1080.0) and f.metres_per_unit == 1.0
+    h = cycle_figures(cyc, _unit_rig(cyc, 0.5))
+    assert h.jerk == pytest.approx(540.0) and h.largest_step == pytest.approx(0.02)
+    assert h.loop_closure == pytest.approx(4.0)
+    assert f.to_dict() == {"loop_closure": pytest.approx(4.0), "jerk": pytest.approx(1080.0),
+                           "largest_step": pytest.approx(0.04), "median_step": pytest.approx(0.01),
+                           "metres_per_unit": 1.0}
+    # fewer than 5 frames, or no skeleton: no figures
+    assert cycle_figures(_root_only(1 + 0.01 * np.arange(4))) is None
+    bare = cc.Motion(cyc.frames, cyc.channels, fps=30)
+    assert cycle_figures(bare) is None
+
+
+def test_pose_quality_of_a_cycle_cut_from_a_climb():
+    """The one-point rig climbing 0.01 a frame, a cycle of frames 20-39: 19 steps of 0.01
+    and a seam of 0.19 (back down to the start), so seam 19 and, against the capture's
+    steps (all 0.01), pop 19; the cycle's poses are captured ones (nearest 0)."""
+    import numpy as np
+
+    m = _root_only(1 + 0.01 * np.arange(60))
+    q = pose_quality(m.window((20, 40)), m, [(0, 60)], 20.0)
+    assert q.seam == pytest.approx(19.0) and q.pop == pytest.approx(19.0)
+    assert q.largest_step == pytest.approx(0.19) and q.p99_capture_step == pytest.approx(0.01)
+    assert q.median_cycle_step == pytest.approx(0.01)
+    assert q.nearest_max == 0.0 and q.nearest_median == 0.0 and q.spread == pytest.approx(0.1)
+    assert q.pops and not q.seamless and not q.strays
+    assert q.figures is not None and q.figures.loop_closure == pytest.approx(19.0)
+
+
+def test_an_exactly_repeating_capture_has_the_median_step_as_spread():
+    """A triangle wave of 0.01 a frame repeating every 20 frames exactly: every pose has a
+    copy a period away (spread 0 on its own), so the spread is the capture's median
+    step, 0.01.  A cycle pose raised to 1.2 is 0.1 above the highest captured pose (1.1):
+    nearest_max 10, while the other poses are captured ones (median 0); the step up to it
+    is 0.16, 16 capture steps (a pop); the loop itself closes evenly (seam 1)."""
+    import numpy as np
+
+    tri = 1 + 0.01 * np.abs(((np.arange(80) + 10) % 20) - 10)
+    cyc = tri[:20].copy()
+    cyc[5] = 1.2
+    q = pose_quality(_root_only(cyc), _root_only(tri), [(0, 80)], 20.0)
+    assert q.spread == pytest.approx(0.01)
+    assert q.nearest_max == pytest.approx(10.0) and q.nearest_median == 0.0
+    assert q.pop == pytest.approx(16.0) and q.seam == pytest.approx(1.0)
+    assert q.strays and q.pops and not q.seamless
+
+
+def test_capture_jerk_is_the_length_weighted_mean_over_runs():
+    """Two runs of cubics, y = a t^3 (jerk 6 a exactly): 10 frames at a = 0.7 (4.2) and 30
+    at a = 0.2 (1.2): the capture's jerk is (10 * 4.2 + 30 * 1.2) / 40 = 1.95, each run
+    weighed by its frames; a run of 4 frames (no open 5-point stencil) does not count,
+    however much it jerks.  The jerk ratio is the cycle's jerk over it."""
+    import numpy as np
+
+    from cyclecoord.quality.pose_space import cycle_figures
+
+    fps = 30.0
+    t10, t30 = np.arange(10) / fps, np.arange(30) / fps
+    y = np.concatenate([1 + 0.7 * t10**3, 1 + 0.2 * t30**3, [1.0, 9.0, -9.0, 1.0]])
+    cap = _root_only(y, fps=fps)
+    cyc = _root_only(1 + 0.01 * np.arange(20), fps=fps)
+    q = pose_quality(cyc, cap, [(0, 10), (10, 40), (40, 44)], 20.0)
+    rig_m = cc.rig.describe_rig(cap).metres_per_unit
+    assert q.capture_jerk == pytest.approx(1.95 * rig_m, rel=1e-6)
+    want = cycle_figures(cyc, cc.rig.describe_rig(cap)).jerk / rig_m / 1.95
+    assert q.jerk_ratio == pytest.approx(want, rel=1e-6)
+
+
+def test_pose_quality_needs_a_skeleton_three_frames_and_a_run():
+    import numpy as np
+
+    m = _root_only(1 + 0.01 * np.arange(60))
+    assert pose_quality(m.window((0, 2)), m, [(0, 60)], 20.0) is None
+    q3 = pose_quality(m.window((0, 3)), m, [(0, 60)], 20.0)
+    assert q3 is not None and q3.figures is None  # a cycle of 3 frames has no jerk figures
+    assert pose_quality(m.window((0, 5)), m, [(0, 60)], 20.0).figures is not None
+    bare = cc.Motion(m.frames, m.channels, fps=30)
+    assert pose_quality(bare, m, [(0, 60)], 20.0) is None
+    assert pose_quality(m, bare, [(0, 60)], 20.0) is None
+    assert pose_quality(m.window((0, 20)), m, [(3, 4), (7, 8)], 20.0) is None  # no run of 2
+
+
+def test_pose_quality_flags_at_their_limits():
+    """pops: a pop over MAX_POP (2), not at it; seamless: a seam up to MAX_SEAM (1.5)
+    and no pop; strays: nearest over 1; a NaN figure calls nothing."""
+    import numpy as np
+
+    from cyclecoord.quality.pose_space import MAX_POP, MAX_SEAM, PoseQuality
+
+    assert MAX_POP == 2.0 and MAX_SEAM == 1.5
+
+    def q(seam=1.0, pop=1.0, near=0.5):
+        return PoseQuality(seam=seam, pop=pop, largest_step=1.0, p99_capture_step=1.0,
+                           median_cycle_step=1.0, nearest_max=near, nearest_median=0.1,
+                           spread=1.0, jerk_ratio=1.0)
+
+    assert not q(pop=2.0).pops and q(pop=2.0001).pops and not q(pop=np.nan).pops
+    assert q(seam=1.5).seamless and not q(seam=1.5001).seamless
+    assert not q(pop=2.5).seamless and q(pop=np.nan).seamless
+    assert not q(near=1.0).strays and q(near=1.0001).strays and not q(near=np.nan).strays
+    d = q(pop=np.nan).to_dict()
+    assert d["pop"] is None and d["seam"] == 1.0 and d["figures"] is None
+    assert d["capture_jerk"] is None  # NaN by default
+
+
+def test_long_takes_are_sampled_down_to_the_reference_frames(monkeypatch):
+    """With MAX_REFERENCE_FRAMES 10: a run of 60 frames is read every 6th frame
+    (ceil(60 / 10)), and its steps are those of its middle 10 frames (25-34)."""
+    import numpy as np
+
+    from cyclecoord.quality import pose_space as ps
+
+    y = 1 + 0.001 * np.arange(60) ** 2  # steps 0.001 (2k + 1): each tells its frame
+    m = _root_only(y)
+    rig = _unit_rig(m)
+    monkeypatch.setattr(ps, "MAX_REFERENCE_FRAMES", 10)
+    (part,) = ps._runs_points(m, [(0, 60)], rig)
+    np.testing.assert_allclose(part[:, -1], y[::6])
+    np.testing.assert_allclose(ps._capture_steps(m, [(0, 60)], rig), np.diff(y[25:35]))
+    parts = ps._runs_points(m, [(0, 35), (35, 59), (59, 60)], rig)  # 60 frames in all
+    assert [len(p) for p in parts] == [6, 4]  # every 6th; the 1-frame run is left out
+    # up to MAX_REFERENCE_FRAMES frames in all, every run is read whole
+    monkeypatch.setattr(ps, "MAX_REFERENCE_FRAMES", 60)
+    np.testing.assert_allclose(ps._capture_steps(m, [(0, 30), (30, 60)], rig),
+                               np.r_[np.diff(y[:30]), np.diff(y[30:])])
