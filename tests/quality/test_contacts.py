@@ -516,3 +516,64 @@ def test_sides_legs_and_the_summary():
     np.testing.assert_array_equal(q.side_planted("front left"), c.side_planted("left"))
     np.testing.assert_array_equal(q.side_planted("left"), c.side_planted("left"))
     assert replace(c, legs=()).leg_labels == c.sides
+
+
+def test_the_ankle_rules_of_leg_length():
+    """The ankle of a leg is its highest given point, moved to its parent when it is a toe
+    (named so, or a bone under half its parent's).  By hand on the test legs (thigh 4, shin
+    4, hip bone sqrt 2, toe sqrt(1.25)):"""
+    from dataclasses import replace
+
+    sk = legs_skeleton()
+    js = list(sk.joints)
+    js[4] = replace(js[4], offset=np.array([0.0, 0.0, 3.0]))  # ltoes 3 long, still a toe by name
+    assert leg_length(Skeleton(tuple(js)), ("ltoes", "rtoes")) == 8.0
+    n = legs_skeleton(("a1", "a2", "a3", "a4", "b1", "b2", "b3", "b4"))
+    js = list(n.joints)
+    js[4] = replace(js[4], offset=np.array([0.0, 0.0, 2.0]))  # exactly half its parent: kept
+    assert leg_length(Skeleton(tuple(js)), ("a4", "b4")) == (2.0 + 4.0 + 8.0) / 2
+    # the knees given: shin 4 (the knee's bone), thigh the hip bone sqrt 2 (parent 1)
+    assert leg_length(n, ("a2", "b2")) == pytest.approx(4 + np.sqrt(2))
+    # a toe right under the root is its own ankle (the root is no ankle): no thigh
+    t = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz"), ""),
+                  Joint("ltoes", 0, [0, -5.0, 0], ("rx",), "X")))
+    assert leg_length(t, ("ltoes",)) == 5.0
+    # a toe under joint 1: the ankle is joint 1, whose parent (the root) adds no thigh
+    s = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz"), ""),
+                  Joint("shin", 0, [0, -4.0, 0], ("rx",), "X"),
+                  Joint("ltoes", 1, [0, -0.5, 1], ("rx",), "X")))
+    assert leg_length(s, ("ltoes",)) == 4.0
+    # a root with an offset: never a thigh; but the highest given point of a chain even
+    # when that is the root (its own offset the shin)
+    h = Skeleton((Joint("root", -1, [0, 3.0, 0], ("tx", "ty", "tz"), ""),
+                  Joint("foot", 0, [0, -5.0, 0], ("rx",), "X")))
+    assert leg_length(h, ("foot",)) == 5.0 and leg_length(h, ("root", "foot")) == 3.0
+    small = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz"), ""),
+                      Joint("foot", 0, [0, -0.5, 0], ("rx",), "X")))
+    assert leg_length(small, ("foot",)) == 0.5
+    with pytest.raises(ParameterError, match="leg length"):
+        leg_length(h, ())
+
+
+def test_only_the_feet_end_sites_count_for_the_floor():
+    """A tail whose end site hangs 9 below the hips' level is no foot: the floor stays at
+    the toe end sites (0.5)."""
+    sk = legs_skeleton()
+    tail = Skeleton(sk.joints + (Joint("tail", 0, [0, -2.0, -1], ("rx",), "X",
+                                       end_site=np.array([0, -9.0, 0])),), name="legs")
+    c = foot_contacts(make_motion(tail), feet=("lfoot", "ltoes", "rfoot", "rtoes"))
+    assert c.floor == 0.5 and c.planted.all()
+
+
+def test_x_up_and_frozen_results():
+    import dataclasses
+
+    c = foot_contacts(make_motion(legs_skeleton()), up="x", speed=None)
+    # along x the left foot points are at +1, the right ones at -1: the floor
+    assert c.up == 0 and c.floor == -1.0
+    np.testing.assert_allclose(c.contact_level, [1.0, 1.0, -1.0, -1.0])
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        c.floor = 0.0
+    s = foot_skating(make_motion(legs_skeleton()))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        s.mean_speed = 1.0
