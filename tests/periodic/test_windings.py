@@ -600,3 +600,24 @@ def test_phase_average_validation():
             phase_average(ph, vals, 4, width)
     # zero weights are allowed (non-negative)
     assert phase_average(ph, vals, 4, 0.01, weights=np.zeros(2)).shape == (4, 1)
+
+
+def test_retime_of_a_run_starting_exactly_on_a_level():
+    """u = t / 8 from exactly 0: the reference level 0 is on frame 0 (no crossing there,
+    crossing_times), then crossed on frames 8 and 16, whole turns 1 and 2; level 0.5,
+    placed a quarter after it, on frames 4, 12, 20.  The pins are (4, 0.25), (8, 1),
+    (12, 1.25), (16, 2), (20, 2.25): the phase is 0 at each reference crossing, the same
+    as for a run starting a hair above 0."""
+    t = np.arange(24, dtype=float)
+    w = _two_level_windings(0, [0.0, 0.25])
+    want = np.empty(24)
+    for a, b, ya, yb in [(4, 8, 0.25, 1.0), (8, 12, 1.0, 1.25), (12, 16, 1.25, 2.0),
+                         (16, 20, 2.0, 2.25)]:
+        want[a:b + 1] = ya + (yb - ya) * (t[a:b + 1] - a) / (b - a)
+    want[:4] = 0.25 + (t[:4] - 4) / 8
+    want[21:] = 2.25 + (t[21:] - 20) / 8
+    out = retime(t / 8, [(0, 24)], w)
+    np.testing.assert_allclose(out, np.mod(want, 1.0), atol=1e-12)
+    assert out[8] == out[16] == 0.0
+    np.testing.assert_allclose(retime(t / 8 + 1e-9, [(0, 24)], w), out, atol=1e-6)
+
