@@ -621,3 +621,99 @@ def test_retime_of_a_run_starting_exactly_on_a_level():
     assert out[8] == out[16] == 0.0
     np.testing.assert_allclose(retime(t / 8 + 1e-9, [(0, 24)], w), out, atol=1e-6)
 
+
+def test_defaults_32_levels_and_anchors_over_0_04_apart():
+    """An even pace (1/64 a frame, exact: every level equally sharp): the default 32
+    levels are 1/32 apart, under the default gap of 0.04, so every other level is an
+    anchor (2/32 = 0.0625 apart), taken from level 0 on."""
+    import dataclasses
+
+    w = complete_windings(np.arange(640) / 64, [(0, 640)])
+    np.testing.assert_array_equal(w.levels, np.arange(32) / 32)
+    assert sorted(w.anchors.tolist()) == list(range(0, 32, 2)) and w.reference == 0
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        w.reference = 1
+
+
+def test_a_level_reached_only_on_frame_0_is_not_crossed():
+    assert crossing_times(np.array([0.25, 0.5]), np.array([0.25]))[0].size == 0
+    assert crossing_times(np.array([0.25, 0.25, 0.2]), np.array([0.25]))[0].size == 0
+
+
+def test_sharpness_at_the_ends_of_the_coordinate():
+    from cyclecoord.periodic.windings import _sharpness
+
+    u = np.array([0.0, 0.1, 0.3, 0.6])  # np.gradient 0.1, 0.15, 0.25, 0.3
+    assert _sharpness(u, [np.array([0.3])]) == pytest.approx(0.1)  # rounds to frame 0
+    assert _sharpness(u, [np.array([3.0])]) == pytest.approx(0.3)  # the last frame
+    assert _sharpness(np.array([0.0, 0.5]), [np.array([0.6])]) == pytest.approx(0.5)
+    assert _sharpness(np.array([0.5]), [np.array([0.0])]) == 0.0  # one frame: no speed
+
+
+def test_runs_of_two_frames_count_and_empty_runs_are_harmless():
+    """A 2-frame run from 0.9 to 1.1 crosses level 0: an anchor, 0.2 turns; a half-open
+    empty run (even at the end) and 1-frame runs change nothing."""
+    w = complete_windings(np.array([0.9, 1.1]), [(0, 2)], n_levels=4)
+    assert w.anchors.tolist() == [0] and w.turns == pytest.approx(0.2)
+    u = fast_slow()
+    base = complete_windings(u, [(0, 19), (19, 39)], n_levels=4)
+    for extra in ([(39, 39)], [(5, 6)], [(5, 6), (30, 31), (12, 12)]):
+        w = complete_windings(u, [(0, 19), (19, 39)] + extra, n_levels=4)
+        assert w.anchors.tolist() == base.anchors.tolist() == [3, 0, 2]
+        np.testing.assert_array_equal(w.pooled, base.pooled)
+        np.testing.assert_array_equal(w.positions, base.positions)
+        assert w.turns == base.turns
+
+
+def test_windings_shorter_than_a_frame():
+    """2.5 turns in one frame: level 0 is reached at 0.4 and 0.8, level 0.5 at 0.2, 0.6
+    and 1.0 (linear interpolation): windings of 0.4 frames, the period; level 0.5 sits
+    half-way.  The re-timed phase is 0 on frame 0 (0.2 before the 0.5 pin at 0.2, half a
+    period) and 0.5 on frame 1 (2.5 turns)."""
+    u = np.array([0.0, 2.5])
+    w = complete_windings(u, [(0, 2)], n_levels=2)
+    np.testing.assert_allclose(w.pooled, [0.4, 0.4, 0.4])
+    assert w.period_frames == pytest.approx(0.4) and w.anchors.tolist() == [0, 1]
+    np.testing.assert_allclose(w.positions, [0.0, 0.5])
+    ph = retime(u, [(0, 2)], w)
+    assert np.all(np.abs(np.mod(ph - [0.0, 0.5] + 0.5, 1.0) - 0.5) < 1e-9)
+
+
+def test_spread_of_two_windings_by_hand():
+    """Level 0 reached on frames 2, 10 and 22 exactly (u piecewise linear through whole
+    turns there): windings 8 and 12, period 10, and (p90 - p10) / median =
+    (11.6 - 8.4) / 10 = 0.32 (linear percentiles)."""
+    u = np.interp(np.arange(25), [0, 2, 10, 22, 24], [0.75, 1, 2, 3, 3.25])
+    w = complete_windings(u, [(0, 25)], n_levels=1)
+    np.testing.assert_allclose(w.lengths, [8.0, 12.0])
+    assert w.period_frames == 10.0 and w.spread == pytest.approx(0.32)
+
+
+def test_positions_are_the_median_fraction_over_reference_windings():
+    """Uneven windings (8 to 16 frames): each anchor's position is the median over the
+    complete reference windings of how far into the winding it is first reached, counted
+    here by a loop over crossing_times."""
+    u = np.concatenate([k + np.arange(n) / n for k, n in enumerate((8, 10, 12, 14, 16, 10))])
+    u = u + 1 / 64
+    w = complete_windings(u, [(0, u.size)], n_levels=8)
+    c = crossing_times(u - np.floor(u[0]), np.arange(8) / 8)
+    r = c[w.reference]
+    assert w.anchors.size > 2
+    for j, pos in zip(w.anchors, w.positions):
+        fr = []
+        for k in range(r.size - 1):
+            inside = [x for x in c[j] if r[k] <= x < r[k + 1]]
+            if inside:
+                fr.append((inside[0] - r[k]) / (r[k + 1] - r[k]))
+        assert len(fr) == r.size - 1 and pos == pytest.approx(np.median(fr))
+    assert len(set(np.round(w.positions, 6))) == w.anchors.size
+
+
+def test_positions_without_windings_wrap_below_the_reference_level():
+    """1/8 a frame, then a quarter turn in the last frame: 0.75 is the sharpest level and
+    the reference, 0.25 and 0.5 are as sharp as the median; no winding is complete, so
+    they sit at their levels' offsets after 0.75, wrapped into [0, 1): 0.5 and 0.75."""
+    u = np.array([0.125, 0.25, 0.375, 0.5, 0.625, 0.875])
+    w = complete_windings(u, [(0, 6)], n_levels=4)
+    assert w.anchors.tolist() == [3, 1, 2]
+    np.testing.assert_allclose(w.positions, [0.0, 0.5, 0.75])
