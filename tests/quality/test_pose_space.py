@@ -370,3 +370,193 @@ def test_long_takes_are_sampled_down_to_the_reference_frames(monkeypatch):
     monkeypatch.setattr(ps, "MAX_REFERENCE_FRAMES", 60)
     np.testing.assert_allclose(ps._capture_steps(m, [(0, 30), (30, 60)], rig),
                                np.r_[np.diff(y[:30]), np.diff(y[30:])])
+
+
+def _turning_arm(n=120):
+    """A root travelling 0.1 a frame along x (removed in its frame) at height 1, with an
+    arm 1 along x whose end site, 1 further, turns 6 degrees a frame about z: a period of
+    60 frames.  Three points (root, arm, end), so a pose step of angle a is the end's
+    chord 2 sin(a / 2) over sqrt(3) (RMS over the points)."""
+    import numpy as np
+
+    from cyclecoord.motion import Motion
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
+                   Joint("arm", 0, [1.0, 0, 0], ("rz",), "Z", end_site=np.array([1.0, 0, 0]))))
+    f = np.zeros((n, 7))
+    f[:, 0] = 0.1 * np.arange(n)
+    f[:, 1] = 1.0
+    f[:, 6] = 6.0 * np.arange(n)
+    return Motion(f, sk.channels, fps=30, skeleton=sk)
+
+
+def test_distances_are_rms_over_the_points_of_a_turning_arm():
+    """Known answers: steps of 2 sin(3 deg) / sqrt 3; the capture repeats exactly, so the
+    spread is that step; a cycle pose turned 3 degrees more (half-way between two
+    captured ones) is 2 sin(1.5 deg) / sqrt 3 from the nearest, sin 1.5 / sin 3 of the
+    spread, and the steps either side of it are 9 and 3 degrees (pop sin 4.5 / sin 3)."""
+    import numpy as np
+
+    cap = _turning_arm()
+    cyc = cap.window((0, 60))
+    g = cyc.frames.copy()
+    g[10, 6] += 3.0
+    q = pose_quality(cyc.with_frames(g), cap, [(0, 120)], 60.0)
+    step = 2 * np.sin(np.radians(3)) / np.sqrt(3)
+    assert q.median_cycle_step == pytest.approx(step) and q.spread == pytest.approx(step)
+    assert q.p99_capture_step == pytest.approx(step)
+    s = np.sin(np.radians([1.5, 3.0, 4.5]))
+    assert q.nearest_max == pytest.approx(s[0] / s[1]) and q.nearest_median == pytest.approx(0.0)
+    assert q.largest_step == pytest.approx(2 * s[2] / np.sqrt(3))
+    assert q.pop == pytest.approx(s[2] / s[1]) and q.seam == pytest.approx(1.0)
+
+
+def test_steps_are_rms_over_the_points():
+    """Two points and the root height per row (7 columns): a step moving each point by 3
+    and 4 is sqrt((9 + 16) / 2); cyclic adds the last-to-first step; fewer than 3 columns
+    count as one point."""
+    import numpy as np
+
+    from cyclecoord.quality.pose_space import _steps
+
+    x = np.zeros((3, 7))
+    x[1, 0], x[1, 4] = 3.0, 4.0
+    x[2] = x[1]
+    np.testing.assert_allclose(_steps(x), [np.sqrt(12.5), 0.0])
+    np.testing.assert_allclose(_steps(x, cyclic=True), [np.sqrt(12.5), 0.0, np.sqrt(12.5)])
+    np.testing.assert_allclose(_steps(np.array([[0.0], [2.0]])), [2.0])
+
+
+def test_a_point_within_a_billionth_of_the_skeletons_size_sits_on_its_parent():
+    """Bones of 100: a twist 5e-8 from its parent (under 1e-9 of 100) is the parent's
+    place again and left out; one 1.5e-7 away is a point of its own; the root is always
+    kept, and the names given may include it (it is not repeated)."""
+    import numpy as np
+
+    from cyclecoord.motion import Motion
+    from cyclecoord.quality.pose_space import _distinct_points, root_frame_points
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
+                   Joint("a", 0, [100.0, 0, 0]),
+                   Joint("near", 1, [0, 5e-8, 0]),
+                   Joint("apart", 1, [0, 1.5e-7, 0])))
+    m = Motion(np.zeros((2, 6)), sk.channels, fps=30, skeleton=sk)
+    assert _distinct_points(sk, ["root", "a", "near", "apart"]) == [0, 1, 3]
+    f = np.zeros((2, 6))
+    f[:, 0] = [0.0, 1.0]
+    m = m.with_frames(f)
+    assert root_frame_points(m, names=["root", "a"]).shape == (2, 7)
+
+
+def test_pose_quality_on_another_layout_of_the_same_body():
+    """A cycle whose skeleton has one more point than the capture's is compared on the
+    points both have (here exactly three: the root, the arm and its end site): a copy of
+    captured frames is at distance 0.  With fewer than three shared points there is
+    nothing to compare."""
+    import numpy as np
+
+    from cyclecoord.motion import Motion
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    root = Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX")
+    arm = Joint("arm", 0, [1.0, 0, 0], ("rz",), "Z", end_site=np.array([1.0, 0, 0]))
+    cap_sk = Skeleton((root, arm))
+    cyc_sk = Skeleton((root, arm, Joint("c", 0, [0, 1.0, 0])))
+    cap = _turning_arm()
+    assert cap.channels == cap_sk.channels == cyc_sk.channels
+    cyc = Motion(cap.frames[30:90], cyc_sk.channels, fps=30, skeleton=cyc_sk)
+    q = pose_quality(cyc, cap, [(0, 120)], 60.0)
+    assert q is not None and q.nearest_max == pytest.approx(0.0, abs=1e-9)
+    assert q.seam == pytest.approx(1.0)
+    # a cycle sharing only the root and the arm (no end site) with the capture: None
+    lone_sk = Skeleton((root, Joint("arm", 0, [1.0, 0, 0], ("rz",), "Z"),
+                        Joint("d", 0, [0, 0, 1.0])))
+    lone = Motion(cap.frames[:60], lone_sk.channels, fps=30, skeleton=lone_sk)
+    assert pose_quality(lone, cap, [(0, 120)], 60.0) is None
+
+
+def test_p99_capture_step_and_a_still_capture():
+    """99 steps of 1/64 and one of 1: the 99th percentile (linear) is at 98.01 of the
+    sorted steps, 1/64 + 0.01 (1 - 1/64).  A capture that never moves has no step to
+    compare a pop with (NaN) and no jerk (the ratio is NaN, not a division by 0)."""
+    import numpy as np
+
+    y = 1 + np.arange(101) / 64
+    y[60:] += 1.0 - 1 / 64
+    q = pose_quality(_root_only(y).window((0, 20)), _root_only(y), [(0, 101)], 20.0)
+    assert q.p99_capture_step == pytest.approx(1 / 64 + 0.01 * (1 - 1 / 64))
+    still = _root_only(np.ones(60))
+    q = pose_quality(_root_only(1 + np.arange(20) / 64), still, [(0, 60)], 20.0)
+    assert np.isnan(q.pop) and np.isnan(q.jerk_ratio) and q.capture_jerk == 0.0
+    # a capture moving at an even pace (exact in binary) has no jerk either
+    even = _root_only(1 + np.arange(60) / 64)
+    assert np.isnan(pose_quality(even.window((0, 20)), even, [(0, 60)], 20.0).jerk_ratio)
+
+
+def test_spread_is_the_90th_percentile_of_the_nearest_pose_half_a_period_away():
+    """A climb at an uneven pace (steps growing with the frame): each frame's nearest pose
+    at least half a period away (10 frames for a period of 20, 1 for a period of 2) is
+    the nearer of the two poses exactly that far, found here by a loop."""
+    import numpy as np
+
+    y = 1 + 0.001 * np.arange(60) ** 1.5
+    m = _root_only(y)
+    for period, half in ((20.0, 10), (2.0, 1)):
+        best = []
+        for k in range(60):
+            d = [abs(y[j] - y[k]) for j in range(60) if abs(j - k) >= half]
+            best.append(min(d))
+        q = pose_quality(m.window((20, 40)), m, [(0, 60)], period)
+        want = max(np.percentile(best, 90), np.median(np.diff(y)))
+        assert q.spread == pytest.approx(want, rel=1e-9)
+
+
+def test_the_reference_frames_limit_is_inclusive():
+    """MAX_REFERENCE_FRAMES (20 000) frames are read whole, one more every other frame;
+    two runs of 10 000 (20 000 in all) give every step of both, 2 x 9 999."""
+    import numpy as np
+
+    from cyclecoord.quality import pose_space as ps
+
+    assert ps.MAX_REFERENCE_FRAMES == 20_000
+    m = _root_only(1 + np.arange(20_001) / 64)
+    rig = _unit_rig(m)
+    assert len(ps._runs_points(m, [(0, 20_000)], rig)[0]) == 20_000
+    assert len(ps._runs_points(m, [(0, 20_001)], rig)[0]) == 10_001
+    assert ps._capture_steps(m, [(0, 10_000), (10_000, 20_000)], rig).size == 19_998
+
+
+def test_a_long_takes_steps_come_from_its_longest_run(monkeypatch):
+    """With MAX_REFERENCE_FRAMES 10: the middle 10 frames of the longest run, whichever
+    comes first, clipped to the run when it is shorter."""
+    import numpy as np
+
+    from cyclecoord.quality import pose_space as ps
+
+    y = 1 + 0.001 * np.arange(60) ** 2
+    m = _root_only(y)
+    rig = _unit_rig(m)
+    monkeypatch.setattr(ps, "MAX_REFERENCE_FRAMES", 10)
+    np.testing.assert_allclose(ps._capture_steps(m, [(0, 35), (35, 60)], rig), np.diff(y[12:22]))
+    np.testing.assert_allclose(ps._capture_steps(m, [(0, 25), (25, 60)], rig), np.diff(y[37:47]))
+    np.testing.assert_allclose(ps._capture_steps(m, [(0, 8), (10, 16)], rig), np.diff(y[0:8]))
+
+
+def test_results_are_frozen():
+    import dataclasses
+
+    import numpy as np
+
+    from cyclecoord.quality.pose_space import cycle_figures
+
+    cyc = _root_only(1 + 0.01 * np.arange(5))
+    f = cycle_figures(cyc, _unit_rig(cyc))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        f.jerk = 0.0
+    q = pose_quality(cyc, cyc, [(0, 5)], 5.0)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        q.seam = 0.0
+    nan = dataclasses.replace(f, jerk=float("nan")).to_dict()
+    assert nan["jerk"] is None and nan["loop_closure"] == pytest.approx(4.0)
