@@ -484,3 +484,55 @@ def test_the_summary_counts_joint_angles_out_of_range():
     assert rep.summary().splitlines()[0] == "plausibility: 1 joint angles outside the inputs' range"
     assert rep.notes == ["1 joint angles leave the inputs' range (+-5 deg), worst a.rz at 120.0 "
                          "(allowed -5.0 to 95.0)"]
+
+
+def test_root_channels_are_not_joint_angles():
+    """The root turned 90 degrees and moved (its channels are not joint angles) while the
+    references never turn it: no violation; the joints' own angles are still checked."""
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
+                   Joint("a", 0, [1.0, 0, 0], ("rz",), "Z"), Joint("a2", 1, [1.0, 0, 0])))
+    ref = cc.Motion(np.zeros((3, 7)), sk.channels, fps=30, skeleton=sk)
+    f = np.zeros((3, 7))
+    f[:, 0] = [0.0, 50.0, 100.0]
+    f[:, 5] = 90.0
+    assert joint_range_violations(cc.Motion(f, sk.channels, fps=30, skeleton=sk), [ref]) == []
+    f[1, 6] = 10.0
+    (v,) = joint_range_violations(cc.Motion(f, sk.channels, fps=30, skeleton=sk), [ref])
+    assert v.channel == ("a", "rz") and v.excess == pytest.approx(5.0)
+
+
+def test_a_reference_turning_through_180_degrees_is_unwrapped():
+    """A reference going 170, 179, -179, -170 turns steadily through 180 (unwrapped: 170
+    to 190): the allowed range is 165 to 195, so -175 (185) is inside and 0 is 165 degrees
+    outside it (nearest turn)."""
+    ref = _swing([170.0, 179.0, -179.0, -170.0])
+    assert joint_range_violations(_swing([-175.0, 175.0]), [ref]) == []
+    (v,) = [v for v in joint_range_violations(_swing([0.0, 180.0]), [ref]) if v.channel[0] == "a"]
+    assert (v.low, v.high, v.frames, v.first_frame) == (165.0, 195.0, 1, 0)
+    assert v.excess == pytest.approx(165.0)
+
+
+def test_violations_are_frozen_and_two_bones_are_enough():
+    import dataclasses
+
+    from cyclecoord.motion import Motion
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    (v,) = [v for v in joint_range_violations(_swing([0.0, 120.0]), [_swing([0.0, 90.0])])]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        v.frames = 0
+    two = Skeleton((Joint("root", -1, [0.0, 0.0, 0.0]), Joint("p", 0, [0.0, 2.0, 0.0]),
+                    Joint("q", 1, [1.0, 0.0, 0.0])))
+    bn = bones(Motion(np.zeros((1, 0)), (), skeleton=two))
+    assert bn.names == ["root", "p"] and bn.pairs.shape == (0, 2)
+
+
+def test_contacts_count_their_frames_in_the_motions_numbering():
+    rep = check_plausibility(_swing([0.0, 170.0, 180.0, 0.0, 175.0], start_frame=5),
+                             threshold=1.5)
+    (c,) = rep.contacts
+    assert c["frames"] == 3 and c["first_frame"] == 6
+    assert c["min_distance"] == pytest.approx(1.0)
+    assert rep.new_contact_frames == [6, 7, 9]
