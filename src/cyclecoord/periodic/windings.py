@@ -83,9 +83,9 @@ def crossing_times(unwrapped: np.ndarray, levels: np.ndarray) -> list[np.ndarray
         lo, hi = u[i - 1], u[i]
         span = np.where(hi > lo, hi - lo, 1.0)
         frac = np.clip((targets - lo) / span, 0.0, 1.0)
-        t = np.where(u[0] >= targets, 0.0, i - 1 + frac)
+        t = i - 1 + frac
         # a target reached exactly at frame 0 is not a crossing inside the stretch
-        out.append(t[targets > u[0]] if np.any(targets > u[0]) else np.zeros(0))
+        out.append(t[targets > u[0]])
     return out
 
 
