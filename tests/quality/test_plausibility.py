@@ -536,3 +536,22 @@ def test_contacts_count_their_frames_in_the_motions_numbering():
     assert c["frames"] == 3 and c["first_frame"] == 6
     assert c["min_distance"] == pytest.approx(1.0)
     assert rep.new_contact_frames == [6, 7, 9]
+
+
+def test_a_reference_listing_the_bones_the_other_way_round_explains_the_contact():
+    """The same rig with b's arm written before a's: its pair is (b, a), the motion's
+    (a, b); matched by bone names either way round, the reference's own approach (1, arm a
+    turned 180 degrees) explains the motion's."""
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz"), ""),
+                   Joint("b", 0, [-1.0, 0, 0], ("rz",), "Z"), Joint("b2", 1, [0, 0, 1.0]),
+                   Joint("a", 0, [1.0, 0, 0], ("rz",), "Z"), Joint("a2", 3, [1.0, 0, 0])))
+    f = np.zeros((2, 5))
+    f[:, 4] = [0.0, 180.0]
+    ref = cc.Motion(f, sk.channels, fps=30, skeleton=sk)
+    assert ("b", "a") in bones(ref).pair_names()
+    rep = check_plausibility(_swing([0.0, 180.0]), [ref], threshold=1.5, margin_deg=90.0)
+    (c,) = rep.contacts
+    assert c["reference_min_distance"] == pytest.approx(1.0) and not c["new"]
+    assert rep.new_contact_frames == [] and rep.clean
