@@ -717,3 +717,9 @@ def test_positions_without_windings_wrap_below_the_reference_level():
     w = complete_windings(u, [(0, 6)], n_levels=4)
     assert w.anchors.tolist() == [3, 1, 2]
     np.testing.assert_allclose(w.positions, [0.0, 0.5, 0.75])
+
+
+def test_edge_taper_of_zero_length_is_no_taper():
+    mask = np.array([0, 1, 1, 1, 0, 1], dtype=bool)
+    for length in (0.0, -0.0, 0):
+        np.testing.assert_array_equal(edge_taper(mask, length), mask.astype(float))
