@@ -258,3 +258,300 @@ def test_a_zero_length_link_away_from_the_origin_is_one_node():
     bn = bones(Motion(np.zeros((1, 0)), (), skeleton=skel))
     assert len(bn.names) == 3  # root-a, a-b (through a_twist), a-c: no bone of length 0
     assert np.all(bn.start != bn.end)
+
+
+# ------------------------------------------------------------------ known answers, by hand
+def _swing_rig():
+    """Root at the origin with two arms: ``a`` 1 along +x, its bone to ``a2`` 1 further,
+    turning about z (angle th: a2 = (1 + cos th, sin th, 0)); ``b`` 1 along -x, its bone
+    to ``b2`` 1 up along z (b's own turn about z does not move it).  Bones, in order:
+    root>a, a, root>b, b; the pairs sharing no joint are (root>a, b), (a, root>b), (a, b),
+    at distances 1, 1 and sqrt(5 + 4 cos th) (1 at th = 180)."""
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    return Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz"), ""),
+                     Joint("a", 0, [1.0, 0, 0], ("rz",), "Z"),
+                     Joint("a2", 1, [1.0, 0, 0]),
+                     Joint("b", 0, [-1.0, 0, 0], ("rz",), "Z"),
+                     Joint("b2", 3, [0, 0, 1.0])))
+
+
+def _swing(angles, b_angles=None, start_frame=0):
+    sk = _swing_rig()
+    f = np.zeros((len(angles), 5))
+    f[:, 3] = angles
+    if b_angles is not None:
+        f[:, 4] = b_angles
+    return cc.Motion(f, sk.channels, fps=30, skeleton=sk, start_frame=start_frame)
+
+
+def _d(th):
+    """Distance of bones a and b at angle th (degrees), by the law of cosines."""
+    return np.sqrt(5 + 4 * np.cos(np.radians(th)))
+
+
+def test_bones_and_pairs_of_a_small_rig_by_hand():
+    bn = bones(_swing([0.0]))
+    assert bn.names == ["root>a", "a", "root>b", "b"]
+    assert bn.start.tolist() == [0, 1, 0, 3] and bn.end.tolist() == [1, 2, 3, 4]
+    assert bn.pairs.tolist() == [[0, 3], [1, 2], [1, 3]]
+    assert bn.pair_names() == [("root>a", "b"), ("a", "root>b"), ("a", "b")]
+    np.testing.assert_allclose(bn.rest_distance, [1.0, 1.0, 2.0])
+    # root>b touches both root>a and b, root>a both a and root>b; nothing touches a and b
+    assert bn.second_neighbours.tolist() == [True, True, False]
+    with pytest.raises(ParameterError, match="skeleton"):
+        bones(cc.Motion(np.zeros((1, 5)), _swing_rig().channels))
+
+
+def test_siblings_starting_at_one_place_are_one_node():
+    """Two children of one joint at the same place (CMU's neck and clavicles) make one
+    node: a bone from each to its own child, and the link to them one bone."""
+    from cyclecoord.motion import Motion
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    skel = Skeleton((
+        Joint("root", -1, [0.0, 0.0, 0.0]),
+        Joint("p", 0, [0.0, 2.0, 0.0]),
+        Joint("q", 0, [0.0, 2.0, 0.0]),
+        Joint("p1", 1, [1.0, 0.0, 0.0]),
+        Joint("q1", 2, [-1.0, 0.0, 0.0]),
+    ))
+    bn = bones(Motion(np.zeros((1, 0)), (), skeleton=skel))
+    assert bn.names == ["root", "p", "q"]  # root-p (root-q is the same bone), p-p1, q-q1
+    assert bn.pairs.size == 0  # all three share the node at (0, 2, 0)
+    one = Skeleton((Joint("root", -1, [0.0, 0.0, 0.0]), Joint("p", 0, [0.0, 2.0, 0.0])))
+    with pytest.raises(ParameterError, match="fewer than two bones"):
+        bones(Motion(np.zeros((1, 0)), (), skeleton=one))
+
+
+def test_segment_distances_in_closed_form():
+    def sd(p0, p1, q0, q1):
+        return float(segment_distances(*(np.array(x, float) for x in (p0, p1, q0, q1))))
+
+    assert sd([0, 0, 0], [0, 0, 0], [3, 4, 0], [3, 4, 0]) == pytest.approx(5.0)  # two points
+    assert sd([0, 1, 0], [0, 1, 0], [-1, 0, 0], [1, 0, 0]) == pytest.approx(1.0)  # point, segment
+    assert sd([2, 1, 0], [2, 1, 0], [-1, 0, 0], [1, 0, 0]) == pytest.approx(np.sqrt(2))
+    assert sd([-1, 0, 0], [1, 0, 0], [0.5, 3, 0], [0.5, 3, 0]) == pytest.approx(3.0)  # segment, point
+    assert sd([-1, 0, 0], [1, 0, 0], [-3, -4, 0], [-3, -4, 0]) == pytest.approx(np.sqrt(20))
+    assert sd([-1, 0, 0], [1, 0, 0], [0, -1, 2], [0, 1, 2]) == pytest.approx(2.0)  # skew, inside
+    assert sd([0, 0, 0], [1, 0, 0], [2, 1, 0], [3, 1, 0]) == pytest.approx(np.sqrt(2))  # parallel
+    assert sd([0, 0, 0], [1, 0, 0], [-3, 1, 0], [-2, 1, 0]) == pytest.approx(np.sqrt(5))
+    assert sd([0, 0, 0], [4, 0, 0], [1, 1, 0], [3, 1, 0]) == pytest.approx(1.0)  # overlapping
+    # the second segment's closest point beyond either end: clamped, the first re-solved
+    assert sd([0, 0, 0], [0, 4, 0], [1, 2, 1], [5, 2, 1]) == pytest.approx(np.sqrt(2))
+    assert sd([0, 0, 0], [0, 4, 0], [-5, 6, 1], [-1, 6, 1]) == pytest.approx(np.sqrt(1 + 4 + 1))
+
+
+def test_segment_distances_match_an_exact_search():
+    """Against a ternary search over the first segment of the (exact) distance from its
+    point to the second segment (convex in the parameter): random, parallel and
+    degenerate segments, to 1e-9."""
+    rng = np.random.default_rng(3)
+    p0, p1, q0, q1 = rng.normal(size=(4, 200, 3))
+    p1[:10] = p0[:10]
+    q1[10:20] = q0[10:20]
+    q0[20:30], q1[20:30] = p0[20:30] + 0.3, p1[20:30] + 0.3  # parallel
+    q0[30:40], q1[30:40] = p1[30:40] + 0.2, p0[30:40] + 0.2  # antiparallel
+
+    def to_q(x):
+        v = q1 - q0
+        vv = np.einsum("ij,ij->i", v, v)
+        t = np.clip(np.einsum("ij,ij->i", x - q0, v) / np.where(vv > 0, vv, 1.0), 0, 1)
+        return np.linalg.norm(x - q0 - t[:, None] * v, axis=1)
+
+    def f(s):
+        return to_q(p0 + s[:, None] * (p1 - p0))
+
+    lo, hi = np.zeros(200), np.ones(200)
+    for _ in range(120):
+        a, b = lo + (hi - lo) / 3, hi - (hi - lo) / 3
+        left = f(a) < f(b)
+        hi = np.where(left, b, hi)
+        lo = np.where(left, lo, a)
+    want = np.minimum(f(0.5 * (lo + hi)), np.minimum(f(np.zeros(200)), f(np.ones(200))))
+    np.testing.assert_allclose(segment_distances(p0, p1, q0, q1), want, rtol=0, atol=1e-9)
+
+
+def test_self_intersections_at_the_clearance():
+    """Arm a turned 0, 90 and 180 degrees: pair (a, root>b) goes from 1 to 0 (a's tip at
+    the root), (a, b) from 2 to 1.  Closer than the clearance is flagged, at it is not: a
+    clearance of 1 flags (a, root>b) on the last frame only.  A clearance of 1.5 ignores
+    (root>a, b) and (a, root>b), one bone apart and 1 apart at rest, and flags (a, b) at
+    1; unless rest contacts are not ignored."""
+    m = _swing([0.0, 90.0, 180.0], start_frame=10)
+    one = self_intersections(m, 1.0)
+    np.testing.assert_allclose(one.distances, [[1, 1, 2], [1, 1, 2], [1, 0, 1]], atol=1e-12)
+    assert one.flagged.tolist() == [[False] * 3, [False] * 3, [False, True, False]]
+    assert not one.ignored.any() and one.frames.tolist() == [2] and one.start_frame == 10
+    np.testing.assert_allclose(one.min_distance, [1, 0, 1], atol=1e-12)
+    c15 = self_intersections(m, 1.5)
+    assert c15.ignored.tolist() == [True, True, False] and c15.threshold == 1.5
+    assert c15.flagged.tolist() == [[False] * 3, [False] * 3, [False, False, True]]
+    assert c15.contacts() == [{"bones": ["a", "b"], "frames": 1, "first_frame": 12,
+                               "min_distance": pytest.approx(1.0)}]
+    every = self_intersections(m, 1.5, ignore_rest_contacts=False)
+    assert not every.ignored.any()
+    assert every.flagged.tolist() == [[True, True, False], [True, True, False], [True, True, True]]
+    assert [c["frames"] for c in every.contacts()] == [3, 3, 1]
+    # the default clearance is 2 % of the bones' total length (4 here)
+    assert self_intersections(m).threshold == pytest.approx(0.08)
+    for bad in (0.0, -1.0, np.nan, np.inf):
+        with pytest.raises(ParameterError, match="threshold"):
+            self_intersections(m, bad)
+    with pytest.raises(ParameterError, match="Motion"):
+        self_intersections("walk")
+
+
+def test_joint_range_by_hand():
+    """References turn a through 0, 90, 180 and b through -10, 10: with the 5-degree
+    margin a may go -5 to 185 and b -15 to 15 (taken on the turn nearest the middle).
+    a at 200 is 15 over; -170 is 190 on that turn, 5 over; 185 is at the limit, inside;
+    b at 40 is 25 over: the worst, listed first."""
+    ref = _swing([0.0, 90.0, 180.0], [-10.0, 10.0, 0.0])
+    m = _swing([200.0, -170.0, 185.0, 30.0], [0.0, 0.0, 40.0, 0.0], start_frame=100)
+    found = joint_range_violations(m, [ref])
+    assert [v.channel for v in found] == [("b", "rz"), ("a", "rz")]
+    b, a = found
+    assert (b.frames, b.first_frame, b.low, b.high, b.worst, b.excess) == (
+        1, 102, -15.0, 15.0, 40.0, pytest.approx(25.0))
+    assert (a.frames, a.first_frame, a.low, a.high, a.worst) == (2, 100, -5.0, 185.0, 200.0)
+    assert a.excess == pytest.approx(15.0)
+    assert a.to_dict() == {"channel": "a.rz", "frames": 2, "first_frame": 100,
+                           "allowed": [-5.0, 185.0], "worst": 200.0,
+                           "excess_deg": pytest.approx(15.0)}
+    # no margin: 185 is out too (5 over 180); a reference a turn down is the same range
+    a0 = [v for v in joint_range_violations(m, [ref], margin_deg=0.0) if v.channel[0] == "a"][0]
+    assert a0.frames == 3 and a0.low == 0.0 and a0.high == 180.0
+    down = _swing([-360.0, -270.0, -180.0], [-10.0, 10.0, 0.0])
+    assert [(v.channel, v.frames) for v in joint_range_violations(m, [ref, down])] == [
+        (("b", "rz"), 1), (("a", "rz"), 2)]
+    with pytest.raises(ParameterError, match="margin"):
+        joint_range_violations(m, [ref], margin_deg=-1.0)
+    with pytest.raises(ParameterError, match="reference"):
+        joint_range_violations(m, [ref, "ref"])
+    with pytest.raises(ParameterError, match="Motion"):
+        joint_range_violations("m", [ref])
+
+
+def test_new_contacts_against_the_references_closest_approach():
+    """Clearance 1.5 on (a, b), at sqrt(5 + 4 cos th).  A reference that comes within
+    sqrt(3) (th = 120, beyond the clearance) lets the motion come to 1.5 - 0.15 = 1.35
+    before a contact is new; one that comes to _d(150) (1.24) lets it come to
+    1.24 - 0.15.  Closer is new, not so close is listed but explained."""
+    far = _swing([0.0, 120.0])
+    th_135 = np.degrees(np.arccos((1.4**2 - 5) / 4))  # (a, b) at 1.4
+    m = _swing([0.0, th_135, 180.0])
+    rep = check_plausibility(m, [far], threshold=1.5, margin_deg=90.0)
+    (c,) = rep.contacts
+    assert c["bones"] == ["a", "b"] and c["frames"] == 2 and c["first_frame"] == 1
+    assert c["new"] and c["reference_min_distance"] == pytest.approx(np.sqrt(3))
+    assert rep.new_contact_frames == [2]  # 1.4 is not under 1.35; 1 is
+    near = _swing([0.0, 150.0])
+    th_160 = _swing([0.0, 160.0, 170.0])
+    rep = check_plausibility(th_160, [near], threshold=1.5, margin_deg=90.0)
+    (c,) = rep.contacts
+    assert c["reference_min_distance"] == pytest.approx(_d(150))
+    # 160: 1.114, not under 1.239 - 0.15 = 1.089; 170: 1.031, under it
+    assert rep.new_contact_frames == [2] and c["new"]
+    rep = check_plausibility(_swing([0.0, 160.0]), [near], threshold=1.5, margin_deg=90.0)
+    assert rep.new_contact_frames == [] and not rep.contacts[0]["new"] and rep.clean
+    assert any(n.startswith("1 bone pairs come within the clearance 1.5") for n in rep.notes)
+    assert any(n.startswith("2 pairs of neighbouring bones") for n in rep.notes)
+
+
+def test_without_references_every_contact_is_new_and_ranges_are_not_checked():
+    rep = check_plausibility(_swing([0.0, 170.0, 180.0], start_frame=5), threshold=1.5)
+    assert rep.new_contact_frames == [6, 7] and rep.joint_range == []
+    assert rep.contacts[0]["reference_min_distance"] is None and rep.contacts[0]["new"]
+    assert not rep.clean
+    note = rep.notes[-1]
+    assert note == ("1 bone pairs come closer than the inputs ever do, e.g. a and b at 1 "
+                    "(clearance 1.5, inputs' closest n/a)")
+    assert rep.summary().splitlines()[0] == "plausibility: new limb contacts in 2 frames"
+    d = rep.to_dict()
+    assert d["clean"] is False and d["n_frames"] == 3 and d["threshold"] == 1.5
+    assert d["new_contact_frames"] == [6, 7] and d["joint_range_violations"] == []
+    clean = check_plausibility(_swing([0.0, 10.0]), threshold=0.5)
+    assert clean.clean and clean.contacts == [] and clean.summary() == (
+        "plausibility: clean\n  no bones closer than 0.5 and every joint angle within the "
+        "inputs' range")
+
+
+def test_the_summary_counts_joint_angles_out_of_range():
+    ref = _swing([0.0, 90.0])
+    rep = check_plausibility(_swing([0.0, 120.0]), [ref], threshold=0.5)
+    assert rep.new_contact_frames == [] and len(rep.joint_range) == 1 and not rep.clean
+    assert rep.summary().splitlines()[0] == "plausibility: 1 joint angles outside the inputs' range"
+    assert rep.notes == ["1 joint angles leave the inputs' range (+-5 deg), worst a.rz at 120.0 "
+                         "(allowed -5.0 to 95.0)"]
+
+
+def test_root_channels_are_not_joint_angles():
+    """The root turned 90 degrees and moved (its channels are not joint angles) while the
+    references never turn it: no violation; the joints' own angles are still checked."""
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
+                   Joint("a", 0, [1.0, 0, 0], ("rz",), "Z"), Joint("a2", 1, [1.0, 0, 0])))
+    ref = cc.Motion(np.zeros((3, 7)), sk.channels, fps=30, skeleton=sk)
+    f = np.zeros((3, 7))
+    f[:, 0] = [0.0, 50.0, 100.0]
+    f[:, 5] = 90.0
+    assert joint_range_violations(cc.Motion(f, sk.channels, fps=30, skeleton=sk), [ref]) == []
+    f[1, 6] = 10.0
+    (v,) = joint_range_violations(cc.Motion(f, sk.channels, fps=30, skeleton=sk), [ref])
+    assert v.channel == ("a", "rz") and v.excess == pytest.approx(5.0)
+
+
+def test_a_reference_turning_through_180_degrees_is_unwrapped():
+    """A reference going 170, 179, -179, -170 turns steadily through 180 (unwrapped: 170
+    to 190): the allowed range is 165 to 195, so -175 (185) is inside and 0 is 165 degrees
+    outside it (nearest turn)."""
+    ref = _swing([170.0, 179.0, -179.0, -170.0])
+    assert joint_range_violations(_swing([-175.0, 175.0]), [ref]) == []
+    (v,) = [v for v in joint_range_violations(_swing([0.0, 180.0]), [ref]) if v.channel[0] == "a"]
+    assert (v.low, v.high, v.frames, v.first_frame) == (165.0, 195.0, 1, 0)
+    assert v.excess == pytest.approx(165.0)
+
+
+def test_violations_are_frozen_and_two_bones_are_enough():
+    import dataclasses
+
+    from cyclecoord.motion import Motion
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    (v,) = [v for v in joint_range_violations(_swing([0.0, 120.0]), [_swing([0.0, 90.0])])]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        v.frames = 0
+    two = Skeleton((Joint("root", -1, [0.0, 0.0, 0.0]), Joint("p", 0, [0.0, 2.0, 0.0]),
+                    Joint("q", 1, [1.0, 0.0, 0.0])))
+    bn = bones(Motion(np.zeros((1, 0)), (), skeleton=two))
+    assert bn.names == ["root", "p"] and bn.pairs.shape == (0, 2)
+
+
+def test_contacts_count_their_frames_in_the_motions_numbering():
+    rep = check_plausibility(_swing([0.0, 170.0, 180.0, 0.0, 175.0], start_frame=5),
+                             threshold=1.5)
+    (c,) = rep.contacts
+    assert c["frames"] == 3 and c["first_frame"] == 6
+    assert c["min_distance"] == pytest.approx(1.0)
+    assert rep.new_contact_frames == [6, 7, 9]
+
+
+def test_a_reference_listing_the_bones_the_other_way_round_explains_the_contact():
+    """The same rig with b's arm written before a's: its pair is (b, a), the motion's
+    (a, b); matched by bone names either way round, the reference's own approach (1, arm a
+    turned 180 degrees) explains the motion's."""
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz"), ""),
+                   Joint("b", 0, [-1.0, 0, 0], ("rz",), "Z"), Joint("b2", 1, [0, 0, 1.0]),
+                   Joint("a", 0, [1.0, 0, 0], ("rz",), "Z"), Joint("a2", 3, [1.0, 0, 0])))
+    f = np.zeros((2, 5))
+    f[:, 4] = [0.0, 180.0]
+    ref = cc.Motion(f, sk.channels, fps=30, skeleton=sk)
+    assert ("b", "a") in bones(ref).pair_names()
+    rep = check_plausibility(_swing([0.0, 180.0]), [ref], threshold=1.5, margin_deg=90.0)
+    (c,) = rep.contacts
+    assert c["reference_min_distance"] == pytest.approx(1.0) and not c["new"]
+    assert rep.new_contact_frames == [] and rep.clean

@@ -83,9 +83,9 @@ def crossing_times(unwrapped: np.ndarray, levels: np.ndarray) -> list[np.ndarray
         lo, hi = u[i - 1], u[i]
         span = np.where(hi > lo, hi - lo, 1.0)
         frac = np.clip((targets - lo) / span, 0.0, 1.0)
-        t = np.where(u[0] >= targets, 0.0, i - 1 + frac)
+        t = i - 1 + frac
         # a target reached exactly at frame 0 is not a crossing inside the stretch
-        out.append(t[targets > u[0]] if np.any(targets > u[0]) else np.zeros(0))
+        out.append(t[targets > u[0]])
     return out
 
 
@@ -276,7 +276,10 @@ def retime(unwrapped: np.ndarray, runs: list[tuple[int, int]], windings: Winding
         crossings = crossing_times(u, lv)
         for j, c in enumerate(crossings):
             # turn index of each crossing, counted from the reference level's turns
-            base = np.ceil(u[0] - lv[j]) + np.arange(c.size)  # the k in u = k + level
+            first = np.ceil(u[0] - lv[j])
+            if first + lv[j] <= u[0]:  # a level on frame 0 is not crossed there (crossing_times)
+                first += 1.0
+            base = first + np.arange(c.size)  # the k in u = k + level
             turn = base + np.floor(lv[j] - ref_level)  # same turn as the reference before it
             times.append(c)
             targets.append(turn + pos[j])
