@@ -334,13 +334,13 @@ def _key_times(times: np.ndarray, where: str) -> np.ndarray:
         k = int(np.argmax(~np.isfinite(t) | (np.abs(t) > MAX_MAGNITUDE)))
         raise Invalid(f"{where}: key time {k} is {t[k]}, not a finite number of seconds")
     if t[0] < 0:
-        raise Invalid(f"{where}: key time 0 is {t[0]!r}; key times start at 0 or later")
+        raise Invalid(f"{where}: key time 0 is {float(t[0])!r}; key times start at 0 or later")
     back = np.flatnonzero(np.diff(t) <= 0)
     if back.size:
         k = int(back[0]) + 1
         raise Invalid(
-            f"{where}: key time {k} ({t[k]!r} s) does not come after key time {k - 1} "
-            f"({t[k - 1]!r} s); key times increase"
+            f"{where}: key time {k} ({float(t[k])!r} s) does not come after key time {k - 1} "
+            f"({float(t[k - 1])!r} s); key times increase"
         )
     return t
 
