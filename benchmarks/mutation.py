@@ -98,7 +98,7 @@ TESTS: dict[str, list[str]] = {
     IO + "gltf.py": [T + "io/test_gltf.py", T + "io/test_rig_export.py", T + "io/test_hostile_gltf_usd.py"],
     IO + "gltf_read.py": [T + "io/test_gltf_read.py", T + "io/test_gltf.py", T + "io/test_rig_export.py", T + "io/test_hostile_gltf_usd.py"],
     IO + "tabular.py": [T + "io/test_tabular.py", T + "io/test_hostile_files.py"],
-    IO + "usd.py": [T + "io/test_usd.py", T + "io/test_rig_export.py", T + "io/test_hostile_gltf_usd.py"],
+    IO + "usd.py": [T + "io/test_usd_read.py", T + "io/test_usd.py", T + "io/test_rig_export.py", T + "io/test_hostile_gltf_usd.py"],
 }
 
 _BINOP = {ast.Add: ast.Sub, ast.Sub: ast.Add, ast.Mult: ast.Div, ast.Div: ast.Mult,
