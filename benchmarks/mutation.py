@@ -97,7 +97,7 @@ TESTS: dict[str, list[str]] = {
     IO + "bvh.py": [T + "io/test_bvh.py", T + "io/test_convert.py", T + "io/test_hostile_files.py"],
     IO + "gltf.py": [T + "io/test_gltf_write.py", T + "io/test_gltf.py", T + "io/test_rig_export.py", T + "io/test_hostile_gltf_usd.py"],
     IO + "gltf_read.py": [T + "io/test_gltf_read.py", T + "io/test_gltf.py", T + "io/test_rig_export.py", T + "io/test_hostile_gltf_usd.py"],
-    IO + "tabular.py": [T + "io/test_tabular.py", T + "io/test_hostile_files.py"],
+    IO + "tabular.py": [T + "io/test_tabular_known.py", T + "io/test_tabular.py", T + "io/test_hostile_files.py"],
     IO + "usd.py": [T + "io/test_usd_read.py", T + "io/test_usd.py", T + "io/test_rig_export.py", T + "io/test_hostile_gltf_usd.py"],
 }
 
