@@ -501,6 +501,17 @@ def test_buffers_from_the_glb_chunk_a_data_uri_and_a_file(tmp_path):
         gr._buffers(gltf, tmp_path / "x.gltf")
 
 
+def test_buffer_byte_length_at_most_2_to_the_53(tmp_path):
+    """byteLength is a whole number in 0..2^53 (JSON's exact integers)."""
+    gltf = g.GLTF2(buffers=[g.Buffer(byteLength=2**53, uri="data:,")])
+    with pytest.raises(Invalid, match=r"^buffers\[0\]: holds fewer than its 9007199254740992 "):
+        gr._buffers(gltf, tmp_path / "x.gltf")
+    gltf.buffers[0].byteLength = 2**53 + 1
+    with pytest.raises(Invalid, match=r"^buffers\[0\]\.byteLength: 9,007,199,254,740,993 is not "
+                                      r"in 0\.\.9,007,199,254,740,992"):
+        gr._buffers(gltf, tmp_path / "x.gltf")
+
+
 def test_buffer_uri_refusals(tmp_path):
     for uri, words in (("data:application/octet-stream;base64", r"buffers\[0\]\.uri: a data URI "
                                                                  "without ','"),
@@ -652,6 +663,10 @@ def test_frame_rate_bounds_and_defaults():
     doc, buffers = _animated([g.Node()], [(0, "translation", [0, 1e6], np.zeros((2, 3)))])
     trans, _, fps = gr._node_tracks(doc, buffers)
     assert fps == 1e-6 and trans.shape[0] == 2
+    # keys float32(1e-6) s apart: 999,999.99 fps, within 1e-4 of 1e6: MAX_FPS itself
+    doc, buffers = _animated([g.Node()], [(0, "translation", [0, 1e-6], np.zeros((2, 3)))])
+    trans, _, fps = gr._node_tracks(doc, buffers)
+    assert fps == 1e6 and trans.shape[0] == 2
     doc, buffers = _animated([g.Node()], [(0, "translation", [0, 2e6], np.zeros((2, 3)))])
     with pytest.raises(Invalid, match=r"^animations\[0\]: key times 2e\+06 s apart over 2 keys "
                                       r"make 5e-07 frames per second; 1e-06\.\.1e\+06"):
