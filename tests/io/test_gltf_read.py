@@ -867,3 +867,54 @@ def test_foreign_file_refusals(tmp_path):
     doc, buffers = _animated([], [])
     with pytest.raises(ParseError, match="the file holds no nodes"):
         gr.read_gltf(_save(doc, buffers, tmp_path / "none.gltf"))
+
+
+# ----------------------------------------------------------------------------- our own files
+def _ours(tmp_path, **write):
+    """A 3-frame arm written by write_gltf (start frame 7, root channels reordered), as a
+    pygltflib document to edit; the motion."""
+    from cyclecoord.io.gltf import write_gltf
+    from cyclecoord.motion import Motion
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
+                   Joint("arm", 0, [0, 2, 0], ("rx", "rz"), "ZX", end_site=[1, 0, 0])),
+                  name="arm")
+    frames = np.zeros((3, 8))
+    frames[:, 0] = [0, 1, 2]
+    frames[:, 7] = [0, 30, 60]  # arm rz
+    m = Motion(frames, sk.channels, fps=10, skeleton=sk, start_frame=7)
+    m = m.select([m.channels[k] for k in (7, 6, 0, 1, 2, 3, 4, 5)])
+    write_gltf(m, tmp_path / "a.gltf", mesh=False, **write)
+    return g.GLTF2.load(str(tmp_path / "a.gltf")), m
+
+
+def test_our_file_gives_back_the_motion(tmp_path):
+    """The stored skeleton, channels in their order, start frame, scale divided out."""
+    doc, m = _ours(tmp_path, scale=0.5)
+    assert doc.nodes[0].translation == [0, 0, 0] and doc.nodes[1].translation == [0, 1, 0]
+    back = gr.read_gltf(tmp_path / "a.gltf")
+    assert back.channels == m.channels and back.start_frame == 7 and back.fps == 10
+    assert back.skeleton.joints[1].offset.tolist() == [0, 2, 0]
+    np.testing.assert_allclose(back.frames, m.frames, atol=1e-4)
+    # without a start frame stored: 0; with a channel list that is not all of them: the
+    # skeleton's own order
+    del doc.extras["cyclecoord"]["start_frame"]
+    doc.extras["cyclecoord"]["channels"] = [["arm", "rz"]]
+    (tmp_path / "b.gltf").write_text(doc.gltf_to_json())
+    back = gr.read_gltf(tmp_path / "b.gltf")
+    assert back.start_frame == 0 and back.channels == m.skeleton.channels
+    # a stored joint without its node
+    doc.nodes[1].name = "elbow"
+    (tmp_path / "c.gltf").write_text(doc.gltf_to_json())
+    with pytest.raises(ParseError, match=r"joints \['arm'\] of the stored skeleton have no node"):
+        gr.read_gltf(tmp_path / "c.gltf")
+
+
+def test_our_file_without_a_stored_scale_is_in_metres(tmp_path):
+    doc, m = _ours(tmp_path, scale=0.5)
+    del doc.extras["cyclecoord"]["scale"]
+    (tmp_path / "b.gltf").write_text(doc.gltf_to_json())
+    back = gr.read_gltf(tmp_path / "b.gltf")
+    tx = back.channels.index(("root", "tx"))
+    np.testing.assert_allclose(back.frames[:, tx], [0, 0.5, 1], atol=1e-6)  # scale 1
