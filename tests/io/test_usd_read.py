@@ -197,6 +197,17 @@ def test_sparse_samples_interpolated_as_usd_does(tmp_path):
         np.testing.assert_allclose(rots[t, 1], np.eye(3), atol=1e-6)
 
 
+def test_one_time_code_between_samples(tmp_path):
+    """A range of one time code (5) between samples at 0 and 10: the one frame is usd-core's
+    value there, half way."""
+    samples = {0: ([[0, 0, 0]], [IDENTITY]), 10: ([[10, 0, 0]], [IDENTITY])}
+    path = _stage(tmp_path / "a.usda", ["r"], samples, start=5, end=5)
+    _s, _p, query, times, _f = usd._open(path)
+    trans, rots = usd._local_transforms(query, times, path)
+    assert times.tolist() == [5] and trans.shape == (1, 1, 3) and rots.shape == (1, 1, 3, 3)
+    np.testing.assert_allclose(trans[0, 0], [5, 0, 0], atol=1e-6)
+
+
 def test_samples_at_every_frame_are_read_as_they_are(tmp_path):
     samples = {t: ([[t, 0, 0]], [(np.cos(t / 4), 0, 0, np.sin(t / 4))]) for t in range(4)}
     path = _stage(tmp_path / "a.usda", ["r"], samples)
