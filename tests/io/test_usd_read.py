@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from pxr import Gf, Usd, UsdSkel, Vt
 
-from cyclecoord.errors import ParseError
+from cyclecoord.errors import ParameterError, ParseError
 from cyclecoord.io import usd
 from cyclecoord.io._limits import MAX_FRAMES, MAX_JOINTS, memory_limit
 from cyclecoord.skeleton import Joint, Skeleton
@@ -369,3 +369,72 @@ def test_why_strips_the_cpp_location():
     long = RuntimeError("x" * 301)
     assert usd._why(long) == "x" * 297 + "..."
     assert usd._why(RuntimeError("y" * 300)) == "y" * 300
+
+
+# ----------------------------------------------------------------------------- write_usd
+def _arm(T=3):
+    """Root (6 dofs) and an arm 2 up (rz) with an end site 1 along x; the root moves 1 a
+    frame along x, the arm turns 0, 45, 90 degrees about z."""
+    from cyclecoord.motion import Motion
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
+                   Joint("arm", 0, [0, 2, 0], ("rz",), "Z", end_site=[1, 0, 0])), name="arm")
+    frames = np.zeros((T, 7))
+    frames[:, 0] = np.arange(T)
+    frames[:, 6] = 45.0 * np.arange(T)
+    return Motion(frames, sk.channels, fps=12.0, skeleton=sk, start_frame=4, source="s.bvh")
+
+
+def test_write_usd_stage(tmp_path):
+    from pxr import UsdGeom
+
+    m = _arm()
+    usd.write_usd(m, tmp_path / "a.USDA", meters_per_unit=0.01)  # the suffix in any case
+    stage = Usd.Stage.Open(str(tmp_path / "a.USDA"))
+    assert UsdGeom.GetStageMetersPerUnit(stage) == 0.01
+    assert UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.y
+    assert stage.GetTimeCodesPerSecond() == 12.0 and stage.GetFramesPerSecond() == 12.0
+    assert (stage.GetStartTimeCode(), stage.GetEndTimeCode()) == (0, 2)
+    assert str(stage.GetDefaultPrim().GetPath()) == "/Motion"
+    skel = UsdSkel.Skeleton(stage.GetPrimAtPath("/Motion/Skeleton"))
+    assert list(skel.GetJointsAttr().Get()) == ["root", "root/arm", "root/arm/arm_end"]
+    assert list(skel.GetJointNamesAttr().Get()) == ["root", "arm", "arm/end"]
+    rest = np.array(skel.GetRestTransformsAttr().Get())
+    bind = np.array(skel.GetBindTransformsAttr().Get())
+    assert rest[:, 3, :3].tolist() == [[0, 0, 0], [0, 2, 0], [1, 0, 0]]  # row-vector: last row
+    assert bind[:, 3, :3].tolist() == [[0, 0, 0], [0, 2, 0], [1, 2, 0]]  # world rest pose
+    assert (rest[:, :3, :3] == np.eye(3)).all() and (bind[:, :3, :3] == np.eye(3)).all()
+    info = json.loads(skel.GetPrim().GetCustomDataByKey("cyclecoord"))
+    assert info["fps"] == 12.0 and info["start_frame"] == 4 and info["source"] == "s.bvh"
+    assert info["channels"] == [list(c) for c in m.channels]
+    anim = UsdSkel.Animation(stage.GetPrimAtPath("/Motion/Skeleton/Animation"))
+    assert list(anim.GetJointsAttr().Get()) == ["root", "root/arm", "root/arm/arm_end"]
+    assert [tuple(s) for s in anim.GetScalesAttr().Get()] == [(1, 1, 1)] * 3
+    for t in range(3):
+        tr = np.array(anim.GetTranslationsAttr().Get(Usd.TimeCode(t)))
+        assert tr.tolist() == [[t, 0, 0], [0, 2, 0], [1, 0, 0]]
+        q = anim.GetRotationsAttr().Get(Usd.TimeCode(t))
+        a = np.radians(45 * t) / 2  # the arm's turn about z: (cos a, 0, 0, sin a) as w x y z
+        assert q[1].GetReal() == pytest.approx(np.cos(a), abs=1e-7)
+        assert list(q[1].GetImaginary()) == pytest.approx([0, 0, np.sin(a)], abs=1e-7)
+        assert q[0].GetReal() == 1 and q[2].GetReal() == 1
+    targets = UsdSkel.BindingAPI(skel.GetPrim()).GetAnimationSourceRel().GetTargets()
+    assert [str(t) for t in targets] == ["/Motion/Skeleton/Animation"]
+    back = usd.read_usd(tmp_path / "a.USDA")
+    assert back.channels == m.channels and back.start_frame == 4
+    np.testing.assert_allclose(back.frames, m.frames, atol=1e-4)
+
+
+def test_write_usd_refusals(tmp_path):
+    m = _arm()
+    with pytest.raises(ParameterError, match=r"USD files end in \.usda, \.usdc, \.usd, got "
+                                             r"'\.txt'"):
+        usd.write_usd(m, tmp_path / "a.txt")
+    with pytest.raises(ParameterError, match=r"got '\(no suffix\)'"):
+        usd.write_usd(m, tmp_path / "a")
+    for bad in (0.0, -1.0, np.nan, np.inf):
+        with pytest.raises(ParameterError, match="meters_per_unit must be a positive number"):
+            usd.write_usd(m, tmp_path / "a.usda", meters_per_unit=bad)
+    assert list(tmp_path.iterdir()) == []
+    usd.write_usd(m, tmp_path / "b.usdc", meters_per_unit=1e-9)
+    assert usd.read_usd(tmp_path / "b.usdc").n_frames == 3
