@@ -422,3 +422,58 @@ def test_csv_at_most_six_channels_a_joint(tmp_path):
     assert e.value.line == 1
     p.write_text(",".join(f"c{k}" for k in range(n)) + "\n" + ",".join(["0"] * n) + "\n")
     assert tb.read_csv(p).frames.shape == (1, n)
+
+
+# ----------------------------------------------------------------------------- more NPZ edges
+def test_npz_refusals_of_the_motion_itself(tmp_path):
+    a = _arrays(tmp_path, _motion(skeleton=False))
+    a["channel_joints"] = np.array(["a"] * 7)
+    a["channel_dofs"] = np.array(["x"] * 7)
+    with pytest.raises(ParseError, match=r"duplicate channels: \[\('a', 'x'\)\] \(arrays "
+                                         r"'frames', 'channel_joints', 'channel_dofs'\)"):
+        _read(tmp_path, a)
+    deep: dict = {}
+    inner = deep
+    for _ in range(100):
+        inner["a"] = {}
+        inner = inner["a"]
+    with pytest.raises(ParameterError, match=r"m\.npz: cannot write NPZ: metadata entry 'x' is "
+                                             r"nested 102 levels deep"):
+        tb.write_npz(_motion(metadata={"x": deep}), tmp_path / "m.npz")
+
+
+def _patched_size(tmp_path, total):
+    """An archive of the motion whose central directory says its members unpack to
+    ``total`` bytes (the first member's uncompressed size changed; nothing is read)."""
+    path = tmp_path / "big.npz"
+    tb.write_npz(_motion(), path)
+    with zipfile.ZipFile(path) as z:
+        infos = z.infolist()
+    others = sum(i.file_size for i in infos[1:])
+    data = bytearray(path.read_bytes())
+    at = data.index(b"PK\x01\x02")  # the first central directory entry
+    data[at + 24 : at + 28] = (total - others).to_bytes(4, "little")
+    path.write_bytes(bytes(data))
+    return path
+
+
+def test_npz_unpacked_size_at_most_two_gib(tmp_path):
+    """MAX_NPZ_BYTES (2 GiB) unpacked is the most: exactly that passes the cap (and is then
+    refused for the memory it needs, here limited), one byte more is refused by the cap."""
+    cap = 2 * 1024**3
+    with memory_limit(1e6), pytest.raises(ParseError, match=f"the archive's arrays \\({cap:,} "
+                                                            "bytes unpacked\\) need"):
+        tb.read_npz(_patched_size(tmp_path, cap))
+    with pytest.raises(ParseError, match=f"the archive unpacks to {cap + 1:,} bytes; at most "
+                                         f"{cap:,} are supported"):
+        tb.read_npz(_patched_size(tmp_path, cap + 1))
+
+
+def test_csv_fps_override_checked(tmp_path):
+    p = tmp_path / "a.csv"
+    p.write_text("# fps=30\na\n1\n")
+    assert tb.read_csv(p, fps="25").fps == 25.0
+    with pytest.raises(ParameterError, match="fps must be a positive number, got 'x'"):
+        tb.read_csv(p, fps="x")
+    with pytest.raises(ParameterError, match="frame rate 0.0 is not a positive number"):
+        tb.read_csv(p, fps=0)
