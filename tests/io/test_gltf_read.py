@@ -469,7 +469,7 @@ def test_check_nodes_fields():
 
 def test_at_most_four_nodes_a_joint():
     assert gr.MAX_NODES == 4 * MAX_JOINTS == 16384
-    nodes = [g.Node() for _ in range(gr.MAX_NODES)]
+    nodes = [g.Node()] * gr.MAX_NODES  # (one object: it has no children)
     assert gr._check_nodes(g.GLTF2(nodes=nodes)) == {}
     with pytest.raises(Invalid, match="^nodes: 16,385 items; at most 16,384"):
         gr._check_nodes(g.GLTF2(nodes=nodes + [g.Node()]))

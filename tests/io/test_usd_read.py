@@ -168,11 +168,13 @@ def test_at_most_twice_max_joints(tmp_path):
     """Joints and end sites: 2 x MAX_JOINTS = 8,192 at most."""
     n = 2 * MAX_JOINTS
     names = [f"j{k}" for k in range(n + 1)]
-    path = _stage(tmp_path / "a.usda", names[:n], _still(names[:n]))
-    assert len(usd._open(path)[2].GetJointOrder()) == n
-    path = _stage(tmp_path / "b.usda", names, _still(names))
+    for count, path in ((n, tmp_path / "a.usda"), (n + 1, tmp_path / "b.usda")):
+        stage = Usd.Stage.CreateInMemory()  # a skeleton of joints alone: all _open reads
+        UsdSkel.Skeleton.Define(stage, "/Skel").CreateJointsAttr(Vt.TokenArray(names[:count]))
+        stage.GetRootLayer().Export(str(path))
+    assert len(usd._open(tmp_path / "a.usda")[2].GetJointOrder()) == n
     with pytest.raises(ParseError, match="8,193 joints; at most 8,192"):
-        usd._open(path)
+        usd._open(tmp_path / "b.usda")
 
 
 # ----------------------------------------------------------------------------- local transforms
