@@ -40,6 +40,9 @@ def test_default_scale():
     asf = Skeleton(_arm().skeleton.joints, source_format="asf", length_unit=0.45)
     assert gw.default_scale(asf) == 0.0254 / 0.45
     assert gw.default_scale(Skeleton(asf.joints, source_format="bvh", length_unit=0.45)) == 1.0
+    # an ASF skeleton without a usable unit (0 or negative): 1, not a division by it
+    for unit in (0.0, -1.0):
+        assert gw.default_scale(Skeleton(asf.joints, source_format="asf", length_unit=unit)) == 1.0
 
 
 def test_check_exportable():
@@ -112,6 +115,8 @@ def test_skeleton_dict_defaults():
         ({"name": "b", "rotation_order": "XYZX"}, r"s\.joints\[1\]\.rotation_order: 4 characters"),
         ({"name": "b" * 1001}, r"s\.joints\[1\]\.name: 1,001 characters; at most 1,000"),
         ({"name": "a"}, r"^s: joint names in a skeleton must be unique"),
+        ({"name": "b", "dofs": ["rx"], "rotation_order": "ZY"},
+         r"^s\.joints\[1\]: joint 'b': rotation order 'ZY' does not match"),
         ({"name": "b", "axis": [[1, 0, 0], [0, 1, 0]]}, r"s\.joints\[1\]\.axis: expected 3x3"),
     ],
 )
@@ -125,6 +130,8 @@ def test_skeleton_dict_sizes():
           "name": "n" * 1000, "source_format": "f" * 100, "length_unit": 1e-300}
     sk = gw.skeleton_from_dict(ok, "s")
     assert sk.length_unit == 1e-300 and len(sk.name) == 1000
+    long = gw.skeleton_from_dict({"joints": [{"name": "j" * 1000}]}, "s")
+    assert long.names == ["j" * 1000]
     for key, value, message in (("name", "n" * 1001, r"s\.name: 1,001 characters"),
                                 ("source_format", "f" * 101, r"s\.source_format: 101 characters"),
                                 ("length_unit", 0.0, r"s\.length_unit: 0\.0 is not in 1e-300"),
