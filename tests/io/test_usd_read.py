@@ -440,3 +440,21 @@ def test_write_usd_refusals(tmp_path):
     assert list(tmp_path.iterdir()) == []
     usd.write_usd(m, tmp_path / "b.usdc", meters_per_unit=1e-9)
     assert usd.read_usd(tmp_path / "b.usdc").n_frames == 3
+
+
+def test_joint_positions_by_usd_core(tmp_path):
+    """Skeleton-space positions: the root at (1, 0, 0) turned a quarter about z carries its
+    child's (0, 2, 0) to (1, 0, 0) + (-2, 0, 0); names are the joint paths when the stage
+    has no jointNames, and jointNames when it has them."""
+    samples = {0: ([[1, 0, 0], [0, 2, 0]], [(S, 0, 0, S), IDENTITY]),
+               1: ([[1, 0, 3], [0, 2, 0]], [(S, 0, 0, S), IDENTITY])}
+    path = _stage(tmp_path / "a.usda", ["r", "r/a"], samples, fps=5)
+    names, pos, fps = usd.usd_joint_positions(path)
+    assert names == ["r", "r/a"] and fps == 5.0
+    np.testing.assert_allclose(pos, [[[1, 0, 0], [-1, 0, 0]], [[1, 0, 3], [-1, 0, 3]]],
+                               atol=1e-6)
+    stage = Usd.Stage.Open(str(path))
+    UsdSkel.Skeleton(stage.GetPrimAtPath("/R/Skel")).CreateJointNamesAttr(
+        Vt.TokenArray(["root", "arm"]))
+    stage.GetRootLayer().Save()
+    assert usd.usd_joint_positions(path)[0] == ["root", "arm"]
