@@ -368,14 +368,14 @@ def test_csv_first_problem_across_chunks(tmp_path):
     p = tmp_path / "a.csv"
     rows = _rows(600)
     rows[10] = "1,inf"  # line 12 (the header is line 1)
-    rows[300] = "1,x"  # line 302, in the second chunk
-    rows[500] = "1,y"  # line 502
+    rows[300] = "1,x"  # line 302, in the second chunk (rows 257..512)
+    rows[530] = "1,y"  # line 532, in the third
     rows[550] = "1,-inf"
     p.write_text("a,b\n" + "\n".join(rows) + "\n")
     with pytest.raises(ParseError, match=r"column 2 \(b\) is 'x', expected a number") as e:
         tb.read_csv(p)
     assert e.value.line == 302
-    rows[300] = rows[500] = "1,1"
+    rows[300] = rows[530] = "1,1"
     p.write_text("a,b\n" + "\n".join(rows) + "\n")
     with pytest.raises(ParseError, match="is 'inf', expected a finite number") as e:
         tb.read_csv(p)
@@ -477,3 +477,35 @@ def test_csv_fps_override_checked(tmp_path):
         tb.read_csv(p, fps="x")
     with pytest.raises(ParameterError, match="frame rate 0.0 is not a positive number"):
         tb.read_csv(p, fps=0)
+
+
+def test_npz_corrupt_member(tmp_path):
+    """A member whose bytes no longer match their CRC: refused naming the array."""
+    path = tmp_path / "m.npz"
+    np.savez(path, frames=np.arange(64.0).reshape(8, 8))  # stored, not compressed
+    data = bytearray(path.read_bytes())
+    at = data.index(np.arange(64.0).tobytes()[8:16])  # the second value's bytes
+    data[at] ^= 0xFF
+    path.write_bytes(bytes(data))
+    with pytest.raises(ParseError, match="array 'frames': corrupt"):
+        tb.read_npz(path)
+
+
+def test_npz_version_and_start_frame_ranges(tmp_path):
+    a = _arrays(tmp_path, _motion(skeleton=False))
+    a["version"] = np.array(2**62)
+    with pytest.raises(ParseError, match="layout version 4611686018427387904; this cyclecoord"):
+        _read(tmp_path, a)
+    for v in (2**62 + 1, -(2**62) - 1):
+        a["version"] = np.array(v)
+        with pytest.raises(ParseError, match="array 'version': expected a whole number in "
+                                             "-4,611,686,018,427,387,904..4,611,686,018,"):
+            _read(tmp_path, a)
+    a["version"] = np.array(1)
+    a["start_frame"] = np.array(10**9)
+    assert _read(tmp_path, a).start_frame == 10**9
+    for v in (10**9 + 1, -1):
+        a["start_frame"] = np.array(v)
+        with pytest.raises(ParseError, match="array 'start_frame': expected a whole number in "
+                                             "0..1,000,000,000"):
+            _read(tmp_path, a)
