@@ -918,3 +918,20 @@ def test_our_file_without_a_stored_scale_is_in_metres(tmp_path):
     back = gr.read_gltf(tmp_path / "b.gltf")
     tx = back.channels.index(("root", "tx"))
     np.testing.assert_allclose(back.frames[:, tx], [0, 0.5, 1], atol=1e-6)  # scale 1
+
+
+def test_animation_entries_must_be_objects():
+    doc, buffers = _animated([g.Node()], [(0, "translation", [0, 1], np.zeros((2, 3)))])
+    doc.animations[0].channels.append(g.AnimationChannel(sampler=0, target=None))
+    with pytest.raises(Invalid, match=r"^animations\[0\]\.channels\[1\]: expected an object with "
+                                      r"a target"):
+        gr._node_tracks(doc, buffers)
+    doc.animations[0].channels[1] = "x"
+    with pytest.raises(Invalid, match=r"^animations\[0\]\.channels\[1\]: expected an object"):
+        gr._node_tracks(doc, buffers)
+    doc.animations[0].samplers.append("x")
+    with pytest.raises(Invalid, match=r"^animations\[0\]\.samplers\[1\]: expected an object"):
+        gr._node_tracks(doc, buffers)
+    doc.animations = ["x"]
+    with pytest.raises(Invalid, match=r"^animations\[0\]: expected an object"):
+        gr._node_tracks(doc, buffers)
