@@ -458,3 +458,19 @@ def test_joint_positions_by_usd_core(tmp_path):
         Vt.TokenArray(["root", "arm"]))
     stage.GetRootLayer().Save()
     assert usd.usd_joint_positions(path)[0] == ["root", "arm"]
+
+
+def test_standard_error_is_given_back_after_a_read(capfd):
+    """While a USD reader runs, file descriptor 2 is held; afterwards it is the process's
+    standard error again (what is written there is seen)."""
+    import os
+
+    from cyclecoord.io.usd import _refusing
+
+    capfd.readouterr()
+    assert _refusing(lambda path: 7)("f.usda") == 7
+    os.write(2, b"after the read\n")
+    with pytest.raises(ParseError):
+        _refusing(lambda path: (_ for _ in ()).throw(ParseError("bad", "f.usda")))("f.usda")
+    os.write(2, b"after the refusal\n")
+    assert capfd.readouterr().err == "after the read\nafter the refusal\n"
