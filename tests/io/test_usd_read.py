@@ -474,3 +474,18 @@ def test_standard_error_is_given_back_after_a_read(capfd):
         _refusing(lambda path: (_ for _ in ()).throw(ParseError("bad", "f.usda")))("f.usda")
     os.write(2, b"after the refusal\n")
     assert capfd.readouterr().err == "after the read\nafter the refusal\n"
+
+
+def test_open_refuses_a_missing_file_and_a_stage_without_a_skeleton(tmp_path):
+    with pytest.raises(ParseError, match="no such USD file"):
+        usd._open(tmp_path / "none.usda")
+    stage = Usd.Stage.CreateInMemory()
+    UsdSkel.Root.Define(stage, "/R")
+    stage.GetRootLayer().Export(str(tmp_path / "empty.usda"))
+    with pytest.raises(ParseError, match="no UsdSkel Skeleton prim in the stage"):
+        usd._open(tmp_path / "empty.usda")
+    stage = Usd.Stage.CreateInMemory()
+    UsdSkel.Skeleton.Define(stage, "/Skel").CreateJointsAttr(Vt.TokenArray([]))
+    stage.GetRootLayer().Export(str(tmp_path / "nojoints.usda"))
+    with pytest.raises(ParseError, match="skeleton /Skel: the joints array is empty"):
+        usd._open(tmp_path / "nojoints.usda")
