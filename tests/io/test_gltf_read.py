@@ -935,3 +935,23 @@ def test_animation_entries_must_be_objects():
     doc.animations = ["x"]
     with pytest.raises(Invalid, match=r"^animations\[0\]: expected an object"):
         gr._node_tracks(doc, buffers)
+
+
+def test_our_turned_file_is_turned_back(tmp_path):
+    """A file whose root the writer turned (a Z-up rig made y-up, up_rotation stored): the
+    reader undoes the turn, translations and rotations, and gives back the frames."""
+    from cyclecoord.io.gltf import _build
+
+    _, m = _ours(tmp_path)
+    frames = m.frames.copy()
+    frames[:, m.channels.index(("root", "rx"))] = [10, 20, 30]
+    frames[:, m.channels.index(("root", "ty"))] = [1, 2, 3]
+    m = m.with_frames(frames)
+    up = np.array([[1.0, 0, 0], [0, 0, 1], [0, -1, 0]])
+    doc, data = _build(m, 1.0, False, up)
+    path = _save(doc, [data], tmp_path / "turned.gltf")
+    names, pos, _ = gr.gltf_joint_positions(path)  # the file's own nodes: turned
+    fk = m.positions().positions  # root, arm, arm/end
+    np.testing.assert_allclose(pos, fk @ up.T, atol=1e-5)
+    back = gr.read_gltf(path)
+    np.testing.assert_allclose(back.frames, m.frames, atol=1e-4)
