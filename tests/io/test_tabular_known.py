@@ -403,13 +403,35 @@ def test_csv_rows_of_exactly_one_chunk_and_more(tmp_path):
 
 
 def test_csv_frame_memory_counts_the_data_lines(tmp_path):
-    """Room for the rows is made first: the lines that are neither blank nor a comment,
-    less the header (3 rows of 2 values: 48 bytes)."""
+    """Room for the rows is made at once, before they are read: the lines that are neither
+    blank nor a comment, less the header (10 rows of 2 values: 160 bytes; at least one
+    row: 16 bytes for a file of one)."""
     p = tmp_path / "a.csv"
-    p.write_text("# fps=10\n\na.x,a.y\n1,2\n# c\n3,4\n  \n5,6\n")
-    with memory_limit(48):
-        assert tb.read_csv(p).frames.tolist() == [[1, 2], [3, 4], [5, 6]]
-    with memory_limit(47), pytest.raises(ParseError, match="3 frames of 2 channels need 48 bytes"):
+    rows = [f"{k},{-k}" for k in range(10)]
+    p.write_text("# fps=10\n\na.x,a.y\n" + "\n# c\n  \n".join(rows) + "\n")
+    with memory_limit(160):
+        assert tb.read_csv(p).frames.tolist() == [[k, -k] for k in range(10)]
+    with memory_limit(159), pytest.raises(ParseError, match="10 frames of 2 channels need 160 "
+                                                            "bytes"):
+        tb.read_csv(p)
+    p.write_text("a.x,a.y\n1,2\n")
+    with memory_limit(16):
+        assert tb.read_csv(p).frames.tolist() == [[1, 2]]
+
+
+def test_csv_row_count_limit(tmp_path, monkeypatch):
+    """At most MAX_FRAMES rows (here patched to 5): 5 read, the 6th refused at its line."""
+    monkeypatch.setattr(tb, "MAX_FRAMES", 5)
+    p = tmp_path / "a.csv"
+    p.write_text("a\n" + "".join(f"{k}\n" for k in range(5)))
+    assert tb.read_csv(p).frames[:, 0].tolist() == [0, 1, 2, 3, 4]
+    p.write_text("a\n" + "".join(f"{k}\n" for k in range(5)) + "# c\n5\n")
+    with pytest.raises(ParseError, match="6 rows; at most 5 frames are supported") as e:
+        tb.read_csv(p)
+    assert e.value.line == 8
+    # the count comes first: a bad row after the limit is not what is reported
+    p.write_text("a\n" + "".join(f"{k}\n" for k in range(5)) + "x\n1,2\n")
+    with pytest.raises(ParseError, match="7 rows; at most 5 frames"):
         tb.read_csv(p)
 
 
