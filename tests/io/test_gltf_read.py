@@ -193,6 +193,20 @@ def test_components_must_be_aligned():
         gr._accessor(gltf, [blob], 0, "x")
 
 
+def test_accessor_type_names():
+    """The type is a string of at most 10 characters naming one of the five kinds."""
+    gltf, buffers = _doc((np.zeros(4, "<f4"), FLOAT, "SCALAR"))
+    gltf.accessors[0].type = "VEC4VEC4VE"  # 10 characters: read, and not a kind
+    with pytest.raises(Invalid, match=r"accessors\[0\]\.type: 'VEC4VEC4VE' is not one of"):
+        gr._accessor(gltf, buffers, 0, "x")
+    gltf.accessors[0].type = "VEC4VEC4VEC"
+    with pytest.raises(Invalid, match=r"accessors\[0\]\.type: 11 characters; at most 10"):
+        gr._accessor(gltf, buffers, 0, "x")
+    gltf.accessors[0].type = 4
+    with pytest.raises(Invalid, match=r"accessors\[0\]\.type: expected a string"):
+        gr._accessor(gltf, buffers, 0, "x")
+
+
 def test_accessor_references_checked():
     gltf, buffers = _doc((np.zeros(3, "<f4"), FLOAT, "SCALAR"))
     with pytest.raises(Invalid, match="^x: 1 is not in 0..0$"):
@@ -485,9 +499,11 @@ def test_buffers_from_the_glb_chunk_a_data_uri_and_a_file(tmp_path):
                  + base64.b64encode(data).decode()),
         g.Buffer(byteLength=10, uri="b.bin"),
         g.Buffer(uri="b.bin"),  # no byteLength: 0 bytes needed
+        g.Buffer(uri="data:,"),  # no bytes at all, and none needed
     ])
+    assert gltf.buffers[4].byteLength is None
     gltf.set_binary_blob(b"abc")
-    assert gr._buffers(gltf, tmp_path / "x.gltf") == [b"abc", data, data, data]
+    assert gr._buffers(gltf, tmp_path / "x.gltf") == [b"abc", data, data, data, b""]
     gltf.buffers[2].byteLength = 11  # a buffer shorter than it says
     with pytest.raises(Invalid, match=r"^buffers\[2\]: holds fewer than its 11 bytes"):
         gr._buffers(gltf, tmp_path / "x.gltf")
