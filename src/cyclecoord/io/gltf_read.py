@@ -351,7 +351,7 @@ def _node_tracks(gltf, buffers, extras: dict | None = None, anim_index: int = 0)
     import pygltflib as g
     from scipy.spatial.transform import Rotation
 
-    from ._checked import Invalid, sequence, text, whole
+    from ._checked import Invalid, sequence, whole
     from ._limits import MAX_FPS, MAX_FRAMES, MIN_FPS, check_memory
 
     extras = _extras(gltf) if extras is None else extras
@@ -428,7 +428,6 @@ def _node_tracks(gltf, buffers, extras: dict | None = None, anim_index: int = 0)
             path = ch.target.path
             if ch.target.node is None or path not in ("translation", "rotation"):
                 continue
-            text(path, f"{at}.target.path", 20)
             node = whole(ch.target.node, f"{at}.target.node", 0, N - 1)
             if not samplers:
                 raise Invalid(f"{at}.sampler: the animation has no samplers")
