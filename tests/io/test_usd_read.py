@@ -210,6 +210,28 @@ def test_one_time_code_between_samples(tmp_path):
     np.testing.assert_allclose(trans[0, 0], [5, 0, 0], atol=1e-6)
 
 
+def test_samples_between_time_codes_and_segments_away_from_zero(tmp_path):
+    """Samples at 2, 2.5 and 4 for the range 2 .. 4: three keys for three frames, yet frame
+    3 is not the sample at 2.5 but between it and 4: x = 1 + (4 - 1) (0.5 / 1.5) = 2.
+    Samples at 2 and 6 for the range 2 .. 6: frame 3 is a quarter of the way, x = 1."""
+    samples = {2: ([[0, 0, 0]], [IDENTITY]), 2.5: ([[1, 0, 0]], [IDENTITY]),
+               4: ([[4, 0, 0]], [IDENTITY])}
+    path = _stage(tmp_path / "a.usda", ["r"], samples, start=2, end=4)
+    _s, _p, query, times, _f = usd._open(path)
+    trans, _ = usd._local_transforms(query, times, path)
+    np.testing.assert_allclose(trans[:, 0, 0], [0, 2, 4], atol=1e-6)
+    samples = {2: ([[0, 0, 0]], [IDENTITY]), 6: ([[4, 0, 0]], [(0, 0, 0, 1.0)])}
+    path = _stage(tmp_path / "b.usda", ["r"], samples, start=2, end=6)
+    _s, _p, query, times, _f = usd._open(path)
+    trans, rots = usd._local_transforms(query, times, path)
+    np.testing.assert_allclose(trans[:, 0, 0], [0, 1, 2, 3, 4], atol=1e-6)
+    for k in range(5):  # a half turn about z over 4 time codes: 45 degrees a code
+        a = np.radians(45 * k)
+        np.testing.assert_allclose(rots[k, 0], [[np.cos(a), -np.sin(a), 0],
+                                                [np.sin(a), np.cos(a), 0], [0, 0, 1]],
+                                   atol=1e-6)
+
+
 def test_samples_at_every_frame_are_read_as_they_are(tmp_path):
     samples = {t: ([[t, 0, 0]], [(np.cos(t / 4), 0, 0, np.sin(t / 4))]) for t in range(4)}
     path = _stage(tmp_path / "a.usda", ["r"], samples)
