@@ -291,6 +291,9 @@ def test_key_times_start_at_zero_or_later_and_increase():
             gr._key_times(np.array([[0.0], [bad], [2e9]]), "w")
     with pytest.raises(Invalid, match="^w: key time 0 is -1500000000.0, not a finite"):
         gr._key_times(np.array([[-1.5e9], [0.0]]), "w")
+    # a key of exactly 1e9 is fine: the error names the first one beyond
+    with pytest.raises(Invalid, match="^w: key time 2 is inf, not a finite"):
+        gr._key_times(np.array([[0.0], [1e9], [np.inf]]), "w")
 
 
 # ----------------------------------------------------------------------------- sampling
@@ -532,6 +535,7 @@ def test_buffer_uri_refusals(tmp_path):
     for uri, words in (("data:application/octet-stream;base64", r"buffers\[0\]\.uri: a data URI "
                                                                  "without ','"),
                        ("data:,@@", r"buffers\[0\]\.uri: not base64 data"),
+                       ("data:,AAAA,AAAA", r"buffers\[0\]\.uri: not base64 data"),  # all after 1st ,
                        ("gone.bin", r"buffers\[0\]: missing file gone\.bin"),
                        (".", r"buffers\[0\]: missing file \.")):  # a folder is not a file
         gltf = g.GLTF2(buffers=[g.Buffer(byteLength=0, uri=uri)])
