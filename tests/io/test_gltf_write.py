@@ -216,6 +216,8 @@ def test_stick_mesh_ring_frame(q, ring):
 
 
 def test_stick_mesh_skips_bones_shorter_than_a_nanometre():
+    verts, _, _ = gw._stick_mesh(np.array([[0, 0, 0], [0, 0, 1e-9]]), [(0, (0, 1))], 1.0)
+    assert verts.shape == (8, 3)  # exactly 1e-9 long: kept
     rest = np.array([[0, 0, 0], [0, 0, 2e-9], [0, 0, 0.5e-9]])
     verts, _, _ = gw._stick_mesh(rest, [(0, (0, 1)), (1, (0, 2))], 1.0)
     assert verts.shape == (8, 3)  # the 2e-9 bone kept, with corners 0.5e-9 away
