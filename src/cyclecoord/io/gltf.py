@@ -184,9 +184,9 @@ class _Blob:
         if kind == "MAT4":
             lo = hi = None
         else:
+            # tolist() gives Python floats for float32 and Python ints for the integer
+            # types: the JSON min/max are of the accessor's own kind as they are
             lo, hi = flat.min(axis=0).tolist(), flat.max(axis=0).tolist()
-        if comp != _FLOAT and lo is not None:
-            lo, hi = [int(v) for v in lo], [int(v) for v in hi]
         self.gltf.accessors.append(
             g.Accessor(
                 bufferView=len(self.gltf.bufferViews) - 1,

@@ -334,13 +334,13 @@ def _key_times(times: np.ndarray, where: str) -> np.ndarray:
         k = int(np.argmax(~np.isfinite(t) | (np.abs(t) > MAX_MAGNITUDE)))
         raise Invalid(f"{where}: key time {k} is {t[k]}, not a finite number of seconds")
     if t[0] < 0:
-        raise Invalid(f"{where}: key time 0 is {t[0]!r}; key times start at 0 or later")
+        raise Invalid(f"{where}: key time 0 is {float(t[0])!r}; key times start at 0 or later")
     back = np.flatnonzero(np.diff(t) <= 0)
     if back.size:
         k = int(back[0]) + 1
         raise Invalid(
-            f"{where}: key time {k} ({t[k]!r} s) does not come after key time {k - 1} "
-            f"({t[k - 1]!r} s); key times increase"
+            f"{where}: key time {k} ({float(t[k])!r} s) does not come after key time {k - 1} "
+            f"({float(t[k - 1])!r} s); key times increase"
         )
     return t
 
@@ -351,7 +351,7 @@ def _node_tracks(gltf, buffers, extras: dict | None = None, anim_index: int = 0)
     import pygltflib as g
     from scipy.spatial.transform import Rotation
 
-    from ._checked import Invalid, sequence, text, whole
+    from ._checked import Invalid, sequence, whole
     from ._limits import MAX_FPS, MAX_FRAMES, MIN_FPS, check_memory
 
     extras = _extras(gltf) if extras is None else extras
@@ -428,7 +428,6 @@ def _node_tracks(gltf, buffers, extras: dict | None = None, anim_index: int = 0)
             path = ch.target.path
             if ch.target.node is None or path not in ("translation", "rotation"):
                 continue
-            text(path, f"{at}.target.path", 20)
             node = whole(ch.target.node, f"{at}.target.node", 0, N - 1)
             if not samplers:
                 raise Invalid(f"{at}.sampler: the animation has no samplers")

@@ -455,14 +455,12 @@ def _local_transforms(query, times: np.ndarray, path: Path) -> tuple[np.ndarray,
     if len(keys) == len(times) and np.array_equal(keys, times):
         rots = Rotation.from_quat(quats.reshape(-1, 4)).as_matrix().reshape(len(times), J, 3, 3)
         return trans, rots
-    seg = np.clip(np.searchsorted(keys, times, side="right") - 1, 0, max(len(keys) - 2, 0))
-    if len(keys) == 1:
-        tr = np.broadcast_to(trans[0], (len(times), J, 3)).copy()
-        q = np.broadcast_to(quats[0], (len(times), J, 4))
-    else:
-        u = ((times - keys[seg]) / (keys[seg + 1] - keys[seg]))[:, None, None]
-        tr = trans[seg] + u * (trans[seg + 1] - trans[seg])
-        q = _slerp(quats[seg], quats[seg + 1], u)
+    # here times holds two time codes or more (one was returned above: keys == [lo]), so
+    # keys holds lo < hi at least and every segment has two ends
+    seg = np.clip(np.searchsorted(keys, times, side="right") - 1, 0, len(keys) - 2)
+    u = ((times - keys[seg]) / (keys[seg + 1] - keys[seg]))[:, None, None]
+    tr = trans[seg] + u * (trans[seg + 1] - trans[seg])
+    q = _slerp(quats[seg], quats[seg + 1], u)
     rots = Rotation.from_quat(q.reshape(-1, 4)).as_matrix().reshape(len(times), J, 3, 3)
     return tr, rots
 
