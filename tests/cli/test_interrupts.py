@@ -224,6 +224,16 @@ def test_feet_interrupted_before_the_report_keeps_the_motion(walk300, tmp_path, 
     assert _listing(tmp_path) == before
 
 
+def _reimport_cli_main(monkeypatch):
+    """Make the next import of cyclecoord.cli.main run again. Importing a submodule binds
+    it as its package's attribute, which here shadows the ``main`` function that
+    ``cyclecoord.cli`` exports: both are put back when the test ends."""
+    import cyclecoord.cli as package
+
+    monkeypatch.delitem(sys.modules, "cyclecoord.cli.main")
+    monkeypatch.setattr(package, "main", package.main)
+
+
 def test_ctrl_c_while_the_console_script_loads_the_commands_is_one_line(monkeypatch, capsys):
     """The console script's entry point imports the command line (numpy, scipy, every
     reader: about a second) inside its own guard: a Ctrl-C there is the one line and exit
@@ -238,7 +248,7 @@ def test_ctrl_c_while_the_console_script_loads_the_commands_is_one_line(monkeypa
                 raise KeyboardInterrupt
             return None
 
-    monkeypatch.delitem(sys.modules, "cyclecoord.cli.main")
+    _reimport_cli_main(monkeypatch)
     monkeypatch.setattr(sys, "meta_path", [CtrlC(), *sys.meta_path])
     assert console() == 130
     assert capsys.readouterr().err == "cyclecoord: interrupted\n"
@@ -261,7 +271,7 @@ def test_a_real_ctrl_c_while_the_console_script_loads_is_held_to_the_end(monkeyp
                 signal.raise_signal(signal.SIGINT)  # delivered now, the import goes on
             return None
 
-    monkeypatch.delitem(sys.modules, "cyclecoord.cli.main")
+    _reimport_cli_main(monkeypatch)
     monkeypatch.setattr(sys, "meta_path", [CtrlC(), *sys.meta_path])
     assert console() == 130
     assert seen and "cyclecoord.cli.main" in sys.modules  # the import itself completed
