@@ -445,4 +445,7 @@ def analysis_motion(motion: Motion) -> Motion:
     """
     if motion.skeleton is None:
         return motion
-    return normalize_rig(motion, drop_reference=False)[0]
+    info = describe_rig(motion)
+    if not (info.static_root or info.constant_position_joints or info.up_axis == "Z"):
+        return motion  # what normalize_rig would give back (a tenth of an animate script)
+    return normalize_rig(motion, info, drop_reference=False)[0]
