@@ -145,17 +145,7 @@ def test_graph_feet_carry_the_body(walks):
 def test_ratios_against_sources_that_never_move():
     # a model trained on hostile frames gave sources with no knee swing and no cadence:
     # animate ended in a ZeroDivisionError in its report (fuzzer model case 200139)
-    from dataclasses import MISSING, fields
-
-    from cyclecoord.quality.generated import GeneratedQuality
-
-    required = [f for f in fields(GeneratedQuality)
-                if f.default is MISSING and f.default_factory is MISSING]
-    values = {f.name: 0.0 for f in required}
-    values.update(frames=10, feet=("lfoot", "rfoot"), contact_fraction={}, freezes=[],
-                  knee_range=(1.0, 1.0), hip_range=(1.0, 1.0), largest_step_frame=0,
-                  largest_accel_frame=0)
-    q = GeneratedQuality(**values)
+    q = _quality()
     assert all(np.isfinite(q.knee_ratio + q.hip_ratio)) and np.isfinite(q.cadence_ratio)
 
 
