@@ -280,9 +280,13 @@ class LatentModel:
         """The model's angles ``(T, C)`` of full frames ``(T, D)``: the modelled channels,
         each on the branch within 180 degrees of its centre (:meth:`angle_centres`), the
         joints of :meth:`chart` re-expressed about their mean rotation."""
-        modelled = set(self.channels_)
-        cols = [i for i, c in enumerate(self.all_channels_) if c in modelled]
+        cols = self._columns()
         return self.to_model(np.asarray(frames, dtype=float)[:, cols])
+
+    def _columns(self) -> list[int]:
+        """Columns of the modelled channels in full frames."""
+        modelled = set(self.channels_)
+        return [i for i, c in enumerate(self.all_channels_) if c in modelled]
 
     def _centred(self, x: np.ndarray) -> np.ndarray:
         c = self.angle_centres()
@@ -316,8 +320,7 @@ class LatentModel:
 
         from ...periodic.rotations import euler_is_safe
 
-        modelled = set(self.channels_)
-        cols = [i for i, c in enumerate(self.all_channels_) if c in modelled]
+        cols = self._columns()
         x = self._centred(np.asarray(self.frames_, dtype=float)[:, cols])
         by_joint: dict[str, dict[str, int]] = {}
         for k, (j, d) in enumerate(self.channels_):
@@ -379,8 +382,7 @@ class LatentModel:
         return a
 
     def _channels0(self) -> np.ndarray:
-        modelled = set(self.channels_)
-        cols = [i for i, c in enumerate(self.all_channels_) if c in modelled]
+        cols = self._columns()
         return np.asarray(self.frames_[0], dtype=float)[cols]
 
     def angle_centres(self) -> np.ndarray:
@@ -398,8 +400,7 @@ class LatentModel:
         if c is None or c.shape != (len(self.channels_),):
             from ...periodic.rotations import circular_mean_degrees
 
-            modelled = set(self.channels_)
-            cols = [i for i, ch in enumerate(self.all_channels_) if ch in modelled]
+            cols = self._columns()
             mean = circular_mean_degrees(np.asarray(self.frames_, dtype=float)[:, cols])
             c = 180.0 * np.round(mean / 180.0)
             c[c <= -180.0] += 360.0  # one name for the half turn: 180, never -180
