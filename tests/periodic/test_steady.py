@@ -257,3 +257,16 @@ def test_gaps_of_a_quarter_period_are_bridged():
         got = steady_mask(u, cand, 100.0, recurrence_distance=r)
         assert got.all() == bridged, gap
         assert got[:500].all() and got[500 + gap :].all()
+
+
+def test_a_tight_curve_is_steady_and_a_corner_within_a_cycle_is_not():
+    """The default ``max_curve`` is 90 degrees a period: a walk on a circle of four to
+    five cycles (Bandai's turning walks take their corners at 51 and 65 degrees a period)
+    is steady all along; a steady spin faster than a quarter turn a cycle is not."""
+    from cyclecoord.periodic.steady import steady_turning
+
+    P = 30
+    t = np.arange(600)
+    assert steady_turning(65.0 / P * t, P).all()
+    assert steady_turning(89.0 / P * t, P).all()
+    assert not steady_turning(91.0 / P * t, P).any()

@@ -204,7 +204,7 @@ def centred_window(n: int, half: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def steady_turning(
-    heading: np.ndarray, period: float, max_turn: float = 30.0, max_curve: float = 60.0
+    heading: np.ndarray, period: float, max_turn: float = 30.0, max_curve: float = 90.0
 ) -> np.ndarray:
     """Frames whose heading turns at a steady rate (see :func:`steady_mask`).
 
@@ -249,7 +249,7 @@ def steady_mask(
     pace_window: float = 2.0,
     max_recurrence: float = 2.0,
     max_turn: float = 30.0,
-    max_curve: float = 60.0,
+    max_curve: float = 90.0,
     speed: np.ndarray | None = None,
     max_speed_ratio: float = 1.3,
 ) -> np.ndarray:
@@ -272,8 +272,11 @@ def steady_mask(
         changes are measured): a frame is not steady where its period-long window turns
         more than ``max_turn`` degrees more or less than the windows half a period before
         and after it (the start or end of a turn), or more than ``max_curve`` degrees in
-        all (a corner, a U-turn, a turn on the spot; 60 degrees a period is a circle of
-        six cycles).
+        all (a corner taken within a cycle, a U-turn, a turn on the spot).  90 degrees a
+        period is a circle walked in four cycles, about 0.8 m in radius at a 1.3 m
+        stride: people walk tighter curves than the 60 degrees that was the limit until
+        the Bandai turning walks, which take their 90-degree turns at up to 51 (left) and
+        65 (right) degrees a period with the cadence of a walk.
     max_turn, max_curve : float
         Degrees per period (see ``heading``).
     max_pace : float
