@@ -78,6 +78,10 @@ Columns (per file):
   knee = thigh to shin, ankle = shin to the ankle-to-ball vector), the p1-p99 range in
   the cycle over the best cut's; the smallest ratio and its leg (named by its thigh
   joint) and angle.
+* **cut pct**, **legs/med** -- context for legs/cut, not a target: the share of the
+  one-period windows of the steady frames (one per starting frame) whose range of that
+  lowest angle is below the cut's (the cut is one stride; at 90 % it is one of the
+  widest), and the smallest range ratio of the cycle against the median window instead.
 
 Targets (issue 23): ``TARGETS``, PASS/FAIL per file and target in a second table, and a
 summary line.  CMU takes also carry the issue's "nothing lost on CMU" targets (period
@@ -818,7 +822,29 @@ def measure_cycle(cap: Capture, cycle_frames: np.ndarray, cycle_fps: float,
     ratios = {k: angle_range(ours[k]) / angle_range(theirs[k]) for k in ours}
     worst = min(ratios, key=ratios.get)
     out.update(leg_ratios=ratios, legs_min=ratios[worst], legs_min_joint=worst)
+    # context, not a target: the same ratios against the median over every one-period
+    # window of the steady frames, and where the cut's range sits among those windows
+    windows = window_leg_ranges(cap, stop - start)
+    if windows:
+        med = {k: angle_range(ours[k]) / float(np.median(v)) for k, v in windows.items()}
+        low = min(med, key=med.get)
+        cut_rank = {k: float(np.mean(np.asarray(windows[k]) < angle_range(theirs[k])))
+                    for k in windows}
+        out.update(legs_over_median_window=med, legs_median_min=med[low],
+                   legs_median_min_joint=low, cut_percentile=cut_rank,
+                   cut_percentile_of_worst=cut_rank[worst])
     return out
+
+
+def window_leg_ranges(cap: Capture, length: int) -> dict[str, list[float]]:
+    """The p1-p99 range of each leg angle over every window of ``length`` frames (one
+    per starting frame) inside the steady frames: how much one stride's range varies."""
+    a, b = cap.steady
+    if length < 2 or b - a <= length:
+        return {}
+    angles = leg_angles(cap.points[a:b], cap.body)
+    return {k: [angle_range(v[i : i + length]) for i in range(0, b - a - length + 1)]
+            for k, v in angles.items()}
 
 
 # ----------------------------------------------------------------- one file
@@ -1038,7 +1064,7 @@ def _table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
 
 FIGURE_HEADERS = ["file", "frames", "steady", "extract", "cpu s", "wall s", "period", "ac",
                   "ac%", "strike", "str%", "step/p99", "near max", "near med", "seam",
-                  "jerk/cut", "legs/cut", "lowest leg joint"]
+                  "jerk/cut", "legs/cut", "lowest leg joint", "cut pct", "legs/med"]
 
 
 def figure_rows(report: dict) -> list[list[str]]:
@@ -1054,7 +1080,8 @@ def figure_rows(report: dict) -> list[list[str]]:
             _f(r.get("strike_period"), "{:.1f}"), _f(r.get("strike_pct"), "{:+.1f}"),
             _f(q.get("step_over_p99")), _f(q.get("near_max")), _f(q.get("near_median")),
             _f(q.get("seam")), _f(q.get("jerk_over_cut")), _f(q.get("legs_min")),
-            q.get("legs_min_joint") or "-",
+            q.get("legs_min_joint") or "-", _f(q.get("cut_percentile_of_worst"), "{:.0%}"),
+            _f(q.get("legs_median_min")),
         ])
     return out
 
@@ -1091,6 +1118,10 @@ def format_report(report: dict) -> str:
               "last-to-first step over the cycle's median step; jerk/cut, legs/cut: against the",
               "best loop cut (legs: smallest p1-p99 range ratio of hip/knee/ankle flexion). All",
               "in root-frame joint positions from this benchmark's own FK, steady frames only.",
+              "cut pct: the share of one-period windows of the steady frames whose range of that",
+              "lowest leg angle is below the cut's (a cut at 90 % took one of the widest strides);",
+              "legs/med: the smallest range ratio against the median window instead (context:",
+              "the targets are against the cut).",
               "", _table(TARGET_HEADERS, target_rows(report)), "",
               "targets: " + "; ".join(f"{k}: {v}" for k, v in TARGETS.items()),
               "CMU only: " + "; ".join(f"{k}: {v}" for k, v in CMU_TARGETS.items())]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import json
 import sys
@@ -282,6 +283,32 @@ def test_a_copy_of_one_captured_period_measures_as_the_capture():
     assert len(q["leg_ratios"]) == 6
     assert q["jerk_over_cut"] == pytest.approx(1.0, rel=1e-6)
     assert q["cut_stop"] - q["cut_start"] == PERIOD
+    # and every one-period window has the range of any other: the median window's too
+    assert q["legs_median_min"] == pytest.approx(1.0, abs=1e-6)
+
+
+def test_window_leg_ranges_are_one_per_starting_frame_and_see_a_wide_stride():
+    rig, frames, cap = _capture(_walk().motion)
+    a, b = cap.steady
+    ranges = bench.window_leg_ranges(cap, PERIOD)
+    assert len(ranges) == 6
+    assert all(len(v) == b - a - PERIOD + 1 for v in ranges.values())
+    # an exactly periodic capture: every window's range is the one-period range, by hand
+    knee = bench.leg_angles(cap.points[a : a + PERIOD], cap.body)
+    for k, v in ranges.items():
+        assert np.allclose(v, bench.angle_range(knee[k]), atol=1e-6)
+    # one stride made wider shows in the windows that hold it, and only in those
+    wide = np.array(frames)
+    col = rig.channels.index(("lfemur", "rx"))
+    stride = slice(a + 2 * PERIOD, a + 3 * PERIOD)
+    wide[stride, col] = wide[stride, col].mean() + 1.5 * (wide[stride, col] - wide[stride, col].mean())
+    cap2 = dataclasses.replace(bench.prepare_capture(rig, wide, cap.fps), steady=cap.steady)
+    hip = np.asarray(bench.window_leg_ranges(cap2, PERIOD)["lfemur hip"])
+    base = ranges["lfemur hip"][0]
+    touching = np.arange(len(hip)) + PERIOD > 2 * PERIOD
+    touching &= np.arange(len(hip)) < 3 * PERIOD
+    assert np.all(hip[~touching] == pytest.approx(base, abs=1e-6))
+    assert hip[2 * PERIOD] > 1.2 * base
 
 
 def test_a_copy_of_one_period_of_a_noisy_capture_is_at_distance_0():
