@@ -723,3 +723,23 @@ def test_edge_taper_of_zero_length_is_no_taper():
     mask = np.array([0, 1, 1, 1, 0, 1], dtype=bool)
     for length in (0.0, -0.0, 0):
         np.testing.assert_array_equal(edge_taper(mask, length), mask.astype(float))
+
+
+def test_the_glitch_filter_of_typical_amplitude_is_timed_in_seconds():
+    """Five frames at 120 fps: 5 at 100 and 120 fps, 3 at 60, none at 30 and 24 (where a
+    5-frame median clipped a real ankle roll of a sixth of a second)."""
+    from cyclecoord.periodic.clip import spike_frames, typical_amplitude
+
+    assert [spike_frames(f) for f in (24, 30, 48, 60, 100, 120, 240)] == [1, 1, 3, 3, 5, 5, 11]
+    # a 2-frame plateau at 30 fps is motion: each window of the capture holds one at full
+    # height, the averaged cycle holds it at half, so the cycle is widened back to it
+    P = 30
+    rep = np.zeros(P)
+    rep[14:16] = 1.0
+    poses = np.tile(rep, 6)[:, None]
+    cycle = 0.5 * rep[:, None]
+    out = typical_amplitude(cycle, np.zeros(poses.shape[0]), poses, spike=spike_frames(30))
+    assert np.ptp(out) == pytest.approx(1.5 * np.ptp(cycle))  # to the gain's cap: 0.75
+    # the 120-fps filter (5 frames) takes the same plateau for a glitch: no widening
+    np.testing.assert_allclose(typical_amplitude(cycle, np.zeros(poses.shape[0]), poses,
+                                                 spike=spike_frames(120)), cycle)
