@@ -188,3 +188,95 @@ def test_gait_survives_saving(models, tmp_path):
     back = LatentModel.load(tmp_path / "run.npz")
     assert back.gait_ is not None
     np.testing.assert_allclose(back.gait().phase, models["run"].gait().phase)
+
+
+# ------------------------------------------------------------- the gait's loop, by hand
+def _gait(values_per_cycle, cycles, frames_per_cycle=10):
+    """One segment of ``cycles`` cycles sampled ``frames_per_cycle`` a cycle, phase 0 at
+    frame 0; the values repeat ``values_per_cycle`` (a function of the phase in [0, 1))
+    plus whatever the caller adds."""
+    from cyclecoord.synthesis.latent.gait import Gait
+
+    n = int(round(cycles * frames_per_cycle)) + 1
+    phase = np.arange(n) / frames_per_cycle
+    gait = Gait(phase=phase, period=np.array([float(frames_per_cycle)]),
+                segments=np.zeros(n, dtype=int))
+    return gait, phase, np.array([values_per_cycle(p % 1.0) for p in phase], dtype=float)
+
+
+def test_the_loop_seam_is_searched_over_a_whole_cycle_of_phases():
+    """2.3 cycles: K = 2 leaves only the last 0.3 cycle to place the seam in; one cycle
+    fewer makes every phase a candidate.  The take repeats exactly except a bump over its
+    first 0.3 cycle, where every K = 2 seam's earlier ends lie: the seamless places are
+    K = 1 seams whose frame and next frame are at phases 1.4-2.2 (earlier ends 0.4-1.2,
+    unbumped), a loop start of 0.4-1.2 cycles."""
+    gait, phase, values = _gait(lambda p: [np.sin(2 * np.pi * p), np.cos(2 * np.pi * p)], 2.3)
+    values[phase <= 0.3 + 1e-9] += 0.5
+    rows, start, K = gait._loop(0, values[:, :, None])
+    assert K == 1.0
+    assert 0.4 - 1e-9 <= start <= 1.2 + 1e-9
+    # the frame at the seam and the next match the frames one cycle earlier exactly
+    f = int(round((start + K) * 10))
+    assert np.allclose(values[f], values[f - 10]) and np.allclose(values[f + 1], values[f - 9])
+    # without values (no seam to judge) the loop is the whole cycles from the start
+    assert gait._loop(0)[1:] == (0.0, 2.0)
+
+
+def test_the_seam_matches_the_next_frame_as_well_as_the_frame():
+    """Two candidate seams with the same pose gap at the frame; at one of them the next
+    frame differs as well (the motion there does not continue): the other is chosen."""
+    gait, phase, values = _gait(lambda p: [np.sin(2 * np.pi * p)], 1.875, frames_per_cycle=8)
+    values[phase >= 1.0] += 0.3  # every seam costs a gap ...
+    values[np.isin(phase, [1.25, 1.5])] -= 0.3  # ... but at 1.25 and 1.5 (exact in binary)
+    values[phase == 1.625] -= 0.3  # and after 1.5 the next frame matches as well
+    rows, start, K = gait._loop(0, values[:, :, None])
+    assert K == 1.0 and start == 0.5  # by the frame alone, 1.25 (start 0.25) would do
+
+
+def test_a_path_plays_the_frames_before_the_loop_end_as_they_are():
+    """A phase before the loop's seam is that training frame (no jump into the loop at the
+    first MOVE); past the seam it is shifted back by whole cycles into the loop."""
+    gait, phase, values = _gait(lambda p: [np.sin(2 * np.pi * p)], 2.3)
+    values[phase <= 0.3 + 1e-9] += 0.5
+    rows, start, K = gait._loop(0, values[:, :, None])
+    assert K == 1.0 and 0.4 - 1e-9 <= start <= 1.2 + 1e-9  # as in the test above
+    u = np.array([0.0, 0.35, start + K - 0.05, start + K, start + K + 0.25, 7.0])
+    got = gait.frame_at(0, u, values[:, :, None])
+    want = [0.0, 3.5, 10 * (start + K - 0.05), 10 * start, 10 * (start + 0.25),
+            10 * (start + np.mod(7.0 - start, K))]
+    np.testing.assert_allclose(got, want, atol=1e-9)
+    # a phase before the segment's first frame is shifted into the loop too
+    assert gait.frame_at(0, np.array([-0.5]), values[:, :, None])[0] == pytest.approx(
+        10 * (start + np.mod(-0.5 - start, K)))
+
+
+def test_foot_locks_are_limited_by_the_pace_of_the_model_posing_each_frame(made):
+    """The lock's pop limit is 1.5x the 99th percentile of the training accelerations of
+    the model that posed the frame (the faster one near a change of model), not the
+    fastest model's everywhere."""
+    from cyclecoord.synthesis.latent.output import LOCK_REACH
+
+    syn, motion = made
+    per = syn._frame_acc99(motion.n_frames)
+    walk, run = syn._acc99("walk"), syn._acc99("run")
+    assert walk < run  # the synthetic jog accelerates more than the walk
+    reach = int(round(LOCK_REACH * syn.fps))
+    a, b = _span(syn, range(0, 10))  # the walk's MOVEs
+    assert np.all(per[a : b - reach] == walk)
+    c, d = _span(syn, range(11, 21))  # the run's MOVEs
+    assert np.all(per[c + reach : d - reach] == run)
+    assert a == 0 and np.all(per[b - reach : c + reach] == run)  # through the transition
+    # a script whose chunks do not match the frames falls back to the largest figure
+    np.testing.assert_array_equal(syn._frame_acc99(motion.n_frames + 1), run)
+
+
+def test_lock_where_clean_takes_one_limit_per_frame():
+    from cyclecoord.synthesis.carry import _limit_words, lock_where_clean
+
+    m = cc.datasets.example_capture().motion[:240]
+    one = lock_where_clean(m, 1e12)
+    per = lock_where_clean(m, np.full(m.n_frames, 1e12))
+    np.testing.assert_array_equal(one.motion.frames, per.motion.frames)
+    assert one.line == per.line and one.locked > 0
+    assert _limit_words(np.full(5, 1234.0)) == "1.23e+03"
+    assert _limit_words(np.array([1000.0, 4500.0])) == "1e+03-4.5e+03"

@@ -178,7 +178,7 @@ class LockOutcome:
 
 def lock_where_clean(
     motion: Motion,
-    limit: float,
+    limit: float | np.ndarray,
     feet: tuple[str, ...] | None = None,
     *,
     min_duration: float = 0.2,
@@ -190,8 +190,10 @@ def lock_where_clean(
     Contacts (:func:`~cyclecoord.quality.contacts.foot_contacts`, low and slow: on a
     carried motion the support foot) of at least ``min_duration`` s are pinned.  After
     locking, a contact around which the largest joint acceleration (relative to the root)
-    exceeds both ``limit`` (length units/s^2, e.g. 1.5x the sources' 99th percentile)
-    and what it was before is unlocked and the rest locked again; so is one where a
+    exceeds both ``limit`` (length units/s^2, e.g. 1.5x the sources' 99th percentile;
+    a number, or one per frame where the frames come from sources of different pace, a
+    walk and a run) and what it was before is unlocked and the rest locked again; so is
+    one where a
     channel leaves ``bounds`` (per-channel low and high values, e.g. the training takes'
     range widened by :data:`RANGE_MARGIN` degrees) that it kept before.
     """
@@ -212,6 +214,7 @@ def lock_where_clean(
     if not planted.any():
         return LockOutcome(motion, 0, [], "foot locking: no contact long enough to pin")
     before = _accel(motion)
+    limit = np.broadcast_to(np.asarray(limit, dtype=float), before.shape)
     outside_before = _outside(motion.frames, bounds)
     skipped: list[tuple[int, int]] = []
     result = None
@@ -245,7 +248,7 @@ def lock_where_clean(
             0,
             spans,
             "foot locking: not done (pinning made joints accelerate past "
-            f"{limit:.3g} units/s^2 or leave the training range"
+            f"{_limit_words(limit)} units/s^2 or leave the training range"
             + (f" at frames {where})" if spans else ")"),
         )
     n_locked = sum(len(contact_runs(planted[:, i])) for i in range(planted.shape[1]))
@@ -274,6 +277,11 @@ def _outside(frames: np.ndarray, bounds) -> np.ndarray:
         return np.zeros(frames.shape[0], dtype=bool)
     lo, hi = bounds
     return ((frames < lo) | (frames > hi)).any(axis=1)
+
+
+def _limit_words(limit: np.ndarray) -> str:
+    lo, hi = float(limit.min()), float(limit.max())
+    return f"{lo:.3g}" if hi <= lo * 1.0005 else f"{lo:.3g}-{hi:.3g}"
 
 
 def _accel(motion: Motion) -> np.ndarray:

@@ -164,8 +164,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         height, not speed, the lowest foot carrying the body; IDLE stands after 0.5 s; no
         foot under the training frames' floor), then, with ``lock``, the planted feet
         pinned where that makes no pop
-        (:func:`~cyclecoord.synthesis.carry.lock_where_clean`, limit 1.5x the models'
-        99th percentile of joint acceleration; the ``notes`` attribute says where not).
+        (:func:`~cyclecoord.synthesis.carry.lock_where_clean`, limit 1.5x the 99th
+        percentile of joint acceleration of the model posing each frame, the faster one
+        within ``LOCK_REACH`` of a change of model; the ``notes`` attribute says where
+        not).
         ``"transitions"``: the blend windows and
         :data:`PLANT_MARGIN` around them only, with the speed-gated contacts of before
         (the feet elsewhere glide with the training frames' root velocity); ``"off"``.

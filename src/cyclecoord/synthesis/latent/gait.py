@@ -61,9 +61,13 @@ class Gait:
         self, segment: int, values: np.ndarray | None = None
     ) -> tuple[np.ndarray, float, float]:
         """The segment's rows, the start ``s`` of its loop ``[s, s + K)`` and its whole
-        cycles ``K``.  With ``values``, the loop is placed where the values at one phase
-        and at the same phase ``K`` cycles later are closest (the seam where stepping
-        past the end jumps back; the capture's cycles differ a little)."""
+        cycles ``K``.  With ``values``, the loop is placed where stepping past its end
+        jumps back least: the seam is the frame whose values, and the next frame's, are
+        nearest the values at the same phases ``K`` cycles earlier (a pose and its
+        motion), over ``K`` the segment's whole cycles and one cycle fewer, so that every
+        phase of a cycle is a candidate (with ``K`` alone a take of 6.02 cycles had only
+        its last half-frame to choose from: the Bandai run's seam jumped 2.2 median
+        latent steps and popped at 2.4x the training 99th percentile of acceleration)."""
         rows = self.rows(segment)
         ph = self.phase[rows]
         lo, span = ph[0], ph[-1] - ph[0]
@@ -71,16 +75,32 @@ class Gait:
         if values is None or span < K:
             return rows, lo, K
         idx = np.arange(rows.size, dtype=float)
-        late = np.flatnonzero(ph >= lo + K)
-        early = self._lerp(values, rows[0] + np.interp(ph[late] - K, ph, idx))
-        gap = np.linalg.norm((values[rows[late]] - early).reshape(late.size, -1), axis=1)
-        return rows, float(ph[late[np.argmin(gap)]] - K), K
+        best = (np.inf, lo, K)
+        for k in (K, K - 1.0) if K >= 2 else (K,):
+            late = np.flatnonzero(ph[:-1] >= lo + k)  # the next frame exists
+            if not late.size:
+                continue
+            gap = np.zeros(late.size)
+            for step in (0, 1):
+                here = rows[late + step]
+                early = self._lerp(values, rows[0] + np.interp(ph[late + step] - k, ph, idx))
+                gap += np.linalg.norm((values[here] - early).reshape(late.size, -1), axis=1)
+            j = int(np.argmin(gap))
+            if gap[j] < best[0]:
+                best = (float(gap[j]), float(ph[late[j]] - k), k)
+        return rows, best[1], best[2]
 
     def frame_at(self, segment: int, u: np.ndarray, values: np.ndarray | None = None):
         """Fractional training-frame indices (into the model's frames) of unwrapped phases
-        ``u`` on ``segment``, shifted by whole cycles into the segment's loop."""
+        ``u`` on ``segment``: a phase the segment holds before its loop's end is played
+        as it is; later ones (and any before the segment's start) are shifted by whole
+        cycles into the loop, so a path only jumps where it crosses the loop's seam (not
+        into the loop from a start before it: on subject 35's walks that first jump
+        accelerated the joints 2.0x the training 99th percentile)."""
         rows, lo, K = self._loop(segment, values)
-        v = lo + np.mod(np.asarray(u, dtype=float) - lo, K)
+        u = np.asarray(u, dtype=float)
+        inside = (u >= self.phase[rows[0]]) & (u < lo + K)
+        v = np.where(inside, u, lo + np.mod(u - lo, K))
         return rows[0] + np.interp(v, self.phase[rows], np.arange(rows.size, dtype=float))
 
     def at(self, values: np.ndarray, segment: int, u: np.ndarray) -> np.ndarray:

@@ -19,6 +19,9 @@ PLANT_MARGIN = 0.2
 LOCK_BLEND = 0.1
 #: Shortest contact (s) the IK lock pins (shorter ones toggle and make the legs jitter).
 LOCK_MIN_CONTACT = 0.2
+#: Seconds either side of a change of model in which a lock may accelerate the joints as
+#: much as the faster model's training takes do (a lock's ease plus two frames).
+LOCK_REACH = 0.2
 #: Gaussian width (s) of the smoothing of the planted track's steps.
 PLANT_SMOOTH = 0.07
 #: Contact searches on the corrected motion.
@@ -283,12 +286,28 @@ class OutputMixin:
             + ("; IDLE stands after 0.5 s" if self.held else "")
         )
         if self.lock:
-            limit = 1.5 * max(self._acc99(k) for k in used)
+            limit = 1.5 * self._frame_acc99(motion.n_frames)
             bounds = channel_bounds([self.models[k].training_motion() for k in used])
             locked = lock_where_clean(out, limit, self.feet, bounds=bounds)
             self.notes.append(locked.line)
             out = locked.motion
         return out
+
+    def _frame_acc99(self, n_frames: int) -> np.ndarray:
+        """(T,) the training 99th percentile of joint acceleration of the model that posed
+        each frame (:meth:`_acc99`), the larger of two models within :data:`LOCK_REACH`
+        seconds of a change of model.  One figure for the whole script (the largest
+        model's) let the locks of a walk pop at 2.0x the walk's own 99th percentile on
+        subject 35's walk + jog script: 1.5x the jog's was within the limit."""
+        from scipy.ndimage import maximum_filter1d
+
+        per = np.concatenate(
+            [np.full(c.X.shape[0], self._acc99(c.model)) for c in self.chunks] or [[0.0]]
+        )
+        if per.size != n_frames:  # not the chunks' frames: one figure, the largest
+            return np.full(n_frames, float(per.max()))
+        reach = int(round(LOCK_REACH * self.fps))
+        return maximum_filter1d(per, size=2 * reach + 1, mode="nearest")
 
     def segments(self) -> list[dict[str, Any]]:
         """Which frames each command made and in which model."""
