@@ -341,6 +341,27 @@ def test_feet_word_bounds_and_ratios():
     assert (z.slip_ratio, z.cadence_ratio, z.root_ratio) == pytest.approx((1.0, 2.0, 3.0))
     assert z.knee_ratio == pytest.approx((4.0, 0.0))
     assert _quality(hip_range=(4e-9, 1e-9)).hip_ratio == pytest.approx((4.0, 1.0))
+    # with the sources' ranges leg by leg, each leg is judged against its own
+    legs = _quality(knee_range=(30.0, 45.0), source_knee_range=60.0, source_knee_legs=(40.0, 90.0),
+                    hip_range=(10.0, 20.0), source_hip_range=40.0, source_hip_legs=(20.0,))
+    assert legs.knee_ratio == (0.75, 0.5)
+    assert legs.hip_ratio == (0.25, 0.5)  # one source leg for two: the pooled range
+
+
+def test_a_limping_capture_measured_against_itself_reads_one_on_each_leg():
+    """Synthetic legs whose left knee bends 10 deg and right 6 deg: against itself, each
+    leg's range ratio is 1 (against the range pooled over legs it would read 1.25 and
+    0.75); the sources' figures keep the pooled median for the summary."""
+    src, knees, _ = _knee_sources()
+    f = src.frames.copy()
+    wave = np.sin(2 * np.pi * np.arange(128) / 64)
+    f[:, knees[0]], f[:, knees[1]] = 10 * wave, 6 * wave
+    limp = src.with_frames(f)
+    q = measure_generated(limp, [limp])
+    assert q.knee_ratio == pytest.approx((1.0, 1.0))
+    assert q.source_knee_legs == pytest.approx(q.knee_range)
+    assert q.source_knee_range == pytest.approx(np.median(q.knee_range))
+    assert q.knee_range[0] == pytest.approx(q.knee_range[1] * 10 / 6, rel=0.05)
 
 
 def test_to_dict_and_summary_lines():

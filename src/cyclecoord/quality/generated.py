@@ -264,6 +264,8 @@ class SourceFigures:
     take_cycle: np.ndarray  # (S,) leg cycle per take, s
     penetration: float  # fraction of frames deeper than PENETRATION_M under the floor
     contact_slide: float  # units/s, median speed of foot points in contact
+    knee_range_legs: tuple[float, ...] = ()  # degrees per leg, median over takes
+    hip_range_legs: tuple[float, ...] = ()
 
     @property
     def root_speed(self) -> float:
@@ -317,6 +319,8 @@ def source_figures(
         contact_slide=float(
             np.median(np.concatenate([_contact_speeds(s, rig, floor)[0] for s in srcs]))
         ),
+        knee_range_legs=tuple(float(x) for x in np.median([_ranges(k.knee) for k in kins], 0)),
+        hip_range_legs=tuple(float(x) for x in np.median([_ranges(k.hip) for k in kins], 0)),
     )
 
 
@@ -327,6 +331,16 @@ def _contact_speeds(motion: Motion, rig: _Rig, floor: float):
     spd = c.speed[c.planted]
     fast = (c.planted & (c.speed > FAST_CONTACT * c.leg_length)).any(axis=1).mean()
     return (spd if spd.size else np.zeros(1)), c, float(fast)
+
+
+def _leg_ratios(
+    ranges: tuple[float, ...], legs: tuple[float, ...], pooled: float
+) -> tuple[float, ...]:
+    """Range over the sources', leg by leg: a capture measured against itself reads 1 on
+    each leg (against the range pooled over legs, the Bandai run's right hip read 0.91 of
+    its own sources: that leg swings less than the left)."""
+    refs = legs if len(legs) == len(ranges) else (pooled,) * len(ranges)
+    return tuple(k / max(r, 1e-9) for k, r in zip(ranges, refs))
 
 
 def _lowest(kin: _Kin, rig: _Rig) -> np.ndarray:
@@ -377,6 +391,9 @@ class GeneratedQuality:
     held_frames: int = 0
     notes: list[str] = field(default_factory=list)
     knee_p99: tuple[float, ...] = ()  # degrees of flexion per leg (the issue's table)
+    #: the sources' ranges leg by leg (median over takes), which the ratios use
+    source_knee_legs: tuple[float, ...] = ()
+    source_hip_legs: tuple[float, ...] = ()
 
     # ---- derived
     @property
@@ -394,11 +411,13 @@ class GeneratedQuality:
 
     @property
     def knee_ratio(self) -> tuple[float, ...]:
-        return tuple(k / max(self.source_knee_range, 1e-9) for k in self.knee_range)
+        """Each leg's knee range over the sources' range of the same leg (over their range
+        pooled over legs when the leg counts differ)."""
+        return _leg_ratios(self.knee_range, self.source_knee_legs, self.source_knee_range)
 
     @property
     def hip_ratio(self) -> tuple[float, ...]:
-        return tuple(k / max(self.source_hip_range, 1e-9) for k in self.hip_range)
+        return _leg_ratios(self.hip_range, self.source_hip_legs, self.source_hip_range)
 
     @property
     def cadence_ratio(self) -> float:
@@ -500,6 +519,8 @@ class GeneratedQuality:
             "hip_range_ratio": [f(x) for x in self.hip_ratio],
             "sources_knee_range_deg": f(self.source_knee_range),
             "sources_hip_range_deg": f(self.source_hip_range),
+            "sources_knee_range_by_leg_deg": [f(x) for x in self.source_knee_legs],
+            "sources_hip_range_by_leg_deg": [f(x) for x in self.source_hip_legs],
             "cycle_s": f(self.cycle_s),
             "sources_cycle_s": f(self.source_cycle_s),
             "cadence_ratio": f(self.cadence_ratio),
@@ -608,6 +629,8 @@ def measure_generated(
         held_frames=int(held.sum()),
         notes=notes,
         knee_p99=tuple(float(x) for x in np.percentile(kin.knee, 99, axis=0)),
+        source_knee_legs=ref.knee_range_legs,
+        source_hip_legs=ref.hip_range_legs,
     )
 
 
