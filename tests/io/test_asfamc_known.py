@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from cyclecoord.errors import ParameterError, ParseError
+from cyclecoord.io._limits import memory_limit
 from cyclecoord.io._acclaim import (
     _asf_listing,
     asf_layout,
@@ -441,6 +442,15 @@ def test_tiny_amc_known_values(tmp_path):
     assert m.skeleton.names == ["root", "upper", "lower"]
     m2 = read_amc(tmp_path / "tiny.amc", fps=30)
     assert m2.fps == 30.0
+
+
+def test_amc_rows_allocated_are_the_frame_lines_counted(tmp_path):
+    put(tmp_path, "tiny.asf", TINY_ASF)
+    p = put(tmp_path, "tiny.amc", TINY_AMC + "# 3\n 4 x\n")  # neither line is a frame number
+    with memory_limit(1), pytest.raises(ParseError) as info:
+        read_amc(p)
+    assert "2 frames of 9 channels need 144 bytes" in info.value.message
+    assert info.value.path == str(p)
 
 
 def test_amc_radians_scale_rotations_only(tmp_path):

@@ -10,6 +10,7 @@ import pytest
 
 from cyclecoord.errors import ParameterError, ParseError
 from cyclecoord.io import read_bvh, write_bvh
+from cyclecoord.io._limits import memory_limit
 from cyclecoord.io.bvh import (
     BVH_CHANNEL_NAMES,
     _bvh_names,
@@ -191,6 +192,20 @@ def test_frame_problems_are_reported_in_a_whole_file_order(tmp_path):
     assert err.line == 21 and "frame 3: value 8 (Leg Zrotation) is 'y'" in err.message
 
 
+def test_rows_allocated_are_bounded_by_the_file(tmp_path):
+    # a frame line holds at least 2 bytes a value ("0 "): a file declaring a huge
+    # 'Frames:' gets room for size // (2 * channels) + 1 frames, the declared count when
+    # that is smaller; under a 1-byte memory limit the refusal names the rows it wanted
+    big = put(tmp_path, HEAD + LEG + "MOTION\nFrames: 9000000\nFrame Time: 0.04\n" + ROWS)
+    size = big.stat().st_size
+    with memory_limit(1), pytest.raises(ParseError) as info:
+        read_bvh(big)
+    assert f"{size // 16 + 1:,} frames of 8 channels need" in info.value.message
+    with memory_limit(1), pytest.raises(ParseError) as info:
+        read_bvh(put(tmp_path, TINY))
+    assert "2 frames of 8 channels need 128 bytes" in info.value.message
+
+
 def test_frames_declared_but_missing(tmp_path):
     err = parse_error(tmp_path, HEAD + LEG + "MOTION\nFrames: 5\nFrame Time: 0.04\n" + ROWS)
     assert err.line == 20 and "'Frames: 5' declared but only 2 frame lines found" in err.message
@@ -357,8 +372,10 @@ def test_bvh_ready_orders():
     tilted = np.eye(3)
     tilted[0, 1] = 1e-11  # not identity to 1e-12: an ASF-style axis
     assert _bvh_ready_orders(_skel("XZ", axis=tilted), None) is None
+    tilted[0, 1] = 1.5e-12  # just past the 1e-12 tolerance
+    assert _bvh_ready_orders(_skel("XZ", axis=tilted), None) is None
     nearly = np.eye(3)
-    nearly[0, 1] = 1e-13
+    nearly[0, 1] = 1e-12  # at the tolerance: identity
     assert _bvh_ready_orders(_skel("XZ", axis=nearly), None) == ["ZXY", "XZY"]
 
 
