@@ -482,3 +482,16 @@ def test_forced_order_and_writer_refusals(tmp_path):
     with pytest.raises(ParameterError, match="needs a skeleton"):
         write_bvh(Motion(np.zeros((1, 1)), [("a", "rx")]), tmp_path / "n.bvh")
     assert not (tmp_path / "n.bvh").exists()
+
+
+def test_a_byte_order_mark_is_not_part_of_the_first_word(tmp_path):
+    # Windows editors save UTF-8 with a BOM; the AMC, ASF and CSV readers drop it, and
+    # the BVH reader did not ("expected HIERARCHY ..., found '\ufeffHIERARCHY'")
+    p = tmp_path / "bom.bvh"
+    p.write_bytes(b"\xef\xbb\xbf" + TINY.replace("\n", "\r\n").encode("utf-8"))
+    m = read_bvh(p)
+    np.testing.assert_array_equal(m.frames[0], [0.5, 1, 1.5, 10, 20, 30, 40, 50])
+    assert m.skeleton.names == ["Hips", "Leg"]
+    # only a leading one: a BOM later in the file is text
+    p.write_bytes(TINY.replace("ROOT Hips", "ROOT \ufeffHips").encode("utf-8"))
+    assert read_bvh(p).skeleton.names == ["\ufeffHips", "Leg"]
