@@ -795,3 +795,114 @@ def test_write_amc_without_a_skeleton_groups_channels(tmp_path):
     with pytest.raises(ParameterError, match=r"frame 2, channel b.rz: non-finite value inf"):
         write_amc(Motion(np.array([[1.0, 2.0, 3.0], [0, 0, np.inf]]), m.channels), tmp_path / "x.amc")
     assert not (tmp_path / "x.amc").exists()
+
+
+def _asf_bones(n: int, chain: bool) -> str:
+    """n bones (lines 3 + 6k .. 8 + 6k for bone k), hung from the root or as a chain."""
+    out = [":root", ":bonedata"]
+    for k in range(1, n + 1):
+        out += ["begin", f"name b{k}", "direction 0 1 0", "length 1", "dof rx", "end"]
+    out += [":hierarchy", "begin"]
+    if chain:
+        out += ["root b1"] + [f"b{k} b{k + 1}" for k in range(1, n)]
+    else:
+        out += ["root " + " ".join(f"b{k}" for k in range(1, n + 1))]
+    out += ["end"]
+    return "\n".join(out) + "\n"
+
+
+def test_asf_bone_and_depth_caps_at_their_boundary(tmp_path):
+    from cyclecoord.io._limits import MAX_DEPTH, MAX_JOINTS
+
+    # MAX_JOINTS joints: the root and MAX_JOINTS - 1 bones
+    sk, _ = parse_asf(_asf_bones(MAX_JOINTS - 1, chain=False), "b.asf")
+    assert len(sk.joints) == MAX_JOINTS
+    with pytest.raises(ParseError) as info:
+        parse_asf(_asf_bones(MAX_JOINTS, chain=False), "b.asf")
+    assert info.value.line == 2 + 6 * MAX_JOINTS  # the 'end' of the bone one too many
+    assert f"more than {MAX_JOINTS - 1:,} bones" in info.value.message
+    # a chain whose last bone hangs MAX_DEPTH levels below the root
+    sk, _ = parse_asf(_asf_bones(MAX_DEPTH, chain=True), "c.asf")
+    assert len(sk.joints) == MAX_DEPTH + 1
+    text = _asf_bones(MAX_DEPTH + 1, chain=True)
+    with pytest.raises(ParseError) as info:
+        parse_asf(text, "c.asf")
+    hier = 2 + 6 * (MAX_DEPTH + 1) + 3  # the 'root b1' line
+    assert info.value.line == hier + MAX_DEPTH  # the line that hangs the last bone
+    assert f"bone 'b{MAX_DEPTH + 1}' hangs {MAX_DEPTH + 1} levels below the root" in info.value.message
+
+
+def test_asf_layout_tolerance_of_a_small_skeleton_is_absolute_1e_12():
+    def two_kids(d):
+        return Skeleton(joints=(
+            Joint("r", -1, [0, 0, 0], (), ""),
+            Joint("a", 0, [0, 0, 0], ("rx",), "X"),
+            Joint("b", 1, [0, 0.5, 0], (), "", end_site=[0, 0.25, 0]),
+            Joint("c", 1, [0, 0.5 + d, 0], (), "", end_site=[0, 0.25, 0]),
+        ))
+    # every length below 1: the tolerance is 1e-12 (the size never drops below 1)
+    assert [b.asf_name for b in asf_layout(two_kids(0.6e-12))] == ["root", "a", "b", "c"]
+    assert [b.asf_name for b in asf_layout(two_kids(1.5e-12))] == [
+        "root", "a", "a_to_b", "b", "a_to_c", "c"
+    ]
+
+
+def test_amc_asf_names_win_over_joint_names(tmp_path):
+    # joint 'a b' is ASF bone 'a_b'; joint 'a_b' is ASF bone 'a_b_2': the AMC name 'a_b'
+    # is the ASF bone (joint 'a b'), not joint 'a_b'
+    sk = Skeleton(joints=(
+        Joint("r", -1, [0, 0, 0], ("rx",), "X"),
+        Joint("a b", 0, [0, 1, 0], ("rx",), "X", end_site=[0, 1, 0]),
+        Joint("a_b", 0, [0, 1, 0], ("ry",), "Y", end_site=[0, 1, 0]),
+    ))
+    m = read_amc(put(tmp_path, "n.amc", "1\nroot 1\na_b 2\na_b_2 3\n"), skeleton=sk)
+    assert m.channels == (("r", "rx"), ("a b", "rx"), ("a_b", "ry"))
+    np.testing.assert_array_equal(m.frames, [[1, 2, 3]])
+
+
+def test_more_asf_edges():
+    with pytest.raises(ParseError, match=r"expected limits as '\(low high\)', got '\( \( \) \)'"):
+        parse_asf(_swap("(-inf inf)", "( ( ) )"), "x")
+    # direction * length of exactly 1e9 is within the cap
+    sk, _ = parse_asf(_swap("length 3", "length 1e9"), "x")
+    np.testing.assert_array_equal(sk.joints[2].end_site, [1e9, 0, 0])
+    # ':name' alone: an empty name
+    sk, _ = parse_asf(_swap(":name tiny", ":name"), "x")
+    assert sk.name == ""
+
+
+def test_header_skeleton_after_unit_lines(tmp_path):
+    put(tmp_path, "named.asf", TINY_ASF)
+    amc = put(tmp_path, "x.amc", ":FULLY-SPECIFIED\n:DEGREES\n\n#!OML:ASF named.asf\n1\n")
+    assert _header_skeleton(amc) == tmp_path / "named.asf"
+
+
+def test_amc_frame_lines_are_counted_with_signs_and_blanks(tmp_path):
+    put(tmp_path, "tiny.asf", TINY_ASF)
+    text = TINY_AMC.replace("\n1\n", "\n +1 \t\n").replace("\n2\n", "\n2\r\n")
+    m = read_amc(put(tmp_path, "tiny.amc", text))
+    assert m.n_frames == 2 and m.metadata["first_frame_number"] == 1
+    with memory_limit(1), pytest.raises(ParseError, match="2 frames of 9 channels"):
+        read_amc(tmp_path / "tiny.amc")
+
+
+def test_write_asf_unnamed_skeleton_of_no_format(tmp_path):
+    sk = Skeleton(joints=(Joint("r", -1, [0, 0, 0], ("rx",), "X"),))
+    write_asf(sk, tmp_path / "u.asf")
+    lines = (tmp_path / "u.asf").read_text().split("\n")
+    assert ":name cyclecoord" in lines
+    assert "  Source skeleton format: unknown." in lines
+    assert lines[lines.index(":hierarchy") + 1 : lines.index(":hierarchy") + 3] == ["  begin", "  end"]
+    assert read_asf(tmp_path / "u.asf").names == ["root"]
+
+
+def test_amc_frame_numbers_at_their_bounds(tmp_path):
+    put(tmp_path, "tiny.asf", TINY_ASF)
+    one = "1\nroot 1 2 3 4 5 6\nupper 7 8\nlower 9\n"
+    for first in ("1000000000", "-1000000000"):
+        m = read_amc(put(tmp_path, "tiny.amc", one.replace("1\n", first + "\n", 1)))
+        assert m.metadata["first_frame_number"] == int(first)
+    for first in ("1000000001", "-1000000001"):
+        with pytest.raises(ParseError, match="a frame number must lie in -1,000,000,000..1,000,000,000") as info:
+            read_amc(put(tmp_path, "tiny.amc", one.replace("1\n", first + "\n", 1)))
+        assert info.value.line == 1

@@ -224,6 +224,7 @@ HEADER_CASES = [
     ("motion then blanks", M + "MOTION\n\n  \n", 16, "expected 'Frames: <count>'"),
     ("frames then nothing", M + "MOTION\n\nFrames: 2\n", 18, "expected 'Frame Time: <seconds>'"),
     ("frames is not first", M + "MOTION\nFrame Time: 0.04\nFrames: 2\n", 17, "expected 'Frames: <count>', found 'Frame Time: 0.04'"),
+    ("frames line cut at 40", M + "MOTION\nFramez: " + "1234567890" * 6 + "\n", 17, "found 'Framez: 12345678901234567890123456789012'"),
     ("frames zero", M + "MOTION\nFrames: 0\nFrame Time: 0.04\n", 17, "must lie in 1.."),
     ("frames negative", M + "MOTION\nFrames: -2\nFrame Time: 0.04\n", 17, "found -2"),
     ("frames decimal", M + "MOTION\nFrames: 2.0\nFrame Time: 0.04\n", 17, "whole number"),
@@ -495,3 +496,36 @@ def test_a_byte_order_mark_is_not_part_of_the_first_word(tmp_path):
     # only a leading one: a BOM later in the file is text
     p.write_bytes(TINY.replace("ROOT Hips", "ROOT \ufeffHips").encode("utf-8"))
     assert read_bvh(p).skeleton.names == ["\ufeffHips", "Leg"]
+
+
+def _chain(n: int) -> str:
+    """A chain of n joints (the deepest at depth n - 1), one channel each."""
+    out = ["HIERARCHY", "ROOT j0", "{", "OFFSET 0 0 0", "CHANNELS 1 Zrotation"]
+    for i in range(1, n):
+        out += [f"JOINT j{i}", "{", "OFFSET 0 1 0", "CHANNELS 1 Zrotation"]
+    out += ["}"] * n + ["MOTION", "Frames: 1", "Frame Time: 0.01", " ".join(["0"] * n)]
+    return "\n".join(out) + "\n"
+
+
+def _bush(n: int) -> str:
+    """A root and n - 1 children: n joints."""
+    out = ["HIERARCHY", "ROOT r", "{", "OFFSET 0 0 0", "CHANNELS 1 Zrotation"]
+    for i in range(1, n):
+        out += [f"JOINT j{i}", "{", "OFFSET 0 1 0", "}"]
+    out += ["}", "MOTION", "Frames: 1", "Frame Time: 0.01", "0"]
+    return "\n".join(out) + "\n"
+
+
+def test_depth_and_joint_caps_at_their_boundary(tmp_path):
+    from cyclecoord.io._limits import MAX_DEPTH, MAX_JOINTS
+
+    m = read_bvh(put(tmp_path, _chain(MAX_DEPTH + 1)))  # the deepest joint at MAX_DEPTH
+    assert len(m.skeleton.joints) == MAX_DEPTH + 1
+    err = parse_error(tmp_path, _chain(MAX_DEPTH + 2))
+    assert err.line == 6 + 4 * MAX_DEPTH  # the JOINT line of the joint one level too deep
+    assert f"more than {MAX_DEPTH} levels deep" in err.message
+    m = read_bvh(put(tmp_path, _bush(MAX_JOINTS)))
+    assert len(m.skeleton.joints) == MAX_JOINTS
+    err = parse_error(tmp_path, _bush(MAX_JOINTS + 1))
+    assert err.line == 6 + 4 * (MAX_JOINTS - 1)  # the JOINT line of joint MAX_JOINTS + 1
+    assert f"more than {MAX_JOINTS:,} joints" in err.message
