@@ -906,3 +906,29 @@ def test_amc_frame_numbers_at_their_bounds(tmp_path):
         with pytest.raises(ParseError, match="a frame number must lie in -1,000,000,000..1,000,000,000") as info:
             read_amc(put(tmp_path, "tiny.amc", one.replace("1\n", first + "\n", 1)))
         assert info.value.line == 1
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (lambda j: j.offset.__setitem__(0, np.nan), "joint 'a': offset component nan"),
+        (lambda j: j.end_site.__setitem__(1, -np.inf), "joint 'a': end site component -inf"),
+        (lambda j: j.axis.__setitem__((2, 2), -1.0), "joint 'a': axis is not a rotation matrix"),
+    ],
+)
+def test_write_asf_refuses_geometry_changed_in_place(tmp_path, change, message):
+    sk = Skeleton(joints=(
+        Joint("r", -1, [0, 0, 0], ("rx",), "X"),
+        Joint("a", 0, [0, 1, 0], ("rx",), "X", end_site=[0, 1, 0]),
+    ))
+    change(sk.joints[1])
+    with pytest.raises(ParameterError, match=f"cannot write ASF: skeleton: {message}"):
+        write_asf(sk, tmp_path / "x.asf")
+    assert not (tmp_path / "x.asf").exists()
+
+
+@pytest.mark.parametrize("unit", [0.0, -1.0, math.nan, math.inf, 2e9])
+def test_write_asf_refuses_a_bad_length_unit(tmp_path, unit):
+    sk = Skeleton(joints=(Joint("r", -1, [0, 0, 0], ("rx",), "X"),), length_unit=unit)
+    with pytest.raises(ParameterError, match=f"length unit {unit!r} is not a positive number"):
+        write_asf(sk, tmp_path / "x.asf")
