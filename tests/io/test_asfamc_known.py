@@ -932,3 +932,21 @@ def test_write_asf_refuses_a_bad_length_unit(tmp_path, unit):
     sk = Skeleton(joints=(Joint("r", -1, [0, 0, 0], ("rx",), "X"),), length_unit=unit)
     with pytest.raises(ParameterError, match=f"length unit {unit!r} is not a positive number"):
         write_asf(sk, tmp_path / "x.asf")
+
+
+def test_amc_uncounted_frames_grow_the_array_a_chunk_at_a_time(tmp_path):
+    """CR-only line ends (old Mac files) read as lines, but the byte count of frame lines
+    finds none: the array starts at 1 frame and grows as each chunk of 256 frames is
+    converted, to 256 and then max(300, 1.25 * 256) = 320 frames: 300 frames of 9 channels
+    need 320 * 9 * 8 = 23,040 bytes and no more."""
+    put(tmp_path, "tiny.asf", TINY_ASF)
+    out = [":DEGREES"]
+    for t in range(300):
+        out += [str(t + 1), f"root {t} 0 0 0 0 0", "upper 0 0", f"lower {t}"]
+    p = tmp_path / "tiny.amc"
+    p.write_bytes("\r".join(out).encode() + b"\r")
+    with memory_limit(23_040):
+        m = read_amc(p)
+    assert m.n_frames == 300 and m.frames[299, 0] == 299 and m.frames[299, 8] == 299
+    with memory_limit(23_039), pytest.raises(ParseError, match="320 frames of 9 channels need"):
+        read_amc(p)
