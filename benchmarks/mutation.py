@@ -54,7 +54,7 @@ T = "tests/"
 COORDS = [T + "periodic/test_coordinates.py", T + "periodic/test_landmarks.py", T + "periodic/test_rips.py",
           T + "periodic/test_estimator_conventions.py"]
 PIPE = [T + "periodic/test_windings.py", T + "periodic/test_pipeline.py"]  # fast first: -x stops early
-ASFAMC = [T + "io/test_asfamc.py", T + "io/test_convert.py", T + "io/test_hostile_files.py"]
+ASFAMC = [T + "io/test_asfamc_known.py", T + "io/test_asfamc.py", T + "io/test_convert.py", T + "io/test_hostile_files.py"]
 
 #: Module (under src/) -> the tests that are its own (run for each of its mutants).
 TESTS: dict[str, list[str]] = {
@@ -94,7 +94,7 @@ TESTS: dict[str, list[str]] = {
     IO + "amc_read.py": ASFAMC,
     IO + "asf_read.py": ASFAMC,
     IO + "asfamc_write.py": ASFAMC,
-    IO + "bvh.py": [T + "io/test_bvh.py", T + "io/test_convert.py", T + "io/test_hostile_files.py"],
+    IO + "bvh.py": [T + "io/test_bvh_known.py", T + "io/test_bvh.py", T + "io/test_convert.py", T + "io/test_hostile_files.py"],
     IO + "gltf.py": [T + "io/test_gltf_write.py", T + "io/test_gltf.py", T + "io/test_rig_export.py", T + "io/test_hostile_gltf_usd.py"],
     IO + "gltf_read.py": [T + "io/test_gltf_read.py", T + "io/test_gltf.py", T + "io/test_rig_export.py", T + "io/test_hostile_gltf_usd.py"],
     IO + "tabular.py": [T + "io/test_tabular_known.py", T + "io/test_tabular.py", T + "io/test_hostile_files.py"],

@@ -531,3 +531,21 @@ def test_npz_version_and_start_frame_ranges(tmp_path):
         with pytest.raises(ParseError, match="array 'start_frame': expected a whole number in "
                                              "0..1,000,000,000"):
             _read(tmp_path, a)
+
+
+def test_csv_uncounted_rows_grow_the_array_a_chunk_at_a_time(tmp_path):
+    """Rows the line count missed (U+2028 separates rows for the reader, not for the byte
+    count: 1 row counted) grow the array as each chunk of CHUNK_FRAMES rows arrives: 1 row,
+    then 256 for the first chunk, then max(300, 1.25 * 256) = 320 rows for the last 44, so
+    300 rows of 2 channels need 320 * 2 * 8 = 5120 bytes and no more."""
+    p = tmp_path / "g.csv"
+    rows = "\u2028".join(f"{k},{2 * k}" for k in range(300))
+    p.write_text("# fps=30\na.rx,a.ry\n" + rows + "\n", encoding="utf-8")
+    with memory_limit(5120):
+        m = tb.read_csv(p)
+    assert m.frames.shape == (300, 2) and m.frames[-1, 1] == 598
+    with memory_limit(5119), pytest.raises(ParseError, match="320 frames of 2 channels need"):
+        tb.read_csv(p)
+    with memory_limit(4096):  # the first chunk alone fits: 256 rows
+        with pytest.raises(ParseError, match="320 frames"):
+            tb.read_csv(p)

@@ -282,7 +282,7 @@ def _lines(path: Path):
     if not path.exists():
         raise ParseError("no such file", path)
     try:
-        yield from text_lines(path, bom=False)
+        yield from text_lines(path)
     except FileNotFoundError:
         raise ParseError("no such file", path) from None
     except OSError as exc:
@@ -303,7 +303,8 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
     Parameters
     ----------
     path : path-like
-        The ``.bvh`` file.  CRLF line ends, tabs and extra whitespace are accepted.
+        The ``.bvh`` file.  CRLF line ends, a UTF-8 byte order mark, tabs and extra
+        whitespace are accepted.
 
     Returns
     -------
