@@ -280,3 +280,26 @@ def test_lock_where_clean_takes_one_limit_per_frame():
     assert one.line == per.line and one.locked > 0
     assert _limit_words(np.full(5, 1234.0)) == "1.23e+03"
     assert _limit_words(np.array([1000.0, 4500.0])) == "1e+03-4.5e+03"
+
+
+def test_a_script_over_two_models_is_also_measured_model_by_model(made):
+    """The report of a walk-run script adds each model's own frames (TRANSITIONs left out)
+    against that model's training takes, after the whole script against all of them."""
+    from cyclecoord.synthesis.latent.script import model_sections, script_quality
+
+    syn, motion = made
+    commands = ([{"command": "MOVE"}] * 10 + [{"command": "TRANSITION"}] + [{"command": "MOVE"}] * 10
+                + [{"command": "TRANSITION"}, {"command": "IDLE"}])
+    sections = model_sections(syn, commands)
+    walk, t1, run, t2, idle = (_span(syn, r) for r in (range(0, 10), [10], range(11, 21), [21], [22]))
+    assert [(s["model"], s["start"], s["stop"]) for s in sections] == [
+        ("walk", *walk), ("run", *run), ("walk", *idle)]
+    quality, lines = script_quality(syn, motion, commands)
+    assert [(s["model"], s["start"], s["stop"]) for s in quality["by_model"]] == [
+        ("walk", *walk), ("run", *run), ("walk", *idle)]
+    own = measure_generated(motion[run[0] : run[1]], training_takes(syn.models, ["run"]))
+    assert quality["by_model"][1]["quality"]["largest_accel_ratio"] == pytest.approx(own.largest_accel)
+    assert lines[-3].startswith(f"    walk frames {walk[0]}-{walk[1]}: feet ")
+    # with no TRANSITION named, a blend's frames go to the model that made them
+    assert [(s["model"], s["start"], s["stop"]) for s in model_sections(syn, [{}] * 23)] == [
+        ("walk", 0, t1[0]), ("run", t1[0], t2[0]), ("walk", t2[0], motion.n_frames)]
