@@ -3,7 +3,7 @@ transitions in step, joints not flattened, freezes, IDLE, slip, pops, leg ranges
 
 Run from a checkout::
 
-    python benchmarks/bench_latent_gait.py [--quick] [--no-shared]
+    python benchmarks/bench_latent_gait.py [--quick] [--no-shared] [--seeds N]
 
 Model pairs (30 fps, every 4th frame of 120 fps captures): a synthetic walk (1.1 s leg
 cycle) and run (0.7 s) from ``cyclecoord.datasets`` (two 5 s segments each), the
@@ -14,6 +14,9 @@ of ``examples/latent_script.json``: walk 3 s (ten MOVEs ``{"ahead": 0.3}``), TRA
 run, run 3 s (ten MOVEs), TRANSITION walk, IDLE 2 s.  Each gait section is measured by
 ``cyclecoord.quality.generated`` against its own model's training takes; the whole
 motion is also checked by ``../shared/tools/motioncheck`` (independent kinematics).
+The gait sections' pops, slip and leg ranges are then given over ``--seeds`` script
+seeds (default 5): median and range, since one seed's figure is one draw of the random
+force.
 """
 
 from __future__ import annotations
@@ -71,16 +74,16 @@ def bandai_pair() -> dict | None:
     return {"walk": [cc.load(walk)], "run": [cc.load(run)]}
 
 
-def script(d: Path, blend: float = 0.4) -> Path:
+def script(d: Path, blend: float = 0.4, seed: int = 0) -> Path:
     ahead = [{"command": "MOVE", "to": {"ahead": 0.3}} for _ in range(10)]
     spec = {
-        "fps": 30, "seed": 0, "models": {"walk": "walk.npz", "run": "run.npz"},
+        "fps": 30, "seed": seed, "models": {"walk": "walk.npz", "run": "run.npz"},
         "start": {"model": "walk", "at": {"frame": 0}},
         "commands": ahead + [{"command": "TRANSITION", "to": "run", "blend": blend}] + ahead
         + [{"command": "TRANSITION", "to": "walk", "blend": blend},
            {"command": "IDLE", "duration": 2.0}],
     }
-    p = d / f"script_{blend:g}.json"
+    p = d / f"script_{blend:g}_{seed}.json"
     p.write_text(json.dumps(spec, indent=1))
     return p
 
@@ -110,7 +113,7 @@ def sections(report) -> dict:
             "T2": span([21]), "idle": span([22])}
 
 
-def measure_pair(label: str, takes: dict, d: Path, quick: bool) -> None:
+def measure_pair(label: str, takes: dict, d: Path, quick: bool, seeds: int = 1) -> None:
     models = {}
     for name, segs in takes.items():
         t = time.perf_counter()
@@ -169,6 +172,28 @@ def measure_pair(label: str, takes: dict, d: Path, quick: bool) -> None:
     said = [n for n in short["notes"] if "blend raised" in n]
     print(f"  blend 0.034 s: {said[0].split(': ', 1)[1] if said else 'not raised'}")
     _check(motion, models, d, a)
+    if seeds > 1:
+        over_seeds(models, d, seeds)
+
+
+def over_seeds(models: dict, d: Path, seeds: int) -> None:
+    """The gait sections' pops and slip over script seeds ``0 .. seeds - 1`` (the random
+    force differs): one seed's figure is one draw (the runs' largest acceleration ranged
+    1.5-2.3x over five seeds on the shared pairs)."""
+    got: dict[str, list] = {"walk": [], "run": []}
+    for seed in range(seeds):
+        motion, rep = run_script(script(d, seed=seed))
+        sec = sections(rep)
+        for part in got:
+            a, b = sec[part]
+            q = measure_generated(motion[a:b], training_takes(models, [part]))
+            got[part].append((q.largest_accel, q.slip_ratio, min(q.knee_ratio), min(q.hip_ratio)))
+    print(f"  over seeds 0-{seeds - 1}: median [min-max]")
+    for part, rows in got.items():
+        r = np.array(rows)
+        cells = [f"{name} {np.median(r[:, i]):.2f} [{r[:, i].min():.2f}-{r[:, i].max():.2f}]"
+                 for i, name in enumerate(("accel x p99", "slip x capt", "knee", "hip"))]
+        print(f"  {part:7s}  " + "; ".join(cells))
 
 
 def _hold(motion, sec):
@@ -202,6 +227,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="shorter takes, fewer iterations")
     ap.add_argument("--no-shared", action="store_true", help="the synthetic pair only")
+    ap.add_argument("--seeds", type=int, default=5,
+                    help="script seeds the gait sections are also measured over (1: none)")
     args = ap.parse_args(argv)
     pairs = [("synthetic walk + run", synthetic_pair(args.quick))]
     if not args.no_shared:
@@ -214,7 +241,7 @@ def main(argv=None) -> int:
     for label, takes in pairs:
         print(label)
         with tempfile.TemporaryDirectory() as tmp:
-            measure_pair(label, takes, Path(tmp), args.quick)
+            measure_pair(label, takes, Path(tmp), args.quick, args.seeds)
     return 0
 
 
