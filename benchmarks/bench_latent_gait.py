@@ -133,7 +133,7 @@ def measure_pair(label: str, takes: dict, d: Path, quick: bool, seeds: int = 1) 
     print(f"  script: {motion.n_frames} frames ({motion.duration:.1f} s); walk chain "
           f"{(sec['walk'][1] - sec['walk'][0]) / 30:.2f} s for 3 s asked")
     print("  section  slip m/s (x capt)  knee/hip range (min of capt)  cycle s (x capt)  "
-          "accel x p99  longest freeze s")
+          "accel x p99  longest freeze s  root m/s (x capt)")
     for part in ("walk", "run"):
         a, b = sec[part]
         src = training_takes(models, [part])
@@ -141,7 +141,7 @@ def measure_pair(label: str, takes: dict, d: Path, quick: bool, seeds: int = 1) 
         print(f"  {part:7s}  {q.support_slip:.2f} ({q.slip_ratio:.2f}x)           "
               f"{min(q.knee_ratio):.2f} / {min(q.hip_ratio):.2f}                  "
               f"{q.cycle_s:.2f} ({q.cadence_ratio:.2f}x)       {q.largest_accel:.2f}        "
-              f"{q.longest_freeze_s:.2f}")
+              f"{q.longest_freeze_s:.2f}              {q.root_speed:.2f} ({q.root_ratio:.2f}x)")
     whole = measure_generated(motion, training_takes(models), hold=_hold(motion, sec))
     print(f"  whole: slip {whole.support_slip:.2f} m/s ({whole.slip_ratio:.2f}x captures), "
           f"accel {whole.largest_accel:.2f}x p99, freezes outside IDLE "
@@ -187,12 +187,14 @@ def over_seeds(models: dict, d: Path, seeds: int) -> None:
         for part in got:
             a, b = sec[part]
             q = measure_generated(motion[a:b], training_takes(models, [part]))
-            got[part].append((q.largest_accel, q.slip_ratio, min(q.knee_ratio), min(q.hip_ratio)))
+            got[part].append((q.largest_accel, q.slip_ratio, min(q.knee_ratio), min(q.hip_ratio),
+                              q.root_ratio))
     print(f"  over seeds 0-{seeds - 1}: median [min-max]")
     for part, rows in got.items():
         r = np.array(rows)
         cells = [f"{name} {np.median(r[:, i]):.2f} [{r[:, i].min():.2f}-{r[:, i].max():.2f}]"
-                 for i, name in enumerate(("accel x p99", "slip x capt", "knee", "hip"))]
+                 for i, name in enumerate(("accel x p99", "slip x capt", "knee", "hip",
+                                           "root speed x capt"))]
         print(f"  {part:7s}  " + "; ".join(cells))
 
 

@@ -162,3 +162,38 @@ def test_targets_close_contacts_hand_over_smoothly():
     np.testing.assert_allclose(tgt[25:37, 0], points[26:36, 0].mean())
     # from one lock (1.47) to the next (3.10) over 5 frames; the jump was 1.15
     assert np.abs(np.diff(tgt[:, 0])).max() < 0.6
+
+
+def test_carry_by_feet_holds_the_body_on_still_feet_but_not_on_landing_ones():
+    """Legs that never move against the root, sliding forward at 8 units/s: with the feet
+    at one height they are planted and carry the body, which then stays put; bobbing
+    0.2 units at 2 Hz (inside the contact band, up to 0.3 leg lengths/s up and down) they
+    carry it only as far as their vertical speed is under VERTICAL_SPEED, by hand: each
+    step keeps its own travel times one minus the lowest point's grounded weight (the
+    heights smoothed over VERTICAL_SMOOTH first)."""
+    from scipy.ndimage import gaussian_filter1d
+
+    from cyclecoord.synthesis.carry import (
+        CONTACT_BAND,
+        VERTICAL_SMOOTH,
+        VERTICAL_SPEED,
+        carry_by_feet,
+    )
+
+    skel = legs_skeleton()
+    tz = skel.channels.index(("root", "tz"))
+    still = make_motion(skel, T=120, fps=60.0, root_speed=8.0)
+    out = carry_by_feet(still)
+    assert np.ptp(out.frames[:, tz]) < 1e-9 * 8.0  # planted feet: the root does not glide
+    bob = make_motion(skel, T=120, fps=60.0, root_speed=8.0, bob=(0.2, 2.0))
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    c = foot_contacts(bob, feet, speed=None, height=CONTACT_BAND)
+    assert np.all(c.height.min(axis=1) <= CONTACT_BAND * c.leg_length)  # always in the band
+    ty = bob.frames[:, skel.channels.index(("root", "ty"))]
+    ty = gaussian_filter1d(ty, VERTICAL_SMOOTH * bob.fps, mode="nearest")  # 2 frames
+    vy = np.abs(np.gradient(ty)) * bob.fps / c.leg_length
+    g = np.exp(-np.maximum(vy - VERTICAL_SPEED, 0.0) / VERTICAL_SPEED)
+    want = np.r_[0.0, np.cumsum(8.0 / 60.0 * (1.0 - 0.5 * (g[1:] + g[:-1])))]
+    got = carry_by_feet(bob, feet).frames[:, tz]
+    np.testing.assert_allclose(got, want, atol=1e-6)
+    assert 0.1 * 8.0 * 119 / 60 < got[-1] < 0.9 * 8.0 * 119 / 60  # partly carried (25 %)

