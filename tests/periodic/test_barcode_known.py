@@ -588,3 +588,108 @@ def test_fit_coordinate_warnings_point_at_the_caller(monkeypatch):
     with pytest.warns(RuntimeWarning, match="scale raised to") as rec:
         est.fit_coordinate()
     assert [w.filename for w in rec] == [__file__]
+
+
+def test_landmark_scale_is_raised_so_the_balls_cover_every_point():
+    est = CircularCoordinates(landmarks=10, refine_birth=False, scale_fraction=0.01)
+    with pytest.warns(RuntimeWarning, match="scale raised to"):
+        est.fit(circle(60))
+    want = 2.0 * est.covering_radius_ * 1.02
+    assert est.selection_.scale == pytest.approx(want, rel=1e-12)
+    assert est.radius_ == pytest.approx(want / 2, rel=1e-12)
+    assert est.selection_.birth < want
+    # a scale already high enough is kept, without a note
+    est = CircularCoordinates(landmarks=10, refine_birth=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        est.fit(circle(60))
+    s = est.selection_
+    assert s.scale == pytest.approx(s.birth + 0.9 * (min(s.death, est.threshold_) - s.birth))
+
+
+def test_landmark_problem_is_weighted_by_the_cells_of_both_ends():
+    # each landmark stands for the points nearest to it; edge weight = product of the two
+    # cells' sizes; the centres' coordinate is -w mod 1 of that weighted least squares
+    x = circle(60)
+    est = CircularCoordinates(landmarks=12, refine_birth=False).fit(x)
+    c = est.centers_
+    owner = np.argmin(np.linalg.norm(x[:, None] - c[None], axis=2), axis=1)
+    mass = np.bincount(owner, minlength=len(c)).astype(float)
+    e, z = est.edges_, est.cocycle_
+    wts = mass[e[:, 0]] * mass[e[:, 1]]
+    d = np.zeros((len(e), len(c)))
+    d[np.arange(len(e)), e[:, 0]] = -1.0
+    d[np.arange(len(e)), e[:, 1]] = 1.0
+    sw = np.sqrt(wts)
+    w = np.linalg.lstsq(sw[:, None] * d, -sw * z, rcond=None)[0]
+    diff = np.mod(est.center_theta_ - np.mod(-w, 1.0) + 0.5, 1.0) - 0.5
+    np.testing.assert_allclose(diff, 0.0, atol=1e-7)
+    np.testing.assert_allclose(est.harmonic_cocycle_, z + d @ w, atol=1e-7)
+    # the centres are the landmark points, and the training coordinate is oriented
+    assert np.array_equal(c, x[est.landmarks_])
+    assert est.coordinates_[0] == 0.0
+
+
+def test_transform_uses_the_fitted_orientation():
+    # the same polygon in both frame orders: new points half-way sit half a step along
+    # frame order
+    for order in (slice(None), slice(None, None, -1)):
+        x = circle(24)[order]
+        est = CircularCoordinates(landmarks=None).fit(x)
+        new = circle(24, phase=np.pi / 24)[order]
+        got = est.transform(new)
+        # counter-clockwise: new i lies between frames i and i + 1; clockwise: i - 1 and i
+        want = (np.arange(24) + (0.5 if order.step is None else -0.5)) / 24
+        d = np.mod(got - want + 0.5, 1) - 0.5
+        assert np.max(np.abs(d)) < 0.01
+        out = est.fit_transform(x)
+        assert np.array_equal(out, est.coordinates_) and out is not est.coordinates_
+    # transform is (sign * raw - offset) mod 1: the flipped orientation (-1, -offset) of a
+    # fitted (1, offset) gives minus the coordinate
+    sign, offset = est.orientation_
+    assert sign == 1.0
+    arrays = est.to_arrays()
+    arrays["orientation"] = np.array([-1.0, -offset])
+    flipped = CircularCoordinates.from_arrays(arrays).transform(new)
+    d = np.mod(flipped + got + 0.5, 1) - 0.5
+    np.testing.assert_allclose(d, 0.0, atol=1e-12)
+
+
+def test_temporal_metric_memory_bound():
+    from cyclecoord.periodic.landmarks import run_bytes
+
+    x = circle(200)
+    need = (8.0 + 13) * 200**2  # the distance matrix and the filtration's copies
+    limit = run_bytes(200, 2) + need
+    CircularCoordinates(landmarks=None, temporal=True, memory_limit=limit).fit_barcode(x)
+    with pytest.raises(ParameterError, match="temporal metric needs a full 200 x 200"):
+        CircularCoordinates(landmarks=None, temporal=True, memory_limit=limit - 1).fit_barcode(x)
+    with pytest.raises(ParameterError, match="temporal metric"):
+        CircularCoordinates(landmarks=None, temporal=True, memory_limit=limit,
+                            memory_reserved=1.0).fit_barcode(x)
+    # the Euclidean metric needs no matrix
+    CircularCoordinates(landmarks=None, memory_limit=limit - 1).fit_barcode(x)
+
+
+def test_complex_estimate_is_computed_when_first_asked_for():
+    est = CircularCoordinates(landmarks=None)
+    est.fit_barcode(circle(30))
+    e = est.complex_estimate_
+    assert e is not None and e.edges > 0 and est._complex_deferred is False
+    assert est.complex_estimate_ is e  # once
+
+
+def test_temporal_metric_with_landmarks_reads_their_distances():
+    x = circle(120)
+    est = CircularCoordinates(landmarks=20, temporal=True).fit(x)
+    idx = est.landmarks_
+    d = temporal_distance_matrix(x)[np.ix_(idx, idx)]
+    s = est.selection_.scale
+    want = [[i, j] for i in range(20) for j in range(i + 1, 20) if d[i, j] <= s]
+    assert est.edges_.tolist() == want
+    assert est.selection_.full_birth is None  # not refined for the temporal metric
+
+
+def test_default_max_scale_of_one_point_is_the_floor():
+    assert default_max_scale(np.zeros((1, 3))) == 1e-9
+    assert default_max_scale(np.array([[0.0], [1e-12]])) == 1e-9

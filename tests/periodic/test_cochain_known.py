@@ -357,3 +357,21 @@ def test_extend_coordinate_three_centres_two_edges():
                                    np.array([[0, 1], [1, 2]]), np.array([0.1, -0.2]), 1.0)
     np.testing.assert_allclose(theta, [0.52], atol=1e-12)
     assert cov.tolist() == [True]
+
+
+def test_harmonic_without_edges_is_zero():
+    theta, harm = harmonic_coordinate(np.zeros((0, 2), np.int64), np.zeros(0), 3)
+    assert theta.tolist() == [0.0, 0.0, 0.0] and harm.shape == (0,)
+    theta, harm = harmonic_coordinate(np.zeros((0, 2), np.int64), np.zeros(0), 3, np.zeros(0))
+    assert theta.tolist() == [0.0, 0.0, 0.0] and harm.shape == (0,)
+
+
+def test_harmonic_on_a_path_with_uneven_potential_by_hand():
+    # path 0-1-2-3 (a tree): every cochain is a coboundary, so harmonic = 0 and
+    # theta = potential f (f(0) = 0, f(j) = f(i) + z(ij)) less its mean, mod 1
+    edges = np.array([[0, 1], [1, 2], [2, 3]])
+    z = np.array([0.4, -0.1, 0.3])
+    f = np.array([0.0, 0.4, 0.3, 0.6])
+    theta, harm = harmonic_coordinate(edges, z, 4)
+    np.testing.assert_allclose(harm, 0.0, atol=1e-12)
+    np.testing.assert_allclose(theta, np.mod(f - f.mean(), 1.0), atol=1e-12)

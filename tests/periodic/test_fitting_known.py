@@ -282,3 +282,30 @@ def test_refine_birth_budget(motion, monkeypatch):
     fit = NS(est=est, selection=sel)
     fitting.TakeFit._refine_birth(run, fit, np.arange(3))  # under one edge: not computed
     assert "max_edges" not in seen and fit.selection.full_birth is None
+
+
+def test_first_clear_follows_its_bar_to_a_new_index():
+    # a 12-gon of radius 1 (bar [0.518, 1.732)) and a 30-gon of radius 3 far away (bar
+    # [0.627, 5.2)): at threshold 1 the 12-gon's bar is the most persistent; it is alive,
+    # so the threshold is raised to 1.6, then 2.56, where the 12-gon's bar has died and the
+    # 30-gon's (alive) is longer: the 12-gon's bar, followed by its birth, is now #1
+    big = 3 * circle(30) + np.array([20.0, 0.0])
+    x = np.concatenate([big, circle(12)])
+    est = CircularCoordinates(landmarks=None, max_scale=1.0)
+    bc, sel = first_clear(est, x, 0, None, 0.9)
+    assert bc.threshold == pytest.approx(2.56)
+    assert sel.index == 1 and est.class_index == 1
+    assert sel.birth == pytest.approx(chord(12), rel=1e-6)
+    assert sel.death == pytest.approx(np.sqrt(3), rel=1e-6)
+    assert bc.h1[0, 0] == pytest.approx(3 * chord(30), rel=1e-6)
+
+
+def test_coordinate_of_keeps_the_fit_warnings_as_notes(motion):
+    run = fitting.TakeFit(motion, PARAMS, True)
+    assert run.T == 120
+    est = CircularCoordinates(landmarks=10, scale_fraction=0.01, refine_birth=False)
+    est.fit_barcode(circle(60))
+    fit = run.coordinate_of(est, np.arange(60))
+    assert np.isfinite(fit.unwrapped[:60]).all() and np.isnan(fit.unwrapped[60:]).all()
+    assert any(n.startswith("scale raised to") for n in fit.notes)
+    assert fit.selection is est.selection_ and fit.est is est
