@@ -378,6 +378,12 @@ def test_refine_birth_covering_radius_skips_older_loops():
     assert got == pytest.approx(chord(30, r=3.0), rel=1e-6)
     # a covering radius too small to reach back to the big circle's birth: nothing
     assert refine_birth(x, lb, covering_radius=0.01) is None
+    # 2 r reaching 2/3 of the way down to the small circle's birth: only the big one
+    cs = chord(8, r=0.5)
+    got = refine_birth(x, lb, covering_radius=(lb - cs) / 3)
+    assert got == pytest.approx(chord(30, r=3.0), rel=1e-6)
+    # a bar born exactly 2 r below the landmark birth is taken (0.1 % slack)
+    assert refine_birth(x, lb, covering_radius=(lb - cs) / 2) == pytest.approx(cs, rel=1e-6)
 
 
 def test_refine_birth_sample_refuses_before_counting(monkeypatch):
@@ -693,3 +699,78 @@ def test_temporal_metric_with_landmarks_reads_their_distances():
 def test_default_max_scale_of_one_point_is_the_floor():
     assert default_max_scale(np.zeros((1, 3))) == 1e-9
     assert default_max_scale(np.array([[0.0], [1e-12]])) == 1e-9
+
+
+def test_landmarks_on_a_distance_matrix_are_those_on_the_points():
+    # angles jittered so that no two distances tie
+    a = np.sort(np.random.default_rng(5).uniform(0, 2 * np.pi, 40))
+    x = np.column_stack([np.cos(a), np.sin(a)])
+    d = np.linalg.norm(x[:, None] - x[None], axis=2)
+    one = compute_barcode(x, max_scale=3.0, n_landmarks=12)
+    two = compute_barcode(d, max_scale=3.0, n_landmarks=12, distance_matrix=True)
+    assert np.array_equal(one.point_indices, two.point_indices) and two.n_points == 12
+    np.testing.assert_allclose(two.h1, one.h1, rtol=1e-6)
+    # the landmarks' loop closes at their widest gap's chord
+    s = np.sort(a[two.point_indices])
+    gap = np.max(np.diff(np.r_[s, s[0] + 2 * np.pi]))
+    np.testing.assert_allclose(two.h1[0, 0], 2 * np.sin(gap / 2), rtol=1e-6)
+
+
+def test_winding_birth_of_two_loops_is_the_first_to_close():
+    a = circle(10)  # closes at chord(10) = 0.618
+    b = circle(8, r=0.5) + np.array([10.0, 0.0])  # closes at 0.5 * chord(8) = 0.383
+    x = np.concatenate([a, b])
+    theta = np.r_[np.arange(10) / 10, np.arange(8) / 8]
+    i, j = np.triu_indices(18, 1)
+    d = np.linalg.norm(x[i] - x[j], axis=1)
+    keep = d < 2.5
+    got = winding_birth(np.column_stack([i, j])[keep], d[keep], theta)
+    assert got == pytest.approx(0.5 * chord(8))
+    # the second loop's coordinate constant: only the first winds
+    theta[10:] = 0.25
+    got = winding_birth(np.column_stack([i, j])[keep], d[keep], theta)
+    assert got == pytest.approx(chord(10))
+
+
+def test_primes_tried_record_the_violations(monkeypatch):
+    seen = []
+
+    def check(edges, z, n):
+        seen.append(1)
+        return CocycleCheck(5, [3, 1, 0][len(seen) - 1])
+
+    monkeypatch.setattr(co_mod, "check_cocycle", check)
+    est = CircularCoordinates(landmarks=None).fit(circle(12))
+    assert est.primes_tried_ == [(47, 3), (53, 1), (59, 0)]
+    assert est.selection_.index == 0
+    assert est.selection_.birth == pytest.approx(chord(12), rel=1e-6)
+
+
+def test_a_better_later_prime_is_kept_when_none_is_clean(monkeypatch):
+    v = iter([3, 1, 2] + [2] * 8)
+    monkeypatch.setattr(co_mod, "check_cocycle", lambda e, z, n: CocycleCheck(5, next(v)))
+    est = CircularCoordinates(landmarks=None)
+    with pytest.warns(RuntimeWarning, match="on 1 of 5 triangles .* using p=53"):
+        est.fit(circle(12))
+    assert est.prime_ == 53 and est.barcode_.prime == 53
+    assert est.cocycle_check_.n_violations == 1
+
+
+def test_full_birth_budget_follows_the_memory_limit(monkeypatch):
+    from cyclecoord.periodic.landmarks import run_bytes
+
+    seen = []
+
+    def spy(points, birth, prime, max_edges, covering_radius):
+        seen.append(max_edges)
+        return 0.125
+
+    monkeypatch.setattr(co_mod, "refine_birth", spy)
+    x = circle(60)
+    est = CircularCoordinates(landmarks=15).fit(x)
+    assert seen == [3_000_000] and est.selection_.full_birth == 0.125
+    est = CircularCoordinates(landmarks=15, memory_limit=run_bytes(60, 2) + 256 * 1000).fit(x)
+    assert seen[1] == 1000
+    monkeypatch.setattr(co_mod, "REFINE_BYTES_PER_EDGE", 1e12)  # under one edge: not computed
+    est = CircularCoordinates(landmarks=15).fit(x)
+    assert len(seen) == 2 and est.selection_.full_birth is None

@@ -309,3 +309,88 @@ def test_coordinate_of_keeps_the_fit_warnings_as_notes(motion):
     assert np.isfinite(fit.unwrapped[:60]).all() and np.isnan(fit.unwrapped[60:]).all()
     assert any(n.startswith("scale raised to") for n in fit.notes)
     assert fit.selection is est.selection_ and fit.est is est
+
+
+# ---------------------------------------------------------------- fit_steady
+def _steady_run(motion, monkeypatch, used_frames, **params):
+    """TakeFit with steady on, frames 0-99 of 120 moving, and steady_frames giving
+    ``used_frames`` (a slice of frames, or None for every moving frame)."""
+    def moving(poses, fps, columns=None):
+        out = np.zeros(len(poses), dtype=bool)
+        out[:100] = True
+        return out
+
+    fitted = []
+
+    def steady(motion_, prepared, joints, unwrapped, moving_, period):
+        assert np.isfinite(period) and moving_.sum() == 100
+        out = np.zeros(len(moving_), dtype=bool)
+        out[used_frames] = True
+        return out
+
+    monkeypatch.setattr(fitting, "moving_mask", moving)
+    monkeypatch.setattr(fitting, "steady_frames", steady)
+    real = fitting.TakeFit.fit_rows
+
+    def spy(self, rows, stage, first_pass=False):
+        fitted.append((rows[0], rows[-1] + 1, stage, first_pass))
+        return real(self, rows, stage, first_pass)
+
+    monkeypatch.setattr(fitting.TakeFit, "fit_rows", spy)
+    run = fitting.TakeFit(motion, {**PARAMS, "steady": True, **params}, True)
+    assert run.moving.sum() == 100
+    return run, fitted
+
+
+def test_fit_steady_refits_on_the_steady_frames(motion, monkeypatch):
+    run, fitted = _steady_run(motion, monkeypatch, slice(10, 90))
+    fit, used = run.fit_steady()
+    assert np.flatnonzero(used).tolist() == list(range(10, 90))
+    assert fitted == [(0, 100, " (first pass)", False), (10, 90, "", False)]
+    assert fit.rows.tolist() == list(range(10, 90))
+    assert set(run.timings) >= {"prepare", "steady", "barcode", "coordinate"}
+    assert "barcode (first pass)" not in run.timings
+    assert not any("cyclecoord detect" in n for n in run.notes)
+
+
+def test_fit_steady_keeps_the_first_fit_when_nearly_every_frame_is_steady(motion, monkeypatch):
+    run, fitted = _steady_run(motion, monkeypatch, slice(0, 95))  # 95 % of the moving frames
+    fit, used = run.fit_steady()
+    assert used.sum() == 100 and fitted == [(0, 100, " (first pass)", False)]
+    assert set(run.timings) >= {"steady", "barcode", "coordinate"}
+    run, fitted = _steady_run(motion, monkeypatch, slice(0, 94))  # under 95 %: refitted
+    fit, used = run.fit_steady()
+    assert used.sum() == 94 and len(fitted) == 2
+
+
+def test_fit_steady_notes_when_most_moving_frames_are_not_the_motion(motion, monkeypatch):
+    run, _ = _steady_run(motion, monkeypatch, slice(0, 49))  # 51 of 100 not used: noted
+    run.fit_steady()
+    note = [n for n in run.notes if "cyclecoord detect" in n]
+    assert note and note[0].startswith("only 49 of the take's 100 moving frames")
+    run, _ = _steady_run(motion, monkeypatch, slice(0, 50))  # exactly half: not noted
+    run.fit_steady()
+    assert not any("cyclecoord detect" in n for n in run.notes)
+
+
+def test_fit_steady_failures(motion, monkeypatch):
+    run, _ = _steady_run(motion, monkeypatch, slice(0, 0))
+    with pytest.raises(NoPeriodicMotionError, match="no stretch of the take repeats steadily"):
+        run.fit_steady()
+    run, _ = _steady_run(motion, monkeypatch, slice(10, 90), min_turns=1000)
+    with pytest.raises(NoPeriodicMotionError, match="turns only .* over the 100 steady frames"):
+        run.fit_steady()
+
+
+def test_fit_steady_without_steady_fits_every_frame_once(motion, monkeypatch):
+    calls = []
+    real = fitting.TakeFit.fit_rows
+
+    def spy(self, rows, stage, first_pass=False):
+        calls.append((len(rows), stage, first_pass))
+        return real(self, rows, stage, first_pass)
+
+    monkeypatch.setattr(fitting.TakeFit, "fit_rows", spy)
+    run = fitting.TakeFit(motion, PARAMS, True)
+    fit, used = run.fit_steady()
+    assert calls == [(120, "", False)] and used.all() and "steady" not in run.timings
