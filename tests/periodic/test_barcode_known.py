@@ -774,3 +774,47 @@ def test_full_birth_budget_follows_the_memory_limit(monkeypatch):
     monkeypatch.setattr(co_mod, "REFINE_BYTES_PER_EDGE", 1e12)  # under one edge: not computed
     est = CircularCoordinates(landmarks=15).fit(x)
     assert len(seen) == 2 and est.selection_.full_birth is None
+
+
+def test_sparse_rips_cohomology_computes_h0_and_h1_only():
+    from scipy.sparse import coo_matrix
+
+    from cyclecoord.periodic._rips import sparse_rips_cohomology
+
+    x = circle(6)
+    d = np.linalg.norm(x[:, None] - x[None], axis=2)
+    c = coo_matrix(np.where(d <= 1.9, d, 0.0)).tocsr().tocoo()
+    res = sparse_rips_cohomology(c.row, c.col, c.data, 6, 1.9, 47)
+    assert len(res["dgms"]) == 2 and len(res["cocycles"]) == 2
+    np.testing.assert_allclose(res["dgms"][1], [[1.0, np.sqrt(3)]], rtol=1e-6)
+    assert len(res["cocycles"][1]) == 1
+
+
+def test_diameter_sweeps_of_a_small_cloud():
+    # all distances under 1: the sweeps still find the largest, 0.5
+    x = np.array([[0.0], [0.1], [0.5], [0.3]])
+    assert _diameter(x, exact_limit=2) == 0.5
+    assert _diameter(x * 1e-6, exact_limit=2) == pytest.approx(0.5e-6)
+
+
+def test_winding_birth_orders_edges_shorter_than_a_picometre():
+    # a triangle with edges 0, 1.5e-12 and 1.7e-12 whose coordinate winds once: the
+    # loop closes at the longest edge (a zero length is stored as 1e-12, still the shortest)
+    pairs = np.array([[0, 1], [1, 2], [0, 2]])
+    got = winding_birth(pairs, np.array([0.0, 1.5e-12, 1.7e-12]), np.array([0.0, 1 / 3, 2 / 3]))
+    assert got == 1.7e-12
+
+
+def test_retry_primes_accept_a_scale_at_the_birth(monkeypatch):
+    # an explicit scale equal to the bar's birth is inside the bar (birth <= scale): a
+    # retry with another prime reads the same bar there
+    x = circle(12)
+    birth = float(compute_barcode(x, max_scale=1.0).h1[0, 0])
+    v = iter([1, 0])
+    monkeypatch.setattr(co_mod, "check_cocycle", lambda e, z, n: CocycleCheck(5, next(v)))
+    est = CircularCoordinates(landmarks=None, max_scale=1.0, scale=birth)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        est.fit(x)
+    assert est.prime_ == 53 and est.primes_tried_ == [(47, 1), (53, 0)]
+    assert est.selection_.scale == birth

@@ -350,6 +350,8 @@ def test_fit_steady_refits_on_the_steady_frames(motion, monkeypatch):
     assert fit.rows.tolist() == list(range(10, 90))
     assert set(run.timings) >= {"prepare", "steady", "barcode", "coordinate"}
     assert "barcode (first pass)" not in run.timings
+    # "steady" counts the first pass (tens of ms) and the steady frames' search (stubbed)
+    assert run.timings["steady"] > 0 and all(t >= 0 for t in run.timings.values())
     assert not any("cyclecoord detect" in n for n in run.notes)
 
 
@@ -394,3 +396,15 @@ def test_fit_steady_without_steady_fits_every_frame_once(motion, monkeypatch):
     run = fitting.TakeFit(motion, PARAMS, True)
     fit, used = run.fit_steady()
     assert calls == [(120, "", False)] and used.all() and "steady" not in run.timings
+
+
+def test_first_clear_raises_the_threshold_at_most_six_times():
+    # two equal 90-gons far apart: equal bars, so neither is clear (gap 1); born at 0.0698
+    # and dying at sqrt 3, they are cut short at every threshold from 0.07 up to
+    # 0.07 x 1.6^6 = 1.17, where the sixth raise stops
+    a = circle(90)
+    x = np.concatenate([a, a + np.array([10.0, 0.0])])
+    est = CircularCoordinates(landmarks=None, max_scale=0.07)
+    bc, sel = first_clear(est, x, 0, None, 0.9)
+    assert bc.threshold == pytest.approx(0.07 * 1.6**6)
+    assert sel.death == np.inf and not sel.clear and est.max_scale == 0.07
