@@ -58,16 +58,16 @@ ASFAMC = [T + "io/test_asfamc_known.py", T + "io/test_asfamc.py", T + "io/test_c
 
 #: Module (under src/) -> the tests that are its own (run for each of its mutants).
 TESTS: dict[str, list[str]] = {
-    P + "_cochain.py": COORDS,
+    P + "_cochain.py": [T + "periodic/test_cochain_known.py", T + "periodic/test_barcode_known.py"] + COORDS,
     P + "_estimator.py": COORDS,
     P + "_kernel.py": [T + "periodic/test_density.py", T + "periodic/test_cycle.py"],
-    P + "_rips.py": COORDS + [T + "periodic/test_memory_guard.py"],
-    P + "barcode.py": COORDS,
+    P + "_rips.py": [T + "periodic/test_barcode_known.py"] + COORDS + [T + "periodic/test_memory_guard.py"],
+    P + "barcode.py": [T + "periodic/test_barcode_known.py"] + COORDS,
     P + "clip.py": PIPE + [T + "periodic/test_planted_travel.py", T + "quality/test_cycle_figures.py"],
-    P + "coordinates.py": COORDS,
+    P + "coordinates.py": [T + "periodic/test_barcode_known.py", T + "periodic/test_cochain_known.py"] + COORDS,
     P + "cycle.py": [T + "periodic/test_cycle.py"],
     P + "density.py": [T + "periodic/test_density.py"],
-    P + "fitting.py": PIPE,
+    P + "fitting.py": [T + "periodic/test_fitting_known.py"] + PIPE,
     P + "landmarks.py": COORDS + [T + "periodic/test_memory_guard.py"],
     P + "phase_model.py": [T + "periodic/test_landmarks.py"],
     P + "pipeline.py": PIPE,

@@ -434,16 +434,17 @@ class CircularCoordinates(ParamsMixin):
             if check.ok:
                 break
         p, bc, sel, check, z = best
+        # stacklevel 3: past the one_blas_thread wrapper, to the caller of fit_coordinate
         if not check.ok:
             warnings.warn(
                 "the integer lift of the cocycle fails the cocycle "
                 f"condition on {check.n_violations} of {check.n_triangles} "
                 f"triangles for every prime tried; using p={p}",
                 RuntimeWarning,
-                stacklevel=2,
+                stacklevel=3,
             )
         for note in notes:
-            warnings.warn(note, RuntimeWarning, stacklevel=2)
+            warnings.warn(note, RuntimeWarning, stacklevel=3)
         ncomp, _ = connected_components(
             sp.csr_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n)),
             directed=False,
