@@ -70,7 +70,7 @@ TESTS: dict[str, list[str]] = {
     P + "density.py": [T + "periodic/test_density.py"],
     P + "fitting.py": PIPE,
     P + "landmarks.py": [T + "periodic/test_landmarks_known.py"] + COORDS + [T + "periodic/test_memory_guard.py"],
-    P + "phase_model.py": [T + "periodic/test_landmarks.py"],
+    P + "phase_model.py": [T + "periodic/test_phase_model_known.py", T + "periodic/test_landmarks.py"],
     P + "pipeline.py": PIPE,
     P + "preprocess.py": [T + "periodic/test_preprocess.py", T + "periodic/test_rotations.py"],
     P + "registration.py": [T + "periodic/test_registration_known.py", T + "periodic/test_windings.py",
