@@ -77,7 +77,7 @@ TESTS: dict[str, list[str]] = {
                             T + "periodic/test_pipeline.py"],
     P + "results.py": PIPE,
     P + "root.py": [T + "periodic/test_root_known.py", T + "periodic/test_root.py", T + "periodic/test_pipeline.py"],
-    P + "rotations.py": [T + "periodic/test_rotations.py"],
+    P + "rotations.py": [T + "periodic/test_rotations_known.py", T + "periodic/test_rotations.py"],
     P + "steady.py": [T + "periodic/test_steady.py"],
     P + "suggest.py": [T + "periodic/test_suggest.py"],
     P + "windings.py": PIPE,
