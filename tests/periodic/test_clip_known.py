@@ -268,3 +268,41 @@ def test_loop_cycle_refuses_an_unknown_start(walk):
     cap, m, prepared, prep = walk
     with pytest.raises(ParameterError, match="cycle_start"):
         loop_cycle(None, m, prepared, prep, cycle_start="middle")
+
+
+@pytest.fixture(scope="module")
+def example():
+    m = cc.datasets.example_capture().motion
+    prep = Preprocessor()
+    return m, prep.fit_transform(m), prep
+
+
+def test_loop_cycle_of_one_captured_cycle_is_that_cycle(example):
+    """A "typical" cycle that is frames 120..239 of the prepared capture itself, averaged
+    from those rows: the clip is those frames of the capture (joints and root, whose
+    differences integrate from frame 120 back to the captured track)."""
+    from cyclecoord.periodic.cycle import TypicalCycle
+
+    m, prepared, prep = example
+    fr = prepared.poses[120:240]
+    ph = np.arange(120) / 120
+    typ = TypicalCycle(frames=fr, phases=ph, curve=fr, sample_phases=ph)
+    rows = np.arange(120, 240)
+    same, clip = loop_cycle(typ, m, prepared, prep, cycle_start="first", rows=rows, metadata={"a": 1})
+    assert same is typ
+    np.testing.assert_allclose(clip.frames, m.frames[120:240], atol=1e-9)
+    assert clip.metadata == {"a": 1} and clip.start_frame == 0 and clip.source.startswith("cycle of ")
+    # from the slowest pose: the joints rolled to start there, the phases with them, the
+    # root still starting at the first row's
+    joints = np.setdiff1d(np.arange(m.n_channels), prepared.root_columns)
+    shift = slowest_frame(fr[:, joints])
+    assert shift != 0
+    rolled, clip2 = loop_cycle(typ, m, prepared, prep, rows=rows)
+    np.testing.assert_allclose(rolled.phases, np.roll(ph, -shift))
+    np.testing.assert_allclose(clip2.frames[:, joints], np.roll(m.frames[120:240], -shift, axis=0)[:, joints], atol=1e-9)
+    root = prepared.root_columns
+    np.testing.assert_allclose(clip2.frames[0, root], m.frames[120, root], atol=1e-9)
+    # without rows: every frame's root changes, the root starting at frame 0's
+    _, clip3 = loop_cycle(typ, m, prepared, prep, cycle_start="first")
+    np.testing.assert_allclose(clip3.frames[0, root], m.frames[0, root], atol=1e-9)
+    np.testing.assert_allclose(clip3.frames[:, joints], m.frames[120:240][:, joints], atol=1e-9)

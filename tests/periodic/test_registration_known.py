@@ -112,6 +112,7 @@ def test_register_band_and_rounds():
     same = register(ph, poses, [(0, len(ph))], P, 0.2 / P, n_iter=0)
     np.testing.assert_array_equal(same, ph)
     assert same is not ph
+    np.testing.assert_array_equal(register(ph, poses, [(0, len(ph))], P, 0.2 / P, n_iter=-3), ph)
     # a long run timed right builds the template, a later run 3 samples late
     ph[100:] = np.mod((true[100:] + 3) / P, 1.0)
     ph[99] = np.nan

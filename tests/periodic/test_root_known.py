@@ -94,6 +94,11 @@ def test_decompose_a_straight_sidestep_and_a_single_frame():
     # the yaw matrix itself: a step along the heading (+x) is forward
     g = frames_of(T, ry=90.0, tx=0.5 * np.arange(T))
     np.testing.assert_allclose(decompose_root(g, layout())[:, 5:7], np.tile([0.0, 0.5], (T, 1)), atol=1e-12)
+    # speeding up: each step its own, the last frame repeating the one before
+    acc = frames_of(T, ry=0.0, tz=0.5 * np.arange(T) ** 2)
+    np.testing.assert_allclose(decompose_root(acc, layout())[:, 6], [0.5, 1.5, 2.5, 3.5, 4.5, 4.5], atol=1e-12)
+    turn = frames_of(T, ry=[0.0, 1.0, 3.0, 6.0, 10.0, 15.0])
+    np.testing.assert_allclose(decompose_root(turn, layout())[:, 4], [1.0, 2.0, 3.0, 4.0, 5.0, 5.0], atol=1e-9)
     one = decompose_root(f[:1], layout())
     np.testing.assert_allclose(one[0, 4:], 0.0)
     assert one[0, 0] == 7.0
