@@ -201,11 +201,14 @@ def test_capture_cycle_documented_parts(walk):
     np.testing.assert_allclose(np.diff(h), 0.5, atol=1e-6)
     # the heading starts at the first phased frame's
     assert h[0] == pytest.approx(heading(m.frames[:1], lay)[0], abs=1e-6)
-    # in place: no ground travel, the first phased frame's ground
-    _, still, _ = capture_cycle(phase, m, prepared, prep, 120.0, cycle_start="first", register_iter=0,
+    # in place: no ground travel, the first phased frame's ground and heading
+    late = phase.copy()
+    late[:10] = np.nan
+    _, still, _ = capture_cycle(late, m, prepared, prep, 120.0, cycle_start="first", register_iter=0,
                                 travel="in_place")
     for d in ("tx", "tz"):
-        np.testing.assert_allclose(still.frames[:, lay.column(d)], m.frames[0, lay.column(d)])
+        np.testing.assert_allclose(still.frames[:, lay.column(d)], m.frames[10, lay.column(d)])
+    assert heading(still.frames[:1], lay)[0] == pytest.approx(5.0, abs=1e-6)  # 0.5 x frame 10
     # straight: the heading stays put
     _, straight, turn2 = capture_cycle(phase, m, prepared, prep, 120.0, cycle_start="first", register_iter=0,
                                        travel="straight")
@@ -259,6 +262,21 @@ def test_capture_cycle_without_a_skeleton_integrates_the_root(walk):
     assert np.isnan(turn)
     root = bprepared.root_columns
     np.testing.assert_allclose(clip.frames[0, root], m.frames[7, root], atol=1e-9)
+    tz = m.channels.index(("root", "tz"))
+    travel = clip.frames[-1, tz] - clip.frames[0, tz]
+    assert abs(travel) > 10.0
+    _, still, _ = capture_cycle(phase, bare, bprepared, bprep, 120.0, cycle_start="first", register_iter=0,
+                                travel="in_place")
+    np.testing.assert_allclose(still.frames[0, root], m.frames[7, root], atol=1e-9)
+    assert abs(still.frames[-1, tz] - still.frames[0, tz]) < 0.05 * abs(travel)
+
+
+def test_capture_cycle_automatic_width(walk):
+    cap, m, prepared, prep = walk
+    typ, _, _ = capture_cycle(np.mod(cap.phase, 1.0), m, prepared, prep, 120.0, bandwidth="auto",
+                              register_iter=0, k=5)
+    assert typ.bandwidth_selection is not None
+    assert typ.bandwidth == typ.bandwidth_selection.bandwidth != CAPTURE_WIDTH
 
 
 # ------------------------------------------------------------------ loop_cycle
