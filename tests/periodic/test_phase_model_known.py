@@ -113,3 +113,21 @@ def test_summary_of_frames_that_do_not_wind():
     model.phase = lambda motion: np.mod(-np.arange(11) / 5.0, 1.0)  # backwards twice
     s = model.summary(None)
     assert s["cycles"] == pytest.approx(-2.0) and np.isnan(s["period_frames"])
+
+
+def test_round_trip_of_a_projected_scaled_model(other, tmp_path):
+    """PCA to 4 dimensions, scaled channels, the Euler root: every part of the preparation
+    is saved and read back (the components, the scale, the flags)."""
+    m = cc.datasets.example_capture().motion
+    model = cc.extract(m, pca=4, normalize=True, rotations="euler").model
+    path = tmp_path / "pca.npz"
+    model.save(path)
+    back = PhaseModel.load(path)
+    p, q = model.preprocessor, back.preprocessor
+    assert q.pca == 4 and q.normalize is True and q.difference_root == p.difference_root
+    assert q.components_.shape == p.components_.shape and q.components_.shape[0] == 4
+    np.testing.assert_array_equal(q.components_, p.components_)
+    np.testing.assert_array_equal(q.scale_, p.scale_)
+    np.testing.assert_array_equal(q.mean_, p.mean_)
+    np.testing.assert_allclose(back.phase(other), model.phase(other), atol=1e-12)
+    assert back.preprocessor.transform(other).points.shape[1] == 4
