@@ -14,7 +14,10 @@ from cyclecoord.periodic.phase_model import PhaseModel
 @pytest.fixture(scope="module")
 def models():
     m = cc.datasets.example_capture().motion
-    return m, {r: cc.extract(m, rotations=r).model for r in ("euler", "rotvec")}
+    # the Euler model projected to 4 dimensions and scaled, the rotvec one neither: between
+    # them every part of the preparation is saved (components or none, scale, flags)
+    return m, {"euler": cc.extract(m, rotations="euler", pca=4, normalize=True).model,
+               "rotvec": cc.extract(m, rotations="rotvec").model}
 
 
 @pytest.fixture(scope="module")
@@ -30,12 +33,20 @@ def test_round_trip_in_either_rotation_space(models, other, rotations, tmp_path)
     model.save(path)
     back = PhaseModel.load(path)
     assert back.preprocessor.rotations == rotations
+    p, q = model.preprocessor, back.preprocessor
     if rotations == "euler":
-        assert back.preprocessor.rotation_map_ is None
+        assert q.rotation_map_ is None
+        assert q.pca == 4 and q.normalize is True and q.components_.shape[0] == 4
+        np.testing.assert_array_equal(q.components_, p.components_)
+        assert q.transform(other).points.shape[1] == 4
     else:
         rmap = back.preprocessor.rotation_map_
         assert rmap is not None and len(rmap.groups) == len(model.preprocessor.rotation_map_.groups) > 0
         np.testing.assert_array_equal(rmap.columns, model.preprocessor.rotation_map_.columns)
+        assert q.pca is None and q.components_ is None and q.normalize is False
+    np.testing.assert_array_equal(q.scale_, p.scale_)
+    np.testing.assert_array_equal(q.mean_, p.mean_)
+    assert q.difference_root == p.difference_root and q.root_mode_ == p.root_mode_
     np.testing.assert_allclose(back.phase(other), model.phase(other), atol=1e-12)
     assert back.channels == tuple(m.channels) and back.fps == m.fps
     assert back.period_frames == model.period_frames
@@ -114,20 +125,3 @@ def test_summary_of_frames_that_do_not_wind():
     s = model.summary(None)
     assert s["cycles"] == pytest.approx(-2.0) and np.isnan(s["period_frames"])
 
-
-def test_round_trip_of_a_projected_scaled_model(other, tmp_path):
-    """PCA to 4 dimensions, scaled channels, the Euler root: every part of the preparation
-    is saved and read back (the components, the scale, the flags)."""
-    m = cc.datasets.example_capture().motion
-    model = cc.extract(m, pca=4, normalize=True, rotations="euler").model
-    path = tmp_path / "pca.npz"
-    model.save(path)
-    back = PhaseModel.load(path)
-    p, q = model.preprocessor, back.preprocessor
-    assert q.pca == 4 and q.normalize is True and q.difference_root == p.difference_root
-    assert q.components_.shape == p.components_.shape and q.components_.shape[0] == 4
-    np.testing.assert_array_equal(q.components_, p.components_)
-    np.testing.assert_array_equal(q.scale_, p.scale_)
-    np.testing.assert_array_equal(q.mean_, p.mean_)
-    np.testing.assert_allclose(back.phase(other), model.phase(other), atol=1e-12)
-    assert back.preprocessor.transform(other).points.shape[1] == 4
