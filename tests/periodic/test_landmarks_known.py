@@ -233,3 +233,17 @@ def test_the_guard_shrinks_by_seven_tenths_until_it_fits():
     # 80 frames, landmarks off, a budget for 56: 80 -> 56, fewer than the frames
     n, est, _ = choose_landmarks(x[:80], 1.0, None, memory_limit=complete_bytes(56))
     assert n == 56
+
+
+def test_what_counts_as_a_repeated_point():
+    """Points: a squared distance within 1e-12 of the largest squared norm repeats a
+    landmark (the product form's rounding); a distance matrix: within 1e-9 of its largest
+    entry.  Points 1000 apart in scale: 1.2e-3 apart (squared 1.44e-6, over 1e-6) are two
+    landmarks, 0.9e-3 apart (0.81e-6) one."""
+    for gap, n in ((1.2e-3, 2), (0.9e-3, 1)):
+        x = np.array([[1000.0], [1000.0 + gap], [1000.0]])
+        assert len(greedy_landmarks(x, 3)[0]) == n
+    for gap, n in ((1.5e-9, 2), (0.5e-9, 1)):
+        d = np.array([[0.0, gap, 1.0], [gap, 0.0, 1.0], [1.0, 1.0, 0.0]])
+        idx, r = greedy_landmarks(d, 3, distance_matrix=True)
+        assert len(idx) == n + 1 and r == 0.0
