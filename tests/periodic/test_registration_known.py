@@ -132,3 +132,17 @@ def test_register_stops_without_two_phased_frames():
     out = register(ph, np.zeros((4, 2)), [(1, 2)], 10, 0.05)
     np.testing.assert_array_equal(np.isnan(out), np.isnan(ph))
     assert out[1] == 0.3
+
+
+def test_align_run_holds_on_the_last_frame_and_skips_on_the_first():
+    """The path's end is the cheapest column of the last frame: a run that holds its last
+    sample (6, 6) against a phase still advancing ends on 6, not on the advancing 7; one
+    that skips at its start (1, 3) starts on 1."""
+    P = 16
+    tpl = ring(P)
+    true = np.array([2, 3, 4, 5, 6, 6])
+    psi = (2 + np.arange(6)) / P
+    np.testing.assert_array_equal(_align_run(tpl[true], psi, tpl, band=2, penalty=0.15), true)
+    true = np.array([1, 3, 4, 5, 6, 7])
+    psi = (2 + np.arange(6)) / P
+    np.testing.assert_array_equal(_align_run(tpl[true], psi, tpl, band=2, penalty=0.15), true)
