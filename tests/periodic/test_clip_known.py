@@ -272,11 +272,24 @@ def test_capture_cycle_without_a_skeleton_integrates_the_root(walk):
 
 
 def test_capture_cycle_automatic_width(walk):
+    """bandwidth="auto": the width select_bandwidth finds on the phased frames with the
+    paper's 10 neighbours by default."""
+    from cyclecoord.periodic.cycle import select_bandwidth
+
     cap, m, prepared, prep = walk
-    typ, _, _ = capture_cycle(np.mod(cap.phase, 1.0), m, prepared, prep, 120.0, bandwidth="auto",
-                              register_iter=0, k=5)
+    phase = np.mod(cap.phase, 1.0)
+    typ, _, _ = capture_cycle(phase, m, prepared, prep, 120.0, bandwidth="auto", register_iter=0)
     assert typ.bandwidth_selection is not None
     assert typ.bandwidth == typ.bandwidth_selection.bandwidth != CAPTURE_WIDTH
+    want = select_bandwidth(phase, prepared.poses, 120.0, k=10)
+    assert typ.bandwidth == want.bandwidth
+    # a short period over many frames, where the grid starts at k's width (10 / (480 sqrt(2 pi))
+    # of a 20-frame period, 0.17 frames, under the half frame it starts at otherwise)
+    fast = np.mod(cap.phase * 6.0, 1.0)
+    typ, _, _ = capture_cycle(fast, m, prepared, prep, 20.0, bandwidth="auto", register_iter=0)
+    want = select_bandwidth(fast, prepared.poses, 20.0, k=10).candidates
+    assert want[0] == pytest.approx(10 / (480 * np.sqrt(2 * np.pi)) * 20.0)
+    np.testing.assert_allclose(typ.bandwidth_selection.candidates, want)
 
 
 # ------------------------------------------------------------------ loop_cycle
@@ -324,3 +337,36 @@ def test_loop_cycle_of_one_captured_cycle_is_that_cycle(example):
     _, clip3 = loop_cycle(typ, m, prepared, prep, cycle_start="first")
     np.testing.assert_allclose(clip3.frames[0, root], m.frames[0, root], atol=1e-9)
     np.testing.assert_allclose(clip3.frames[:, joints], m.frames[120:240][:, joints], atol=1e-9)
+
+
+def _scrambled(m, seed=0):
+    """The same rotations written as wrapping, branch-flipping Euler numbers."""
+    rng = np.random.default_rng(seed)
+    f = m.frames.copy()
+    for j in m.skeleton.joints[1:]:
+        if len(j.rotation_order) != 3:
+            continue
+        cols = [m.channel_index(j.name, "r" + a.lower()) for a in j.rotation_order]
+        a = f[:, cols]
+        alt = np.column_stack([a[:, 0] + 180.0, 180.0 - a[:, 1], a[:, 2] + 180.0])
+        a = np.where((rng.random(len(f)) < 0.5)[:, None], alt, a) + 360.0 * rng.integers(-2, 3, size=a.shape)
+        f[:, cols] = a
+    return m.with_frames(f)
+
+
+def test_loop_cycle_writes_its_first_frame_as_the_first_row_was_written():
+    """Euler numbers that flip and wrap from frame to frame: the clip's first frame takes
+    the branch of the capture's first row (its exact numbers), later frames follow on."""
+    from cyclecoord.periodic.cycle import TypicalCycle
+
+    s = _scrambled(cc.datasets.example_capture().motion)
+    prep = Preprocessor()
+    prepared = prep.fit_transform(s)
+    fr = prepared.poses[120:240]
+    ph = np.arange(120) / 120
+    typ = TypicalCycle(frames=fr, phases=ph, curve=fr, sample_phases=ph)
+    _, clip = loop_cycle(typ, s, prepared, prep, cycle_start="first", rows=np.arange(120, 240))
+    np.testing.assert_allclose(clip.frames[0], s.frames[120], atol=1e-6)
+    np.testing.assert_allclose(clip.positions().positions, s[120:240].positions().positions, atol=1e-6)
+    joints = np.setdiff1d(np.arange(s.n_channels), prepared.root_columns)
+    assert np.abs(np.diff(clip.frames[:, joints], axis=0)).max() < 20

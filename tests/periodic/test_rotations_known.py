@@ -102,6 +102,11 @@ def test_to_channels_inverts_and_takes_the_reference_branch():
     np.testing.assert_allclose(ch2[0, [2, 0, 4]], near[[2, 0, 4]], atol=1e-9)
     near[1] = -170.0 - 180.0 + 1.0  # -349: nearer -350 than 10, one turn down
     np.testing.assert_allclose(rmap.to_channels(vec, near=near)[:, 1], [-350.0, -340.0, -330.0])
+    # the turns are counted from the first row's angle to the reference's
+    vec[:, 1] = [100.0, 110.0, 120.0]
+    for ref, want in ((460.0, 460.0), (-250.0, -260.0), (-100.0, -260.0), (-70.0, 100.0), (640.0, 820.0)):
+        near[1] = ref
+        np.testing.assert_allclose(rmap.to_channels(vec, near=near)[:, 1], want + np.array([0.0, 10.0, 20.0]))
 
 
 def _skeleton_motion(T=50, seed=0):
