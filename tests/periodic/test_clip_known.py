@@ -370,3 +370,18 @@ def test_loop_cycle_writes_its_first_frame_as_the_first_row_was_written():
     np.testing.assert_allclose(clip.positions().positions, s[120:240].positions().positions, atol=1e-6)
     joints = np.setdiff1d(np.arange(s.n_channels), prepared.root_columns)
     assert np.abs(np.diff(clip.frames[:, joints], axis=0)).max() < 20
+
+
+def test_planted_weights_follow_the_contacts_of_the_rows():
+    """Rows 10..49 phased one frame per sample over one cycle, a kernel far narrower than a
+    sample: each phase's weight is the contact of its own frame, found on frames 10..49
+    (the left foot lifted on 20..29)."""
+    from cyclecoord.quality.contacts import foot_contacts
+    from tests._legs import legs_skeleton, make_motion
+
+    m = make_motion(legs_skeleton(), T=60, lift_left=np.arange(20, 30))
+    rows = np.arange(10, 50)
+    feet, w = planted_weights(m, rows, (rows - 10) / 40.0, 40, 0.1 / 40, FEET)
+    want = foot_contacts(m[10:50], FEET).planted.astype(float)
+    assert want[:, 0].min() == 0.0 and want[:, 2].min() == 1.0  # the left foot lifts, the right does not
+    np.testing.assert_allclose(w, want, atol=1e-6)
