@@ -385,3 +385,19 @@ def test_planted_weights_follow_the_contacts_of_the_rows():
     want = foot_contacts(m[10:50], FEET).planted.astype(float)
     assert want[:, 0].min() == 0.0 and want[:, 2].min() == 1.0  # the left foot lifts, the right does not
     np.testing.assert_allclose(w, want, atol=1e-6)
+
+
+def test_loop_cycle_from_the_last_row_alone(example):
+    """Rows holding only the last frame (whose root difference repeats the one before):
+    that row gives the root's change and start, rather than no row at all."""
+    from cyclecoord.periodic.cycle import TypicalCycle
+
+    m, prepared, prep = example
+    last = len(prepared.poses) - 1
+    fr = prepared.poses[last - 3:]
+    ph = np.arange(4) / 4
+    typ = TypicalCycle(frames=fr, phases=ph, curve=fr, sample_phases=ph)
+    _, clip = loop_cycle(typ, m, prepared, prep, cycle_start="first", rows=np.array([last]))
+    root = prepared.root_columns
+    np.testing.assert_allclose(clip.frames[0, root], m.frames[last, root], atol=1e-9)
+    assert np.all(np.isfinite(clip.frames))

@@ -247,3 +247,29 @@ def test_what_counts_as_a_repeated_point():
         d = np.array([[0.0, gap, 1.0], [gap, 0.0, 1.0], [1.0, 1.0, 0.0]])
         idx, r = greedy_landmarks(d, 3, distance_matrix=True)
         assert len(idx) == n + 1 and r == 0.0
+
+
+def test_projected_screening_keeps_points_on_the_far_side_of_the_origin():
+    """50,000 points on a line (in 5 dimensions): 49,997 at 2.232, one each at -1, 0.5 and
+    3.832.  From 2.232 the farthest is -1 (3.232 away).  Then 0.5 is 1.5 from -1, nearer
+    than the 1.732 to its first landmark, although its projection points away from -1's
+    (a negative product); 3.832 stays 1.6 from its nearest, the farthest: it is the third
+    landmark, and 0.5 is left 1.5 from -1."""
+    x = np.zeros((50_000, 5))
+    x[:, 0] = 2.232
+    x[1, 0], x[2, 0], x[3, 0] = -1.0, 0.5, 3.832
+    idx, radius = greedy_landmarks(x, 3)
+    assert idx.tolist() == [0, 1, 3] and radius == pytest.approx(1.5, rel=1e-12)
+    idx, radius = greedy_landmarks(x, 6)
+    assert idx.tolist() == [0, 1, 3, 2] and radius == 0.0
+
+
+def test_a_sampled_estimate_exactly_at_the_budget_fits():
+    """The guard steps in only when the estimate exceeds the budget: at exactly the
+    sampled estimate every frame is kept, with the estimate and the plain reason."""
+    from cyclecoord.periodic.landmarks import estimate_complex
+
+    x = np.random.default_rng(3).standard_normal((300, 3))
+    est = estimate_complex(x, 0.5)
+    assert est.edges < comb(300, 2)  # not every pair: the estimate is below the complete complex's
+    assert choose_landmarks(x, 0.5, None, memory_limit=est.bytes) == (None, est, "every frame (landmarks off)")

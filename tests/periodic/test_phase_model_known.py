@@ -125,3 +125,18 @@ def test_summary_of_frames_that_do_not_wind():
     s = model.summary(None)
     assert s["cycles"] == pytest.approx(-2.0) and np.isnan(s["period_frames"])
 
+
+
+def test_a_model_file_with_a_pickled_array_is_refused(models, tmp_path):
+    """Model files are plain arrays: one holding a pickled object is not read (loading it
+    would run code), even beside every array a model needs."""
+    _, by = models
+    good = tmp_path / "good.npz"
+    by["euler"].save(good)
+    with np.load(good) as data:
+        arrays = {k: data[k] for k in data.files}
+    arrays["extra"] = np.array([{"a": 1}], dtype=object)
+    evil = tmp_path / "evil.npz"
+    np.savez(evil, **arrays)
+    with pytest.raises(ParseError, match="not a cyclecoord model file"):
+        PhaseModel.load(evil)
