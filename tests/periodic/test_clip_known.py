@@ -175,7 +175,7 @@ def walk():
     m = cap.motion
     f = m.frames.copy()
     ry, rx, rz = (m.channels.index(("root", d)) for d in ("ry", "rx", "rz"))
-    f[:, ry] = 0.5 * np.arange(len(f))  # turning half a degree every frame
+    f[:, ry] = 0.15 * np.arange(len(f))  # turning 0.15 degrees a frame (72 in all: clear of gimbal lock at 90)
     f[:, rx] = f[:, rz] = 0.0
     m = m.with_frames(f)
     prep = Preprocessor()
@@ -183,7 +183,7 @@ def walk():
 
 
 def test_capture_cycle_documented_parts(walk):
-    """120 frames a cycle; turning 0.5 degrees a frame, 60 degrees a cycle; the cycle in the
+    """120 frames a cycle; turning 0.15 degrees a frame, 18 degrees a cycle; the cycle in the
     prepared space is the written clip's own; cycle_start="first" keeps phase 0 first."""
     cap, m, prepared, prep = walk
     phase = np.mod(cap.phase, 1.0)
@@ -191,14 +191,14 @@ def test_capture_cycle_documented_parts(walk):
                                     metadata={"k": 1})
     assert typ.frames.shape == (120, m.n_channels) and clip.n_frames == 120
     np.testing.assert_allclose(typ.phases, np.arange(120) / 120)
-    assert turn == pytest.approx(60.0, abs=1e-6)
+    assert turn == pytest.approx(18.0, abs=1e-6)
     np.testing.assert_allclose(typ.frames, prep.transform(clip).poses, atol=1e-9)
     assert typ.bandwidth == CAPTURE_WIDTH and typ.bandwidth_selection is None
     assert clip.metadata == {"k": 1} and clip.start_frame == 0
     assert not typ.frames.flags.writeable and not typ.phases.flags.writeable
     lay = root_layout(m)
     h = heading(clip.frames, lay)
-    np.testing.assert_allclose(np.diff(h), 0.5, atol=1e-6)
+    np.testing.assert_allclose(np.diff(h), 0.15, atol=1e-6)
     # the heading starts at the first phased frame's
     assert h[0] == pytest.approx(heading(m.frames[:1], lay)[0], abs=1e-6)
     # in place: no ground travel, the first phased frame's ground and heading
@@ -208,11 +208,11 @@ def test_capture_cycle_documented_parts(walk):
                                 travel="in_place")
     for d in ("tx", "tz"):
         np.testing.assert_allclose(still.frames[:, lay.column(d)], m.frames[10, lay.column(d)])
-    assert heading(still.frames[:1], lay)[0] == pytest.approx(5.0, abs=1e-6)  # 0.5 x frame 10
+    assert heading(still.frames[:1], lay)[0] == pytest.approx(1.5, abs=1e-6)  # 0.15 x frame 10
     # straight: the heading stays put
     _, straight, turn2 = capture_cycle(phase, m, prepared, prep, 120.0, cycle_start="first", register_iter=0,
                                        travel="straight")
-    assert np.ptp(heading(straight.frames, lay)) < 1e-6 and turn2 == pytest.approx(60.0, abs=1e-6)
+    assert np.ptp(heading(straight.frames, lay)) < 1e-6 and turn2 == pytest.approx(18.0, abs=1e-6)
 
 
 def test_capture_cycle_slowest_start_and_width(walk):
