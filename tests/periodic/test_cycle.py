@@ -898,3 +898,13 @@ def test_check_bandwidth_normalises():
     for weighting in ("mean", "gaussian"):
         with pytest.raises(ParameterError):
             check_bandwidth(2.0, weighting)
+
+
+def test_knn_centroids_default_to_the_papers_ten_neighbours():
+    """Without k: the 10 nearest (the paper's), here the 5 lowest and 5 highest frames around
+    phase 0; a capture of exactly 10 frames is averaged whole."""
+    theta = (np.arange(100) + 0.5) / 100
+    out = knn_centroids(theta, np.arange(100, dtype=float), [0.0])
+    assert out[0, 0] == pytest.approx(np.mean([0, 1, 2, 3, 4, 95, 96, 97, 98, 99]))
+    ten = knn_centroids(np.arange(10) / 10, np.arange(10, dtype=float), [0.3])
+    assert ten[0, 0] == pytest.approx(4.5)
