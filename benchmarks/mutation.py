@@ -76,7 +76,7 @@ TESTS: dict[str, list[str]] = {
     P + "results.py": PIPE,
     P + "root.py": [T + "periodic/test_root.py", T + "periodic/test_pipeline.py"],
     P + "rotations.py": [T + "periodic/test_rotations.py"],
-    P + "steady.py": [T + "periodic/test_steady.py"],
+    P + "steady.py": [T + "periodic/test_steady_known.py", T + "periodic/test_steady.py"],
     P + "suggest.py": [T + "periodic/test_suggest.py"],
     P + "windings.py": PIPE,
     **{P + "detection/" + m: [T + "periodic/test_detect.py"]
