@@ -79,8 +79,9 @@ TESTS: dict[str, list[str]] = {
     P + "steady.py": [T + "periodic/test_steady_known.py", T + "periodic/test_steady.py"],
     P + "suggest.py": [T + "periodic/test_suggest.py"],
     P + "windings.py": PIPE,
-    **{P + "detection/" + m: [T + "periodic/test_detect.py"]
-       for m in ("_segments.py", "classes.py", "cycles.py", "detector.py", "result.py", "scoring.py")},
+    **{P + "detection/" + m: [T + "periodic/test_detect_known.py", T + "periodic/test_detect.py"]
+       for m in ("_segments.py", "classes.py", "cycles.py", "detector.py", "scoring.py")},
+    P + "detection/result.py": [T + "periodic/test_detect.py"],
     P + "detection/windows.py": [T + "periodic/test_windows.py", T + "periodic/test_detect.py"],
     Q + "contacts.py": [T + "quality/test_contacts.py"],
     Q + "cycle_quality.py": [T + "quality/test_reference.py", T + "quality/test_cycle_figures.py"],
