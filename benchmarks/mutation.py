@@ -70,7 +70,7 @@ TESTS: dict[str, list[str]] = {
     P + "fitting.py": PIPE,
     P + "landmarks.py": COORDS + [T + "periodic/test_memory_guard.py"],
     P + "phase_model.py": [T + "periodic/test_landmarks.py"],
-    P + "pipeline.py": PIPE,
+    P + "pipeline.py": [T + "periodic/test_pipeline_known.py"] + PIPE,
     P + "preprocess.py": [T + "periodic/test_preprocess.py", T + "periodic/test_rotations.py"],
     P + "registration.py": [T + "periodic/test_windings.py", T + "periodic/test_pipeline.py"],
     P + "results.py": PIPE,
