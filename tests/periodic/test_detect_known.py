@@ -658,3 +658,89 @@ def test_pop_is_the_largest_cycle_step_over_the_p99_step_of_the_rows():
     # rows 10-19: steps of 10
     assert _pop(cycle, poses, np.arange(10, 20)) == pytest.approx(0.3)
     assert np.isnan(_pop(cycle, np.zeros((20, 1)), np.arange(20)))
+
+
+# ------------------------------------------------------------------ detect's stages, spied on
+class _Stop(Exception):
+    pass
+
+
+@pytest.mark.parametrize(
+    "delay,lags", [(0.25, [30]), ((0.1, 0.2), [12, 24]), (0, None), (None, None), ((0, 0.1), [12])]
+)
+def test_detect_delay_seconds_become_frames(walk, monkeypatch, delay, lags):
+    from cyclecoord.periodic.detection import detector
+
+    seen = {}
+
+    class Spy:
+        def __init__(self, **kw):
+            seen.update(kw)
+            raise _Stop
+
+    monkeypatch.setattr(detector, "Preprocessor", Spy)
+    with pytest.raises(_Stop):
+        detector.detect(walk, delay=delay, progress=False)
+    assert seen["delay"] == lags
+    assert seen["difference_root"] is True and seen["rotations"] == "auto"
+
+
+@pytest.mark.parametrize("memory_limit", [None, 5e8])
+def test_detect_passes_the_estimator_options(walk, monkeypatch, memory_limit):
+    from cyclecoord.periodic.detection import detector
+
+    seen = {}
+
+    class Spy:
+        def __init__(self, **kw):
+            seen.update(kw)
+            raise _Stop
+
+    monkeypatch.setattr(detector, "CircularCoordinates", Spy)
+    with pytest.raises(_Stop):
+        detector.detect(walk, memory_limit=memory_limit, prime=13, scale_fraction=0.7,
+                        landmarks=40, progress=False)
+    assert seen["refine_birth"] is False and seen["prime"] == 13
+    assert seen["scale_fraction"] == 0.7 and seen["landmarks"] == 40
+    assert ("memory_limit" in seen) == (memory_limit is not None)
+    if memory_limit is not None:
+        assert seen["memory_limit"] == memory_limit
+
+
+def test_detect_notes_a_landmark_barcode(walk):
+    from cyclecoord.periodic.detection import detect
+
+    r = detect(walk, landmarks=60, progress=False, method="global")
+    assert any(n.startswith("barcode on 60 landmarks: ") for n in r.warnings)
+    assert not any("landmarks" in n for n in detect(walk, landmarks=None, progress=False,
+                                                   method="global").warnings)
+
+
+def test_detect_drops_unsteady_frames_on_the_joints_with_half_the_speed_window(walk, monkeypatch):
+    """window 0.5 s at 120 fps: 61 frames (odd); pieces under 30 frames are dropped; the
+    joints read are the prepared poses without the root's columns."""
+    from cyclecoord.periodic.detection import _segments, detector
+
+    seen = {}
+    real = _segments.drop_unsteady
+
+    def spy(labels, segments, joints, motion, min_run):
+        seen.update(joints=joints.shape, min_run=min_run)
+        return real(labels, segments, joints, motion, min_run)
+
+    monkeypatch.setattr(detector, "drop_unsteady", spy)
+    detector.detect(walk, window=0.5, progress=False, method="global")
+    assert seen["min_run"] == 30
+    from cyclecoord.periodic.preprocess import Preprocessor
+
+    prep = Preprocessor(delay=[30]).fit_transform(walk)
+    assert seen["joints"] == (240, prep.poses.shape[1] - len(prep.root_columns))
+
+
+def test_detect_windows_method_leaves_classes_out_and_auto_joins_them(walk):
+    from cyclecoord.periodic.detection import detect
+
+    auto = detect(walk, progress=False, window_lengths=(1.0,))
+    assert auto.method == "auto" and len(auto.windows) > 0 and len(auto.classes) >= 1
+    assert auto.n_motions == 1 and auto.classes[0].motion == 0
+    assert "windows" in auto.timings
