@@ -350,3 +350,38 @@ def test_extract_coordinate_timing_options_reach_the_average(walk):
     c = cc.extract(walk, timing="coordinate", weighting="mean")
     assert not np.allclose(c.cycle.frames, b.cycle.frames)
     assert c.parameters["weighting"] == "mean"
+
+
+def test_extract_timings_are_each_stages_seconds(base):
+    t = base.timings
+    assert all(0.0 <= v < 600.0 for v in t.values()), t
+
+
+def _pq(pop, strays=False, nearest=3.04):
+    return NS(figures=None, pop=pop, strays=strays, nearest_max=nearest)
+
+
+def test_extract_says_when_the_cycle_pops_or_holds_stray_poses(walk, monkeypatch):
+    monkeypatch.setattr(pipeline, "pose_quality", lambda *a, **k: _pq(2.5 * pipeline.MAX_POP, True))
+    r = cc.extract(walk)
+    pops = [w for w in r.warnings if "pops" in w]
+    assert len(pops) == 1 and pops[0].startswith(
+        f"the cycle pops: its largest frame step is {2.5 * pipeline.MAX_POP:.1f}x")
+    strays = [w for w in r.warnings if w.startswith("some cycle poses are 3.0x")]
+    assert len(strays) == 1 and "--rotations rotvec" in strays[0]
+    monkeypatch.setattr(pipeline, "pose_quality", lambda *a, **k: _pq(pipeline.MAX_POP))
+    r = cc.extract(walk)  # exactly at the limit: no pop, no stray
+    assert not any("pops" in w or "some cycle poses" in w for w in r.warnings)
+
+
+def test_extract_without_pose_figures_reads_the_pop_in_the_prepared_space(walk, monkeypatch):
+    monkeypatch.setattr(pipeline, "pose_quality", lambda *a, **k: None)
+    r = cc.extract(walk)
+    ratio = r.distance["largest_cycle_step"] / r.distance["p99_frame_step"]
+    assert r.pose_quality is None and not any("pops" in w for w in r.warnings)
+    assert set(r.jerk) == {"original", "cycle"} and np.isfinite(r.jerk["original"])
+    monkeypatch.setattr(pipeline, "MAX_POP", 0.99 * ratio)
+    r = cc.extract(walk)
+    assert any(f"its largest frame step is {ratio:.1f}x" in w for w in r.warnings)
+    monkeypatch.setattr(pipeline, "MAX_POP", ratio)
+    assert not any("pops" in w for w in cc.extract(walk).warnings)
