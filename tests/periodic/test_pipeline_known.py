@@ -385,3 +385,21 @@ def test_extract_without_pose_figures_reads_the_pop_in_the_prepared_space(walk, 
     assert any(f"its largest frame step is {ratio:.1f}x" in w for w in r.warnings)
     monkeypatch.setattr(pipeline, "MAX_POP", ratio)
     assert not any("pops" in w for w in cc.extract(walk).warnings)
+
+
+class _Stop(Exception):
+    pass
+
+
+@pytest.mark.parametrize("kw,clear", [({}, True), ({"require_clear": False}, False)])
+def test_extract_require_clear_reaches_the_fit(walk, monkeypatch, kw, clear):
+    seen = []
+
+    def spy(motion, params, require_clear):
+        seen.append((motion.n_frames, params["steady"], params["min_turns"], require_clear))
+        raise _Stop
+
+    monkeypatch.setattr(pipeline, "TakeFit", spy)
+    with pytest.raises(_Stop):
+        cc.extract(walk, frames=(10, 210), **kw)
+    assert seen == [(200, True, 1.5, clear)]
