@@ -744,3 +744,18 @@ def test_detect_windows_method_leaves_classes_out_and_auto_joins_them(walk):
     assert auto.method == "auto" and len(auto.windows) > 0 and len(auto.classes) >= 1
     assert auto.n_motions == 1 and auto.classes[0].motion == 0
     assert "windows" in auto.timings
+
+
+def test_motion_cycles_read_a_backward_coordinate_as_the_same_cycle(found):
+    """The lead class's coordinate turned backwards (1 - theta) winds as many times the
+    other way: the phase is its negation, and the cycle is the same, frame for frame."""
+    import dataclasses
+
+    from cyclecoord.periodic.detection import motion_cycles
+
+    lead = found.classes[0]
+    back = dataclasses.replace(found, classes=[dataclasses.replace(
+        lead, coordinate=np.mod(-lead.coordinate, 1.0))])
+    (a,), (b,) = motion_cycles(found), motion_cycles(back)
+    np.testing.assert_allclose(b.cycle.frames, a.cycle.frames, atol=1e-9)
+    assert b.phase_from == "class 0" and b.n_frames_used == a.n_frames_used
