@@ -759,3 +759,54 @@ def test_motion_cycles_read_a_backward_coordinate_as_the_same_cycle(found):
     (a,), (b,) = motion_cycles(found), motion_cycles(back)
     np.testing.assert_allclose(b.cycle.frames, a.cycle.frames, atol=1e-9)
     assert b.phase_from == "class 0" and b.n_frames_used == a.n_frames_used
+
+
+def test_class_period_of_a_segment_under_one_turn():
+    """21 frames at 1/40 of a turn a frame, never excited: 0.5 turns, 20 steps: 40."""
+    theta = np.mod(np.arange(21) / 40.0, 1.0)
+    cyc, period = class_period(theta, np.zeros(21, bool), 0, 21)
+    assert cyc == pytest.approx(0.5) and period == pytest.approx(40.0)
+
+
+def test_drop_unsteady_does_not_judge_the_turn_of_a_two_frame_segment():
+    """Frames 100-101 inside the 90-degree turn (2.25 degrees a frame, 90 a period): a
+    segment of two frames has no window to judge a turn over and is kept; one of three
+    frames is judged and dropped."""
+    m, joints = _turning_walk()
+    for n, kept in ((2, True), (3, False)):
+        seg = Segment(110, 110 + n, 0, (0,), 1.0, 2.0, 1.5, 0.1, 40.0)
+        labels = np.full(240, -1)
+        labels[110 : 110 + n] = 0
+        labels, out = drop_unsteady(labels, [seg], joints, m, min_run=1)
+        assert (len(out) == 1) == kept, n
+
+
+def test_motions_from_classes_strength_is_speed_times_consistency():
+    """C excites frames 50-59 with speed 0.05 but consistency 0.2 (strength 0.01): A and
+    B (0.02 x 1) are stronger there."""
+    A = _cls(3, [(0, 60)], 0.02)
+    B = _cls(1, [(10, 60)], 0.02)
+    C = _cls(0, [(50, 100)], 0.05)
+    C.consistency = np.full(100, 0.2)
+    _, labels, segs, n = motions_from_classes([A, B, C], 100, 10, 0.5)
+    np.testing.assert_array_equal(labels, [0] * 60 + [1] * 40)
+
+
+@pytest.mark.parametrize("timing", ["capture", "coordinate"])
+def test_motion_cycles_in_time_over_the_period_loop_cleanly(found, timing):
+    """Without a lead class the phase is time over the segment's period (40 frames of a
+    steady 40-frame walk): a clean loop, close to the class-phase cycle."""
+    import dataclasses
+
+    from cyclecoord.periodic.detection import motion_cycles
+
+    seg = found.segments[0]
+    timed = dataclasses.replace(found, segments=[dataclasses.replace(seg, classes=())])
+    (mc,) = motion_cycles(timed, timing=timing, n_samples=100)
+    (ref,) = motion_cycles(found, timing=timing, n_samples=100)
+    assert mc.phase_from == "time" and mc.cycle.n_frames == ref.cycle.n_frames
+    assert mc.loop_closure < 1.5 and mc.largest_step < 1.5
+    cols = [i for i, (j, _) in enumerate(found.motion.channels) if j != "root"]
+    a, b = mc.cycle.frames[:, cols], ref.cycle.frames[:, cols]
+    shift = min(np.abs(np.roll(a, k, axis=0) - b).mean() for k in range(len(a)))
+    assert shift < 0.2 * np.abs(b - b.mean(axis=0)).mean()  # measured 0.11-0.13

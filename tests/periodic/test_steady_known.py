@@ -352,3 +352,27 @@ def test_steady_mask_pace_limits():
     assert steady_mask(t * 0.8 / P, cand, P, max_pace=1.25).all()
     assert not steady_mask(t * 0.75 / P, cand, P, max_pace=1.25).any()
     assert not steady_mask(-t / P, cand, P).any()  # backwards is not at pace
+
+
+def test_steady_mask_reads_the_pace_over_one_period_besides_pace_window():
+    """Period 100, one turn a period but a stall over frames 400-549.  At frame 380 the
+    one-period window (330-430) turns 0.7 (at pace: over 1 / 1.6); the two-period one
+    (280-480) 1.2 turns over 2 periods, 0.6 a period (not): frame 380 is steady."""
+    t = np.arange(1000)
+    u = np.where(t < 400, t, np.where(t < 550, 400, t - 150)) / 100.0
+    cand = np.ones(1000, bool)
+    got = steady_mask(u, cand, 100.0)
+    assert got[380] and got[:380].all()
+    assert not got[420:530].any()
+
+
+def test_steady_mask_trims_a_slow_stretch_at_the_takes_start_from_its_end():
+    """Candidates 0-99 (slow, 0.3) and 150-279 (1.0), still after: the first stretch meets
+    still frames at its end, and slow all along it is trimmed whole from there (the
+    take's first frame does not stop the trim)."""
+    T, P = 300, 20.0
+    t = np.arange(T)
+    cand = (t < 100) | ((t >= 150) & (t < 280))
+    u = np.where(cand, t / P, np.nan)
+    speed = np.where(t < 100, 0.3, np.where(t < 280, 1.0, 0.0))
+    assert stretches(steady_mask(u, cand, P, speed=speed)) == [(150, 280)]

@@ -325,3 +325,46 @@ def test_targets_table_and_the_root_either_or():
     assert v["legs"] is True
     assert list(targets(CycleQuality(**_BASE))) == ["period", "root", "jerk", "legs", "seam",
                                                    "coverage", "skating"]
+
+
+def test_leg_length_is_the_chain_from_the_root_down():
+    from cyclecoord.quality.cycle_quality import _leg_length
+
+    m = _legs()
+    # root -> lfemur (1, -1, 0) -> ltibia 4 -> lfoot 4 -> ltoes (0, -0.5, 1)
+    assert _leg_length(m, "ltoes") == pytest.approx(np.sqrt(2) + 8 + np.sqrt(1.25))
+    assert _leg_length(m, "lfemur") == pytest.approx(np.sqrt(2))
+    assert _leg_length(m, "rfoot") == pytest.approx(np.sqrt(2) + 8)
+    assert _leg_length(m, "root") == 0.0
+
+
+def test_root_heading_of_a_skeleton_is_unwrapped_through_180():
+    """The legs rig's root turning from 170 to 190 degrees (ry) over 11 frames: the
+    heading read from its rotation crosses 180 and is unwrapped: 20 degrees over 10
+    steps, 22 a loop of 11 frames."""
+    m = _legs(T=11, fps=10.0)
+    f = m.frames.copy()
+    f[:, m.channels.index(("root", "ry"))] = np.linspace(170.0, 190.0, 11)
+    m = m.with_frames(f)
+    hpr = root_orientation(m)
+    np.testing.assert_allclose(hpr[:, 0] - hpr[0, 0], np.linspace(0.0, 20.0, 11), atol=1e-9)
+    assert heading_change(m) == pytest.approx(22.0)
+
+
+def test_foot_skating_reads_each_point_at_its_own_resting_level():
+    """The left leg held out 30 degrees to the side (its foot about 1.07 over the floor,
+    under a quarter leg) and swinging 5 degrees to and fro; the right leg stands.  Each
+    point is in contact near its own resting level, so the swinging foot's speed counts:
+    the mean of the four points' horizontal speeds."""
+    m = _legs(T=60, fps=30.0)
+    f = m.frames.copy()
+    f[:, m.channels.index(("lfemur", "rz"))] = 30.0
+    f[:, m.channels.index(("lfemur", "rx"))] = 5.0 * np.sin(2 * np.pi * np.arange(60) / 30.0)
+    m = m.with_frames(f)
+    pos = m.positions()
+    idx = [pos.names.index(n) for n in ("lfoot", "ltoes", "rfoot", "rtoes")]
+    p = pos.positions[:, idx]
+    assert 0.6 < p[:, 0, 1].min() - p[:, 2, 1].max()  # the left foot is off the floor
+    v = np.linalg.norm(np.diff(p[:, :, [0, 2]], axis=0), axis=2) * 30.0
+    assert v[:, :2].mean() > 1.0 and v[:, 2:].max() < 1e-9
+    assert foot_skating_speed(m) == pytest.approx(v.mean(), rel=1e-9)
