@@ -810,3 +810,19 @@ def test_motion_cycles_in_time_over_the_period_loop_cleanly(found, timing):
     a, b = mc.cycle.frames[:, cols], ref.cycle.frames[:, cols]
     shift = min(np.abs(np.roll(a, k, axis=0) - b).mean() for k in range(len(a)))
     assert shift < 0.2 * np.abs(b - b.mean(axis=0)).mean()  # measured 0.11-0.13
+
+
+def test_class_period_reads_a_run_ending_where_it_started_as_it_goes():
+    """Run 0-48 rises 1.5 turns at 1/16 a frame and comes back exactly; run 60-69 turns
+    1.125 at 1/8 a frame (together 1.125 excited turns).  The first run, ending where it
+    started, is read as it goes (rising first): its complete windings of 16 frames
+    outnumber the second run's of 8, so the period is 16."""
+    inc = np.r_[np.full(24, 1 / 16), np.full(24, -1 / 16), np.zeros(11), np.full(10, 1 / 8)]
+    u = np.r_[0.0, np.cumsum(inc)]  # 70 frames, exact sixteenths
+    theta = np.mod(u, 1.0)
+    mask = np.zeros(70, bool)
+    mask[0:49] = True
+    mask[60:70] = True
+    assert u[48] == u[0]
+    cyc, period = class_period(theta, mask, 0, 70)
+    assert period == pytest.approx(16.0)
