@@ -403,3 +403,38 @@ def test_extract_require_clear_reaches_the_fit(walk, monkeypatch, kw, clear):
     with pytest.raises(_Stop):
         cc.extract(walk, frames=(10, 210), **kw)
     assert seen == [(200, True, 1.5, clear)]
+
+
+def test_extract_feet_reach_the_fit_as_joint_names(walk, monkeypatch):
+    seen = []
+
+    def spy(motion, params, require_clear):
+        seen.append(params["feet"])
+        raise _Stop
+
+    monkeypatch.setattr(pipeline, "TakeFit", spy)
+    with pytest.raises(_Stop):
+        cc.extract(walk, feet="lfoot:ltoes,rfoot:rtoes")
+    with pytest.raises(_Stop):
+        cc.extract(walk, feet=("lfoot", "ltoes", "rfoot", "rtoes"))
+    assert seen == [["lfoot", "ltoes", "rfoot", "rtoes"]] * 2
+
+
+def test_extract_blanks_the_coordinate_outside_the_used_frames(walk):
+    f = np.r_[np.repeat(walk.frames[:1], 80, axis=0), walk.frames]
+    r = cc.extract(walk.with_frames(f))
+    unused = ~r.used
+    assert unused[:60].all()
+    assert np.isnan(r.coordinate[unused]).all() and np.isnan(r.unwrapped[unused]).all()
+    assert np.isfinite(r.coordinate[r.used]).all() and np.isfinite(r.unwrapped[r.used]).all()
+    assert np.isnan(r.phase[unused]).all() and np.isfinite(r.heading_per_cycle)
+
+
+def test_extract_coordinate_sampling_options_reach_the_average(walk):
+    q = cc.extract(walk, timing="coordinate", sampling="quantile")
+    r = cc.extract(walk, timing="coordinate", sampling="random", random_state=1)
+    s = cc.extract(walk, timing="coordinate", sampling="random", random_state=2)
+    assert not np.allclose(q.cycle.frames, r.cycle.frames)
+    assert not np.allclose(r.cycle.frames, s.cycle.frames)
+    few = cc.extract(walk, timing="coordinate", n_samples=10)
+    assert not np.allclose(few.cycle.frames, q.cycle.frames)

@@ -233,6 +233,13 @@ def test_cycle_quality_by_hand():
     assert q.coverage == pytest.approx(1.0)
     assert np.isnan(q.coverage_ratio)  # the reference's coverage is 0
     # seam: step 30 -> 0 (with rtibia 2 -> 0) over the median step
+    # pop: the seam step (30, 2) over the used take frames' steps, all (10, 4); over the
+    # whole take the steps (30, 4) back to each group's start (4 of 19) weigh in too
+    assert q.largest_step == pytest.approx(np.hypot(30, 2) / np.hypot(10, 4))
+    assert cycle_quality(cyc, take, reference=ref).largest_step == pytest.approx(
+        np.hypot(30, 2) / np.percentile([np.hypot(10, 4)] * 15 + [np.hypot(30, 4)] * 4, 99))
+    steps = [np.hypot(10, 2)] * 3 + [np.hypot(30, 2)]
+    assert q.step_spread == pytest.approx(np.percentile(steps, 90) / np.percentile(steps, 10))
     # seam: the step 30 -> 0 (rtibia 2 -> 0) over the median inside step (10, 2)
     assert q.seam == pytest.approx(np.hypot(30, 2) / np.hypot(10, 2))
     assert q.root_closure_degrees == 0.0 and q.heading_change == 0.0
