@@ -829,11 +829,12 @@ def test_class_period_reads_a_run_ending_where_it_started_as_it_goes():
 
 
 def test_drop_unsteady_drops_a_short_piece_late_in_the_capture():
-    """A 5-frame segment at frames 100-104 is under min_run 10 wherever it lies."""
+    """A 5-frame segment at frames 100-104 is under min_run 10 wherever it lies (at 2 fps
+    its joints move for over a second: no pause in it)."""
     T = 120
     ang = 2 * np.pi * np.arange(T) / 30
     joints = 30.0 * np.column_stack([np.sin(ang), np.cos(ang)])
-    motion = Motion(joints, [("a", "rx"), ("b", "rx")], fps=30.0)
+    motion = Motion(joints, [("a", "rx"), ("b", "rx")], fps=2.0)
     labels = np.full(T, -1)
     labels[100:105] = 0
     seg = Segment(100, 105, 0, (0,), 1.0, 2.0, 1.5, 0.2, 30.0)
