@@ -842,3 +842,26 @@ def test_drop_unsteady_drops_a_short_piece_late_in_the_capture():
     assert out == [] and np.all(got == -1)
     got, out = drop_unsteady(labels, [seg], joints, motion, min_run=5)
     assert [(s.start, s.stop) for s in out] == [(100, 105)]
+
+
+def test_motion_cycles_fall_back_to_time_when_the_class_phase_never_winds(found):
+    """A lead class whose coordinate stands still over its excited frames has no complete
+    winding to re-time by: the phase falls back to time over the period from the
+    segment's start.  With cycle_start="first" the cycle then starts at phase 0, the
+    pose of the segment's first frame and of every period after it (their mean, within a
+    few degrees; two frames later the poses are 17 degrees away)."""
+    import dataclasses
+
+    from cyclecoord.periodic.detection import motion_cycles
+
+    lead = found.classes[0]
+    seg = found.segments[0]
+    assert lead.mask[seg.start:seg.stop].all() and seg.period_frames == pytest.approx(40.0)
+    still = dataclasses.replace(found, classes=[dataclasses.replace(
+        lead, coordinate=np.full_like(lead.coordinate, 0.3))])
+    (mc,) = motion_cycles(still, cycle_start="first")
+    assert mc.phase_from == "class 0"
+    cols = [i for i, (j, _) in enumerate(found.motion.channels) if j != "root"]
+    starts = np.arange(seg.start, seg.stop, 40)
+    first = found.motion.frames[starts][:, cols].mean(axis=0)
+    assert np.abs(mc.cycle.frames[0, cols] - first).max() < 5.0  # measured 2.2
