@@ -343,9 +343,14 @@ def test_extract_cycle_options_object_reaches_the_cycle(walk, base):
         cc.extract(walk, cycle=CycleOptions(), timing="coordinate")
 
 
-def test_extract_coordinate_timing_options_reach_the_average(walk):
+@pytest.fixture(scope="module")
+def coord(walk):
+    return cc.extract(walk, timing="coordinate")
+
+
+def test_extract_coordinate_timing_options_reach_the_average(walk, coord):
     a = cc.extract(walk, timing="coordinate", n_neighbors=1)
-    b = cc.extract(walk, timing="coordinate", n_neighbors=10)
+    b = coord  # n_neighbors 10
     assert not np.allclose(a.cycle.frames, b.cycle.frames)
     c = cc.extract(walk, timing="coordinate", weighting="mean")
     assert not np.allclose(c.cycle.frames, b.cycle.frames)
@@ -430,8 +435,8 @@ def test_extract_blanks_the_coordinate_outside_the_used_frames(walk):
     assert np.isnan(r.phase[unused]).all() and np.isfinite(r.heading_per_cycle)
 
 
-def test_extract_coordinate_sampling_options_reach_the_average(walk):
-    q = cc.extract(walk, timing="coordinate", sampling="quantile")
+def test_extract_coordinate_sampling_options_reach_the_average(walk, coord):
+    q = coord  # sampling "quantile"
     r = cc.extract(walk, timing="coordinate", sampling="random", random_state=1)
     s = cc.extract(walk, timing="coordinate", sampling="random", random_state=2)
     assert not np.allclose(q.cycle.frames, r.cycle.frames)
