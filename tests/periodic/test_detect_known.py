@@ -865,3 +865,37 @@ def test_motion_cycles_fall_back_to_time_when_the_class_phase_never_winds(found)
     starts = np.arange(seg.start, seg.stop, 40)
     first = found.motion.frames[starts][:, cols].mean(axis=0)
     assert np.abs(mc.cycle.frames[0, cols] - first).max() < 5.0  # measured 2.2
+
+
+def test_detect_defaults_beside_a_configured_preprocessor_are_no_conflict(walk, monkeypatch):
+    """Every keyword a Preprocessor carries left at detect's default is no clash; the
+    preprocessor's settings (its delays in frames, as seconds) reach the preparation, and
+    the estimator's reach the barcode; a changed keyword beside it is an error."""
+    from cyclecoord.periodic.coordinates import CircularCoordinates
+    from cyclecoord.periodic.detection import detector
+    from cyclecoord.periodic.preprocess import Preprocessor
+
+    seen = {}
+
+    def spy(motion, timings, notes, preprocess, estimate):
+        seen.update(preprocess=dict(preprocess), estimate=dict(estimate))
+        raise _Stop
+
+    monkeypatch.setattr(detector, "_barcode_of", spy)
+    pre = Preprocessor(delay=[12, 24], normalize=True, pca=4, difference_root=False,
+                       rotations="euler")
+    est = CircularCoordinates(prime=13, scale_fraction=0.6, temporal=True, landmarks=50,
+                              max_scale=7.0, memory_limit=1e9)
+    with pytest.raises(_Stop):
+        detector.detect(walk, preprocessor=pre, estimator=est, progress=False)
+    assert seen["preprocess"] == dict(difference_root=False, normalize=True, pca=4,
+                                      delay=(0.1, 0.2), rotations="euler")
+    assert seen["estimate"] == dict(max_scale=7.0, prime=13, scale_fraction=0.6, temporal=True,
+                                    landmarks=50, memory_limit=1e9)
+    with pytest.raises(_Stop):
+        detector.detect(walk, preprocessor=Preprocessor(), estimator=CircularCoordinates(),
+                        progress=False)
+    for name, value in (("delay", 0.5), ("normalize", True), ("pca", 3),
+                        ("difference_root", False), ("rotations", "rotvec")):
+        with pytest.raises(ParameterError, match=name):
+            detector.detect(walk, preprocessor=Preprocessor(), progress=False, **{name: value})
