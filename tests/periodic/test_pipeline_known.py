@@ -443,3 +443,13 @@ def test_extract_coordinate_sampling_options_reach_the_average(walk, coord):
     assert not np.allclose(r.cycle.frames, s.cycle.frames)
     few = cc.extract(walk, timing="coordinate", n_samples=10)
     assert not np.allclose(few.cycle.frames, q.cycle.frames)
+
+
+def test_extract_auto_bandwidth_needs_kernel_weighting_only_in_coordinate_timing():
+    with pytest.raises(ParameterError, match="too few"):  # capture timing: weighting unused
+        cc.extract(_bare(9), bandwidth="auto", weighting="mean", n_neighbors=1)
+    with pytest.raises(ParameterError, match="needs weighting='kernel'"):
+        cc.extract(_bare(9), bandwidth="auto", weighting="mean", timing="coordinate",
+                   n_neighbors=1)
+    with pytest.raises(ParameterError, match="too few"):
+        cc.extract(_bare(9), bandwidth="auto", timing="coordinate", n_neighbors=1)
