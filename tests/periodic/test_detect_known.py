@@ -899,3 +899,26 @@ def test_detect_defaults_beside_a_configured_preprocessor_are_no_conflict(walk, 
                         ("difference_root", False), ("rotations", "rotvec")):
         with pytest.raises(ParameterError, match=name):
             detector.detect(walk, preprocessor=Preprocessor(), progress=False, **{name: value})
+
+
+def test_detect_timings_are_each_stages_seconds(found):
+    assert all(0.0 <= v < 600.0 for v in found.timings.values()), found.timings
+
+
+def test_motion_cycles_turn_each_backward_run_of_the_class_forward(found):
+    """The lead class excited on the segment but one frame three before its end: a
+    two-frame run closes it.  With the coordinate backwards each run is turned forward,
+    the two-frame one too, so the cycle is the forward coordinate's, frame for frame."""
+    import dataclasses
+
+    from cyclecoord.periodic.detection import motion_cycles
+
+    lead = found.classes[0]
+    seg = found.segments[0]
+    mask = lead.mask.copy()
+    mask[seg.stop - 3] = False
+    fwd = dataclasses.replace(found, classes=[dataclasses.replace(lead, mask=mask)])
+    back = dataclasses.replace(found, classes=[dataclasses.replace(
+        lead, mask=mask, coordinate=np.mod(-lead.coordinate, 1.0))])
+    (a,), (b,) = motion_cycles(fwd), motion_cycles(back)
+    np.testing.assert_allclose(b.cycle.frames, a.cycle.frames, atol=1e-9)

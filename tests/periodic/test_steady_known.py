@@ -376,3 +376,15 @@ def test_steady_mask_trims_a_slow_stretch_at_the_takes_start_from_its_end():
     u = np.where(cand, t / P, np.nan)
     speed = np.where(t < 100, 0.3, np.where(t < 280, 1.0, 0.0))
     assert stretches(steady_mask(u, cand, P, speed=speed)) == [(150, 280)]
+
+
+def test_steady_mask_a_slow_stretch_reaching_the_takes_end_is_trimmed_from_its_start():
+    """Candidates 50-149 at speed 1 and 200-299 at 0.3 (the median over both, 0.65, makes
+    0.3 slow): the second stretch, out of still frames and slow to the take's last frame,
+    is trimmed whole from its start; the take's end does not trim."""
+    T, P = 300, 20.0
+    t = np.arange(T)
+    cand = ((t >= 50) & (t < 150)) | (t >= 200)
+    u = np.where(cand, t / P, np.nan)
+    speed = np.where(t < 150, 1.0, 0.3)
+    assert stretches(steady_mask(u, cand, P, speed=speed)) == [(50, 150)]

@@ -375,3 +375,14 @@ def test_foot_skating_reads_each_point_at_its_own_resting_level():
     v = np.linalg.norm(np.diff(p[:, :, [0, 2]], axis=0), axis=2) * 30.0
     assert v[:, :2].mean() > 1.0 and v[:, 2:].max() < 1e-9
     assert foot_skating_speed(m) == pytest.approx(v.mean(), rel=1e-9)
+
+
+def test_a_ratio_with_an_infinite_side_is_no_ratio():
+    from cyclecoord.quality.cycle_quality import _ratio
+
+    assert _ratio(3.0, 2.0) == 1.5
+    for a, b in ((1.0, float("inf")), (float("inf"), 2.0), (float("nan"), 2.0), (1.0, float("nan")),
+                 (1.0, 0.0)):
+        assert np.isnan(_ratio(a, b)), (a, b)
+    take = _motion({"lfemur.rx": 10.0 * (np.arange(8) % 2)})
+    assert np.isnan(cycle_quality(take, take, skating_take=float("inf")).skating_ratio)
