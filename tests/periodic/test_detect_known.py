@@ -922,3 +922,22 @@ def test_motion_cycles_turn_each_backward_run_of_the_class_forward(found):
         lead, mask=mask, coordinate=np.mod(-lead.coordinate, 1.0))])
     (a,), (b,) = motion_cycles(fwd), motion_cycles(back)
     np.testing.assert_allclose(b.cycle.frames, a.cycle.frames, atol=1e-9)
+
+
+def test_detect_runs_with_one_blas_thread(walk, monkeypatch):
+    """detect holds the one-BLAS-thread limit (cyclecoord._blas) while its stages run, as
+    extract does; _speed_window, a pure helper, needs none."""
+    from cyclecoord import _blas
+    from cyclecoord.periodic.detection import detector
+
+    seen = []
+
+    def spy(*args):
+        seen.append(_blas._LIMITED.get())
+        raise _Stop
+
+    monkeypatch.setattr(detector, "candidate_classes", spy)
+    with pytest.raises(_Stop):
+        detector.detect(walk, progress=False)
+    assert seen == [True]
+    assert not _blas._LIMITED.get()  # restored afterwards
