@@ -415,3 +415,53 @@ def test_window_table_defaults_and_a_hop_of_one_frame(monkeypatch):
     assert sorted({w.stop - w.start for w in wins}) == [20, 40, 60]
     slow = W.window_table(pts[:14], pts[:14], 1.0, lengths=(10.0,), progress=False)
     assert [w.start for w in slow] == [0, 1, 2, 3, 4]
+
+
+def _circle_win(a, b, birth=1.0, cycles=3.0):
+    ang = 2 * np.pi * np.arange(16) / 16
+    cycle = 10.0 * np.column_stack([np.cos(ang), np.sin(ang)])
+    return WindowInfo(start=a, stop=b, step=1, birth=birth, death=5.0, threshold=6.0, scale=4.0,
+                      clear=True, cycles=cycles, steadiness=1.0, period_frames=16.0, looping=True,
+                      cycle=cycle)
+
+
+def _circle_class(index, motion, lo, hi, T):
+    from cyclecoord.periodic.detection.result import DetectedClass
+
+    mask = np.zeros(T, bool)
+    mask[lo:hi] = True
+    return DetectedClass(index=index, birth=1.0, death=5.0, scale=3.0,
+                         coordinate=(np.arange(T) % 16) / 16.0, speed=np.full(T, 1 / 16),
+                         consistency=np.ones(T), mask=mask, motion=motion)
+
+
+def test_a_window_group_sharing_two_global_motions_equally_joins_the_first():
+    """Global motions 0 (frames 0-49) and 1 (50-99); a group of windows over frames 25-74
+    shares half its frames with each (over merge_overlap 0.4): a tie goes to the first."""
+    T = 100
+    ang = 2 * np.pi * np.arange(T) / 16
+    poses = 10.0 * np.column_stack([np.cos(ang), np.sin(ang)])
+    kept = [_circle_class(0, 0, 0, 50, T), _circle_class(1, 1, 50, 100, T)]
+    win = _circle_win(25, 75)
+    glob = np.r_[np.zeros(50, int), np.ones(50, int)]
+    labels, segments, n = W.windowed_motions([win], kept, glob, 2, poses, window=5,
+                                             min_cycles=1.5, similarity=0.5, merge_overlap=0.4)
+    assert n == 2 and np.array_equal(labels, glob)
+    assert win.motion == 0
+
+
+def test_windows_inside_a_segment_start_before_its_end():
+    """One group of two windows, 0-40 (birth 1) and 40-100 (birth 3); the poses of frames
+    40-59 are far off the cycle, so the motion labels 0-39 and 60-99.  The first segment
+    ends at frame 40, where the second window starts: that window is not inside it, so the
+    segment's birth is the first window's alone."""
+    T = 100
+    ang = 2 * np.pi * np.arange(T) / 16
+    poses = 10.0 * np.column_stack([np.cos(ang), np.sin(ang)])
+    poses[40:60] += 1000.0
+    wins = [_circle_win(0, 40, birth=1.0), _circle_win(40, 100, birth=3.0)]
+    labels, segments, n = W.windowed_motions(wins, [], np.full(T, -1), 0, poses, window=3,
+                                             min_cycles=1.5, similarity=0.5, merge_overlap=0.5)
+    assert n == 1
+    assert [(s.start, s.stop) for s in segments] == [(0, 40), (60, 100)]
+    assert segments[0].birth == 1.0 and segments[1].birth == 3.0

@@ -1037,3 +1037,29 @@ def test_grounded_keeps_ends_parting_strictly_over_0_3_of_the_height():
     assert geo.grounded() == [1]
     geo.median[0] = np.nextafter(3.0, 4.0)
     assert geo.grounded() == [1, 2]
+
+
+def test_a_quadrupeds_front_pair_is_ahead_on_average_though_staggered():
+    """Anonymous names, rest pose: the chest 0.5 ahead of the pelvis, its legs staggered
+    (left hip 1 ahead of it, right 1 behind, so the right front leg is behind the hind
+    legs).  The pair ahead is the one whose two legs are ahead on average: the chest's."""
+    from _walkers import ROT, _leg
+
+    names = quadruped_names("anonymous")
+    j = [Joint(names["pelvis"], -1, [0, 0, 0], ("tx", "ty", "tz") + ROT, "ZYX")]
+    j.append(Joint(names["spine"], 0, [0, 0, 0.25], ROT, "ZYX"))
+    j.append(Joint(names["chest"], 1, [0, 0, 0.25], ROT, "ZYX"))
+    j.append(Joint(names["neck"], 2, [0, 1.5, 1.0], ROT, "ZYX"))
+    j.append(Joint(names["head"], 3, [0, 1.0, 1.0], ROT, "ZYX", end_site=[0, 0, 1.5]))
+    j.append(Joint(names["tail"], 0, [0, 0.5, -1.0], ROT, "ZYX", end_site=[0, -1.0, -2.0]))
+    for prefix, parent, hip in (("hl_", 0, [1.5, 0, 0]), ("hr_", 0, [-1.5, 0, 0]),
+                                ("fl_", 2, [1.5, 0, 1.0]), ("fr_", 2, [-1.5, 0, -1.0])):
+        _leg(j, names, prefix, parent, hip)
+    legs = find_legs(Skeleton(tuple(j), name="staggered")).legs
+    got = {g.label: g.points for g in legs}
+    assert got == {
+        "front left": (names["fl_ankle"], names["fl_toe"]),
+        "front right": (names["fr_ankle"], names["fr_toe"]),
+        "hind left": (names["hl_ankle"], names["hl_toe"]),
+        "hind right": (names["hr_ankle"], names["hr_toe"]),
+    }

@@ -555,3 +555,25 @@ def test_a_reference_listing_the_bones_the_other_way_round_explains_the_contact(
     (c,) = rep.contacts
     assert c["reference_min_distance"] == pytest.approx(1.0) and not c["new"]
     assert rep.new_contact_frames == [] and rep.clean
+
+
+def test_siblings_exactly_the_tolerance_apart_are_one_node():
+    """Siblings p and q 2**-17 apart, in a skeleton whose total length L makes the
+    tolerance 1e-6 L exactly 2**-17 (the bone r is cut to that length): at the tolerance
+    is within it, so root>p and root>q are one bone."""
+    from cyclecoord.motion import Motion
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    d = 2.0**-17
+    skel = Skeleton((
+        Joint("root", -1, [0.0, 0.0, 0.0]),
+        Joint("p", 0, [0.0, 2.0, 0.0]),
+        Joint("q", 0, [d, 2.0, 0.0]),
+        Joint("p1", 1, [1.0, 0.0, 0.0]),
+        Joint("q1", 2, [-1.0, 0.0, 0.0]),
+        Joint("r", 0, [0.0, 0.0, 1.6293945312354476]),
+    ))
+    m = Motion(np.zeros((1, 0)), (), skeleton=skel)
+    pos = m.positions().positions[0]
+    assert 1e-6 * skel.total_length() == d and np.linalg.norm(pos[1] - pos[2]) == d
+    assert bones(m).names == ["root>p", "p", "q", "root>r"]

@@ -762,3 +762,36 @@ def test_autocorrelation_period_first_lag_and_a_unit_energy_take():
     assert float(np.sum(square**2)) == 1.0 and square.mean() == 0.0
     m = _motion({"lfemur.rx": square})
     assert autocorrelation_period(m) == pytest.approx(8, abs=0.1)
+
+
+def test_average_cycle_reads_two_values_as_wraps_and_three_as_a_coordinate():
+    """A coordinate needs three frames to be told from wrap times: two values in [0, 1)
+    for a 2-frame take are the wraps 0 and 0.5 (one piece); three for a 3-frame take are a
+    coordinate, which never wraps there (refused)."""
+    two = _motion({"lfemur.rx": [0.0, 4.0]})
+    assert average_cycle(two, np.array([0.0, 0.5]), 2).metadata["pieces"] == [(0.0, 0.5)]
+    three = _motion({"lfemur.rx": [0.0, 4.0, 8.0]})
+    with pytest.raises(ParameterError, match="wrap at least twice"):
+        average_cycle(three, np.array([0.0, 0.5, 0.9]), 2)
+
+
+def test_autocorrelation_period_looks_one_frame_either_side_of_a_short_biased_peak():
+    """18 frames at 10 fps, lags 2-14 searched (neighbours 1 and 15): the biased curve's only
+    peak whose normalised correlation reaches 0.3 is at lag 4 (0.236 against 0.221 and
+    0.029); 10 % of 4 frames is under one, so the normalised curve is read at lags 3-5 only
+    -- not at lag 2, where it is higher (0.401 against 0.339) -- and the parabola through
+    lags 3, 4, 5 gives the period."""
+    x = np.array([1, 1, 2, 2, 1, 2, 0, 1, 1, 1, 0, 0, 1, -1, -1, -1, 1, 0], dtype=float)
+    y = x - x.mean()
+
+    def r(lag):
+        a, b = y[:-lag], y[lag:]
+        return float(np.sum(a * b) / np.sqrt(np.sum(a * a) * np.sum(b * b)))
+
+    def biased(lag):
+        return float(np.sum(y[:-lag] * y[lag:]) / np.sum(y * y))
+
+    assert biased(3) < biased(4) > biased(5) and r(4) >= 0.3 and r(2) > r(4)
+    want = 4 + 0.5 * (r(3) - r(5)) / (r(3) - 2 * r(4) + r(5))
+    got = autocorrelation_period(_motion({"lfemur.rx": x}), min_lag=0.2, max_lag=1.5)
+    assert got == pytest.approx(want, abs=1e-9)

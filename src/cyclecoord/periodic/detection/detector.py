@@ -32,14 +32,14 @@ __all__ = ["detect", "METHODS"]
 METHODS = ("auto", "global", "windows")
 
 
-@one_blas_thread
-
 def _speed_window(window: float, fps: float) -> int:
     """Frames the coordinate's speed is averaged over for a ``window`` of seconds: the
     nearest whole number of frames to ``window * fps``, made odd (an even count gets one
     more frame) so that the window is centred on its frame, and at least 3."""
     return max(3, int(round(window * fps)) | 1)
 
+
+@one_blas_thread
 def detect(
     motion: Motion,
     frames: tuple[int | None, int | None] | None = None,
