@@ -237,14 +237,14 @@ def test_steady_turning_equals_its_definition(period):
 def test_steady_turning_default_limits():
     """Period 10: the heading turns -30 degrees a period, then +30 from frame 50: at frame
     50 the window rate is 0, the windows half a period before and after read -30 and +30,
-    a change of exactly the default 30 (kept); -31 to +31 is a change of 31 (not).  60
-    degrees a period all along is the default curve limit (kept), 61 is a corner."""
+    a change of exactly the default 30 (kept); -31 to +31 is a change of 31 (not).  90
+    degrees a period all along is the default curve limit (kept), 91 is a corner."""
     t = np.arange(100.0)
     for r, ok in ((3.0, True), (3.1, False)):
         h = np.where(t < 50, -r * t, -50 * r + r * (t - 50))
         assert steady_turning(h, 10.0)[50] == ok, r
-    assert not steady_turning(6.1 * t, 10.0).any() and steady_turning(6.0 * t, 10.0).all()
-    assert steady_turning(-6.0 * t, 10.0).all() and not steady_turning(-6.1 * t, 10.0).any()
+    assert not steady_turning(9.1 * t, 10.0).any() and steady_turning(9.0 * t, 10.0).all()
+    assert steady_turning(-9.0 * t, 10.0).all() and not steady_turning(-9.1 * t, 10.0).any()
 
 
 # ------------------------------------------------------------------ steady_mask
