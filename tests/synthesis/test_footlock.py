@@ -167,7 +167,7 @@ def test_targets_close_contacts_hand_over_smoothly():
 def test_carry_by_feet_holds_the_body_on_still_feet_but_not_on_landing_ones():
     """Legs that never move against the root, sliding forward at 8 units/s: with the feet
     at one height they are planted and carry the body, which then stays put; bobbing
-    0.2 units at 2 Hz (inside the contact band, up to 0.3 leg lengths/s up and down) they
+    0.2 units at 4 Hz (inside the contact band, up to 0.6 leg lengths/s up and down) they
     carry it only as far as their vertical speed is under VERTICAL_SPEED, by hand: each
     step keeps its own travel times one minus the lowest point's grounded weight (the
     heights smoothed over VERTICAL_SMOOTH first)."""
@@ -185,7 +185,7 @@ def test_carry_by_feet_holds_the_body_on_still_feet_but_not_on_landing_ones():
     still = make_motion(skel, T=120, fps=60.0, root_speed=8.0)
     out = carry_by_feet(still)
     assert np.ptp(out.frames[:, tz]) < 1e-9 * 8.0  # planted feet: the root does not glide
-    bob = make_motion(skel, T=120, fps=60.0, root_speed=8.0, bob=(0.2, 2.0))
+    bob = make_motion(skel, T=120, fps=60.0, root_speed=8.0, bob=(0.2, 4.0))
     feet = ("lfoot", "ltoes", "rfoot", "rtoes")
     c = foot_contacts(bob, feet, speed=None, height=CONTACT_BAND)
     assert np.all(c.height.min(axis=1) <= CONTACT_BAND * c.leg_length)  # always in the band
