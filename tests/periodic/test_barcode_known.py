@@ -14,7 +14,6 @@ import pytest
 import ripser
 
 from cyclecoord.errors import ParameterError
-from cyclecoord.periodic import barcode as bc_mod
 from cyclecoord.periodic import coordinates as co_mod
 from cyclecoord.periodic._cochain import CocycleCheck
 from cyclecoord.periodic._rips import _euclidean_distances, rips_cohomology

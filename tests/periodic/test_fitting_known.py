@@ -14,7 +14,7 @@ import pytest
 import cyclecoord as cc
 from cyclecoord.errors import NoPeriodicMotionError, ParameterError
 from cyclecoord.periodic import fitting
-from cyclecoord.periodic.barcode import CLEAR_GAP, CLEAR_MIN_FRACTION, CLEAR_RATIO, default_max_scale
+from cyclecoord.periodic.barcode import CLEAR_GAP, CLEAR_RATIO, default_max_scale
 from cyclecoord.periodic.coordinates import CircularCoordinates
 from cyclecoord.periodic.fitting import (
     ALIVE_RATIO,

@@ -1,7 +1,6 @@
 """periodic.registration on templates shifted or time-warped by a known amount."""
 
 import numpy as np
-import pytest
 
 from cyclecoord.periodic.registration import _align_run, hold_weights, register
 

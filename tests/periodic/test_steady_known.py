@@ -11,7 +11,6 @@ from scipy.ndimage import gaussian_filter1d, uniform_filter1d
 from cyclecoord.periodic.steady import (
     _smoothed_steps,
     centred_window,
-    clean_runs,
     moving_mask,
     period_speed,
     recurrence,
