@@ -75,7 +75,7 @@ TESTS: dict[str, list[str]] = {
     P + "preprocess.py": [T + "periodic/test_preprocess.py", T + "periodic/test_rotations.py"],
     P + "registration.py": [T + "periodic/test_registration_known.py", T + "periodic/test_windings.py",
                             T + "periodic/test_pipeline.py"],
-    P + "results.py": PIPE,
+    P + "results.py": [T + "periodic/test_pipeline_known.py"] + PIPE,
     P + "root.py": [T + "periodic/test_root_known.py", T + "periodic/test_root.py", T + "periodic/test_pipeline.py"],
     P + "rotations.py": [T + "periodic/test_rotations_known.py", T + "periodic/test_rotations.py"],
     P + "steady.py": [T + "periodic/test_steady_known.py", T + "periodic/test_steady.py"],

@@ -401,3 +401,18 @@ def test_loop_cycle_from_the_last_row_alone(example):
     root = prepared.root_columns
     np.testing.assert_allclose(clip.frames[0, root], m.frames[last, root], atol=1e-9)
     assert np.all(np.isfinite(clip.frames))
+
+
+def test_typical_amplitude_leaves_a_channel_whose_range_is_exactly_the_floor():
+    """A channel of the cycle whose range is exactly 1e-9 (the floor: a channel that
+    still is not widened) is left as it is; one of 1.5e-9 is widened to the capture's
+    range of 1.8e-9 (a gain of 1.2)."""
+    from cyclecoord.periodic.clip import typical_amplitude
+
+    cycle = np.zeros((4, 2))
+    cycle[1, 0] = 1e-9
+    cycle[1, 1] = 1.5e-9
+    poses = np.tile(np.array([[0.0, 0.0], [1.8e-9, 1.8e-9], [0.0, 0.0], [0.0, 0.0]]), (3, 1))
+    out = typical_amplitude(cycle, np.zeros(len(poses)), poses, spike=1)
+    np.testing.assert_array_equal(out[:, 0], cycle[:, 0])
+    assert np.ptp(out[:, 1]) == pytest.approx(1.8e-9, rel=1e-9)

@@ -29,6 +29,9 @@ def test_cycle_lengths_by_hand():
     # hand: u = 0.25 + 0.4 t reaches 1.25 at t = 2.5, 2.25 at t = 5)
     u = 0.25 + 0.4 * np.arange(7)
     np.testing.assert_allclose(cycle_lengths(u), [2.5, 2.5])
+    # the count of levels is of the turns from u[0] (2.4 here), not of u's last value (3.0)
+    u = 0.6 + 0.4 * np.arange(7)
+    np.testing.assert_allclose(cycle_lengths(u), [2.5, 2.5])
     # a step back is not a crossing: the running maximum is read
     u = np.array([0.0, 0.6, 0.2, 0.8, 1.2, 1.6, 2.1])
     # 1.0 crossed between frames 3 (0.8) and 4 (1.2): 3.5; 2.0 between 5 (1.6) and 6 (2.1): 5.8
@@ -265,6 +268,7 @@ def test_extract_result_fields(walk, base):
     assert base.cycle.n_frames == int(round(base.period_frames))
     assert base.cycles == pytest.approx(base.windings.turns)
     np.testing.assert_array_equal(base.cycle_frames, base.windings.lengths)
+    assert base.to_report()["period_spread"] == pytest.approx(base.windings.spread)
     assert base.used.all() and np.isfinite(base.phase).all()
     assert set(base.distance) == {"median", "p90", "max", "median_frame_step", "p99_frame_step",
                                   "largest_cycle_step"}
