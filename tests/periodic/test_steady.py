@@ -270,3 +270,15 @@ def test_a_tight_curve_is_steady_and_a_corner_within_a_cycle_is_not():
     assert steady_turning(65.0 / P * t, P).all()
     assert steady_turning(89.0 / P * t, P).all()
     assert not steady_turning(91.0 / P * t, P).any()
+
+
+def test_steady_mask_keeps_a_curve_up_to_its_default_limit():
+    """steady_mask's own default max_curve is 90 degrees a period, as steady_turning's: a
+    heading turning 89 degrees a period is steady, 91 is not (a corner taken within a
+    cycle); the coordinate winds at the period's pace all along."""
+    P, T = 30.0, 600
+    t = np.arange(T)
+    u = t / P
+    cand = np.ones(T, dtype=bool)
+    assert steady_mask(u, cand, P, heading=89.0 / P * t).all()
+    assert not steady_mask(u, cand, P, heading=91.0 / P * t).any()
