@@ -523,3 +523,12 @@ def test_max_samples_defaults_to_20000():
     theta = np.linspace(0.0, 1.0, 20001, endpoint=False)
     assert PeriodicDensity(n_components=1, max_iter=1).fit(theta).n_samples_ == 20000
     assert PeriodicDensity(n_components=1, max_iter=1).fit(theta[:20000]).n_samples_ == 20000
+
+
+def test_the_default_density_is_seeded():
+    """Without random_state the density is seeded with 0 (deterministic by default, as the
+    pipeline's): two default fits agree with each other and with random_state=0."""
+    x = draw(300, seed=2)
+    assert PeriodicDensity().get_params()["random_state"] == 0
+    a, b = PeriodicDensity(max_iter=20).fit(x), PeriodicDensity(max_iter=20, random_state=0).fit(x)
+    np.testing.assert_array_equal(a.means_, b.means_)

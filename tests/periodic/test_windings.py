@@ -743,3 +743,16 @@ def test_the_glitch_filter_of_typical_amplitude_is_timed_in_seconds():
     # the 120-fps filter (5 frames) takes the same plateau for a glitch: no widening
     np.testing.assert_allclose(typical_amplitude(cycle, np.zeros(poses.shape[0]), poses,
                                                  spike=spike_frames(120)), cycle)
+
+
+def test_phase_average_is_the_same_under_small_weights():
+    """A weighted phase average does not depend on the weights' scale: two samples at
+    phases 0 and 0.01 (values 0 and 1), width 0.01, read at phase 0 give
+    e^-0.5 / (1 + e^-0.5) = 0.3775 with weights of 1 or of 0.001 alike (weights summing
+    under 1 are still weights, not an empty window)."""
+    ph = np.array([0.0, 0.01])
+    vals = np.array([[0.0], [1.0]])
+    want = np.exp(-0.5) / (1.0 + np.exp(-0.5))
+    for scale in (1.0, 1e-3):
+        out = phase_average(ph, vals, 1, 0.01, weights=np.full(2, scale))
+        assert out[0, 0] == pytest.approx(want)

@@ -1063,3 +1063,18 @@ def test_a_quadrupeds_front_pair_is_ahead_on_average_though_staggered():
         "hind left": (names["hl_ankle"], names["hl_toe"]),
         "hind right": (names["hr_ankle"], names["hr_toe"]),
     }
+
+
+def test_the_ends_are_the_leaves_below_the_root_the_first_child_included():
+    """_Geometry's end joints: every joint without (unignored) children except the root;
+    a leaf that is the root's very first child (joint 1, a tail here) is one of them."""
+    from cyclecoord.quality.legs import _Geometry
+
+    joints = (
+        Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz", "rx", "ry", "rz"), "ZYX"),
+        Joint("tail", 0, [0, 0, -3], ("rx",), "X"),
+        Joint("thigh", 0, [1, -1, 0], ("rx",), "X"),
+        Joint("shin", 2, [0, -4, 0], ("rx",), "X"),
+    )
+    geo = _Geometry(Skeleton(joints, name="t"), None, "y")
+    assert geo.ends == [1, 3]
