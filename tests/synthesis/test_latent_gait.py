@@ -258,7 +258,7 @@ def test_foot_locks_are_limited_by_the_pace_of_the_model_posing_each_frame(made)
 
     syn, motion = made
     per = syn._frame_acc99(motion.n_frames)
-    walk, run = syn._acc99("walk"), syn._acc99("run")
+    walk, run = syn._lock_acc99("walk"), syn._lock_acc99("run")
     assert walk < run  # the synthetic jog accelerates more than the walk
     reach = int(round(LOCK_REACH * syn.fps))
     a, b = _span(syn, range(0, 10))  # the walk's MOVEs
@@ -268,6 +268,24 @@ def test_foot_locks_are_limited_by_the_pace_of_the_model_posing_each_frame(made)
     assert a == 0 and np.all(per[b - reach : c + reach] == run)  # through the transition
     # a script whose chunks do not match the frames falls back to the largest figure
     np.testing.assert_array_equal(syn._frame_acc99(motion.n_frames + 1), run)
+
+
+def test_the_lock_limit_is_measured_as_the_lock_measures_the_motion(made):
+    """The lock compares the pinned motion's root-relative, world-oriented accelerations
+    (``carry._accel``) with the limit; the limit is their training 99th percentile, not
+    the pelvis-frame figure of the blends' budget (1.56x larger on the Bandai run)."""
+    from cyclecoord.synthesis.carry import _accel
+
+    syn, _ = made
+    for name in ("walk", "run"):
+        m = syn.models[name]
+        train = m.training_motion()
+        acc = np.concatenate([
+            _accel(train[rows[0] : rows[-1] + 1])[1:-1]
+            for s in np.unique(m.segments_)
+            if (rows := np.flatnonzero(m.segments_ == s)).size > 2
+        ])
+        assert syn._lock_acc99(name) == pytest.approx(np.percentile(acc, 99))
 
 
 def test_lock_where_clean_takes_one_limit_per_frame():

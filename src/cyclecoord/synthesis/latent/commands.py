@@ -165,7 +165,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         foot under the training frames' floor), then, with ``lock``, the planted feet
         pinned where that makes no pop
         (:func:`~cyclecoord.synthesis.carry.lock_where_clean`, limit 1.5x the 99th
-        percentile of joint acceleration of the model posing each frame, the faster one
+        percentile of root-relative joint acceleration of the training takes of the
+        model posing each frame, the faster one
         within ``LOCK_REACH`` of a change of model; the ``notes`` attribute says where
         not).
         ``"transitions"``: the blend windows and
@@ -216,7 +217,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self._graphs: dict[str, CommandGraph] = {}
         self._bridges: dict[tuple[str, str], Bridges] = {}
         self._crossings: dict[tuple[str, str], Crossings] = {}
-        self._acc: dict[str, float] = {}
+        self._acc: dict = {}
         self.sim_seconds = 0.0
         self.sim_cpu_seconds = 0.0
         self.clamped = {"values": 0, "max_deg": 0.0}
