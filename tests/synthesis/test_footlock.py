@@ -6,6 +6,7 @@ import pytest
 from cyclecoord.errors import ParameterError
 from cyclecoord.motion import Motion
 from cyclecoord.quality.contacts import foot_contacts, foot_skating
+from cyclecoord.synthesis.carry import carry_by_feet
 from cyclecoord.synthesis.footlock import lock_feet
 
 
@@ -197,3 +198,81 @@ def test_carry_by_feet_holds_the_body_on_still_feet_but_not_on_landing_ones():
     got = carry_by_feet(bob, feet).frames[:, tz]
     np.testing.assert_allclose(got, want, atol=1e-6)
     assert 0.1 * 8.0 * 119 / 60 < got[-1] < 0.9 * 8.0 * 119 / 60  # partly carried (25 %)
+
+
+def _stance_then_swing(fps=30.0, speed=8.0, T=60, stance=(20, 24), forward=False):
+    """Right leg held up and forward; the left foot on the floor for ``stance`` frames,
+    still in the world (its thigh swinging back at the root's speed) or, ``forward``,
+    swinging forward against the root (a foot landing); lifted (knee bent) elsewhere."""
+    skel = legs_skeleton()
+    m = make_motion(skel, T=T, fps=fps, root_speed=speed)
+    col = {c: i for i, c in enumerate(m.channels)}
+    frames = m.frames.copy()
+    frames[:, col[("rfemur", "rx")]] = -40.0
+    frames[:, col[("rtibia", "rx")]] = 60.0
+    frames[:, col[("ltibia", "rx")]] = 60.0
+    # the left foot's z against the root for thigh angles near 0, by forward kinematics
+    grid = np.linspace(-15.0, 15.0, 61)
+    probe = np.repeat(frames[:1], grid.size, axis=0)
+    probe[:, col[("lfemur", "rx")]] = grid
+    probe[:, col[("ltibia", "rx")]] = 0.0
+    probe[:, col[("root", "tz")]] = 0.0
+    z = m.with_frames(probe).positions()["lfoot"][:, 2]
+    order = np.argsort(z)
+    a, b = stance
+    t = np.arange(a, b)
+    root_z = frames[t, col[("root", "tz")]]
+    mid = root_z.mean()
+    want = -(root_z - mid) if not forward else 3.0 * (root_z - mid)
+    frames[t, col[("lfemur", "rx")]] = np.interp(want, z[order], grid[order])
+    frames[t, col[("ltibia", "rx")]] = 0.0
+    return m.with_frames(frames)
+
+
+def test_support_leaves_out_a_foot_that_goes_with_the_root_faster_than_agreement():
+    """A foot on the floor still in the world bears weight and carries the body; one
+    that goes over the ground faster than AGREEMENT of the root's speed (a foot landing,
+    swinging forward) does not, and the root keeps its own step there (by hand: the
+    left foot's world speed is 4x the root's, its share exp(-(4 - 0.5) / 0.25) ~ 1e-6)."""
+    from cyclecoord.synthesis.carry import support
+
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    tz = legs_skeleton().channels.index(("root", "tz"))
+    still = _stance_then_swing(stance=(20, 30))
+    s = support(still, feet)
+    inner = slice(23, 27)  # clear of the lift's vertical speed (smoothed over a frame)
+    assert np.all(s.carry[inner, :2].sum(axis=1) > 0.99)
+    assert np.all(s.planted[inner, :2].any(axis=1))
+    carried = carry_by_feet(still, feet).positions()["ltoes"][inner, 2]
+    assert np.ptp(carried) < 0.02 * 8.0 * 4 / 30  # the standing toes stay put
+    landing = _stance_then_swing(stance=(20, 30), forward=True)
+    s = support(landing, feet)
+    assert np.all(s.carry[inner].sum(axis=1) < 1e-3)
+    assert not s.planted[inner].any()
+    own = np.diff(landing.frames[:, tz])
+    np.testing.assert_allclose(np.diff(carry_by_feet(landing, feet).frames[:, tz])[inner],
+                               own[inner], rtol=1e-3)
+
+
+def test_lock_where_clean_pins_a_stance_of_a_tenth_of_a_second():
+    """A run's stance at 30 fps is a handful of frames: the 3-5 weight-bearing frames of a
+    foot that slides at 0.3x the root's speed (under AGREEMENT) are pinned by default;
+    with the earlier 0.2 s minimum they were not."""
+    from cyclecoord.synthesis.carry import lock_where_clean, support
+
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    m = _stance_then_swing(stance=(20, 27))
+    col = {c: i for i, c in enumerate(m.channels)}
+    frames = m.frames.copy()  # let the standing foot slide slowly: 0.3x the root's speed
+    frames[20:27, col[("lfemur", "rx")]] *= 0.7
+    m = m.with_frames(frames)
+    planted = support(m, feet).planted[:, :2].any(axis=1)
+    assert 3 <= planted.sum() < 6  # its first and last two frames land and lift
+    on = np.flatnonzero(planted)
+    slid = np.ptp(m.positions()["ltoes"][on, 2])
+    assert slid > 0.1
+    out = lock_where_clean(m, 1e12, feet)
+    assert out.locked >= 1
+    assert np.ptp(out.motion.positions()["ltoes"][on, 2]) < 0.05 * slid
+    old = lock_where_clean(m, 1e12, feet, min_duration=0.2).motion
+    assert np.ptp(old.positions()["ltoes"][on, 2]) == pytest.approx(slid)

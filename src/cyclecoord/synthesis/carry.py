@@ -17,12 +17,15 @@ on the ground carries it, as the periodic pipeline's cycles do
 * where no point is in contact (a run's flight), or the lowest point moves up or down
   faster than :data:`VERTICAL_SPEED` (a foot landing or lifting off a few centimetres
   above the floor), the root keeps its own step;
+* so it does where the low point goes over the ground, with the root's own step, faster
+  than :data:`AGREEMENT` of the root's speed: a foot still swinging forward as it lands
+  is not yet bearing weight (:func:`support`);
 * frames of an asked hold (``hold``) stand: their ground steps fade to 0 over
   :data:`STAND_AFTER` seconds;
 * no foot below the floor: the root is raised, smoothly, where the lowest foot point
   (toe end sites included) would go under ``floor``.
 
-:func:`lock_where_clean` then pins the planted feet by a leg IK
+:func:`lock_where_clean` then pins the weight-bearing points (:attr:`Support.planted`) by a leg IK
 (:func:`~cyclecoord.synthesis.footlock.lock_feet`) where it makes no joint accelerate past
 the limit, and says where it could not.
 """
@@ -35,14 +38,18 @@ import numpy as np
 
 from ..errors import CycleCoordError
 from ..motion import Motion
+from ..quality.contacts import FootContacts
 
 __all__ = [
+    "AGREEMENT",
     "carry_by_feet",
     "channel_bounds",
     "lock_where_clean",
     "LockOutcome",
     "LOWNESS",
     "STAND_AFTER",
+    "Support",
+    "support",
     "VERTICAL_SPEED",
 ]
 
@@ -72,6 +79,36 @@ VERTICAL_SPEED = 0.3
 #: Gaussian width (s) of the smoothing of the foot points' heights before their vertical
 #: speed is read (a generated pose's frame-to-frame jitter is not a foot lifting).
 VERTICAL_SMOOTH = 1.0 / 30.0
+#: A foot point bears weight only while it goes over the ground (its horizontal speed in
+#: the world, with the root's own step) at most this fraction of the root's speed; its
+#: share falls off above (to 1/e at 1.5 times it).  The Bandai run carried by its own
+#: feet travelled at 0.67x its captured speed: at each foot strike the lowest point is
+#: the landing foot, a few centimetres up and still swinging forward, and it held the
+#: root back (0.92x with this gate).  Root speed over the captures' and support-foot
+#: slip over the captures' (latent runs: medians over five script seeds of
+#: ``benchmarks/bench_latent_gait.py``; 143_01 read at 60 fps):
+#:
+#: ======  ==================  ==================  ==================  =================
+#: gate    Bandai latent run   143_01 latent run   Bandai latent walk  143_01 graph
+#:         slip / root         slip / root         slip / root         slip / root
+#: ======  ==================  ==================  ==================  =================
+#: none    2.15 / 0.56         2.36 / 0.61         0.06 / 0.74         0.84 / 0.87
+#: 0.8     2.30 / 0.80         2.11 / 0.94         0.06 / 0.89         --
+#: 0.5     2.66 / 0.90         2.32 / 1.00         0.07 / 0.92         0.86 / 0.95
+#: ======  ==================  ==================  ==================  =================
+#:
+#: With the lock pinning the weight-bearing points (:class:`Support`, 0.1 s stances) the
+#: 0.5 row reads 2.52 / 0.90, 1.69 / 1.00, 0.00 / 0.92 and 0.90 / 0.95.
+AGREEMENT = 0.5
+#: A low point that goes over the ground faster than :data:`AGREEMENT` for longer than
+#: this (s) is a held pose gliding with the root, not a landing foot: it carries.
+GLIDE_SECONDS = 0.15
+#: Root speed (leg lengths/s) under which :data:`AGREEMENT` is read against this speed
+#: instead (a body standing or turning on the spot).
+STILL_SPEED = 0.3
+#: A point whose weight-bearing figure (lowness, grounded, going with the body; each in
+#: 0-1) is over this is pinned by :func:`lock_where_clean`.
+LOCK_SUPPORT = 0.5
 #: An asked hold stands still after this many seconds.
 STAND_AFTER = 0.5
 #: Gaussian width (s) of the smoothing of the carried track's steps.
@@ -122,7 +159,6 @@ def carry_by_feet(
     from scipy.ndimage import gaussian_filter1d, maximum_filter1d
 
     from ..periodic.root import planted_ground, root_layout
-    from ..quality.contacts import foot_contacts
     from ..quality.legs import find_feet
 
     layout = root_layout(motion)
@@ -130,28 +166,9 @@ def carry_by_feet(
         return motion
     try:
         feet = find_feet(motion.skeleton, motion) if feet is None else tuple(feet)
-        contacts = foot_contacts(motion, feet, speed=None, height=CONTACT_BAND, floor=floor)
+        weights = support(motion, feet, floor).carry
     except CycleCoordError:
         return motion
-    # the lowest points carry the body (what the support foot is); a point's share falls
-    # off with its height over the lowest, and all shares with the lowest point's height
-    # over its own ground level once it leaves the contact band (a run's flight)
-    y = contacts.height + contacts.contact_level  # absolute heights
-    above = (y - y.min(axis=1, keepdims=True)) / contacts.leg_length
-    share_low = np.exp(-above / LOWNESS)
-    share_low /= share_low.sum(axis=1, keepdims=True)
-    rel = contacts.height / contacts.leg_length
-    low = y.argmin(axis=1)
-    lowest = rel[np.arange(rel.shape[0]), low]
-    grounded = np.exp(-np.maximum(lowest - CONTACT_BAND, 0.0) / LOWNESS)
-    # ... and with its vertical speed: in a run's flight the lowest point is a foot a few
-    # centimetres up, coming down or lifting off, and carrying the body by it held the
-    # root back (the Bandai run, carried by its own feet, travelled at 0.59x its speed)
-    ys = gaussian_filter1d(y, VERTICAL_SMOOTH * motion.fps, axis=0, mode="nearest")
-    vy = np.abs(np.gradient(ys, axis=0))[np.arange(len(low)), low] * motion.fps
-    vy = vy / contacts.leg_length
-    grounded = grounded * np.exp(-np.maximum(vy - VERTICAL_SPEED, 0.0) / VERTICAL_SPEED)
-    weights = share_low * grounded[:, None]
     cols = [layout.column("tx"), layout.column("tz")]
     own = np.diff(motion.frames[:, cols], axis=0)
     steps = np.diff(planted_ground(motion, layout, feet, weights), axis=0)
@@ -174,6 +191,84 @@ def carry_by_feet(
             frames[:, ty] += lift / _translation_scale(out, ty)
             out = motion.with_frames(frames)
     return out
+
+
+
+
+@dataclass(frozen=True)
+class Support:
+    """Which foot points carry the body on each frame (:func:`support`).
+
+    Attributes
+    ----------
+    carry : ndarray, shape (T, F)
+        Each point's share of carrying the body (a row sums to at most 1; the rest of
+        the step is the root's own).
+    planted : ndarray of bool, shape (T, F)
+        Points that bear weight on the frame (low, grounded and going with the body):
+        what :func:`lock_where_clean` pins.
+    contacts : FootContacts
+        The height-only contacts the two are read from.
+    """
+
+    carry: np.ndarray
+    planted: np.ndarray
+    contacts: FootContacts
+
+
+def support(motion: Motion, feet: tuple[str, ...], floor: float | None = None) -> Support:
+    """The foot points that carry the body of ``motion`` on each frame.
+
+    A point carries the body while it is among the lowest (its share falls off over
+    :data:`LOWNESS` leg lengths above the lowest point), the lowest point is in the
+    contact band and not moving up or down faster than :data:`VERTICAL_SPEED`, and the
+    point goes over the ground at most :data:`AGREEMENT` of the root's own speed.
+    """
+    from scipy.ndimage import gaussian_filter1d
+
+    from ..quality.contacts import foot_contacts
+
+    contacts = foot_contacts(motion, feet, speed=None, height=CONTACT_BAND, floor=floor)
+    leg = contacts.leg_length
+    # the lowest points carry the body (what the support foot is); a point's share falls
+    # off with its height over the lowest, and all shares with the lowest point's height
+    # over its own ground level once it leaves the contact band (a run's flight)
+    y = contacts.height + contacts.contact_level  # absolute heights
+    low_share = np.exp(-(y - y.min(axis=1, keepdims=True)) / leg / LOWNESS)
+    rel = contacts.height / leg
+    low = y.argmin(axis=1)
+    rows = np.arange(rel.shape[0])
+    grounded = np.exp(-np.maximum(rel[rows, low] - CONTACT_BAND, 0.0) / LOWNESS)
+    # ... and with its vertical speed: in a run's flight the lowest point is a foot a few
+    # centimetres up, coming down or lifting off, and carrying the body by it held the
+    # root back (the Bandai run, carried by its own feet, travelled at 0.59x its speed)
+    ys = gaussian_filter1d(y, VERTICAL_SMOOTH * motion.fps, axis=0, mode="nearest")
+    vy = np.abs(np.gradient(ys, axis=0))[rows, low] * motion.fps / leg
+    grounded = grounded * np.exp(-np.maximum(vy - VERTICAL_SPEED, 0.0) / VERTICAL_SPEED)
+    # ... and a point that goes over the ground with the root's own step faster than
+    # AGREEMENT of the root's speed is a foot landing or lifting, not one bearing weight
+    pos = motion.positions()
+    cols = [pos.names.index(f) for f in feet]
+    root = pos.positions[:, 0][:, [0, 2]]
+    rel_xz = pos.positions[:, cols][:, :, [0, 2]] - root[:, None, :]
+    v_root = np.gradient(root, axis=0) * motion.fps
+    v_world = np.gradient(rel_xz, axis=0) * motion.fps + v_root[:, None, :]
+    pace = np.maximum(np.linalg.norm(v_root, axis=-1), STILL_SPEED * leg)
+    over = np.linalg.norm(v_world, axis=-1) / pace[:, None]
+    goes_with = np.exp(-np.maximum(over - AGREEMENT, 0.0) / (0.5 * AGREEMENT))
+    # a foot landing is a few frames; a point that stays low and still against the root
+    # for longer while the root glides is a held pose (a stalled path): it carries
+    from ..quality.contacts import contact_runs
+
+    held = (rel <= CONTACT_BAND) & (goes_with < 0.5)
+    held &= np.linalg.norm(v_world - v_root[:, None, :], axis=-1) < AGREEMENT * pace[:, None]
+    for i in range(goes_with.shape[1]):
+        for a, b in contact_runs(held[:, i]):
+            if b - a > GLIDE_SECONDS * motion.fps:
+                goes_with[a:b, i] = 1.0
+    on = grounded[:, None] * goes_with
+    carry = low_share / low_share.sum(axis=1, keepdims=True) * on
+    return Support(carry=carry, planted=low_share * on > LOCK_SUPPORT, contacts=contacts)
 
 
 def _translation_scale(motion: Motion, col: int) -> float:
@@ -213,14 +308,16 @@ def lock_where_clean(
     limit: float | np.ndarray,
     feet: tuple[str, ...] | None = None,
     *,
-    min_duration: float = 0.2,
+    min_duration: float = 0.1,
     blend: float = 0.1,
     bounds: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> LockOutcome:
     """Pin the planted feet (leg IK) except where the pin makes a pop.
 
-    Contacts (:func:`~cyclecoord.quality.contacts.foot_contacts`, low and slow: on a
-    carried motion the support foot) of at least ``min_duration`` s are pinned.  After
+    The weight-bearing points (:attr:`Support.planted`: low, grounded and going with the
+    body; on a carried motion the support foot), gaps under ``min_duration`` s closed,
+    are pinned for stretches of at least ``min_duration`` s (a run's stance at 30 fps is
+    5-7 frames: low-and-slow contacts of 0.2 s pinned none of the Bandai run's).  After
     locking, a contact around which the largest joint acceleration (relative to the root)
     exceeds both ``limit`` (length units/s^2, e.g. 1.5x the sources' 99th percentile;
     a number, or one per frame where the frames come from sources of different pace, a
@@ -229,19 +326,25 @@ def lock_where_clean(
     channel leaves ``bounds`` (per-channel low and high values, e.g. the training takes'
     range widened by :data:`RANGE_MARGIN` degrees) that it kept before.
     """
-    from ..quality.contacts import contact_runs, foot_contacts
+    from ..quality.contacts import contact_runs
     from ..quality.legs import find_feet
     from .footlock import pin_feet
 
     try:
         feet = find_feet(motion.skeleton, motion) if feet is None else tuple(feet)
-        contacts = foot_contacts(motion, feet, min_duration=min_duration)
+        held = support(motion, feet)
     except CycleCoordError as exc:
         return LockOutcome(motion, 0, [], f"foot locking: not done ({exc})")
-    planted = contacts.planted.copy()
+    contacts = held.contacts
+    planted = held.planted.copy()
+    shortest = min_duration * motion.fps
     for i in range(planted.shape[1]):  # short touches toggle and make the legs jitter
+        runs = contact_runs(planted[:, i])
+        for (_, b), (a, _) in zip(runs[:-1], runs[1:]):
+            if a - b < shortest:
+                planted[b:a, i] = True
         for a, b in contact_runs(planted[:, i]):
-            if b - a < min_duration * motion.fps:
+            if b - a < shortest:
                 planted[a:b, i] = False
     if not planted.any():
         return LockOutcome(motion, 0, [], "foot locking: no contact long enough to pin")

@@ -161,8 +161,9 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
     plant : {"all", "transitions", "off"}, default "all"
         Where :meth:`motion` moves the root as the planted feet carry it.  ``"all"``:
         everywhere, by :func:`~cyclecoord.synthesis.carry.carry_by_feet` (contact from
-        height, not speed, the lowest foot carrying the body; IDLE stands after 0.5 s; no
-        foot under the training frames' floor), then, with ``lock``, the planted feet
+        height, not speed, the lowest foot carrying the body unless it goes over the
+        ground faster than half the root's speed; IDLE stands after 0.5 s; no foot
+        under the training frames' floor), then, with ``lock``, the weight-bearing feet
         pinned where that makes no pop
         (:func:`~cyclecoord.synthesis.carry.lock_where_clean`, limit 1.5x the 99th
         percentile of root-relative joint acceleration of the training takes of the
