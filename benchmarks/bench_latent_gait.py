@@ -7,7 +7,10 @@ Run from a checkout::
 
 Model pairs (30 fps, every 4th frame of 120 fps captures): a synthetic walk (1.1 s leg
 cycle) and run (0.7 s) from ``cyclecoord.datasets`` (two 5 s segments each), the
-shared subject 35 walks (35_07/08/13/16) with the 143_01 jog, and the Bandai Namco walk
+shared subject 35 walks (35_07/08/13/16) with the 143_01 jog (read at 60 fps, every 2nd
+frame: AMC files carry no rate, and at 120 fps the take runs at 5.9 m/s with 338 steps a
+minute, past a sprinter's cadence; at 60 fps it is a 2.9 m/s jog at 169), and the
+Bandai Namco walk
 and run (``../shared/data/bvh/bandai``, 30 fps takes on a static-root rig whose spine
 sits near gimbal lock).  The script, in the style
 of ``examples/latent_script.json``: walk 3 s (ten MOVEs ``{"ahead": 0.3}``), TRANSITION
@@ -41,6 +44,8 @@ from cyclecoord.synthesis.latent.script import run_script, training_takes  # noq
 
 SHARED = ROOT.parent / "shared"
 CHECKER = SHARED / "tools" / "motioncheck" / "motioncheck.py"
+#: 143_01 read at this rate (AMC files carry none): see the module text.
+JOG_FPS = 60.0
 
 
 def synthetic_pair(quick: bool) -> dict:
@@ -61,7 +66,8 @@ def shared_pair() -> dict | None:
     jog = cmu / "143" / "143_01.amc"
     if not all(p.is_file() for p in walks + [jog]):
         return None
-    return {"walk": [cc.load(p)[::4] for p in walks], "run": [cc.load(jog)[::4]]}
+    run = cc.load(jog, fps=JOG_FPS)[:: int(JOG_FPS) // 30]
+    return {"walk": [cc.load(p)[::4] for p in walks], "run": [run]}
 
 
 def bandai_pair() -> dict | None:
