@@ -8,8 +8,8 @@ Run from a checkout::
 For each set -- subject 35's walks (set w1: 35_16, 35_07, 35_08, 35_13; a walk of
 ``--frames`` frames) and the 143_01 jog (one 100-frame take, read at 60 fps: see
 ``JOG_FPS``; a run of half as many frames) -- every method generates from the first
-take's frame 0 and is measured with one measure, :func:`cyclecoord.quality.generated.measure_generated`, against the set's
-captures:
+take's frame 0 and is measured with one measure,
+:func:`cyclecoord.quality.generated.measure_generated`, against the set's captures:
 
 * **graph (ours)**: ``cyclecoord graph``'s defaults: the phase-aware field
   (``delaunay+phase``), latent dims ``auto``, root carried by the feet, feet pinned
