@@ -56,8 +56,22 @@ OUTSIDE_DENSITY = 0.05
 LIMIT_MARGIN = 0.1
 #: Path radius of a MOVE ahead along the gait, as a fraction of the particle's: on the
 #: synthetic run the full radius let the random force throw the pose 3.2x the training
-#: 99th percentile of pose speed in one step.
-AHEAD_RADIUS = 0.25
+#: 99th percentile of pose speed in one step.  The path is the captured gait's own
+#: latent trajectory; what the particle strays from it the pose shows as jitter.  The
+#: gait sections' largest acceleration over the training 99th percentile (medians over
+#: 15 script seeds of ``benchmarks/bench_latent_gait.py``; [largest]):
+#:
+#: ======  ==============  ==============  ==============  ==============
+#: ahead   Bandai run      143_01 jog      Bandai walk     subject 35 walk
+#: ======  ==============  ==============  ==============  ==============
+#: 0.25    1.92 [2.49]     1.59 [1.87]     1.33 [1.68]     1.14 [1.53]
+#: 0.2     1.78 [2.14]     1.54 [1.92]     1.25 [1.35]     1.07 [1.41]
+#: 0.15    1.80 [1.98]     1.41 [1.69]     1.22 [1.44]     0.96 [1.20]
+#: ======  ==============  ==============  ==============  ==============
+#:
+#: Tighter is stiff: at 0.083 one seed in five of the jog threw the pose 21x, at 0.05
+#: most pairs did.  The jog's knee range reads 0.81 at 0.15 (0.86 at 0.25).
+AHEAD_RADIUS = 0.15
 #: Bytes of one edge of a networkx graph (its weight dict in both directions).
 _EDGE_BYTES = 400
 #: Bytes a synthesised frame takes until the motion is written, besides a training frame
