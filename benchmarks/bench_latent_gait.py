@@ -162,7 +162,9 @@ def measure_pair(label: str, takes: dict, d: Path, quick: bool, seeds: int = 1) 
     r = motion.frames[a + 15 : b][:, cols]
     step = np.linalg.norm(r[5:] - r[:-5], axis=1).max() * 30 / 5  # over 1/6 s
     idle_speed = step * cc.rig.metres_per_unit(motion)
-    print(f"  IDLE after 0.5 s: largest root speed {idle_speed:.3f} m/s")
+    feet = measure_generated(motion[a + 15 : b], training_takes(models, ["walk"]))
+    print(f"  IDLE after 0.5 s: largest root speed {idle_speed:.3f} m/s, support foot "
+          f"{feet.support_slip:.3f} m/s (median)")
     print(f"  joints: {rep['clamped_to_training_range']['values']} values eased into the range "
           f"(largest {rep['clamped_to_training_range']['max_deg']:.1f} deg), "
           f"{flattened(motion, models)} flattened frames")

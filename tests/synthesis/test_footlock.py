@@ -276,3 +276,34 @@ def test_lock_where_clean_pins_a_stance_of_a_tenth_of_a_second():
     assert np.ptp(out.motion.positions()["ltoes"][on, 2]) < 0.05 * slid
     old = lock_where_clean(m, 1e12, feet, min_duration=0.2).motion
     assert np.ptp(old.positions()["ltoes"][on, 2]) == pytest.approx(slid)
+
+
+def test_lock_where_clean_stands_the_feet_of_an_asked_hold():
+    """A body standing (root held) whose legs sway: each foot slides 0.3 leg lengths/s at
+    most, over AGREEMENT of the still body's pace, so it bears no weight; on frames of an
+    asked hold the low, slow contacts are pinned too, and the feet stand."""
+    from cyclecoord.synthesis.carry import lock_where_clean, support
+
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    skel = legs_skeleton()
+    m = make_motion(skel, T=90, fps=30.0)
+    col = {c: i for i, c in enumerate(m.channels)}
+    frames = m.frames.copy()
+    t = np.arange(90) / 30.0
+    for side, sign in (("l", 1.0), ("r", -1.0)):
+        frames[:, col[(f"{side}femur", "rx")]] = sign * 5.0 * np.sin(2 * np.pi * 0.5 * t)
+    m = m.with_frames(frames)
+    z = m.positions()["lfoot"][:, 2]
+    leg = support(m, feet).contacts.leg_length
+    speed = np.abs(np.gradient(z)) * 30 / leg
+    assert 0.25 < speed.max() < 0.5  # slow, but not still
+    fast = np.flatnonzero(speed > 0.25)
+    assert not support(m, feet).planted[fast][:, :2].any()  # bears no weight there
+    free = lock_where_clean(m, 1e12, feet).motion.positions()["lfoot"][:, 2]
+    np.testing.assert_allclose(free[fast], z[fast], atol=1e-6)
+    hold = np.zeros(90, bool)
+    hold[20:] = True
+    held = lock_where_clean(m, 1e12, feet, hold=hold)
+    assert held.locked >= 2
+    for f in ("lfoot", "rfoot"):
+        assert np.ptp(held.motion.positions()[f][30:60, 2]) < 0.02 * np.ptp(z[30:60])

@@ -109,6 +109,10 @@ STILL_SPEED = 0.3
 #: A point whose weight-bearing figure (lowness, grounded, going with the body; each in
 #: 0-1) is over this is pinned by :func:`lock_where_clean`.
 LOCK_SUPPORT = 0.5
+#: On frames of an asked hold, low, slow contacts
+#: (:func:`~cyclecoord.quality.contacts.foot_contacts`' defaults) at least this long (s)
+#: are pinned as well as the weight-bearing points.
+STILL_CONTACT = 0.2
 #: An asked hold stands still after this many seconds.
 STAND_AFTER = 0.5
 #: Gaussian width (s) of the smoothing of the carried track's steps.
@@ -271,6 +275,23 @@ def support(motion: Motion, feet: tuple[str, ...], floor: float | None = None) -
     return Support(carry=carry, planted=low_share * on > LOCK_SUPPORT, contacts=contacts)
 
 
+def _tidy(planted: np.ndarray, shortest: float) -> np.ndarray:
+    """``planted`` (T, F) with gaps under ``shortest`` frames closed, then stretches under
+    it dropped (short touches toggle and make the legs jitter)."""
+    from ..quality.contacts import contact_runs
+
+    out = np.array(planted, dtype=bool)
+    for i in range(out.shape[1]):
+        runs = contact_runs(out[:, i])
+        for (_, b), (a, _) in zip(runs[:-1], runs[1:]):
+            if a - b < shortest:
+                out[b:a, i] = True
+        for a, b in contact_runs(out[:, i]):
+            if b - a < shortest:
+                out[a:b, i] = False
+    return out
+
+
 def _translation_scale(motion: Motion, col: int) -> float:
     """World units per unit of a root translation channel (1 on ASF and BVH; measured)."""
     moved = motion.frames[:1].copy()
@@ -311,13 +332,16 @@ def lock_where_clean(
     min_duration: float = 0.1,
     blend: float = 0.1,
     bounds: tuple[np.ndarray, np.ndarray] | None = None,
+    hold: np.ndarray | None = None,
 ) -> LockOutcome:
     """Pin the planted feet (leg IK) except where the pin makes a pop.
 
     The weight-bearing points (:attr:`Support.planted`: low, grounded and going with the
-    body; on a carried motion the support foot), gaps under ``min_duration`` s closed,
-    are pinned for stretches of at least ``min_duration`` s (a run's stance at 30 fps is
-    5-7 frames: low-and-slow contacts of 0.2 s pinned none of the Bandai run's).  After
+    body; on a carried motion the support foot), and on ``hold`` frames (a stand asked
+    for, ``(T,)`` bool) the low, slow contacts of at least :data:`STILL_CONTACT` s too,
+    gaps under ``min_duration`` s closed, are pinned for stretches of at least
+    ``min_duration`` s (a run's stance at 30 fps is 5-7 frames: low-and-slow contacts of
+    0.2 s pinned none of the Bandai run's).  After
     locking, a contact around which the largest joint acceleration (relative to the root)
     exceeds both ``limit`` (length units/s^2, e.g. 1.5x the sources' 99th percentile;
     a number, or one per frame where the frames come from sources of different pace, a
@@ -326,26 +350,28 @@ def lock_where_clean(
     channel leaves ``bounds`` (per-channel low and high values, e.g. the training takes'
     range widened by :data:`RANGE_MARGIN` degrees) that it kept before.
     """
-    from ..quality.contacts import contact_runs
+    from ..quality.contacts import contact_runs, foot_contacts
     from ..quality.legs import find_feet
     from .footlock import pin_feet
 
     try:
         feet = find_feet(motion.skeleton, motion) if feet is None else tuple(feet)
         held = support(motion, feet)
+        planted = held.planted.copy()
+        if hold is not None and np.any(hold):
+            # where a stand was asked, the low, slow contacts too: the root is held, so
+            # every sway of the pose is a foot speed over the ground (an IDLE's feet
+            # glided 0.35 m/s on the Bandai script with the weight-bearing points alone)
+            slow = foot_contacts(motion, feet, min_duration=STILL_CONTACT).planted
+            planted |= slow & np.asarray(hold, dtype=bool)[:, None]
     except CycleCoordError as exc:
         return LockOutcome(motion, 0, [], f"foot locking: not done ({exc})")
     contacts = held.contacts
-    planted = held.planted.copy()
     shortest = min_duration * motion.fps
-    for i in range(planted.shape[1]):  # short touches toggle and make the legs jitter
-        runs = contact_runs(planted[:, i])
-        for (_, b), (a, _) in zip(runs[:-1], runs[1:]):
-            if a - b < shortest:
-                planted[b:a, i] = True
-        for a, b in contact_runs(planted[:, i]):
-            if b - a < shortest:
-                planted[a:b, i] = False
+    planted = _tidy(planted, shortest)
+    # a stretch the hold's contacts lengthened that pops falls back to its weight-bearing
+    # frames before it is dropped
+    fallback = _tidy(held.planted, shortest) & planted
     if not planted.any():
         return LockOutcome(motion, 0, [], "foot locking: no contact long enough to pin")
     before = _accel(motion)
@@ -353,7 +379,7 @@ def lock_where_clean(
     outside_before = _outside(motion.frames, bounds)
     skipped: list[tuple[int, int]] = []
     result = None
-    for _ in range(3):
+    for _ in range(5):
         if not planted.any():
             break
         trial = pin_feet(motion, replace(contacts, planted=planted), blend=blend)
@@ -369,8 +395,13 @@ def lock_where_clean(
         for i in range(planted.shape[1]):
             for a, b in contact_runs(planted[:, i]):
                 if ((bad >= a - pad) & (bad < b + pad)).any():  # a pop or out of range
-                    planted[a:b, i] = False
-                    skipped.append((a, b))
+                    alt = fallback[a:b, i].copy()
+                    fallback[a:b, i] = False
+                    if alt.any() and not alt.all():  # a lengthened stretch: its own part
+                        planted[a:b, i] = alt
+                    else:
+                        planted[a:b, i] = False
+                        skipped.append((a, b))
                     dropped = True
         if not dropped:  # the pops are not at a pin
             result = trial

@@ -288,7 +288,9 @@ class OutputMixin:
         if self.lock:
             limit = 1.5 * self._frame_acc99(motion.n_frames)
             bounds = channel_bounds([self.models[k].training_motion() for k in used])
-            locked = lock_where_clean(out, limit, self.feet, bounds=bounds)
+            locked = lock_where_clean(
+                out, limit, self.feet, bounds=bounds, hold=self.hold_mask(motion.n_frames)
+            )
             self.notes.append(locked.line)
             out = locked.motion
         return out
