@@ -229,29 +229,57 @@ def _stance_then_swing(fps=30.0, speed=8.0, T=60, stance=(20, 24), forward=False
     return m.with_frames(frames)
 
 
+def _sliding_foot(slide, T=45, fps=30.0, speed=2.0, step=1.0):
+    """Right leg held up and forward; the left foot always on the floor: still in the
+    world, except over the frames ``slide = (a, b)`` where it goes forward by ``step``
+    units over the ground (its thigh turning against the root's travel)."""
+    skel = legs_skeleton()
+    m = make_motion(skel, T=T, fps=fps, root_speed=speed)
+    col = {c: i for i, c in enumerate(m.channels)}
+    frames = m.frames.copy()
+    frames[:, col[("rfemur", "rx")]] = -40.0
+    frames[:, col[("rtibia", "rx")]] = 60.0
+    grid = np.linspace(-25.0, 25.0, 201)
+    probe = np.repeat(frames[:1], grid.size, axis=0)
+    probe[:, col[("lfemur", "rx")]] = grid
+    probe[:, col[("root", "tz")]] = 0.0
+    z = m.with_frames(probe).positions()["lfoot"][:, 2]
+    order = np.argsort(z)
+    a, b = slide
+    t = np.arange(T)
+    world = np.interp(t, [a, b], [0.0, step])  # the foot's ground position
+    root_z = frames[:, col[("root", "tz")]]
+    rel = world - root_z + 0.5 * root_z[-1]  # about mid-stride
+    frames[:, col[("lfemur", "rx")]] = np.interp(rel, z[order], grid[order])
+    return m.with_frames(frames)
+
+
 def test_support_leaves_out_a_foot_that_goes_with_the_root_faster_than_agreement():
-    """A foot on the floor still in the world bears weight and carries the body; one
-    that goes over the ground faster than AGREEMENT of the root's speed (a foot landing,
-    swinging forward) does not, and the root keeps its own step there (by hand: the
-    left foot's world speed is 4x the root's, its share exp(-(4 - 0.5) / 0.25) ~ 1e-6)."""
-    from cyclecoord.synthesis.carry import support
+    """A foot on the floor still in the world bears weight and carries the body; one that
+    goes over the ground faster than AGREEMENT of the root's speed for a few frames (a foot
+    landing, swinging forward) does not, and the root keeps its own step there; one that
+    does so for longer than GLIDE_SECONDS while it is the grounded lowest point (a stride
+    shorter than the root's step) carries."""
+    from cyclecoord.synthesis.carry import GLIDE_SECONDS, support
 
     feet = ("lfoot", "ltoes", "rfoot", "rtoes")
     tz = legs_skeleton().channels.index(("root", "tz"))
-    still = _stance_then_swing(stance=(20, 30))
-    s = support(still, feet)
-    inner = slice(23, 27)  # clear of the lift's vertical speed (smoothed over a frame)
-    assert np.all(s.carry[inner, :2].sum(axis=1) > 0.99)
-    assert np.all(s.planted[inner, :2].any(axis=1))
-    carried = carry_by_feet(still, feet).positions()["ltoes"][inner, 2]
-    assert np.ptp(carried) < 0.02 * 8.0 * 4 / 30  # the standing toes stay put
-    landing = _stance_then_swing(stance=(20, 30), forward=True)
+    landing = _sliding_foot((20, 23))  # 1 unit in 0.1 s: 10 units/s, 5x the root's
     s = support(landing, feet)
-    assert np.all(s.carry[inner].sum(axis=1) < 1e-3)
-    assert not s.planted[inner].any()
+    on = s.carry[:, :2].sum(axis=1)
+    assert np.all(on[5:18] > 0.99) and np.all(on[25:40] > 0.99)  # standing: carries
+    assert np.all(on[21:23] < 1e-3)  # landing (central differences inside it): does not
+    assert not s.planted[20:23, :2].any()
+    out = carry_by_feet(landing, feet)
     own = np.diff(landing.frames[:, tz])
-    np.testing.assert_allclose(np.diff(carry_by_feet(landing, feet).frames[:, tz])[inner],
-                               own[inner], rtol=1e-3)
+    np.testing.assert_allclose(np.diff(out.frames[:, tz])[21], own[21], rtol=1e-3)
+    still = out.positions()["ltoes"][:, 2]  # the lowest point carries
+    assert np.ptp(still[5:18]) < 1e-3 and np.ptp(still[25:40]) < 1e-3
+    # the same speed over the ground for 0.5 s: a short stride, carried
+    n = int(round(0.5 * 30))
+    assert n > GLIDE_SECONDS * 30
+    short = _sliding_foot((15, 15 + n), step=2.5 * 2.0 * n / 30)
+    assert np.all(support(short, feet).carry[17 : 13 + n, :2].sum(axis=1) > 0.9)
 
 
 def test_lock_where_clean_pins_a_stance_of_a_tenth_of_a_second():
@@ -279,9 +307,10 @@ def test_lock_where_clean_pins_a_stance_of_a_tenth_of_a_second():
 
 
 def test_lock_where_clean_stands_the_feet_of_an_asked_hold():
-    """A body standing (root held) whose legs sway: each foot slides 0.3 leg lengths/s at
-    most, over AGREEMENT of the still body's pace, so it bears no weight; on frames of an
-    asked hold the low, slow contacts are pinned too, and the feet stand."""
+    """A body standing (root held) whose legs sway three times a second: each foot slides
+    0.3 leg lengths/s at most, over AGREEMENT of the still body's pace, for under
+    GLIDE_SECONDS at a time, so it bears no weight; on frames of an asked hold the low,
+    slow contacts are pinned too, and the feet stand."""
     from cyclecoord.synthesis.carry import lock_where_clean, support
 
     feet = ("lfoot", "ltoes", "rfoot", "rtoes")
@@ -291,7 +320,7 @@ def test_lock_where_clean_stands_the_feet_of_an_asked_hold():
     frames = m.frames.copy()
     t = np.arange(90) / 30.0
     for side, sign in (("l", 1.0), ("r", -1.0)):
-        frames[:, col[(f"{side}femur", "rx")]] = sign * 5.0 * np.sin(2 * np.pi * 0.5 * t)
+        frames[:, col[(f"{side}femur", "rx")]] = sign * 1.0 * np.sin(2 * np.pi * 3.0 * t)
     m = m.with_frames(frames)
     z = m.positions()["lfoot"][:, 2]
     leg = support(m, feet).contacts.leg_length
