@@ -5,7 +5,7 @@ import pytest
 
 from cyclecoord.errors import ParameterError
 from cyclecoord.motion import Motion
-from cyclecoord.quality.contacts import foot_contacts, foot_skating
+from cyclecoord.quality.contacts import contact_runs, foot_contacts, foot_skating
 from cyclecoord.synthesis.carry import carry_by_feet
 from cyclecoord.synthesis.footlock import lock_feet
 
@@ -336,3 +336,37 @@ def test_lock_where_clean_stands_the_feet_of_an_asked_hold():
     assert held.locked >= 2
     for f in ("lfoot", "rfoot"):
         assert np.ptp(held.motion.positions()[f][30:60, 2]) < 0.02 * np.ptp(z[30:60])
+
+
+def test_lock_where_clean_keeps_what_is_clear_of_a_pop(monkeypatch):
+    """A pin that pops at one frame is taken off around that frame (the ease and two
+    frames either side), not over its whole contact: the stance's two ends stay pinned."""
+    from cyclecoord.synthesis import carry
+
+    m = _walkish(T=120, fps=60.0)
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    planted = carry.support(m, feet).planted[:, 1]  # ltoes
+    runs = [(a, b) for a, b in contact_runs(planted) if b - a >= 24]
+    assert runs, "a long stance of the left toes"
+    a, b = runs[0]
+    k = (a + b) // 2
+    real = carry._accel
+    calls = []
+
+    def fake(motion):  # the unpinned motion is clean; every pinned one pops at frame k
+        calls.append(1)
+        out = np.zeros(motion.n_frames)
+        if len(calls) > 1:
+            out[k] = 10.0
+        return out
+
+    monkeypatch.setattr(carry, "_accel", fake)
+    out = carry.lock_where_clean(m, 1.0, feet)
+    monkeypatch.setattr(carry, "_accel", real)
+    pad = int(round(0.1 * 60)) + 2
+    assert any(s <= k - pad and e >= k + pad for s, e in out.skipped)
+    toes = out.motion.positions()["ltoes"][:, [0, 2]]
+    for lo, hi in ((a + 1, k - pad - 1), (k + pad + 2, b - 1)):
+        assert hi - lo >= 3
+        assert np.ptp(toes[lo:hi], axis=0).max() < 1e-3  # pinned
+    assert np.ptp(toes[k - 2 : k + 3], axis=0).max() > 1e-3  # free around the pop

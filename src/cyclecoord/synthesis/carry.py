@@ -114,10 +114,6 @@ STILL_SPEED = 0.3
 #: A point whose weight-bearing figure (lowness, grounded, going with the body; each in
 #: 0-1) is over this is pinned by :func:`lock_where_clean`.
 LOCK_SUPPORT = 0.5
-#: On frames of an asked hold, low, slow contacts
-#: (:func:`~cyclecoord.quality.contacts.foot_contacts`' defaults) at least this long (s)
-#: are pinned as well as the weight-bearing points.
-STILL_CONTACT = 0.2
 #: An asked hold stands still after this many seconds.
 STAND_AFTER = 0.5
 #: Gaussian width (s) of the smoothing of the carried track's steps.
@@ -346,7 +342,7 @@ def lock_where_clean(
 
     The weight-bearing points (:attr:`Support.planted`: low, grounded and going with the
     body; on a carried motion the support foot), and on ``hold`` frames (a stand asked
-    for, ``(T,)`` bool) the low, slow contacts of at least :data:`STILL_CONTACT` s too,
+    for, ``(T,)`` bool) every point in the contact band too,
     gaps under ``min_duration`` s closed, are pinned for stretches of at least
     ``min_duration`` s (a run's stance at 30 fps is 5-7 frames: low-and-slow contacts of
     0.2 s pinned none of the Bandai run's).  After
@@ -358,7 +354,7 @@ def lock_where_clean(
     channel leaves ``bounds`` (per-channel low and high values, e.g. the training takes'
     range widened by :data:`RANGE_MARGIN` degrees) that it kept before.
     """
-    from ..quality.contacts import contact_runs, foot_contacts
+    from ..quality.contacts import contact_runs
     from ..quality.legs import find_feet
     from .footlock import pin_feet
 
@@ -367,11 +363,12 @@ def lock_where_clean(
         held = support(motion, feet)
         planted = held.planted.copy()
         if hold is not None and np.any(hold):
-            # where a stand was asked, the low, slow contacts too: the root is held, so
-            # every sway of the pose is a foot speed over the ground (an IDLE's feet
-            # glided 0.35 m/s on the Bandai script with the weight-bearing points alone)
-            slow = foot_contacts(motion, feet, min_duration=STILL_CONTACT).planted
-            planted |= slow & np.asarray(hold, dtype=bool)[:, None]
+            # where a stand was asked, every point in the contact band too: the root is
+            # held, so every sway of the pose is a foot speed over the ground (an IDLE's
+            # feet glided 0.35 m/s on the Bandai script with the weight-bearing points
+            # alone; with the low, slow contacts, 0.41 m/s on subject 35's: they came
+            # and went with the sway)
+            planted |= held.contacts.planted & np.asarray(hold, dtype=bool)[:, None]
     except CycleCoordError as exc:
         return LockOutcome(motion, 0, [], f"foot locking: not done ({exc})")
     contacts = held.contacts
@@ -380,6 +377,10 @@ def lock_where_clean(
     # a stretch the hold's contacts lengthened that pops falls back to its weight-bearing
     # frames before it is dropped
     fallback = _tidy(held.planted, shortest) & planted
+    asked = np.zeros(len(planted), bool) if hold is None else np.asarray(hold, dtype=bool)
+    settled = asked.copy()  # a hold's frames once its root stands (STAND_AFTER)
+    for a, b in contact_runs(asked):
+        settled[a : min(b, a + int(round(STAND_AFTER * motion.fps)))] = False
     if not planted.any():
         return LockOutcome(motion, 0, [], "foot locking: no contact long enough to pin")
     before = _accel(motion)
@@ -387,7 +388,7 @@ def lock_where_clean(
     outside_before = _outside(motion.frames, bounds)
     skipped: list[tuple[int, int]] = []
     result = None
-    for _ in range(5):
+    for _ in range(6):
         if not planted.any():
             break
         trial = pin_feet(motion, replace(contacts, planted=planted), blend=blend)
@@ -402,15 +403,28 @@ def lock_where_clean(
         dropped = False
         for i in range(planted.shape[1]):
             for a, b in contact_runs(planted[:, i]):
-                if ((bad >= a - pad) & (bad < b + pad)).any():  # a pop or out of range
-                    alt = fallback[a:b, i].copy()
-                    fallback[a:b, i] = False
-                    if alt.any() and not alt.all():  # a lengthened stretch: its own part
-                        planted[a:b, i] = alt
-                    else:
-                        planted[a:b, i] = False
-                        skipped.append((a, b))
-                    dropped = True
+                near = bad[(bad >= a - pad) & (bad < b + pad)]
+                if not near.size:
+                    continue
+                dropped = True  # a pop or out of range: ...
+                alt = fallback[a:b, i].copy()
+                fallback[a:b, i] = False
+                if alt.any() and not alt.all():  # ... a lengthened stretch: its own part
+                    planted[a:b, i] = alt
+                    continue
+                if asked[a:b].any():  # ... a stand's stretch: its settled part, or all
+                    part = settled[a:b] & planted[a:b, i]
+                    planted[a:b, i] = part if not part.all() else False
+                    skipped.append((a, b))
+                    continue
+                keep = np.ones(b - a, dtype=bool)  # ... else what is clear of the pops
+                for f in near:
+                    keep[max(f - pad - a, 0) : max(f + pad + 1 - a, 0)] = False
+                piece = np.zeros((len(planted), 1), dtype=bool)
+                piece[a:b, 0] = keep
+                planted[a:b, i] = _tidy(piece, shortest)[a:b, 0]
+                lost = np.flatnonzero(~planted[a:b, i]) + a
+                skipped.append((int(lost[0]), int(lost[-1]) + 1))
         if not dropped:  # the pops are not at a pin
             result = trial
             break
