@@ -200,41 +200,11 @@ def test_carry_by_feet_holds_the_body_on_still_feet_but_not_on_landing_ones():
     assert 0.1 * 8.0 * 119 / 60 < got[-1] < 0.9 * 8.0 * 119 / 60  # partly carried (25 %)
 
 
-def _stance_then_swing(fps=30.0, speed=8.0, T=60, stance=(20, 24), forward=False):
-    """Right leg held up and forward; the left foot on the floor for ``stance`` frames,
-    still in the world (its thigh swinging back at the root's speed) or, ``forward``,
-    swinging forward against the root (a foot landing); lifted (knee bent) elsewhere."""
-    skel = legs_skeleton()
-    m = make_motion(skel, T=T, fps=fps, root_speed=speed)
-    col = {c: i for i, c in enumerate(m.channels)}
-    frames = m.frames.copy()
-    frames[:, col[("rfemur", "rx")]] = -40.0
-    frames[:, col[("rtibia", "rx")]] = 60.0
-    frames[:, col[("ltibia", "rx")]] = 60.0
-    # the left foot's z against the root for thigh angles near 0, by forward kinematics
-    grid = np.linspace(-15.0, 15.0, 61)
-    probe = np.repeat(frames[:1], grid.size, axis=0)
-    probe[:, col[("lfemur", "rx")]] = grid
-    probe[:, col[("ltibia", "rx")]] = 0.0
-    probe[:, col[("root", "tz")]] = 0.0
-    z = m.with_frames(probe).positions()["lfoot"][:, 2]
-    order = np.argsort(z)
-    a, b = stance
-    t = np.arange(a, b)
-    root_z = frames[t, col[("root", "tz")]]
-    mid = root_z.mean()
-    want = -(root_z - mid) if not forward else 3.0 * (root_z - mid)
-    frames[t, col[("lfemur", "rx")]] = np.interp(want, z[order], grid[order])
-    frames[t, col[("ltibia", "rx")]] = 0.0
-    return m.with_frames(frames)
-
-
-def _sliding_foot(slide, T=45, fps=30.0, speed=2.0, step=1.0):
-    """Right leg held up and forward; the left foot always on the floor: still in the
-    world, except over the frames ``slide = (a, b)`` where it goes forward by ``step``
-    units over the ground (its thigh turning against the root's travel)."""
-    skel = legs_skeleton()
-    m = make_motion(skel, T=T, fps=fps, root_speed=speed)
+def _right_leg_up(T, fps, speed):
+    """Legs sliding forward at ``speed``, the right leg held up and forward; and a table
+    of the left thigh angle (degrees) giving each z of the straight left foot against
+    the root, by forward kinematics: ``(motion, frames, columns, angle_of_z)``."""
+    m = make_motion(legs_skeleton(), T=T, fps=fps, root_speed=speed)
     col = {c: i for i, c in enumerate(m.channels)}
     frames = m.frames.copy()
     frames[:, col[("rfemur", "rx")]] = -40.0
@@ -245,12 +215,34 @@ def _sliding_foot(slide, T=45, fps=30.0, speed=2.0, step=1.0):
     probe[:, col[("root", "tz")]] = 0.0
     z = m.with_frames(probe).positions()["lfoot"][:, 2]
     order = np.argsort(z)
+    return m, frames, col, lambda want: np.interp(want, z[order], grid[order])
+
+
+def _stance_then_swing(fps=30.0, speed=8.0, T=60, stance=(20, 24), forward=False):
+    """Right leg held up and forward; the left foot on the floor for ``stance`` frames,
+    still in the world (its thigh swinging back at the root's speed) or, ``forward``,
+    swinging forward against the root (a foot landing); lifted (knee bent) elsewhere."""
+    m, frames, col, angle = _right_leg_up(T, fps, speed)
+    frames[:, col[("ltibia", "rx")]] = 60.0
+    a, b = stance
+    t = np.arange(a, b)
+    root_z = frames[t, col[("root", "tz")]]
+    mid = root_z.mean()
+    want = -(root_z - mid) if not forward else 3.0 * (root_z - mid)
+    frames[t, col[("lfemur", "rx")]] = angle(want)
+    frames[t, col[("ltibia", "rx")]] = 0.0
+    return m.with_frames(frames)
+
+
+def _sliding_foot(slide, T=45, fps=30.0, speed=2.0, step=1.0):
+    """Right leg held up and forward; the left foot always on the floor: still in the
+    world, except over the frames ``slide = (a, b)`` where it goes forward by ``step``
+    units over the ground (its thigh turning against the root's travel)."""
+    m, frames, col, angle = _right_leg_up(T, fps, speed)
     a, b = slide
-    t = np.arange(T)
-    world = np.interp(t, [a, b], [0.0, step])  # the foot's ground position
+    world = np.interp(np.arange(T), [a, b], [0.0, step])  # the foot's ground position
     root_z = frames[:, col[("root", "tz")]]
-    rel = world - root_z + 0.5 * root_z[-1]  # about mid-stride
-    frames[:, col[("lfemur", "rx")]] = np.interp(rel, z[order], grid[order])
+    frames[:, col[("lfemur", "rx")]] = angle(world - root_z + 0.5 * root_z[-1])
     return m.with_frames(frames)
 
 
