@@ -18,16 +18,16 @@ on the ground carries it, as the periodic pipeline's cycles do
   faster than :data:`VERTICAL_SPEED` (a foot landing or lifting off a few centimetres
   above the floor), the root keeps its own step;
 * so it does where the low point goes over the ground, with the root's own step, faster
-  than :data:`AGREEMENT` of the root's speed: a foot still swinging forward as it lands
-  is not yet bearing weight (:func:`support`);
+  than :data:`AGREEMENT` of the root's speed for a moment: a foot still swinging forward
+  as it lands is not yet bearing weight (:func:`support`);
 * frames of an asked hold (``hold``) stand: their ground steps fade to 0 over
   :data:`STAND_AFTER` seconds;
 * no foot below the floor: the root is raised, smoothly, where the lowest foot point
   (toe end sites included) would go under ``floor``.
 
-:func:`lock_where_clean` then pins the weight-bearing points (:attr:`Support.planted`) by a leg IK
-(:func:`~cyclecoord.synthesis.footlock.lock_feet`) where it makes no joint accelerate past
-the limit, and says where it could not.
+:func:`lock_where_clean` then pins the weight-bearing points (:attr:`Support.planted`)
+by a leg IK (:func:`~cyclecoord.synthesis.footlock.lock_feet`) where it makes no joint
+accelerate past the limit, and says where it could not.
 """
 
 from __future__ import annotations
@@ -198,8 +198,6 @@ def carry_by_feet(
     return out
 
 
-
-
 @dataclass(frozen=True)
 class Support:
     """Which foot points carry the body on each frame (:func:`support`).
@@ -227,11 +225,13 @@ def support(motion: Motion, feet: tuple[str, ...], floor: float | None = None) -
     A point carries the body while it is among the lowest (its share falls off over
     :data:`LOWNESS` leg lengths above the lowest point), the lowest point is in the
     contact band and not moving up or down faster than :data:`VERTICAL_SPEED`, and the
-    point goes over the ground at most :data:`AGREEMENT` of the root's own speed.
+    point goes over the ground at most :data:`AGREEMENT` of the root's own speed, or
+    faster for longer than :data:`GLIDE_SECONDS` as the grounded lowest point or still
+    against the root (a short stride, a held pose; a landing foot is a few frames).
     """
     from scipy.ndimage import gaussian_filter1d
 
-    from ..quality.contacts import foot_contacts
+    from ..quality.contacts import contact_runs, foot_contacts
 
     contacts = foot_contacts(motion, feet, speed=None, height=CONTACT_BAND, floor=floor)
     leg = contacts.leg_length
@@ -264,8 +264,6 @@ def support(motion: Motion, feet: tuple[str, ...], floor: float | None = None) -
     # a foot landing is a few frames; a point that stays the grounded lowest, or low and
     # still against the root, for longer while it goes over the ground is a stride
     # shorter than the root's step or a held pose (a stalled path): it carries
-    from ..quality.contacts import contact_runs
-
     still = (rel <= CONTACT_BAND) & (
         np.linalg.norm(v_world - v_root[:, None, :], axis=-1) < AGREEMENT * pace[:, None]
     )
@@ -345,14 +343,16 @@ def lock_where_clean(
     for, ``(T,)`` bool) every point in the contact band too,
     gaps under ``min_duration`` s closed, are pinned for stretches of at least
     ``min_duration`` s (a run's stance at 30 fps is 5-7 frames: low-and-slow contacts of
-    0.2 s pinned none of the Bandai run's).  After
-    locking, a contact around which the largest joint acceleration (relative to the root)
-    exceeds both ``limit`` (length units/s^2, e.g. 1.5x the sources' 99th percentile;
-    a number, or one per frame where the frames come from sources of different pace, a
-    walk and a run) and what it was before is unlocked and the rest locked again; so is
-    one where a
+    0.2 s pinned none of the Bandai run's).  After locking, where the largest joint
+    acceleration (relative to the root) exceeds both ``limit`` (length units/s^2, e.g.
+    1.5x the sources' 99th percentile; a number, or one per frame where the frames come
+    from sources of different pace, a walk and a run) and what it was before, or a
     channel leaves ``bounds`` (per-channel low and high values, e.g. the training takes'
-    range widened by :data:`RANGE_MARGIN` degrees) that it kept before.
+    range widened by :data:`RANGE_MARGIN` degrees) that it kept before, the contact
+    around it is unpinned there (its frames within the ease and two frames of it; a
+    hold's contact keeps only its frames after :data:`STAND_AFTER`, then none; one the
+    hold lengthened falls back to its weight-bearing frames first) and the rest locked
+    again, up to six times.
     """
     from ..quality.contacts import contact_runs
     from ..quality.legs import find_feet
