@@ -1,4 +1,5 @@
-"""Mutation score of the tests over periodic/, quality/ and io's readers and writers (issue 27).
+"""Mutation score of the tests over periodic/, quality/, io's readers and writers (issue 27) and
+synthesis/carry.py (the feet that carry generated motion, issue 24).
 
 A small AST mutation tester of our own, rather than mutmut or cosmic-ray: it samples the
 mutants deterministically (every k-th of a fixed order, so a run of a few hundred fits in
@@ -103,6 +104,8 @@ TESTS: dict[str, list[str]] = {
     IO + "gltf_read.py": [T + "io/test_gltf_read.py", T + "io/test_gltf.py", T + "io/test_rig_export.py", T + "io/test_hostile_gltf_usd.py"],
     IO + "tabular.py": [T + "io/test_tabular_known.py", T + "io/test_tabular.py", T + "io/test_hostile_files.py"],
     IO + "usd.py": [T + "io/test_usd_read.py", T + "io/test_usd.py", T + "io/test_rig_export.py", T + "io/test_hostile_gltf_usd.py"],
+    "cyclecoord/synthesis/carry.py": [T + "synthesis/test_carry_known.py", T + "synthesis/test_footlock.py",
+                                      T + "synthesis/test_latent_gait.py"],
 }
 
 _BINOP = {ast.Add: ast.Sub, ast.Sub: ast.Add, ast.Mult: ast.Div, ast.Div: ast.Mult,
