@@ -80,3 +80,108 @@ def test_a_lock_whose_every_pin_pops_pins_nothing_and_says_so(monkeypatch):
     assert out.locked == 0
     assert out.motion is m
     assert out.line.startswith("foot locking: not done")
+
+
+def test_motions_it_cannot_carry_come_back_as_they_are():
+    m = make_motion(legs_skeleton(), T=30, fps=30.0, root_speed=3.0)
+    assert carry.carry_by_feet(m[:2]).frames.tolist() == m[:2].frames.tolist()
+    from cyclecoord.motion import Motion
+
+    bare = Motion(m.frames, m.channels, fps=m.fps)  # no skeleton
+    assert carry.carry_by_feet(bare) is bare
+
+
+def test_smoothing_the_carried_steps_is_a_gaussian_of_smooth_seconds():
+    from scipy.ndimage import gaussian_filter1d
+
+    from test_footlock import _walkish  # noqa: E402
+
+    m = _walkish(T=120, fps=60.0)
+    cols = [m.channels.index(("root", d)) for d in ("tx", "tz")]
+    raw = np.diff(carry.carry_by_feet(m).frames[:, cols], axis=0)
+    got = np.diff(carry.carry_by_feet(m, smooth=0.05).frames[:, cols], axis=0)
+    np.testing.assert_allclose(got, gaussian_filter1d(raw, 0.05 * 60, axis=0, mode="nearest"),
+                               atol=1e-9)
+
+
+def test_the_floor_lift_at_a_low_frame_rate_by_hand():
+    """At 10 fps the lift's half-width is one frame (0.1 s): one frame 0.5 under the floor
+    lifts the root by the running maximum over 3 frames, smoothed by a Gaussian of half
+    a frame, and at least 0.5 on that frame."""
+    from scipy.ndimage import gaussian_filter1d, maximum_filter1d
+
+    m = make_motion(legs_skeleton(), T=20, fps=10.0)
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    ty = m.channels.index(("root", "ty"))
+    frames = m.frames.copy()
+    frames[10, ty] -= 0.5  # one frame sinks
+    m = m.with_frames(frames)
+    floor = float(carry._lowest_points(m, feet)[0])
+    depth = np.maximum(floor - carry._lowest_points(m, feet), 0.0)
+    want = np.maximum(gaussian_filter1d(maximum_filter1d(depth, 3), 0.5, mode="nearest"), depth)
+    out = carry.carry_by_feet(m, feet, floor=floor)
+    np.testing.assert_allclose(out.frames[:, ty] - m.frames[:, ty], want, atol=1e-9)
+
+
+def test_a_lock_without_feet_it_can_find_says_so_and_pins_nothing():
+    m = make_motion(legs_skeleton(), T=30, fps=30.0)
+    out = carry.lock_where_clean(m, 1e12, ("nofoot",))
+    assert out.locked == 0 and out.motion is m
+    assert out.line.startswith("foot locking: not done (")
+
+
+def test_a_pop_exactly_an_ease_and_two_frames_before_a_contact_takes_its_first_frame(
+    monkeypatch,
+):
+    from test_footlock import _walkish  # noqa: E402
+
+    m = _walkish(T=120, fps=60.0)
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    planted = carry.support(m, feet).planted
+    from cyclecoord.quality.contacts import contact_runs
+
+    pad = int(round(0.1 * 60)) + 2
+    a, b = next((a, b) for a, b in contact_runs(planted[:, 1]) if a >= pad + 1)
+    calls = []
+
+    def fake(motion):
+        calls.append(1)
+        out = np.zeros(motion.n_frames)
+        if len(calls) > 1:
+            out[a - pad] = 10.0
+        return out
+
+    monkeypatch.setattr(carry, "_accel", fake)
+    out = carry.lock_where_clean(m, 1.0, feet)
+    assert (a, a + 1) in out.skipped
+
+
+def test_channel_bounds_default_margin_and_the_range_edges():
+    m = make_motion(legs_skeleton(), T=10, fps=30.0, root_speed=5.0)
+    lo, hi = carry.channel_bounds([m])
+    other = [i for i in range(len(m.channels)) if i not in m.root_channels()]
+    np.testing.assert_allclose(lo[other], m.frames[:, other].min(axis=0) - carry.RANGE_MARGIN)
+    assert carry.RANGE_MARGIN == 5.0
+    edge = np.array([hi, lo])  # exactly on the bounds: inside
+    edge[~np.isfinite(edge)] = 0.0
+    assert not carry._outside(edge, (lo, hi)).any()
+    assert carry._outside(edge + 1e-6, (lo, hi))[0]
+
+
+def test_accel_is_the_largest_root_relative_joint_acceleration_by_hand():
+    """One thigh swinging with constant angular acceleration while the root glides:
+    the knee's acceleration, by hand from its positions, is the largest."""
+    m = make_motion(legs_skeleton(), T=9, fps=30.0, root_speed=4.0)
+    frames = m.frames.copy()
+    t = np.arange(9) / 30.0
+    frames[:, m.channels.index(("lfemur", "rx"))] = 200.0 * t**2
+    m = m.with_frames(frames)
+    pos = m.positions()
+    rel = {n: pos[n] - pos["root"] for n in pos.names}
+    acc = np.zeros(7)
+    for n, p in rel.items():
+        a2 = (p[2:] - 2 * p[1:-1] + p[:-2]) * 30.0**2
+        acc = np.maximum(acc, np.sqrt((a2**2).sum(axis=1)))
+    got = carry._accel(m)
+    np.testing.assert_allclose(got[1:-1], acc)
+    assert got[0] == got[1] and got[-1] == got[-2]

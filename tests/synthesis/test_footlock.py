@@ -272,6 +272,11 @@ def test_support_leaves_out_a_foot_that_goes_with_the_root_faster_than_agreement
     assert n > GLIDE_SECONDS * 30
     short = _sliding_foot((15, 15 + n), step=2.5 * 2.0 * n / 30)
     assert np.all(support(short, feet).carry[17 : 13 + n, :2].sum(axis=1) > 0.9)
+    # ... and for 0.23 s, over GLIDE_SECONDS but under twice it
+    n = 7
+    assert GLIDE_SECONDS * 30 < n - 1 < 2 * GLIDE_SECONDS * 30
+    short = _sliding_foot((15, 15 + n), step=2.5 * 2.0 * n / 30)
+    assert np.all(support(short, feet).carry[17 : 13 + n, :2].sum(axis=1) > 0.9)
 
 
 def test_lock_where_clean_pins_a_stance_of_a_tenth_of_a_second():
