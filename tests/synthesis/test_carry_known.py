@@ -185,3 +185,57 @@ def test_accel_is_the_largest_root_relative_joint_acceleration_by_hand():
     got = carry._accel(m)
     np.testing.assert_allclose(got[1:-1], acc)
     assert got[0] == got[1] and got[-1] == got[-2]
+
+
+def test_support_shares_fall_off_with_height_over_the_lowest_point_by_hand():
+    """Standing still, the right foot raised a little (its thigh turned 2 degrees): each
+    point's share of carrying is exp(-(its height - the lowest) / leg length / LOWNESS),
+    normalised over the points (every point grounded, none moving)."""
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    m = make_motion(legs_skeleton(), T=12, fps=30.0)
+    frames = m.frames.copy()
+    frames[:, m.channels.index(("rfemur", "rx"))] = -2.0
+    m = m.with_frames(frames)
+    s = carry.support(m, feet)
+    y = np.stack([m.positions()[f][:, 1] for f in feet], axis=1)
+    w = np.exp(-(y - y.min(axis=1, keepdims=True)) / s.contacts.leg_length / carry.LOWNESS)
+    np.testing.assert_allclose(s.carry[5], w[5] / w[5].sum(), rtol=1e-9)
+    assert 0.0 < s.carry[5, 3] < s.carry[5, 1]  # the raised toes carry less, not nothing
+
+
+def test_tidy_closes_short_gaps_then_drops_short_stretches():
+    x = np.zeros((20, 1), dtype=bool)
+    x[2:6, 0] = x[7:10, 0] = x[11:13, 0] = True  # gaps of 1 and 1 frame
+    x[16:17, 0] = True  # a lone frame
+    got = carry._tidy(x, 2.0)[:, 0]
+    want = np.zeros(20, dtype=bool)
+    want[2:13] = True
+    np.testing.assert_array_equal(got, want)
+
+
+def test_support_and_lock_outcomes_are_frozen_records():
+    import dataclasses
+
+    m = make_motion(legs_skeleton(), T=6, fps=30.0)
+    s = carry.support(m, ("lfoot", "rfoot"))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        s.carry = None
+    out = carry.lock_where_clean(m, 1e12, ("nofoot",))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        out.locked = 3
+
+
+def test_limit_words_name_one_limit_only_when_they_are_all_but_equal():
+    assert carry._limit_words(np.array([1000.0, 1000.4])) == "1e+03"
+    assert carry._limit_words(np.array([1000.0, 1500.0])) == "1e+03-1.5e+03"
+
+
+def test_the_feet_share_of_each_step_is_clipped_to_one():
+    from test_footlock import _walkish  # noqa: E402
+
+    m = _walkish(T=60, fps=60.0)
+    one = carry.carry_by_feet(m, share=np.ones(59))
+    two = carry.carry_by_feet(m, share=np.full(59, 2.0))
+    np.testing.assert_array_equal(one.frames, two.frames)
+    half = carry.carry_by_feet(m, share=np.full(59, 0.5))
+    assert not np.allclose(half.frames, one.frames)
