@@ -238,4 +238,17 @@ def test_the_feet_share_of_each_step_is_clipped_to_one():
     two = carry.carry_by_feet(m, share=np.full(59, 2.0))
     np.testing.assert_array_equal(one.frames, two.frames)
     half = carry.carry_by_feet(m, share=np.full(59, 0.5))
-    assert not np.allclose(half.frames, one.frames)
+    none = carry.carry_by_feet(m, share=np.zeros(59))
+    cols = [m.channels.index(("root", d)) for d in ("tx", "tz")]
+    np.testing.assert_allclose(none.frames[:, cols], m.frames[:, cols])  # its own steps
+    want = 0.5 * np.diff(one.frames[:, cols], axis=0) + 0.5 * np.diff(m.frames[:, cols], axis=0)
+    np.testing.assert_allclose(np.diff(half.frames[:, cols], axis=0), want, atol=1e-9)
+
+
+def test_a_lock_with_no_contact_long_enough_pins_nothing():
+    from test_footlock import _walkish  # noqa: E402
+
+    m = _walkish(T=30, fps=60.0)  # half a second
+    out = carry.lock_where_clean(m, 1e12, min_duration=1.0)
+    assert out.locked == 0 and out.motion is m
+    assert out.line == "foot locking: no contact long enough to pin"
