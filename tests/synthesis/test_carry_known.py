@@ -252,3 +252,34 @@ def test_a_lock_with_no_contact_long_enough_pins_nothing():
     out = carry.lock_where_clean(m, 1e12, min_duration=1.0)
     assert out.locked == 0 and out.motion is m
     assert out.line == "foot locking: no contact long enough to pin"
+
+
+def test_a_hold_whose_pin_pops_early_keeps_its_settled_part(monkeypatch):
+    """Legs swaying six times a second under a held body: on the hold every foot point in
+    the band is pinned; a pop two frames into the hold takes its stretch back to the
+    part after STAND_AFTER seconds, and the feet stand there."""
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    m = make_motion(legs_skeleton(), T=90, fps=30.0)
+    col = {c: i for i, c in enumerate(m.channels)}
+    frames = m.frames.copy()
+    t = np.arange(90) / 30.0
+    for side, sign in (("l", 1.0), ("r", -1.0)):
+        frames[:, col[(f"{side}femur", "rx")]] = sign * 0.5 * np.sin(2 * np.pi * 6.0 * t)
+    m = m.with_frames(frames)
+    hold = np.zeros(90, dtype=bool)
+    hold[20:] = True
+    calls = []
+
+    def fake(motion):
+        calls.append(1)
+        out = np.zeros(motion.n_frames)
+        if len(calls) > 1:
+            out[22] = 10.0
+        return out
+
+    monkeypatch.setattr(carry, "_accel", fake)
+    out = carry.lock_where_clean(m, 1.0, feet, hold=hold)
+    settled = 20 + int(round(carry.STAND_AFTER * 30))
+    z = out.motion.positions()["lfoot"][:, 2]
+    assert np.ptp(z[settled + 4 :]) < 0.02 * np.ptp(m.positions()["lfoot"][:, 2])
+    assert out.locked >= 2
