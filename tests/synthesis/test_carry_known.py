@@ -283,3 +283,30 @@ def test_a_hold_whose_pin_pops_early_keeps_its_settled_part(monkeypatch):
     z = out.motion.positions()["lfoot"][:, 2]
     assert np.ptp(z[settled + 4 :]) < 0.02 * np.ptp(m.positions()["lfoot"][:, 2])
     assert out.locked >= 2
+
+
+def test_a_pop_the_motion_had_before_pinning_does_not_unpin(monkeypatch):
+    """Past the limit, but no more than 5 % over what the frame had before pinning: the pop
+    is the motion's own, and every pin stays; 6 % over: the pin around it comes off."""
+    from test_footlock import _walkish  # noqa: E402
+
+    m = _walkish(T=120, fps=60.0)
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    k = 60
+
+    def run(ratio):
+        calls = []
+
+        def fake(motion):
+            calls.append(1)
+            out = np.zeros(motion.n_frames)
+            out[k] = 10.0 if len(calls) == 1 else 10.0 * ratio
+            return out
+
+        monkeypatch.setattr(carry, "_accel", fake)
+        return carry.lock_where_clean(m, 1.0, feet)
+
+    kept = run(1.04)
+    assert not kept.skipped and kept.locked > 0
+    assert carry.support(m, feet).planted[k - 8 : k + 9].any()  # a pin near the pop ...
+    assert run(1.06).skipped  # ... comes off at 6 % over
