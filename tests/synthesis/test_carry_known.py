@@ -310,3 +310,20 @@ def test_a_pop_the_motion_had_before_pinning_does_not_unpin(monkeypatch):
     assert not kept.skipped and kept.locked > 0
     assert carry.support(m, feet).planted[k - 8 : k + 9].any()  # a pin near the pop ...
     assert run(1.06).skipped  # ... comes off at 6 % over
+
+
+def test_in_flight_the_root_keeps_its_own_step():
+    """Legs held still against a root that glides at 2 units/s: on the ground the feet
+    carry (a held pose: the root stays); lifted 1 unit (11 % of the leg, past the 5 %
+    contact band) for 20 frames, nothing carries and the root keeps its own step there
+    (the share falls off over LOWNESS leg lengths above the band: exp(-6) here)."""
+    m = make_motion(legs_skeleton(), T=60, fps=30.0, root_speed=2.0)
+    ty, tz = (m.channels.index(("root", d)) for d in ("ty", "tz"))
+    frames = m.frames.copy()
+    frames[20:40, ty] += 1.0
+    m = m.with_frames(frames)
+    out = carry.carry_by_feet(m, ("lfoot", "ltoes", "rfoot", "rtoes"))
+    steps = np.diff(out.frames[:, tz])
+    own = 2.0 / 30.0
+    np.testing.assert_allclose(steps[24:35], own, rtol=1e-2)  # flying: its own step
+    np.testing.assert_allclose(steps[5:15], 0.0, atol=1e-6 * own)  # standing: held
