@@ -329,3 +329,19 @@ def test_a_script_over_two_models_is_also_measured_model_by_model(made):
     # with no TRANSITION named, a blend's frames go to the model that made them
     assert [(s["model"], s["start"], s["stop"]) for s in model_sections(syn, [{}] * 23)] == [
         ("walk", 0, t1[0]), ("run", t1[0], t2[0]), ("walk", t2[0], motion.n_frames)]
+
+
+def test_foot_pins_ease_over_a_tenth_of_the_quickest_leg_cycle(made):
+    """LOCK_BLEND (0.1 s) for the walk alone (its cycle is 1.1 s); with the run, a tenth of
+    the run's cycle (0.7 s): a run's stance at 30 fps is 5-7 frames."""
+    from cyclecoord.synthesis.latent.output import LOCK_BLEND
+
+    syn, _ = made
+    cycle = {}
+    for name in ("walk", "run"):
+        g = syn.gait(name)
+        cycle[name] = float(np.median(g.period[g.usable])) / syn.models[name].fps_
+    assert cycle["walk"] / 10 > LOCK_BLEND > cycle["run"] / 10
+    assert syn._lock_ease(["walk"]) == LOCK_BLEND
+    assert syn._lock_ease(["walk", "run"]) == pytest.approx(cycle["run"] / 10)
+    assert 0.06 < syn._lock_ease(["run"]) < 0.08
