@@ -38,3 +38,14 @@ def make_motion(skel, T=120, fps=60.0, root_speed=0.0, lift_left=None, bob=(0.0,
     if lift_left is not None:
         frames[lift_left, col[(skel.names[1], "rx")]] = -40.0  # swing the left thigh forward
     return Motion(frames, channels, fps=fps, skeleton=skel)
+
+
+def swaying_legs(degrees, hz, T=90, fps=30.0):
+    """Standing legs (root still) whose thighs sway in opposition, ``degrees`` each way
+    at ``hz``: the feet slide back and forth under a held body."""
+    m = make_motion(legs_skeleton(), T=T, fps=fps)
+    frames = m.frames.copy()
+    t = np.arange(T) / fps
+    for side, sign in (("lfemur", 1.0), ("rfemur", -1.0)):
+        frames[:, m.channels.index((side, "rx"))] = sign * degrees * np.sin(2 * np.pi * hz * t)
+    return m.with_frames(frames)

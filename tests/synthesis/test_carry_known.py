@@ -6,7 +6,7 @@ import pytest
 
 from cyclecoord.synthesis import carry
 
-from _legs import legs_skeleton, make_motion  # tests/ is on the path (rootdir conftest)
+from _legs import legs_skeleton, make_motion, swaying_legs  # tests/ is on the path (rootdir conftest)
 
 
 def test_translation_scale_is_one_world_unit_per_channel_unit():
@@ -259,13 +259,7 @@ def test_a_hold_whose_pin_pops_early_keeps_its_settled_part(monkeypatch):
     the band is pinned; a pop two frames into the hold takes its stretch back to the
     part after STAND_AFTER seconds, and the feet stand there."""
     feet = ("lfoot", "ltoes", "rfoot", "rtoes")
-    m = make_motion(legs_skeleton(), T=90, fps=30.0)
-    col = {c: i for i, c in enumerate(m.channels)}
-    frames = m.frames.copy()
-    t = np.arange(90) / 30.0
-    for side, sign in (("l", 1.0), ("r", -1.0)):
-        frames[:, col[(f"{side}femur", "rx")]] = sign * 0.5 * np.sin(2 * np.pi * 6.0 * t)
-    m = m.with_frames(frames)
+    m = swaying_legs(0.5, 6.0)
     hold = np.zeros(90, dtype=bool)
     hold[20:] = True
     calls = []

@@ -10,7 +10,7 @@ from cyclecoord.synthesis.carry import carry_by_feet
 from cyclecoord.synthesis.footlock import lock_feet
 
 
-from _legs import legs_skeleton, make_motion  # tests/ is on the path (rootdir conftest)
+from _legs import legs_skeleton, make_motion, swaying_legs  # tests/ is on the path (rootdir conftest)
 
 
 def _walkish(T=120, fps=60.0):
@@ -306,19 +306,12 @@ def test_lock_where_clean_pins_a_stance_of_a_tenth_of_a_second():
 def test_lock_where_clean_stands_the_feet_of_an_asked_hold():
     """A body standing (root held) whose legs sway three times a second: each foot slides
     0.3 leg lengths/s at most, over AGREEMENT of the still body's pace, for under
-    GLIDE_SECONDS at a time, so it bears no weight; on frames of an asked hold the low,
-    slow contacts are pinned too, and the feet stand."""
+    GLIDE_SECONDS at a time, so it bears no weight; on frames of an asked hold every
+    point in the contact band is pinned too, and the feet stand."""
     from cyclecoord.synthesis.carry import lock_where_clean, support
 
     feet = ("lfoot", "ltoes", "rfoot", "rtoes")
-    skel = legs_skeleton()
-    m = make_motion(skel, T=90, fps=30.0)
-    col = {c: i for i, c in enumerate(m.channels)}
-    frames = m.frames.copy()
-    t = np.arange(90) / 30.0
-    for side, sign in (("l", 1.0), ("r", -1.0)):
-        frames[:, col[(f"{side}femur", "rx")]] = sign * 1.0 * np.sin(2 * np.pi * 3.0 * t)
-    m = m.with_frames(frames)
+    m = swaying_legs(1.0, 3.0)
     z = m.positions()["lfoot"][:, 2]
     leg = support(m, feet).contacts.leg_length
     speed = np.abs(np.gradient(z)) * 30 / leg
