@@ -258,6 +258,42 @@ def test_a_path_plays_the_frames_before_the_loop_end_as_they_are():
         10 * (start + np.mod(-0.5 - start, K)))
 
 
+def test_a_path_cross_fades_over_the_seam_between_two_stretches_of_the_take():
+    """A take of 3.5 cycles drifting 0.4 a cycle: every seam of a loop of K cycles jumps
+    0.4 K. Played through the seam, the path goes from the loop's end played on past the
+    seam to its start played from before it (the frames K cycles earlier) along a quintic
+    over ``fade`` cycles, centred on the seam as far as the take has frames; away from
+    it the path is the frames as they are, and ``fade=0`` is the jump. (A smooth bump at
+    the take's start keeps the seam off its first frames.)"""
+    from cyclecoord.synthesis.latent.gait import SEAM_FADE
+
+    gait, phase, values = _gait(lambda p: [np.sin(2 * np.pi * p)], 3.5, frames_per_cycle=20)
+    values[:, 0] += 0.4 * phase + 0.5 * np.exp(-(((phase - 0.1) / 0.1) ** 2))
+    rows, start, K = gait._loop(0, values)
+    seam = start + K
+    assert SEAM_FADE == 0.5
+    # the fade reaches half its length each way, as far as the take has frames
+    before, after = min(0.25, start - phase[0]), min(0.25, phase[-1] - seam)
+    assert before >= 0.1 and after >= 0.1
+    u = seam + np.linspace(-0.5, 0.5, 201)
+    got = gait.at(values, 0, u)[:, 0]
+    a = np.clip((u - seam + before) / (before + after), 0.0, 1.0)
+    w = a * a * a * (a * (6 * a - 15) + 10)
+    late = np.interp(u, phase, values[:, 0])  # the loop's end played on past the seam
+    early = np.interp(u - K, phase, values[:, 0])  # its start, K cycles earlier
+    inside = (u >= seam - before) & (u < seam + after)
+    want = np.where(inside, (1 - w) * late + w * early, gait.at(values, 0, u, fade=0.0)[:, 0])
+    np.testing.assert_allclose(got, want, atol=1e-9)
+    # the jump without the fade, and the fade's largest second difference far below it
+    jump = gait.at(values, 0, u, fade=0.0)[:, 0]
+    gap = abs(np.interp(seam, phase, values[:, 0]) - np.interp(start, phase, values[:, 0]))
+    assert gap > 0.2 and np.abs(np.diff(jump)).max() > 0.9 * gap
+    assert np.abs(np.diff(got, 2)).max() < 0.05 * np.abs(np.diff(jump, 2)).max()
+    # on the first pass, before the fade's window, the frames are played as they are
+    first = np.linspace(phase[0], seam - 0.26, 50)
+    np.testing.assert_allclose(gait.at(values, 0, first), gait.at(values, 0, first, fade=0.0))
+
+
 def test_foot_locks_are_limited_by_the_pace_of_the_model_posing_each_frame(made):
     """The lock's pop limit is 1.5x the 99th percentile of the training accelerations of
     the model that posed the frame (the faster one near a change of model), not the
