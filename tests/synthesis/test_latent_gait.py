@@ -124,9 +124,11 @@ def test_the_particle_path_is_smoothed_before_it_is_posed(models):
     t0, t1 = _span(syn, [4])
     np.testing.assert_allclose(smooth.frames[t0:t1][:, cols], raw.frames[t0:t1][:, cols], atol=1e-9)
     np.testing.assert_allclose(smooth.frames[t1][cols], raw.frames[t1][cols], atol=1e-9)
-    # what it is for: the joints' largest acceleration in the chain drops (measured 0.85x)
-    acc = [np.abs(np.diff(m.frames[a:b][:, cols], 2, axis=0)).max() for m in (raw, smooth)]
-    assert acc[1] < 0.9 * acc[0]
+    # what it is for: the joints' jerk in the chain drops (RMS third difference, measured
+    # 0.52x; its largest acceleration is the knee's own swing, 55 of the 57 degrees it
+    # reached in training, which smoothing leaves alone)
+    jerk = [np.sqrt(np.mean(np.diff(m.frames[a:b][:, cols], 3, axis=0) ** 2)) for m in (raw, smooth)]
+    assert jerk[1] < 0.7 * jerk[0]
 
 
 def test_path_smoothing_is_a_checked_particle_parameter():
@@ -292,6 +294,34 @@ def test_a_path_cross_fades_over_the_seam_between_two_stretches_of_the_take():
     # on the first pass, before the fade's window, the frames are played as they are
     first = np.linspace(phase[0], seam - 0.26, 50)
     np.testing.assert_allclose(gait.at(values, 0, first), gait.at(values, 0, first, fade=0.0))
+
+
+def test_the_gait_phase_advances_evenly_within_a_cycle_and_keeps_the_takes_pace():
+    """A phase stepping 0.8 and 1.2 times its mean rate in alternate quarter cycles (as
+    the pipeline's re-timing does in stretches), over a take whose cycles lengthen from
+    20 to 26 frames: made even, its rate within every cycle is within 2 % of the
+    cycle's own mean (it was 20 % off), and whole cycles still take their frames."""
+    from cyclecoord.synthesis.latent.gait import even_phase
+
+    lengths = np.linspace(20.0, 26.0, 8)  # frames per cycle, slowing over the take
+    rate = np.concatenate([np.repeat(1.0 / L, int(L)) for L in lengths])
+    n = rate.size
+    wobble = np.where((np.arange(n) // 5) % 2 == 0, 0.8, 1.2)
+    phase = np.concatenate([[0.0], np.cumsum(rate * wobble)])[:n]
+    assert np.abs(np.diff(phase) / rate[1:] - 1).max() > 0.19
+    even = even_phase(phase, 23.0)
+    ends = np.concatenate([[0], np.cumsum(lengths.astype(int))])
+    inner = slice(int(lengths[0]), n - int(lengths[-1]))  # (the Gaussian's edges aside)
+    step = np.diff(even)
+    local = np.interp(np.arange(n - 1), ends[:-1] + lengths / 2, 1.0 / lengths)
+    assert np.abs(step / local - 1)[inner].max() < 0.02
+    # the pace of the take is kept: later cycles take more frames
+    assert step[inner][-1] < 0.85 * step[inner][0]
+    # a straight phase is kept as it is, and a short or periodless one unchanged
+    line = 0.3 + np.arange(40) / 21.0
+    np.testing.assert_allclose(even_phase(line, 21.0), line, atol=1e-12)
+    np.testing.assert_array_equal(even_phase(phase[:2], 23.0), phase[:2])
+    np.testing.assert_array_equal(even_phase(phase, np.nan), phase)
 
 
 def test_foot_locks_are_limited_by_the_pace_of_the_model_posing_each_frame(made):
