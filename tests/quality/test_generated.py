@@ -289,6 +289,33 @@ def test_the_measure_reads_any_rig_as_the_plain_one(rig):
     assert a.knee_range == pytest.approx(b.knee_range) and a.root_speed > 0.3
 
 
+def test_a_motion_on_a_bigger_body_is_compared_per_leg_length():
+    """The sources' walk played on a body 1.25x as big (every bone and the root's travel
+    scaled, the unit kept): the same slip, root speed, steps, accelerations and cadence
+    ratios as the walk against itself, and the console says the body differs. Compared in
+    units, the same joint angles on longer bones read 1.25x on each."""
+    from _rigs import CMU_UNIT, in_units, walk
+
+    plain = walk()
+    big = in_units(plain, CMU_UNIT / 1.25)
+    big = big.with_frames(big.frames, fps=plain.fps)
+    a, b = measure_generated(big[20:120], [plain]), measure_generated(plain[20:120], [plain])
+    assert b.body_scale == 1.0 and a.body_scale == pytest.approx(1.25)
+    assert a.leg_length_m == pytest.approx(1.25 * b.leg_length_m)
+    # in the sources' unit the big body's figures are 1.25x ...
+    assert a.largest_accel * a.body_scale == pytest.approx(1.25 * b.largest_accel, rel=1e-6)
+    assert a.support_slip == pytest.approx(1.25 * b.support_slip, rel=1e-6)
+    assert a.root_speed == pytest.approx(1.25 * b.root_speed, rel=1e-6)
+    # ... and per leg length they are the walk's
+    for key in ("slip_ratio", "root_ratio", "largest_accel", "largest_step", "cadence_ratio",
+                "longest_freeze_s"):
+        assert getattr(a, key) == pytest.approx(getattr(b, key), rel=1e-6), key
+    assert b.root_ratio > 0.5 and b.largest_accel > 0.5
+    assert any("legs 1.25x the sources'" in line for line in a.summary())
+    assert not any("legs" in line and "the sources'" in line for line in b.summary()[1:])
+    assert a.to_dict()["body_scale"] == pytest.approx(1.25)
+
+
 def test_plausibility_has_no_bone_from_a_static_root_to_the_hips():
     """The Bandai rig's static ``joint_Root`` sits on the floor where the walk passes it:
     measured as the capture's rig, a "bone" from it to the travelling hips met the legs

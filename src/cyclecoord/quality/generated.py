@@ -25,6 +25,14 @@ figure of the source captures (resampled to the motion's rate):
   root (heading removed) against the sources' 99th percentiles;
 * **root speed**: median horizontal root speed over 0.5 s windows against the sources'.
 
+A motion on a body of another size than its sources' (a script whose run model was
+captured on a smaller actor, written on the walk's skeleton) is compared per leg length:
+the ratios of slip, root speed, pose step and acceleration divide the motion's figure by
+its leg length over the sources' (:attr:`GeneratedQuality.body_scale`, said on the
+console).  Played unchanged on subject 35's skeleton, whose legs are 1.18x subject 143's,
+143_01's own jog read an acceleration 1.19x its p99 in units/s²; the same angular
+motion on longer bones is not a more violent one.
+
 The figures follow the definitions of an independent checker's (its own forward
 kinematics); ``tests/quality/test_generated.py`` compares them on a graph output and on a
 captured take.  Distances are in metres from the sources' skeleton unit
@@ -60,6 +68,8 @@ FREEZE_SECONDS = 0.2
 PLANTED_RATIO = 1.5
 #: Above this multiple the feet "glide" (between the two they "slip").
 GLIDING_RATIO = 4.0
+#: Leg lengths within this fraction of the sources' are the same body (nothing said).
+BODY_SAME = 0.02
 #: Window of the root speed, seconds.
 ROOT_WINDOW = 0.5
 #: A foot point deeper than this (metres) under the floor counts as under it.
@@ -394,11 +404,16 @@ class GeneratedQuality:
     #: the sources' ranges leg by leg (median over takes), which the ratios use
     source_knee_legs: tuple[float, ...] = ()
     source_hip_legs: tuple[float, ...] = ()
+    #: the motion's leg length over the sources': every ratio of a length (slip, root
+    #: speed, pose step, acceleration) is taken per leg length, so a motion played on a
+    #: bigger body than its sources' is not a faster or more violent one
+    body_scale: float = 1.0
 
     # ---- derived
     @property
     def slip_ratio(self) -> float:
-        return self.support_slip / max(self.source_support_slip, 1e-9)
+        """Support-foot slip over the sources', per leg length."""
+        return self.support_slip / self.body_scale / max(self.source_support_slip, 1e-9)
 
     @property
     def feet_word(self) -> str:
@@ -425,7 +440,8 @@ class GeneratedQuality:
 
     @property
     def root_ratio(self) -> float:
-        return self.root_speed / max(self.source_root_speed, 1e-9)
+        """Root speed over the sources', per leg length."""
+        return self.root_speed / self.body_scale / max(self.source_root_speed, 1e-9)
 
     def headline(self) -> str:
         """The first line of a report: feet, freezes, strides, pops, speed."""
@@ -483,6 +499,11 @@ class GeneratedQuality:
             f"{self.largest_accel_frame}) the sources' p99; root speed {self.root_speed:.2f} "
             f"m/s, {self.root_ratio:.2f}x the sources'"
         )
+        if abs(self.body_scale - 1.0) > BODY_SAME:
+            lines.append(
+                f"  body: legs {self.body_scale:.2f}x the sources' ({self.leg_length_m:.2f} m): "
+                "slip, root speed, steps and accelerations are compared per leg length"
+            )
         lines.extend(f"  {n}" for n in self.notes)
         return lines
 
@@ -498,6 +519,7 @@ class GeneratedQuality:
             "feet": list(self.feet),
             "feet_verdict": self.feet_word,
             "leg_length_m": f(self.leg_length_m),
+            "body_scale": f(self.body_scale),
             "support_slip_m_per_s": f(self.support_slip),
             "support_slip_leg_lengths_per_s": f(self.support_slip_legs),
             "sources_support_slip_m_per_s": f(self.source_support_slip),
@@ -573,6 +595,7 @@ def measure_generated(
     kin = _kin(motion, rig)
     m = ref.metres
     legs = rig.leg_length
+    body = legs / ref.leg_length if ref.leg_length > 0 and legs > 0 else 1.0
     # feet: contact from height alone, at the sources' floor
     spd, contacts, fast = _contact_speeds(motion, rig, ref.floor)
     support = _support(kin, rig)
@@ -580,7 +603,7 @@ def measure_generated(
     lowest = _lowest(kin, rig)
     depth = ref.floor - lowest
     # freezes
-    slow = kin.pose_speed() < FREEZE_FRACTION * ref.pose_speed_median
+    slow = kin.pose_speed() / body < FREEZE_FRACTION * ref.pose_speed_median
     slow = np.r_[slow, slow[-1:]]  # a step's flag on its first frame; the last frame copies
     held = np.zeros(kin.n, dtype=bool) if hold is None else np.asarray(hold, dtype=bool)
     if held.shape != (kin.n,):
@@ -619,10 +642,10 @@ def measure_generated(
         source_knee_range=ref.knee_range,
         source_hip_range=ref.hip_range,
         cycle_s=cycle,
-        source_cycle_s=ref.cycle_at(rs),
-        largest_step=_over(float(ps.max()), ref.step_p99),
+        source_cycle_s=ref.cycle_at(rs / body),
+        largest_step=_over(float(ps.max()) / body, ref.step_p99),
         largest_step_frame=int(ps.argmax()),
-        largest_accel=_over(float(acc.max()), ref.accel_p99),
+        largest_accel=_over(float(acc.max()) / body, ref.accel_p99),
         largest_accel_frame=int(acc.argmax()) + 1,
         root_speed=rs * m,
         source_root_speed=ref.root_speed * m,
@@ -631,6 +654,7 @@ def measure_generated(
         knee_p99=tuple(float(x) for x in np.percentile(kin.knee, 99, axis=0)),
         source_knee_legs=ref.knee_range_legs,
         source_hip_legs=ref.hip_range_legs,
+        body_scale=float(body),
     )
 
 
