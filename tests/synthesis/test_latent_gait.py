@@ -82,8 +82,9 @@ def test_cadence_ranges_and_pops_match_the_training_takes(models, made, part, co
 
 
 def _chain(models, smooth, radius=0.15):
-    """Four MOVEs ahead in the walk, a TRANSITION to the run, two MOVEs; no planting."""
-    syn = Synthesizer(models, fps=30, seed=0, plant="off", lock=False,
+    """Four MOVEs ahead in the walk, a TRANSITION to the run, two MOVEs; no planting, and
+    no gait detail (the captured frames' own, which the path's smoothing leaves alone)."""
+    syn = Synthesizer(models, fps=30, seed=0, plant="off", lock=False, detail=False,
                       params=ParticleParams(smooth=smooth, radius=radius))
     syn.start("walk", {"frame": 0})
     for _ in range(4):
@@ -129,6 +130,74 @@ def test_the_particle_path_is_smoothed_before_it_is_posed(models):
     # reached in training, which smoothing leaves alone)
     jerk = [np.sqrt(np.mean(np.diff(m.frames[a:b][:, cols], 3, axis=0) ** 2)) for m in (raw, smooth)]
     assert jerk[1] < 0.7 * jerk[0]
+
+
+def test_the_detail_is_what_the_model_leaves_out_of_each_training_frame(models):
+    m = models["run"]
+    d = m.detail()
+    assert set(d) == {"angles", "height", "velocity", "turn", "tilt"}
+    np.testing.assert_allclose(m.pose(m.X_) + d["angles"], m.angles(m.frames_), atol=1e-9)
+    w = m.root_weights(m.X_)
+    np.testing.assert_allclose(w @ m.root_.height + d["height"], m.root_.height, atol=1e-9)
+    np.testing.assert_allclose(
+        np.einsum("tn,nab->tab", w, m.root_.tilt) + d["tilt"], m.root_.tilt, atol=1e-9
+    )
+    # the PCA leaves something out (else there were nothing to add)
+    assert np.abs(d["angles"]).max() > 1.0
+
+
+def test_a_gait_carries_its_detail_and_fades_it_into_frames_without_one(models):
+    """A MOVE ahead poses its particle and adds the detail at the phases its path steps
+    through; an IDLE after it (the same particle with or without the detail) gets the
+    last gait frame's detail fading as a smoothstep over DETAIL_FADE seconds, and none
+    after that."""
+    from cyclecoord.synthesis.latent.output import DETAIL_FADE
+
+    def run(detail):
+        syn = Synthesizer(
+            models, fps=30, seed=0, plant="off", lock=False, clamp=False, detail=detail,
+            params=ParticleParams(smooth=0.0, random=0.0, likelihood=0.0),
+        )
+        syn.start("walk", {"frame": 0})
+        for _ in range(3):
+            syn.command += 1
+            syn.move({"ahead": 0.3}, stop=False)
+        syn.command += 1
+        syn.idle(duration=1.0)
+        return syn
+
+    on, off = run(True), run(False)
+    m = models["walk"]
+    # the MOVEs: pose of the particle's X plus the detail at the path's phases
+    moves = [c for c in on.chunks if c.detail is not None]
+    assert len(moves) == 3 and not any(c.detail is not None for c in off.chunks)
+    for c in moves:
+        np.testing.assert_allclose(c.angles, m.pose(c.X) + c.detail["angles"], atol=1e-9)
+    # the IDLE: the detail of the last gait frame, faded, for DETAIL_FADE seconds
+    F = int(round(DETAIL_FADE * 30))
+    idle_on, idle_off = on.chunks[-1].angles, off.chunks[-1].angles
+    np.testing.assert_allclose(idle_on, idle_off, atol=1e-9)  # the same particle
+    last = moves[-1].detail["angles"][-1]
+    added = on._fade_detail([c.angles for c in on.chunks], [c.root for c in on.chunks])[0][-1]
+    k = np.arange(1, F + 1)
+    u_ = 1.0 - k / (F + 1.0)
+    fade = u_ * u_ * (3 - 2 * u_)
+    np.testing.assert_allclose(added[:F] - idle_on[:F], fade[:, None] * last, atol=1e-9)
+    np.testing.assert_allclose(added[F:], idle_on[F:], atol=1e-12)
+
+
+def test_gait_detail_is_a_checked_script_key(models, tmp_path):
+    import json
+
+    from cyclecoord.synthesis.latent.script import load_script
+
+    for name in ("walk", "run"):
+        models[name].save(tmp_path / f"{name}.npz")
+    spec = {"models": {"walk": "walk.npz", "run": "run.npz"}, "gait_detail": "yes",
+            "commands": [{"command": "IDLE", "duration": 0.5}]}
+    (tmp_path / "s.json").write_text(json.dumps(spec))
+    with pytest.raises(ParameterError, match="gait_detail: must be true or false"):
+        load_script(tmp_path / "s.json")
 
 
 def test_path_smoothing_is_a_checked_particle_parameter():

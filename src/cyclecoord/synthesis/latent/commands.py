@@ -46,7 +46,7 @@ from .output import (  # noqa: F401
     OutputMixin,
 )
 from .particle import ParticleParams, RandomForce, simulate
-from .stepping import GaitMixin
+from .stepping import GaitMixin, interp_rows
 
 __all__ = ["CommandGraph", "Crossings", "Synthesizer", "resample", "smootherstep", "smoothstep"]
 
@@ -149,6 +149,10 @@ class _Chunk:
     #: the angles and root are the model's pose of X (a particle's path), not a blend or a
     #: played capture: :meth:`OutputMixin.motion` may pose a smoothed X instead
     particle: bool = False
+    #: the gait detail the frames carry (:meth:`~.model.LatentModel.detail`'s parts, each
+    #: ``(T, ...)``; included in ``angles`` and ``root``, added again when a particle's X
+    #: is posed again), None without a gait
+    detail: dict[str, np.ndarray] | None = None
 
 
 @dataclass
@@ -198,6 +202,11 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         Foot point joint names the planting and locking use (default
         :func:`~cyclecoord.quality.legs.find_legs` on the motion: names of the common
         rigs, else its geometry).
+    detail : bool, default True
+        Frames stepping along a gait (MOVE ahead, in-step TRANSITION) carry the joint
+        angles the model's PCA leaves out of the training frame at their phase
+        (:meth:`~.model.LatentModel.detail`); it fades in and out over
+        :data:`DETAIL_FADE` seconds where frames without a gait meet them.
     """
 
     models: dict[str, LatentModel]
@@ -210,6 +219,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
     plant: str = "all"
     lock: bool = True
     feet: tuple[str, ...] | None = None
+    detail: bool = True
 
     def __post_init__(self) -> None:
         if not self.models:
@@ -243,6 +253,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         # (model, segment, unwrapped phase) where the last stepping command left the
         # particle, and the one the MOVE being made will leave
         self._cursor = self._next_cursor = None
+        self._path_detail: dict | None = None  # the gait detail along the MOVE's path
         widest = max(m.X_.shape[0] for m in self.models.values())
         channels = max(len(m.all_channels_) for m in self.models.values())
         self.frame_bytes = _FRAME_BYTES * channels + _FRAME_BYTES_PER_TRAINING_FRAME * widest
@@ -345,14 +356,24 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             )
         return self.models[self.current]
 
-    def _run(self, path: np.ndarray, radius: float | None = None, ride: bool = False) -> None:
+    def _run(
+        self,
+        path: np.ndarray,
+        radius: float | None = None,
+        ride: bool = False,
+        detail: dict[str, np.ndarray] | None = None,
+    ) -> None:
         m = self._need_start("moving")
         self._cursor, self._next_cursor = self._next_cursor, None
         params = self.params if radius is None else self.params.replace(radius=radius)
         t0, c0 = time.perf_counter(), time.process_time()
         self.reserve(path.shape[0] - 1)
         X, V = simulate(m, path, self.x, self.v, self.fps, params, self.force, self.t, ride)
-        self._emit(self.current, X, m.pose(X), self._root(m, X), particle=True)
+        pose, root = m.pose(X), self._root(m, X)
+        if detail is not None:
+            pose = pose + detail["angles"]
+            root = {k: root[k] + detail[k] for k in root}
+        self._emit(self.current, X, pose, root, particle=True, detail=detail)
         self.sim_seconds += time.perf_counter() - t0
         self.sim_cpu_seconds += time.process_time() - c0
         self.x, self.v = X[-1], V[-1]
@@ -381,10 +402,12 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             return angles
         return self.models[to].to_model(self.models[src].to_channels(angles))
 
-    def _emit(self, name, X, angles, root, clip: bool = True, particle: bool = False) -> None:
+    def _emit(
+        self, name, X, angles, root, clip: bool = True, particle: bool = False, detail=None
+    ) -> None:
         if clip:
             angles = self._clip(name, angles)
-        self.chunks.append(_Chunk(name, X, angles, root, self.command, particle))
+        self.chunks.append(_Chunk(name, X, angles, root, self.command, particle, detail))
         self.t += X.shape[0] / self.fps
 
     @staticmethod
@@ -437,9 +460,11 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
                 raise ParameterError(f"an ahead target takes no other keys, got {sorted(to)}")
             timed = self.ahead_path(to["ahead"]) or self.segment_ahead(to["ahead"])
             poly, times = timed
+            along = self._path_detail
             if radius is None:
                 radius = AHEAD_RADIUS * self.params.radius
         else:
+            along = None
             goal = self.target(to)
             if path == "line":
                 poly, nodes = np.vstack([self.x, goal]), [-1, -1]
@@ -469,7 +494,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         n += (r_in + r_out) // 2
         u = eased(n, r_in, r_out) * times[-1]
         samples = np.stack([np.interp(u, times, poly[:, k]) for k in range(poly.shape[1])], 1)
-        self._run(samples, radius, ride=True)
+        detail = None
+        if along is not None:
+            detail = {k: interp_rows(u, times, v)[1:] for k, v in along.items()}
+        self._run(samples, radius, ride=True, detail=detail)
 
     def idle(
         self, at: Any = None, duration: float = 1.0, radius: float | None = None, hover: float = 1.0

@@ -11,7 +11,14 @@ from ...errors import ParameterError
 from ...motion import Motion
 from .model import heading_matrix
 
-__all__ = ["LOCK_BLEND", "LOCK_MIN_CONTACT", "PLANT_MARGIN", "PLANT_ROUNDS", "PLANT_SMOOTH"]
+__all__ = [
+    "DETAIL_FADE",
+    "LOCK_BLEND",
+    "LOCK_MIN_CONTACT",
+    "PLANT_MARGIN",
+    "PLANT_ROUNDS",
+    "PLANT_SMOOTH",
+]
 
 #: Seconds either side of a blend in which the root follows the planted feet.
 PLANT_MARGIN = 0.2
@@ -26,6 +33,9 @@ LOCK_REACH = 0.2
 PLANT_SMOOTH = 0.07
 #: Contact searches on the corrected motion.
 PLANT_ROUNDS = 2
+#: Seconds over which a gait's detail fades out into frames without a gait (and in from
+#: them): an IDLE after a TRANSITION, a MOVE to a target between MOVEs ahead.
+DETAIL_FADE = 0.25
 
 
 class OutputMixin:
@@ -123,18 +133,55 @@ class OutputMixin:
             w = u * u * (3.0 - 2.0 * u)
             Xs = X + w[:, None] * (gaussian_filter1d(X, sigma, axis=0, mode="nearest") - X)
             m = self.models[chunks[i].model]
-            A = self._clip(chunks[i].model, m.pose(Xs), count=False)
-            R = self._root(m, Xs)
+            P, R = m.pose(Xs), self._root(m, Xs)
             edges = np.cumsum([0] + [c.X.shape[0] for c in chunks[i : j + 1]])
+            for c, a, b in zip(chunks[i : j + 1], edges[:-1], edges[1:]):
+                if c.detail is not None:
+                    P[a:b] += c.detail["angles"]
+                    for key in keys:
+                        R[key][a:b] += c.detail[key]
+            A = self._clip(chunks[i].model, P, count=False)
             for n, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
                 angles[i + n] = A[a:b]
                 roots[i + n] = {key: R[key][a:b] for key in keys}
             i = j + 1
+        angles, roots = self._fade_detail(angles, roots)
         # each chunk's angles are in its model's chart: the rig's channels, continuous
         angles = [self.models[c.model].to_channels(a) for c, a in zip(chunks, angles)]
         return self._continuous(np.concatenate(angles)), {
             key: np.concatenate([r[key] for r in roots]) for key in keys
         }
+
+    def _fade_detail(self, angles: list, roots: list) -> tuple[list, list]:
+        """Each chunk's angles and root motion with the gait detail of the nearest frames
+        that have it (within :data:`DETAIL_FADE` seconds, of the same model) added to
+        frames that have none, held at its value there and fading out as a smoothstep of
+        the distance, so a gait's frames meet an IDLE or a MOVE to a target without a
+        step."""
+        F = int(round(DETAIL_FADE * self.fps))
+        chunks = self.chunks
+        sizes = [c.X.shape[0] for c in chunks]
+        has = np.repeat([c.detail is not None for c in chunks], sizes)
+        if F < 1 or has.all() or not has.any():
+            return angles, roots
+        which = np.repeat(np.arange(len(chunks)), sizes)
+        local = np.concatenate([np.arange(n) for n in sizes])
+        src = np.flatnonzero(has)
+        angles = [a.copy() for a in angles]
+        roots = [{k: v.copy() for k, v in r.items()} for r in roots]
+        for t in np.flatnonzero(~has):
+            c = which[t]
+            k = np.searchsorted(src, t)
+            for f in (src[k - 1] if k > 0 else None, src[k] if k < src.size else None):
+                if f is None or abs(f - t) > F or chunks[which[f]].model != chunks[c].model:
+                    continue
+                u = 1.0 - abs(f - t) / (F + 1.0)
+                w = u * u * (3.0 - 2.0 * u)
+                d = chunks[which[f]].detail
+                angles[c][local[t]] += w * d["angles"][local[f]]
+                for key in roots[c]:
+                    roots[c][key][local[t]] += w * d[key][local[f]]
+        return angles, roots
 
     def _continuous(self, angles: np.ndarray) -> np.ndarray:
         """The Euler channels ``(T, C)`` of every joint a model charts about its mean

@@ -53,6 +53,7 @@ TOP_KEYS = {
     "bridge_threshold",
     "plant",
     "lock_feet",
+    "gait_detail",
     "feet",
     "commands",
 }
@@ -279,6 +280,8 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
         raise _fail(p, "plant", f"must be transitions, all or off, got {spec['plant']!r}")
     if not isinstance(spec.get("lock_feet", True), bool):
         raise _fail(p, "lock_feet", f"must be true or false, got {spec['lock_feet']!r}")
+    if not isinstance(spec.get("gait_detail", True), bool):
+        raise _fail(p, "gait_detail", f"must be true or false, got {spec['gait_detail']!r}")
     feet = spec.get("feet")
     if feet is not None and (
         not isinstance(feet, list) or not feet or not all(isinstance(f, str) for f in feet)
@@ -416,6 +419,7 @@ def run_script(
         plant=spec.get("plant", "all"),
         lock=spec.get("lock_feet", True),
         feet=feet,
+        detail=spec.get("gait_detail", True),
     )
     start = spec.get("start", {"model": next(iter(models))})
     t0 = time.perf_counter()

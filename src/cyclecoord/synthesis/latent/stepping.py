@@ -82,7 +82,17 @@ class GaitMixin:
         X = g.at(m.X_, seg, u)
         X[0] = self.x
         self._next_cursor = (self.current, seg, float(u[-1]))
+        self._path_detail = self._detail_at(self.current, seg, u)
         return X, np.arange(n + 1) / self.fps
+
+    def _detail_at(self, name: str, segment: int, u: np.ndarray) -> dict | None:
+        """Model ``name``'s gait detail (:meth:`~.model.LatentModel.detail`, each part
+        ``(len(u), ...)``) at unwrapped phases ``u`` of ``segment`` (None when the
+        synthesizer adds none)."""
+        if not self.detail:
+            return None
+        g = self.gait(name)
+        return {k: g.at(v, segment, u) for k, v in self.models[name].detail().items()}
 
     def segment_ahead(self, seconds: float) -> tuple[np.ndarray, np.ndarray]:
         """``{"ahead": seconds}`` on a model without a gait: along the nearest training
@@ -102,6 +112,11 @@ class GaitMixin:
         t = t0 + np.arange(n + 1) / self.fps
         X = np.stack([np.interp(t, m.times_[rows], m.X_[rows, j]) for j in range(m.X_.shape[1])], 1)
         X[0] = self.x
+        self._path_detail = (
+            {k: interp_rows(t, m.times_[rows], v[rows]) for k, v in m.detail().items()}
+            if self.detail
+            else None
+        )
         return X, t - t0
 
     def can_step_across(self, src: str, to: str) -> bool:
@@ -157,10 +172,19 @@ class GaitMixin:
             + w.reshape((-1,) + (1,) * (r1[k].ndim - 1)) * r2[k]
             for k in r1
         }
-        blended = (1 - wc) * self._into(src, to, self._clip(src, m1.pose(Xa))) + wc * self._clip(
-            to, m2.pose(Xb)
-        )
-        self._emit(to, Xb, blended, root, clip=False)
+        Da, Db = self._detail_at(src, sa, ua + du), self._detail_at(to, sb, ub + du)
+        Pa, Pb = m1.pose(Xa), m2.pose(Xb)
+        detail = None
+        if Da is not None:
+            Pa, Pb = Pa + Da["angles"], Pb + Db["angles"]
+            detail = {
+                k: (1 - w.reshape((-1,) + (1,) * (Da[k].ndim - 1))) * Da[k]
+                + w.reshape((-1,) + (1,) * (Da[k].ndim - 1)) * Db[k]
+                for k in Da
+            }
+            root = {k: root[k] + detail[k] for k in root}
+        blended = (1 - wc) * self._into(src, to, self._clip(src, Pa)) + wc * self._clip(to, Pb)
+        self._emit(to, Xb, blended, root, clip=False, detail=detail)
         c = self.crossings_threshold(src)
         self.events.append(
             {
@@ -197,3 +221,10 @@ def _better(best, cand, m1, m2, x):
     if best is None or d < best[1]:
         return (seg, u, x2), d
     return best
+
+
+def interp_rows(t: np.ndarray, times: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """``values`` ``(M, ...)`` given at ``times`` ``(M,)``, linear at ``t`` ``(T,)``."""
+    flat = values.reshape(values.shape[0], -1)
+    out = np.stack([np.interp(t, times, col) for col in flat.T], axis=1)
+    return out.reshape((len(t),) + values.shape[1:])
