@@ -350,9 +350,9 @@ def lock_where_clean(
     channel leaves ``bounds`` (per-channel low and high values, e.g. the training takes'
     range widened by :data:`RANGE_MARGIN` degrees) that it kept before, the contact
     around it is unpinned there (its frames within the ease and two frames of it; a
-    hold's contact keeps only its frames after :data:`STAND_AFTER`, then none; one the
-    hold lengthened falls back to its weight-bearing frames first) and the rest locked
-    again, up to six times.
+    hold's contact keeps only its frames after :data:`STAND_AFTER`, then what of those is
+    clear of the pops; one the hold lengthened falls back to its weight-bearing frames
+    first) and the rest locked again, up to six times.
     """
     from ..quality.contacts import contact_runs
     from ..quality.legs import find_feet
@@ -412,11 +412,13 @@ def lock_where_clean(
                 if alt.any() and not alt.all():  # ... a lengthened stretch: its own part
                     planted[a:b, i] = alt
                     continue
-                if asked[a:b].any():  # ... a stand's stretch: its settled part, or all
+                if asked[a:b].any():  # ... a stand's stretch: its settled part, ...
                     part = settled[a:b] & planted[a:b, i]
-                    planted[a:b, i] = part if not part.all() else False
-                    skipped.append((a, b))
-                    continue
+                    if not part.all():
+                        planted[a:b, i] = part
+                        skipped.append((a, b))
+                        continue
+                    # ... then what of it is clear of the pops (below)
                 keep = np.ones(b - a, dtype=bool)  # ... else what is clear of the pops
                 for f in near:
                     keep[max(f - pad - a, 0) : max(f + pad + 1 - a, 0)] = False
