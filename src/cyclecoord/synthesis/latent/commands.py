@@ -395,6 +395,32 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             self.clamped["max_deg"] = max(self.clamped["max_deg"], float(over.max(initial=0.0)))
         return clipped
 
+    def _mix(
+        self, src: str, to: str, a: np.ndarray, b: np.ndarray, w: np.ndarray
+    ) -> np.ndarray:
+        """``(1 - w) a + w b`` of model ``src``'s angles ``a`` and model ``to``'s ``b``
+        (each ``(T, C)``, ``w`` ``(T,)``), in ``to``'s chart, each joint's rotation
+        slerped: linear in the rig's channels elsewhere.
+
+        Linear in ``to``'s chart, a joint ``to`` models about its mean rotation mixed a
+        pose far from that mean written in it, whose Euler angles there flip from frame
+        to frame: at the Bandai walk-run hop the right elbow swung 17 degrees a frame
+        with the run's weight at 0.05 and the hand accelerated 2.3x the run's 99th
+        percentile."""
+        from scipy.spatial.transform import Rotation
+
+        ma, mb = self.models[src], self.models[to]
+        ca, cb = ma.to_channels(a), mb.to_channels(b)
+        w = np.asarray(w, dtype=float).reshape(-1)
+        out = (1.0 - w[:, None]) * ca + w[:, None] * cb
+        for idx, order in _rotation_columns(mb):
+            Ra = Rotation.from_euler(order, ca[:, idx], degrees=True)
+            Rb = Rotation.from_euler(order, cb[:, idx], degrees=True)
+            step = (Ra.inv() * Rb).as_rotvec()
+            R = Ra * Rotation.from_rotvec(w[:, None] * step)
+            out[:, idx] = R.as_euler(order, degrees=True)
+        return mb.to_model(out)
+
     def _into(self, src: str, to: str, angles: np.ndarray) -> np.ndarray:
         """Model ``src``'s angles ``(T, C)`` in model ``to``'s chart: the same rotations
         (:meth:`~.model.LatentModel.chart`), so a blend mixes like with like."""
@@ -589,3 +615,16 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self.x = X[-1]
         self.v = (X[-1] - X[-2]) * self.fps if len(X) > 1 else np.zeros_like(self.x)
 
+
+def _rotation_columns(model: LatentModel) -> list[tuple[np.ndarray, str]]:
+    """``(columns, order)`` of each joint of ``model`` with three rotation channels."""
+    by_joint: dict[str, dict[str, int]] = {}
+    for k, (j, d) in enumerate(model.channels_):
+        if d in ("rx", "ry", "rz"):
+            by_joint.setdefault(j, {})[d[1]] = k
+    out = []
+    for j, c in by_joint.items():
+        order = model.skeleton_[j].rotation_order.upper()
+        if len(c) == 3 and sorted(order) == ["X", "Y", "Z"]:
+            out.append((np.array([c[a.lower()] for a in order], dtype=int), order))
+    return out

@@ -292,8 +292,8 @@ class CrossingMixin:
         }
         # each model's pose is clipped to its own range before the blend, so the frames
         # after the blend continue without a jump
-        blended = (1 - w) * self._into(src, to, self._clip(src, m1.pose(X1))) + w * self._clip(
-            to, m2.pose(X2)
+        blended = self._mix(
+            src, to, self._clip(src, m1.pose(X1)), self._clip(to, m2.pose(X2)), w[:, 0]
         )
         self._emit(to, X2, blended, root, clip=False)
         self.events.append(

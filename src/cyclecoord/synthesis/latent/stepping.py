@@ -165,7 +165,6 @@ class GaitMixin:
         du = np.concatenate([[0.0], np.cumsum(steps)])[1:]
         Xa = ga.at(m1.X_, sa, ua + du)
         Xb = gb.at(m2.X_, sb, ub + du)
-        wc = w[:, None]
         r1, r2 = self._root(m1, Xa), self._root(m2, Xb)
         root = {
             k: (1 - w.reshape((-1,) + (1,) * (r1[k].ndim - 1))) * r1[k]
@@ -183,7 +182,7 @@ class GaitMixin:
                 for k in Da
             }
             root = {k: root[k] + detail[k] for k in root}
-        blended = (1 - wc) * self._into(src, to, self._clip(src, Pa)) + wc * self._clip(to, Pb)
+        blended = self._mix(src, to, self._clip(src, Pa), self._clip(to, Pb), w)
         self._emit(to, Xb, blended, root, clip=False, detail=detail)
         c = self.crossings_threshold(src)
         self.events.append(
