@@ -743,6 +743,27 @@ def test_animate_no_progress_reaches_run_script(monkeypatch, tmp_path):
         "progress"] is False
 
 
+def test_animate_refuses_limbs_through_each_other_unless_allowed(monkeypatch, tmp_path):
+    """A script whose motion keeps new limb contacts is refused (report written with the
+    reason, no motion); --allow-contacts writes it."""
+    import cyclecoord.synthesis.latent.script as S
+
+    motion = cc.datasets.example_capture().motion[:40]
+    report = {"plausibility": {"clean": False, "new_contact_frames": [7, 8, 9],
+                               "notes": ["1 bone pairs come closer than the inputs ever do"]},
+              "timing": {"frames_per_second": 0}, "frames": 40, "duration_s": 0.33,
+              "fps": 120.0, "transitions": []}
+    monkeypatch.setattr(S, "run_script", lambda *a, **k: (motion, dict(report)))
+    script = tmp_path / "s.json"
+    script.write_text(json.dumps({"models": {}, "commands": []}))
+    out, rep = tmp_path / "a.bvh", tmp_path / "a.json"
+    argv = ["animate", str(script), "-o", str(out), "--report", str(rep)]
+    assert main(argv) == 1 and not out.exists()
+    assert "limbs passing through each other in 3 frames" in json.loads(rep.read_text())["refused"]
+    assert main(argv + ["--allow-contacts"]) == 0 and cc.load(out).n_frames == 40
+    assert "refused" not in json.loads(rep.read_text())
+
+
 def test_spy_sees_what_it_replaced(monkeypatch):
     """The helper itself: a method spy gets the instance, a function spy the arguments."""
     spy = Spy(monkeypatch, "cyclecoord.motion.Motion.window", stop=False)

@@ -163,6 +163,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         **dict.fromkeys(("-o", "--report"), "tests/synthesis/test_latent_cli.py::"
                         "test_animate_writes_bvh_and_report_reproducibly"),
         "--no-check": W + "test_animate_no_check_reaches_run_script",
+        "--allow-contacts": W + "test_animate_refuses_limbs_through_each_other_unless_allowed",
         "--feet": W + "test_animate_feet_reach_the_script",
         "--no-progress": W + "test_animate_no_progress_reaches_run_script",
     },

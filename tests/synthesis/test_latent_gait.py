@@ -186,6 +186,53 @@ def test_a_gait_carries_its_detail_and_fades_it_into_frames_without_one(models):
     np.testing.assert_allclose(added[F:], idle_on[F:], atol=1e-12)
 
 
+def test_frames_whose_limbs_come_too_close_are_pulled_to_the_captured_pose(models, monkeypatch):
+    """A new limb contact at frame 10 of a MOVE chain (and one on the IDLE after it): the
+    gait frame is posed as the captured frame at its phase (the path's pose plus its
+    detail), its neighbours part way, frames further than UNTANGLE_WIDTH unchanged; the
+    IDLE frame, on no gait's path, is left as it was; a note says so."""
+    from types import SimpleNamespace
+
+    import cyclecoord.quality.plausibility as P
+    from cyclecoord.synthesis.latent.output import UNTANGLE_WIDTH
+
+    def made():
+        syn = Synthesizer(models, fps=30, seed=0, plant="off", lock=False)
+        syn.start("walk", {"frame": 0})
+        for _ in range(3):
+            syn.command += 1
+            syn.move({"ahead": 0.3}, stop=False)
+        syn.command += 1
+        syn.idle(duration=1.0)
+        return syn
+
+    plain = made()
+    before = plain._assemble(*plain._posed())
+    idle = sum(c.X.shape[0] for c in plain.chunks[:-1]) + 10
+    calls = []
+
+    def fake(motion, refs, *a, **k):
+        calls.append(1)
+        return SimpleNamespace(new_contact_frames=[10, idle] if len(calls) == 1 else [])
+
+    monkeypatch.setattr(P, "check_plausibility", fake)
+    syn = made()
+    after = syn._untangled()
+    assert len(calls) == 2
+    m = models["walk"]
+    chunk, start = syn.chunks[0], 0  # the first MOVE: frames 0-12
+    assert chunk.path is not None and 10 < chunk.X.shape[0]
+    target = syn._clip("walk", m.pose(chunk.path) + chunk.detail["angles"], count=False)
+    cols = [after.channel_index(*c) for c in m.channels_]
+    np.testing.assert_allclose(after.frames[10, cols], m.to_channels(target)[10 - start],
+                               atol=1e-6)
+    w = int(round(UNTANGLE_WIDTH * 30))
+    far = [f for f in range(after.n_frames) if abs(f - 10) > w]
+    np.testing.assert_allclose(after.frames[far], before.frames[far], atol=1e-9)
+    assert not np.allclose(after.frames[11, cols], before.frames[11, cols])
+    assert any("pulled toward the captured pose" in n and "(frames 10-10)" in n for n in syn.notes)
+
+
 def test_gait_detail_is_a_checked_script_key(models, tmp_path):
     import json
 

@@ -35,6 +35,13 @@ def add_parser(subparsers) -> None:
         "--report", metavar="R.json", help="write a JSON report (commands, bridges, timing, checks)"
     )
     p.add_argument("--no-check", action="store_true", help="skip the plausibility checks")
+    p.add_argument(
+        "--allow-contacts",
+        action="store_true",
+        help="write the motion even when its limbs pass through each other (bone contacts the "
+        "training takes never make, left after frames along a gait were pulled toward the "
+        "captured pose); by default such a motion is refused and only the report is written",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar over the commands")
     add_feet_option(p)
     add_memory_option(p)
@@ -67,6 +74,9 @@ def run(args: argparse.Namespace) -> int:
     motion, report = run_script(
         script, check=not args.no_check, progress=not args.no_progress, feet=args.feet or None
     )
+    crossing = (report.get("plausibility") or {}).get("new_contact_frames") or []
+    if crossing and not args.allow_contacts:
+        return _refuse_crossing(args, report, crossing)
     # every output moves into place at the end, so a failure or Ctrl-C leaves none
     with Outputs() as staged:
         skeleton = [asf for _option, asf in _skeleton_output(args)]
@@ -114,3 +124,24 @@ def run(args: argparse.Namespace) -> int:
         pl = report["plausibility"]
         print("plausibility: " + ("clean" if pl["clean"] else "; ".join(pl["notes"])))
     return 0
+
+
+def _refuse_crossing(args: argparse.Namespace, report: dict, frames: list) -> int:
+    """Write the report, not a motion whose limbs pass through each other."""
+    from ..errors import ImplausibleMotionError
+    from ..io import atomic_write
+
+    where = f"frames {frames[0]}-{frames[-1]}" if len(frames) > 1 else f"frame {frames[0]}"
+    why = (
+        f"synthesised motion has limbs passing through each other in {len(frames)} frames "
+        f"({where}); nothing written (--allow-contacts writes it anyway; another seed may "
+        "avoid it)"
+    )
+    report = {**report, "refused": why}
+    if args.report:
+        with Outputs() as staged, atomic_write(staged.file(args.report)) as fh:
+            json.dump(report, fh, indent=2, default=float)
+    for line in report.get("motion_quality_lines", []):
+        print(line)
+    print("plausibility: " + "; ".join(report["plausibility"]["notes"]))
+    raise ImplausibleMotionError(why)

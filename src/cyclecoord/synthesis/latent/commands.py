@@ -153,6 +153,9 @@ class _Chunk:
     #: ``(T, ...)``; included in ``angles`` and ``root``, added again when a particle's X
     #: is posed again), None without a gait
     detail: dict[str, np.ndarray] | None = None
+    #: the latent path ``(T, q)`` the particle followed along a gait (None elsewhere):
+    #: its pose plus the detail is the captured frame at each frame's phase
+    path: np.ndarray | None = None
 
 
 @dataclass
@@ -373,7 +376,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         if detail is not None:
             pose = pose + detail["angles"]
             root = {k: root[k] + detail[k] for k in root}
-        self._emit(self.current, X, pose, root, particle=True, detail=detail)
+        self._emit(
+            self.current, X, pose, root, particle=True, detail=detail,
+            path=None if detail is None else np.array(path[1:], dtype=float),
+        )
         self.sim_seconds += time.perf_counter() - t0
         self.sim_cpu_seconds += time.process_time() - c0
         self.x, self.v = X[-1], V[-1]
@@ -429,11 +435,19 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         return self.models[to].to_model(self.models[src].to_channels(angles))
 
     def _emit(
-        self, name, X, angles, root, clip: bool = True, particle: bool = False, detail=None
+        self,
+        name,
+        X,
+        angles,
+        root,
+        clip: bool = True,
+        particle: bool = False,
+        detail=None,
+        path=None,
     ) -> None:
         if clip:
             angles = self._clip(name, angles)
-        self.chunks.append(_Chunk(name, X, angles, root, self.command, particle, detail))
+        self.chunks.append(_Chunk(name, X, angles, root, self.command, particle, detail, path))
         self.t += X.shape[0] / self.fps
 
     @staticmethod
