@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from ..._words import plural
 from ...errors import ParameterError
 from ...motion import Motion
 from .model import heading_matrix
@@ -94,10 +95,11 @@ class OutputMixin:
             motion = self._assemble(*self._posed(pull))
         if pulled:
             spans = sorted(pulled)
+            where = f"frames {spans[0]}-{spans[-1]}" if len(spans) > 1 else f"frame {spans[0]}"
             self.notes.append(
-                f"limbs: {len(spans)} frames came closer than the training takes' and were "
-                f"pulled toward the captured pose at their gait phase (frames {spans[0]}-"
-                f"{spans[-1]})"
+                f"limbs: {plural(len(spans), 'frame')} came closer than the training takes' "
+                f"and {'was' if len(spans) == 1 else 'were'} pulled toward the captured pose "
+                f"at {'its' if len(spans) == 1 else 'their'} gait phase ({where})"
             )
         return motion
 
