@@ -223,6 +223,43 @@ def test_synthesizer_transition_and_output(walk_model, jog_model):
     np.testing.assert_array_equal(again.motion().frames, motion.frames)
 
 
+def test_a_played_segment_carries_its_detail_into_the_move_after_it(walk_model):
+    """PLAY's frames are the captured ones, which hold what the model leaves out of them:
+    marked as detail, that fades into the MOVE after it over DETAIL_FADE seconds instead
+    of stepping at the join (the README's script popped at 3.6x there)."""
+    from cyclecoord.synthesis.latent.output import DETAIL_FADE
+
+    def made(detail):
+        syn = Synthesizer({"walk": walk_model}, fps=30, seed=0, plant="off", lock=False,
+                          detail=detail)
+        syn.start("walk")
+        syn.play("b", 0.0, 0.5)
+        syn.move({"segment": "b", "time": 0.2})
+        return syn
+
+    syn, bare = made(True), made(False)
+    played = syn.chunks[-2]
+    idx = np.flatnonzero(walk_model.segments_ == walk_model.segment_index("b"))[:15]
+    np.testing.assert_allclose(played.detail["angles"], walk_model.detail()["angles"][idx],
+                               atol=1e-9)
+    np.testing.assert_allclose(played.angles, walk_model.pose(played.X) + played.detail["angles"],
+                               atol=1e-6)
+    assert bare.chunks[-2].detail is None
+    # the MOVE's first frames: the played frames' last detail, fading
+    a, _ = syn._posed()
+    b, _ = bare._posed()
+    n = sum(c.X.shape[0] for c in syn.chunks[:-1])
+    F = int(round(DETAIL_FADE * 30))
+    k = np.arange(1, F + 1)
+    u = 1.0 - k / (F + 1.0)
+    fade = (u * u * (3 - 2 * u))[:, None] * played.detail["angles"][-1]
+    np.testing.assert_allclose(a[n : n + F] - b[n : n + F],
+                               fade, atol=1e-6)
+    np.testing.assert_allclose(a[n + F :], b[n + F :], atol=1e-9)
+    # and the join steps less than without it
+    assert np.abs(a[n] - a[n - 1]).max() < np.abs(b[n] - b[n - 1]).max()
+
+
 def test_transition_without_bridges_crosses_at_the_closest_poses(walk_model, jog_model):
     # a threshold no pair can meet: the transition still happens, at the closest pair
     syn = Synthesizer({"walk": walk_model, "jog": jog_model}, fps=30, seed=1, bridge_threshold=1e-9)

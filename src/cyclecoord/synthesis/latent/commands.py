@@ -625,7 +625,16 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             "turn": interp(r.turn[idx])[:, 0],
             "tilt": interp(r.tilt[idx]).reshape(-1, 3, 3),
         }
-        self._emit(self.current, X, interp(m.angles(m.frames_[idx])), root)
+        # the captured frames carry what the model leaves out of them: marked as detail,
+        # it fades out into a MOVE after them (and in from one before) instead of
+        # stepping (the README's script popped its toes at 3.6x the Twist takes' 99th
+        # percentile where its PLAY met the next MOVE)
+        detail = None
+        if self.detail:
+            detail = {
+                k: interp(v[idx]).reshape((len(t),) + v.shape[1:]) for k, v in m.detail().items()
+            }
+        self._emit(self.current, X, interp(m.angles(m.frames_[idx])), root, detail=detail)
         self.x = X[-1]
         self.v = (X[-1] - X[-2]) * self.fps if len(X) > 1 else np.zeros_like(self.x)
 
