@@ -254,10 +254,10 @@ def test_a_lock_with_no_contact_long_enough_pins_nothing():
     assert out.line == "foot locking: no contact long enough to pin"
 
 
-def test_a_hold_whose_pin_pops_early_keeps_its_settled_part(monkeypatch):
-    """Legs swaying six times a second under a held body: on the hold every foot point in
-    the band is pinned; a pop two frames into the hold takes its stretch back to the
-    part after STAND_AFTER seconds, and the feet stand there."""
+def _hold_popping_at(monkeypatch, frame: int):
+    """Legs swaying six times a second under a body held from frame 20 of 90, locked with
+    every pinning after the first making a pop at ``frame``: the lock's outcome, the lfoot
+    depth per frame, the legs' sway (its range unlocked) and the first settled frame."""
     feet = ("lfoot", "ltoes", "rfoot", "rtoes")
     m = swaying_legs(0.5, 6.0)
     hold = np.zeros(90, dtype=bool)
@@ -268,14 +268,21 @@ def test_a_hold_whose_pin_pops_early_keeps_its_settled_part(monkeypatch):
         calls.append(1)
         out = np.zeros(motion.n_frames)
         if len(calls) > 1:
-            out[22] = 10.0
+            out[frame] = 10.0
         return out
 
     monkeypatch.setattr(carry, "_accel", fake)
     out = carry.lock_where_clean(m, 1.0, feet, hold=hold)
-    settled = 20 + int(round(carry.STAND_AFTER * 30))
     z = out.motion.positions()["lfoot"][:, 2]
     sway = np.ptp(m.positions()["lfoot"][:, 2])
+    return out, z, sway, 20 + int(round(carry.STAND_AFTER * 30))
+
+
+def test_a_hold_whose_pin_pops_early_keeps_its_settled_part(monkeypatch):
+    """On the hold every foot point in the band is pinned; a pop two frames into the hold
+    takes its stretch back to the part after STAND_AFTER seconds, and the feet stand
+    there."""
+    out, z, sway, settled = _hold_popping_at(monkeypatch, 22)
     assert np.ptp(z[settled + 4 :]) < 0.02 * sway
     assert out.locked >= 2
     # the frames between the pop and the settled part are not pinned (the legs sway)
@@ -287,25 +294,8 @@ def test_a_hold_whose_settled_pin_pops_keeps_what_is_clear_of_the_pop(monkeypatc
     the settled stretch is cut around the pop (an ease and two frames each way), not
     dropped, and the feet stand before and after it. (Dropped, one IDLE in five of the
     Bandai and subject 35 scripts let its feet glide 0.2-0.4 m/s.)"""
-    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
-    m = swaying_legs(0.5, 6.0)
-    hold = np.zeros(90, dtype=bool)
-    hold[20:] = True
-    calls = []
-
-    def fake(motion):
-        calls.append(1)
-        out = np.zeros(motion.n_frames)
-        if len(calls) > 1:
-            out[60] = 10.0
-        return out
-
-    monkeypatch.setattr(carry, "_accel", fake)
-    out = carry.lock_where_clean(m, 1.0, feet, hold=hold)
-    settled = 20 + int(round(carry.STAND_AFTER * 30))
+    out, z, sway, settled = _hold_popping_at(monkeypatch, 60)
     pad = int(round(0.1 * 30)) + 2
-    z = out.motion.positions()["lfoot"][:, 2]
-    sway = np.ptp(m.positions()["lfoot"][:, 2])
     # pinned before the pop (from the settled part's ease on) and after it
     assert np.ptp(z[settled + 4 : 60 - pad - 4]) < 0.02 * sway
     assert np.ptp(z[60 + pad + 4 :]) < 0.02 * sway

@@ -132,6 +132,18 @@ def test_the_particle_path_is_smoothed_before_it_is_posed(models):
     assert jerk[1] < 0.7 * jerk[0]
 
 
+def _moves_then_idle(models, **options):
+    """Three MOVEs ahead in the walk and a 1 s IDLE; no planting, no lock."""
+    syn = Synthesizer(models, fps=30, seed=0, plant="off", lock=False, **options)
+    syn.start("walk", {"frame": 0})
+    for _ in range(3):
+        syn.command += 1
+        syn.move({"ahead": 0.3}, stop=False)
+    syn.command += 1
+    syn.idle(duration=1.0)
+    return syn
+
+
 def test_the_detail_is_what_the_model_leaves_out_of_each_training_frame(models):
     m = models["run"]
     d = m.detail()
@@ -154,17 +166,10 @@ def test_a_gait_carries_its_detail_and_fades_it_into_frames_without_one(models):
     from cyclecoord.synthesis.latent.output import DETAIL_FADE
 
     def run(detail):
-        syn = Synthesizer(
-            models, fps=30, seed=0, plant="off", lock=False, clamp=False, detail=detail,
+        return _moves_then_idle(
+            models, clamp=False, detail=detail,
             params=ParticleParams(smooth=0.0, random=0.0, likelihood=0.0),
         )
-        syn.start("walk", {"frame": 0})
-        for _ in range(3):
-            syn.command += 1
-            syn.move({"ahead": 0.3}, stop=False)
-        syn.command += 1
-        syn.idle(duration=1.0)
-        return syn
 
     on, off = run(True), run(False)
     m = models["walk"]
@@ -196,17 +201,7 @@ def test_frames_whose_limbs_come_too_close_are_pulled_to_the_captured_pose(model
     import cyclecoord.quality.plausibility as P
     from cyclecoord.synthesis.latent.output import UNTANGLE_WIDTH
 
-    def made():
-        syn = Synthesizer(models, fps=30, seed=0, plant="off", lock=False)
-        syn.start("walk", {"frame": 0})
-        for _ in range(3):
-            syn.command += 1
-            syn.move({"ahead": 0.3}, stop=False)
-        syn.command += 1
-        syn.idle(duration=1.0)
-        return syn
-
-    plain = made()
+    plain = _moves_then_idle(models)
     before = plain._assemble(*plain._posed())
     idle = sum(c.X.shape[0] for c in plain.chunks[:-1]) + 10
     calls = []
@@ -216,7 +211,7 @@ def test_frames_whose_limbs_come_too_close_are_pulled_to_the_captured_pose(model
         return SimpleNamespace(new_contact_frames=[10, idle] if len(calls) == 1 else [])
 
     monkeypatch.setattr(P, "check_plausibility", fake)
-    syn = made()
+    syn = _moves_then_idle(models)
     after = syn._untangled()
     assert len(calls) == 2
     m = models["walk"]
@@ -263,6 +258,8 @@ def test_two_models_poses_blend_as_rotations():
 
         def to_model(self, a):
             return np.array(a, dtype=float)
+
+        rotation_columns = LatentModel.rotation_columns
 
     chans = [("root", "tx"), ("j", "rz"), ("j", "rx"), ("j", "ry")]
     model = Plain(channels_=chans, skeleton_={"j": SimpleNamespace(rotation_order="ZXY")})

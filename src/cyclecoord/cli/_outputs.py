@@ -31,7 +31,15 @@ from typing import Any, Callable, Iterable
 
 from ..io import StagedOutputs, input_files, refuse_clobber
 
-__all__ = ["OUTPUT_FLAGS", "Outputs", "Paths", "capture_inputs", "check_paths", "declare"]
+__all__ = [
+    "OUTPUT_FLAGS",
+    "Outputs",
+    "Paths",
+    "capture_inputs",
+    "check_paths",
+    "crossing_refusal",
+    "declare",
+]
 
 #: Option names that write what they name (when they take a value: blend's --extract is a
 #: switch); a command that has one must declare it.
@@ -153,3 +161,12 @@ class Outputs(StagedOutputs):
     def discard(self) -> None:
         super().discard()
         self._lines.clear()
+
+
+def crossing_refusal(what: str, frames: list[int], hint: str) -> str:
+    """Why a motion whose limbs pass through each other in ``frames`` is not written."""
+    where = f"frames {frames[0]}-{frames[-1]}" if len(frames) > 1 else f"frame {frames[0]}"
+    return (
+        f"{what} has limbs passing through each other in {len(frames)} frames ({where}); "
+        f"nothing written (--allow-contacts writes it anyway; {hint})"
+    )

@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 from ._options import add_feet_option, add_memory_option
-from ._outputs import Outputs, declare
+from ._outputs import Outputs, crossing_refusal, declare
 
 __all__ = ["add_parser", "run"]
 
@@ -131,12 +131,7 @@ def _refuse_crossing(args: argparse.Namespace, report: dict, frames: list) -> in
     from ..errors import ImplausibleMotionError
     from ..io import atomic_write
 
-    where = f"frames {frames[0]}-{frames[-1]}" if len(frames) > 1 else f"frame {frames[0]}"
-    why = (
-        f"synthesised motion has limbs passing through each other in {len(frames)} frames "
-        f"({where}); nothing written (--allow-contacts writes it anyway; another seed may "
-        "avoid it)"
-    )
+    why = crossing_refusal("synthesised motion", frames, "another seed may avoid it")
     report = {**report, "refused": why}
     if args.report:
         with Outputs() as staged, atomic_write(staged.file(args.report)) as fh:

@@ -13,7 +13,7 @@ from pathlib import Path
 from ..errors import ParameterError
 from ..io import input_files
 from ._options import EXIT_OK, add_memory_option, check_output, positive_float, positive_int
-from ._outputs import Outputs, declare
+from ._outputs import Outputs, crossing_refusal, declare
 from .report import clean, load_input, write_json
 
 __all__ = ["add_parser", "run"]
@@ -370,11 +370,8 @@ def _refuse_crossing(args, motion, payload, report, frames, out, quality) -> int
     from ..errors import ImplausibleMotionError
     from .blend import finish
 
-    where = f"frames {frames[0]}-{frames[-1]}" if len(frames) > 1 else f"frame {frames[0]}"
-    why = (
-        f"generated motion has limbs passing through each other in {len(frames)} frames "
-        f"({where}); nothing written (--allow-contacts writes it anyway; another --start or "
-        "--method may avoid it)"
+    why = crossing_refusal(
+        "generated motion", frames, "another --start or --method may avoid it"
     )
     payload = {**payload, "refused": why}
     try:

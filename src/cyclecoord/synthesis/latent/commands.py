@@ -419,7 +419,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         ca, cb = ma.to_channels(a), mb.to_channels(b)
         w = np.asarray(w, dtype=float).reshape(-1)
         out = (1.0 - w[:, None]) * ca + w[:, None] * cb
-        for idx, order in _rotation_columns(mb):
+        for idx, order in mb.rotation_columns():
             Ra = Rotation.from_euler(order, ca[:, idx], degrees=True)
             Rb = Rotation.from_euler(order, cb[:, idx], degrees=True)
             step = (Ra.inv() * Rb).as_rotvec()
@@ -637,17 +637,3 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self._emit(self.current, X, interp(m.angles(m.frames_[idx])), root, detail=detail)
         self.x = X[-1]
         self.v = (X[-1] - X[-2]) * self.fps if len(X) > 1 else np.zeros_like(self.x)
-
-
-def _rotation_columns(model: LatentModel) -> list[tuple[np.ndarray, str]]:
-    """``(columns, order)`` of each joint of ``model`` with three rotation channels."""
-    by_joint: dict[str, dict[str, int]] = {}
-    for k, (j, d) in enumerate(model.channels_):
-        if d in ("rx", "ry", "rz"):
-            by_joint.setdefault(j, {})[d[1]] = k
-    out = []
-    for j, c in by_joint.items():
-        order = model.skeleton_[j].rotation_order.upper()
-        if len(c) == 3 and sorted(order) == ["X", "Y", "Z"]:
-            out.append((np.array([c[a.lower()] for a in order], dtype=int), order))
-    return out

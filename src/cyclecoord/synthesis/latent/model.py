@@ -323,16 +323,8 @@ class LatentModel:
 
         cols = self._columns()
         x = self._centred(np.asarray(self.frames_, dtype=float)[:, cols])
-        by_joint: dict[str, dict[str, int]] = {}
-        for k, (j, d) in enumerate(self.channels_):
-            if d in ("rx", "ry", "rz"):
-                by_joint.setdefault(j, {})[d[1]] = k
         out = []
-        for j, c in by_joint.items():
-            order = self.skeleton_[j].rotation_order.upper()
-            if len(c) != 3 or sorted(order) != ["X", "Y", "Z"]:
-                continue
-            idx = np.array([c[a.lower()] for a in order], dtype=int)
+        for idx, order in self.rotation_columns():
             if euler_is_safe(x[:, idx]):
                 continue
             with warnings.catch_warnings():
@@ -340,6 +332,20 @@ class LatentModel:
                 mean = Rotation.from_euler(order, x[:, idx], degrees=True).mean()
             out.append((idx, order, mean.as_matrix()))
         return tuple(out)
+
+    def rotation_columns(self) -> list[tuple[np.ndarray, str]]:
+        """``(columns, order)`` of each joint with three rotation channels: its columns of
+        :attr:`channels_` in its Euler order (upper case)."""
+        by_joint: dict[str, dict[str, int]] = {}
+        for k, (j, d) in enumerate(self.channels_):
+            if d in ("rx", "ry", "rz"):
+                by_joint.setdefault(j, {})[d[1]] = k
+        out = []
+        for j, c in by_joint.items():
+            order = self.skeleton_[j].rotation_order.upper()
+            if len(c) == 3 and sorted(order) == ["X", "Y", "Z"]:
+                out.append((np.array([c[a.lower()] for a in order], dtype=int), order))
+        return out
 
     def to_model(self, values: np.ndarray) -> np.ndarray:
         """Channel values ``(T, C)`` of :attr:`channels_` (degrees) in the model's chart."""
