@@ -224,9 +224,10 @@ def test_synthesizer_transition_and_output(walk_model, jog_model):
 
 
 def test_a_played_segment_carries_its_detail_into_the_move_after_it(walk_model):
-    """PLAY's frames are the captured ones, which hold what the model leaves out of them:
-    marked as detail, that fades into the MOVE after it over DETAIL_FADE seconds instead
-    of stepping at the join (the README's script popped at 3.6x there)."""
+    """PLAY's frames are the captured ones (re-timed to ease from rest, where its approach
+    stopped, to the captured pace), which hold what the model leaves out of them: marked
+    as detail, that fades into the MOVE after it over DETAIL_FADE seconds instead of
+    stepping at the join (the README's script popped at 3.6x there)."""
     from cyclecoord.synthesis.latent.output import DETAIL_FADE
 
     def made(detail):
@@ -239,10 +240,19 @@ def test_a_played_segment_carries_its_detail_into_the_move_after_it(walk_model):
 
     syn, bare = made(True), made(False)
     played = syn.chunks[-2]
-    idx = np.flatnonzero(walk_model.segments_ == walk_model.segment_index("b"))[:15]
-    np.testing.assert_allclose(played.detail["angles"], walk_model.detail()["angles"][idx],
+    idx = np.flatnonzero(walk_model.segments_ == walk_model.segment_index("b"))
+    # 0.5 s of frames, the playback easing from rest over the synthesizer's ease
+    ramp = int(round(syn.ease * 30))
+    assert played.X.shape[0] == 15 + ramp // 2
+    np.testing.assert_allclose(played.detail["angles"][0], walk_model.detail()["angles"][idx[0]],
                                atol=1e-9)
-    np.testing.assert_allclose(played.angles, walk_model.pose(played.X) + played.detail["angles"],
+    steps = np.linalg.norm(np.diff(played.X, axis=0), axis=1)
+    captured = np.linalg.norm(np.diff(walk_model.X_[idx[:16]], axis=0), axis=1)
+    assert steps[0] < 0.2 * captured[0]  # from rest ...
+    assert np.median(steps[ramp:]) == pytest.approx(np.median(captured[ramp // 2 :]), rel=0.1)
+    # (at a captured frame the pose of its latent point plus its detail is the frame)
+    np.testing.assert_allclose(played.angles[0],
+                               walk_model.pose(played.X[:1])[0] + played.detail["angles"][0],
                                atol=1e-6)
     assert bare.chunks[-2].detail is None
     # the MOVE's first frames: the played frames' last detail, fading
