@@ -276,6 +276,12 @@ def test_two_models_poses_blend_as_rotations():
     R = Rotation.from_euler("ZXY", out[:, 1:], degrees=True)
     np.testing.assert_allclose(np.degrees(R.magnitude()), 90.0 * w, atol=1e-6)
     np.testing.assert_allclose(out[:, 1], 90.0 * w, atol=1e-6)
+    # a middle angle passing 90 keeps going (the principal solution would flip z and y by
+    # a half turn: the same rotation, written as a jump)
+    a = np.tile([0.0, 0.0, 80.0, 0.0], (5, 1))
+    b = np.tile([0.0, 0.0, 100.0, 0.0], (5, 1))
+    out = Synthesizer._mix(fake, "a", "b", a, b, w)
+    np.testing.assert_allclose(out[:, 1:], np.c_[0 * w, 80 + 20 * w, 0 * w], atol=1e-6)
 
 
 def test_path_smoothing_is_a_checked_particle_parameter():

@@ -415,6 +415,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         percentile."""
         from scipy.spatial.transform import Rotation
 
+        from ...conventions import continuous_euler
+
         ma, mb = self.models[src], self.models[to]
         ca, cb = ma.to_channels(a), mb.to_channels(b)
         w = np.asarray(w, dtype=float).reshape(-1)
@@ -424,7 +426,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             Rb = Rotation.from_euler(order, cb[:, idx], degrees=True)
             step = (Ra.inv() * Rb).as_rotvec()
             R = Ra * Rotation.from_rotvec(w[:, None] * step)
-            out[:, idx] = R.as_euler(order, degrees=True)
+            # the Euler solution nearest the first pose's, continuous over the blend
+            out[:, idx] = continuous_euler(R.as_matrix()[:, None], order, ca[0, idx])[:, 0]
         return mb.to_model(out)
 
     def _into(self, src: str, to: str, angles: np.ndarray) -> np.ndarray:
