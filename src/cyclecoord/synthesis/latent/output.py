@@ -68,7 +68,7 @@ class OutputMixin:
         own pose, which makes no new contact), fully at the frame and easing off over
         :data:`UNTANGLE_WIDTH` seconds each side, up to :data:`UNTANGLE_ROUNDS` times.
         With the gait detail on the Bandai walk-run script, legs passed 1-2 cm closer
-        than the captures on one or two frames in nine script seeds of fifteen."""
+        than the captures on one or two frames in eight script seeds of fifteen."""
         motion = self._assemble(*self._posed())
         if not any(c.path is not None for c in self.chunks):
             return motion
