@@ -529,7 +529,8 @@ def test_lock_where_clean_takes_one_limit_per_frame():
 
 def test_a_script_over_two_models_is_also_measured_model_by_model(made):
     """The report of a walk-run script adds each model's own frames (TRANSITIONs left out)
-    against that model's training takes, after the whole script against all of them."""
+    against that model's training takes, after the whole script against all of them, and
+    each TRANSITION's window against the faster of its models'."""
     from cyclecoord.synthesis.latent.script import model_sections, script_quality
 
     syn, motion = made
@@ -544,7 +545,15 @@ def test_a_script_over_two_models_is_also_measured_model_by_model(made):
         ("walk", *walk), ("run", *run), ("walk", *idle)]
     own = measure_generated(motion[run[0] : run[1]], training_takes(syn.models, ["run"]))
     assert quality["by_model"][1]["quality"]["largest_accel_ratio"] == pytest.approx(own.largest_accel)
-    assert lines[-3].startswith(f"    walk frames {walk[0]}-{walk[1]}: feet ")
+    assert lines[-5].startswith(f"    walk frames {walk[0]}-{walk[1]}: feet ")
+    # each TRANSITION window, three frames each side, against the faster model's takes
+    for win, (a, b), pair in zip(quality["transitions"], (t1, t2), (["walk", "run"],
+                                                                    ["run", "walk"])):
+        assert win["models"] == pair and (win["start"], win["stop"]) == (a, b)
+        want = min(measure_generated(motion[a - 3 : b + 3], training_takes(syn.models, [k]))
+                   .largest_accel for k in pair)
+        assert win["largest_accel_ratio"] == pytest.approx(want)
+    assert lines[-2].startswith(f"  TRANSITION walk -> run frames {t1[0] - 3}-{t1[1] + 3}: ")
     # with no TRANSITION named, a blend's frames go to the model that made them
     assert [(s["model"], s["start"], s["stop"]) for s in model_sections(syn, [{}] * 23)] == [
         ("walk", 0, t1[0]), ("run", t1[0], t2[0]), ("walk", t2[0], motion.n_frames)]

@@ -333,7 +333,7 @@ def training_takes(models: dict[str, LatentModel], names=None) -> list:
 def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None, list[str]]:
     """The measure of generated motion (:mod:`cyclecoord.quality.generated`) against the
     training segments of the models the script used, IDLE frames counted as asked holds."""
-    from ...quality.generated import lead_lines
+    from ...quality.generated import lead_lines, measure_generated
 
     hold = syn.hold_mask(motion.n_frames)
     sources = training_takes(syn.models, {c.model for c in syn.chunks})
@@ -351,7 +351,47 @@ def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None,
             quality["by_model"].append({**sec, "quality": q})
             lines.append(f"    {sec['model']} frames {a}-{b}: "
                          + sub[0].replace("generated motion: ", ""))
+    if quality is not None:
+        # the model sections leave the blends out: each TRANSITION's window (and three
+        # frames each side) judged against the faster of its two models' takes
+        quality["transitions"] = []
+        for win in transition_windows(syn, commands):
+            a, b = max(win["start"] - 3, 0), min(win["stop"] + 3, motion.n_frames)
+            if b - a < 3:
+                continue
+            pop = min(
+                measure_generated(motion[a:b], training_takes(syn.models, [k]), feet=feet)
+                .largest_accel
+                for k in win["models"]
+            )
+            quality["transitions"].append({**win, "largest_accel_ratio": float(pop)})
+            lines.append(
+                f"  TRANSITION {' -> '.join(win['models'])} frames {a}-{b}: largest accel "
+                f"{pop:.2f}x the faster model's p99"
+            )
     return quality, lines
+
+
+def transition_windows(syn, commands: list) -> list[dict[str, Any]]:
+    """Each TRANSITION's frames ``[{"models": [from, to], "start", "stop"}]``."""
+    out: list[dict[str, Any]] = []
+    before = None
+    for seg in syn.segments():
+        k = seg["command"]
+        kind = commands[k].get("command") if 0 <= k < len(commands) else None
+        if kind == "TRANSITION":
+            if out and out[-1]["command"] == k:
+                out[-1]["stop"] = seg["stop"]
+                if seg["model"] not in out[-1]["models"]:
+                    out[-1]["models"].append(seg["model"])
+            else:
+                models = [before] if before is not None else []
+                if seg["model"] not in models:
+                    models.append(seg["model"])
+                out.append({"command": k, "models": models, "start": seg["start"],
+                            "stop": seg["stop"]})
+        before = seg["model"]
+    return out
 
 
 def model_sections(syn, commands: list) -> list[dict[str, Any]]:
