@@ -49,3 +49,20 @@ def swaying_legs(degrees, hz, T=90, fps=30.0):
     for side, sign in (("lfemur", 1.0), ("rfemur", -1.0)):
         frames[:, m.channels.index((side, "rx"))] = sign * degrees * np.sin(2 * np.pi * hz * t)
     return m.with_frames(frames)
+
+
+def pins_pop_at(monkeypatch, frame: int) -> None:
+    """``carry._accel`` made clean on the unpinned motion (its first call) and a pop of
+    10 units/s^2 at ``frame`` on every pinned one after it (the lock's pop test by hand)."""
+    from cyclecoord.synthesis import carry
+
+    calls = []
+
+    def fake(motion):
+        calls.append(1)
+        out = np.zeros(motion.n_frames)
+        if len(calls) > 1:
+            out[frame] = 10.0
+        return out
+
+    monkeypatch.setattr(carry, "_accel", fake)

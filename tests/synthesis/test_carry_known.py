@@ -6,7 +6,7 @@ import pytest
 
 from cyclecoord.synthesis import carry
 
-from _legs import legs_skeleton, make_motion, swaying_legs  # tests/ is on the path (rootdir conftest)
+from _legs import legs_skeleton, make_motion, pins_pop_at, swaying_legs  # tests/ is on the path (rootdir conftest)
 
 
 def test_translation_scale_is_one_world_unit_per_channel_unit():
@@ -142,16 +142,7 @@ def test_a_pop_exactly_an_ease_and_two_frames_before_a_contact_takes_its_first_f
 
     pad = int(round(0.1 * 60)) + 2
     a, b = next((a, b) for a, b in contact_runs(planted[:, 1]) if a >= pad + 1)
-    calls = []
-
-    def fake(motion):
-        calls.append(1)
-        out = np.zeros(motion.n_frames)
-        if len(calls) > 1:
-            out[a - pad] = 10.0
-        return out
-
-    monkeypatch.setattr(carry, "_accel", fake)
+    pins_pop_at(monkeypatch, a - pad)
     out = carry.lock_where_clean(m, 1.0, feet)
     assert (a, a + 1) in out.skipped
 
@@ -262,16 +253,7 @@ def _hold_popping_at(monkeypatch, frame: int):
     m = swaying_legs(0.5, 6.0)
     hold = np.zeros(90, dtype=bool)
     hold[20:] = True
-    calls = []
-
-    def fake(motion):
-        calls.append(1)
-        out = np.zeros(motion.n_frames)
-        if len(calls) > 1:
-            out[frame] = 10.0
-        return out
-
-    monkeypatch.setattr(carry, "_accel", fake)
+    pins_pop_at(monkeypatch, frame)
     out = carry.lock_where_clean(m, 1.0, feet, hold=hold)
     z = out.motion.positions()["lfoot"][:, 2]
     sway = np.ptp(m.positions()["lfoot"][:, 2])

@@ -10,7 +10,7 @@ from cyclecoord.synthesis.carry import carry_by_feet
 from cyclecoord.synthesis.footlock import lock_feet
 
 
-from _legs import legs_skeleton, make_motion, swaying_legs  # tests/ is on the path (rootdir conftest)
+from _legs import legs_skeleton, make_motion, pins_pop_at, swaying_legs  # tests/ is on the path (rootdir conftest)
 
 
 def _walkish(T=120, fps=60.0):
@@ -341,16 +341,7 @@ def test_lock_where_clean_keeps_what_is_clear_of_a_pop(monkeypatch):
     a, b = runs[0]
     k = (a + b) // 2
     real = carry._accel
-    calls = []
-
-    def fake(motion):  # the unpinned motion is clean; every pinned one pops at frame k
-        calls.append(1)
-        out = np.zeros(motion.n_frames)
-        if len(calls) > 1:
-            out[k] = 10.0
-        return out
-
-    monkeypatch.setattr(carry, "_accel", fake)
+    pins_pop_at(monkeypatch, k)  # the unpinned motion is clean; every pinned one pops at k
     out = carry.lock_where_clean(m, 1.0, feet)
     monkeypatch.setattr(carry, "_accel", real)
     pad = int(round(0.1 * 60)) + 2
