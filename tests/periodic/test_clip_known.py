@@ -416,3 +416,13 @@ def test_typical_amplitude_leaves_a_channel_whose_range_is_exactly_the_floor():
     out = typical_amplitude(cycle, np.zeros(len(poses)), poses, spike=1)
     np.testing.assert_array_equal(out[:, 0], cycle[:, 0])
     assert np.ptp(out[:, 1]) == pytest.approx(1.8e-9, rel=1e-9)
+
+
+def test_capture_cycle_with_no_phased_frame_is_a_clear_refusal():
+    """Re-timing can leave no frame with a phase (a 50-frame half of the 143_01 jog with
+    ``min_turns=0.75``): that was a ParameterError from deep inside ``phase_average``
+    about array shapes; it is now a NoPeriodicMotionError saying what happened."""
+    from cyclecoord.errors import NoPeriodicMotionError
+
+    with pytest.raises(NoPeriodicMotionError, match="only 0 of the 50 frames"):
+        capture_cycle(np.full(50, np.nan), None, None, None, 42.0)

@@ -18,7 +18,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import NoPeriodicMotionError, ParameterError
 from ..motion import Motion
 from .cycle import TypicalCycle, select_bandwidth
 from .preprocess import PreparedData, Preprocessor
@@ -32,6 +32,7 @@ __all__ = [
     "planted_weights",
     "anchor_to_feet",
     "typical_amplitude",
+    "window_ranges",
     "spike_frames",
     "slowest_frame",
     "joint_columns",
@@ -168,6 +169,28 @@ def spike_frames(fps: float) -> int:
     return 2 * int(np.floor(SPIKE_SECONDS * float(fps) / 2.0)) + 1
 
 
+def window_ranges(
+    poses: np.ndarray, runs: list[tuple[int, int]], period: int, spike: int = 5
+) -> np.ndarray | None:
+    """Median range ``(C,)`` of each channel over every window of one period.
+
+    Windows lie inside the runs ``[(start, stop), ...]`` of ``poses`` ``(T, C)``, one
+    starting every eighth of a period, each channel after a running median of ``spike``
+    frames; None when no run holds a whole window.
+    """
+    from scipy.ndimage import median_filter
+
+    P = int(period)
+    ranges = []
+    for a, b in runs:
+        if b - a < max(P, spike + 1):
+            continue
+        smooth = median_filter(poses[a:b], size=(spike, 1), mode="nearest")
+        for s in range(0, b - a - P + 1, max(1, P // 8)):
+            ranges.append(np.ptp(smooth[s : s + P], axis=0))
+    return np.median(np.asarray(ranges), axis=0) if ranges else None
+
+
 def typical_amplitude(
     cycle: np.ndarray, phase: np.ndarray, poses: np.ndarray, spike: int = 5
 ) -> np.ndarray:
@@ -203,16 +226,9 @@ def typical_amplitude(
 
     ok = np.isfinite(np.asarray(phase, dtype=float))
     P = len(cycle)
-    ranges = []
-    for a, b in stretches(ok):
-        if b - a < max(P, spike + 1):
-            continue
-        smooth = median_filter(poses[a:b], size=(spike, 1), mode="nearest")
-        for s in range(0, b - a - P + 1, max(1, P // 8)):
-            ranges.append(np.ptp(smooth[s : s + P], axis=0))
-    if not ranges:
+    typical = window_ranges(poses, stretches(ok), P, spike)
+    if typical is None:
         return cycle
-    typical = np.median(np.asarray(ranges), axis=0)
     have = np.ptp(median_filter(cycle, size=(spike, 1), mode="wrap"), axis=0)
     gain = np.clip(
         np.where(have > 1e-9, typical / np.maximum(have, 1e-9), 1.0), 1.0, MAX_AMPLITUDE_GAIN
@@ -356,6 +372,12 @@ def capture_cycle(
     width = CAPTURE_WIDTH if bandwidth is None or bandwidth == "auto" else float(bandwidth)
     phase = np.array(phase, dtype=float)
     finite = np.flatnonzero(np.isfinite(phase))
+    if finite.size < 2:
+        raise NoPeriodicMotionError(
+            f"only {finite.size} of the {phase.size} frames could be given a phase in the "
+            "cycle (the circular coordinate never completes a steady turn): nothing to "
+            "average into a cycle"
+        )
     if finite.size > MAX_CYCLE_FRAMES:
         # a long take's cycle is averaged from its middle MAX_CYCLE_FRAMES phased frames
         # (over a hundred repetitions): registration's cost stays bounded
