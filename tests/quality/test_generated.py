@@ -203,6 +203,20 @@ def test_cycle_is_the_first_autocorrelation_peak_near_the_highest():
     assert np.isnan(_cycle(np.sin(2 * np.pi * t[:79] / 20), fps))  # 39 lags: under 0.4 s
 
 
+def test_cycle_of_a_take_under_two_cycles_is_its_knee_peaks_spacing():
+    """A take of 0.8 s at 60 fps (each half of the 143_01 jog) is too short for the
+    autocorrelation to reach a 0.7 s cycle; its two flexion peaks 0.7 s apart give it
+    (the console said "the sources' nan s" before).  A double bump (the stance flexion,
+    under the mean) is not a peak; one peak, or peaks 0.2 s apart, give none."""
+    from cyclecoord.quality.generated import _cycle
+
+    fps, t = 60.0, np.arange(48)
+    knee = 40 + 35 * np.sin(2 * np.pi * (t + 6) / 42) + 10 * np.sin(4 * np.pi * (t + 6) / 42)
+    assert _cycle(knee, fps) == pytest.approx(0.7, abs=1 / 60)
+    assert np.isnan(_cycle(knee[:30], fps))
+    assert np.isnan(_cycle(np.sin(2 * np.pi * t / 12), fps))
+
+
 def _knee_sources():
     """Synthetic legs at 64 fps (128 frames) and, as sources, the same legs bending both
     knees 10 deg at 1 Hz: (motion, knee columns, [sources])."""

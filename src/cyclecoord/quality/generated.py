@@ -208,12 +208,32 @@ def _kin(motion: Motion, rig: _Rig) -> _Kin:
     )
 
 
+def _peak_cycle(k: np.ndarray, fps: float) -> float:
+    """Leg cycle of a take too short for the autocorrelation (under two cycles): the
+    median spacing of its knee's flexion peaks, one per stretch above the mean by half
+    a standard deviation (its highest frame, not at the take's ends); NaN with fewer
+    than two or a spacing outside ``CYCLE_RANGE``."""
+    above = np.r_[False, k > 0.5 * float(np.std(k)), False].astype(int)
+    edges = np.flatnonzero(np.diff(above))
+    peaks = []
+    for a, b in zip(edges[::2], edges[1::2]):
+        top = a + int(np.argmax(k[a:b]))
+        if 0 < top < k.size - 1:
+            peaks.append(top)
+    if len(peaks) < 2:
+        return float("nan")
+    c = float(np.median(np.diff(peaks))) / fps
+    return c if CYCLE_RANGE[0] <= c <= CYCLE_RANGE[1] else float("nan")
+
+
 def _cycle(signal: np.ndarray, fps: float) -> float:
     k = np.asarray(signal, dtype=float) - np.mean(signal)
     n = k.size
     lo, hi = int(CYCLE_RANGE[0] * fps), min(int(CYCLE_RANGE[1] * fps), n // 2)
-    if hi <= lo or not np.any(k):
+    if not np.any(k):
         return float("nan")
+    if hi <= lo + 1:
+        return _peak_cycle(k, fps)
     spec = np.fft.rfft(k, 2 * n)
     ac = np.fft.irfft(spec * np.conj(spec))[:n] / np.arange(n, 0, -1)
     ac = ac / ac[0]
@@ -490,8 +510,12 @@ class GeneratedQuality:
         lines.append(
             f"  strides: knee range {knees}, hip range {hips} of the sources' "
             f"({self.source_knee_range:.0f} / {self.source_hip_range:.0f} deg); leg cycle "
-            f"{self.cycle_s:.2f} s against the sources' {self.source_cycle_s:.2f} s at this "
-            f"root speed ({self.cadence_ratio:.2f}x)"
+            + (
+                f"{self.cycle_s:.2f} s against the sources' {self.source_cycle_s:.2f} s at "
+                f"this root speed ({self.cadence_ratio:.2f}x)"
+                if np.isfinite(self.source_cycle_s)
+                else f"{self.cycle_s:.2f} s (the sources give none: under two knee swings each)"
+            )
         )
         lines.append(
             f"  pops: largest pose step {self.largest_step:.2f}x (frame "
