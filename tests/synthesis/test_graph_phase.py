@@ -13,7 +13,14 @@ from cyclecoord.errors import ParameterError
 from cyclecoord.quality.generated import measure_generated, source_figures
 from cyclecoord.quality.plausibility import check_plausibility
 from cyclecoord.synthesis.graph import MotionGraphSynth, build_graph
-from cyclecoord.synthesis.graph.phase import PhaseField, align_phases, follow_phase
+from cyclecoord.synthesis.graph.phase import (
+    PhaseField,
+    align_phases,
+    amplitude_gain,
+    follow_phase,
+    match_phase,
+    take_phases,
+)
 
 
 def folded(n: int, period: float, shift: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
@@ -69,6 +76,80 @@ def test_phases_of_takes_are_put_on_one_origin():
     other = np.roll(z, 17, axis=0)  # the same loop, started 17 frames later
     out = align_phases([phase, phase.copy()], [z, other])
     assert ((out[1] - phase) % 1.0) == pytest.approx(1 - 17 / 60.0, abs=0.02)
+
+
+def _loop(phase: np.ndarray) -> np.ndarray:
+    a = 2 * np.pi * phase
+    return np.column_stack([np.cos(a), 0.5 * np.sin(a), 0.3 * np.sin(2 * a)])
+
+
+def test_match_phase_recovers_a_short_takes_warped_phase():
+    """A take of just over one cycle, whose pace varies 0.7-1.3x and which starts at a
+    third of a turn, matched to a reference take's cycle: its phase comes back monotone
+    and within 0.03 of a turn (the latent angle, the fallback before, dwells and jumps
+    where the curve is not round: 0.35 of a turn backwards on the 143_01 jog's half)."""
+    ref_phase = np.arange(240) / 60.0
+    t = np.arange(70)
+    true = 1 / 3 + t / 60.0 + 0.3 / (2 * np.pi) * np.sin(2 * np.pi * t / 70) * 60 / 70 * 0.5
+    assert np.diff(true).min() > 0.6 / 60 and np.diff(true).max() < 1.4 / 60
+    got = match_phase(_loop(true), ref_phase, _loop(ref_phase), 1 / 60.0)
+    assert np.diff(got).min() >= 0
+    err = ((got - true + 0.5) % 1.0) - 0.5
+    assert np.abs(err).max() < 0.03
+
+
+def test_take_phases_matches_a_take_without_its_own_coordinate(walks, monkeypatch):
+    """A take whose circular coordinate fails is matched to the others' cycle, with a
+    note, not given the latent angle; with no take left, every take gets the angle."""
+    from cyclecoord.errors import NoPeriodicMotionError
+    from cyclecoord.periodic import pipeline
+    from cyclecoord.synthesis.graph.latent import PoseSpace
+
+    latent = [PoseSpace(3).fit(walks).transform(m) for m in walks]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        own = take_phases(walks, latent)
+    real = pipeline.extract
+
+    def failing(m, **kw):
+        if m is walks[1] or kw.get("min_turns") and m.n_frames == walks[1].n_frames:
+            raise NoPeriodicMotionError("no circle here")
+        return real(m, **kw)
+
+    monkeypatch.setattr(pipeline, "extract", failing)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = take_phases(walks, latent)
+    assert out.source == ["coordinate", "matched", "coordinate"]
+    assert any("take 1: matched" in n and "no circle here" in n for n in out.notes)
+    err = ((out.phases[1] - own.phases[1] + 0.5) % 1.0) - 0.5
+    assert np.abs(err - np.median(err)).max() < 0.05 and abs(np.median(err)) < 0.05
+    monkeypatch.setattr(pipeline, "extract", lambda m, **kw: (_ for _ in ()).throw(
+        NoPeriodicMotionError("none")))
+    assert take_phases(walks, latent).source == ["latent angle"] * 3
+
+
+def test_amplitude_gain_undoes_the_neighbour_averaging():
+    """Strides alternating 0.8x and 1.2x in one channel with their extremes 4 frames
+    apart in timing: the field's neighbour average over them is narrower than the median
+    stride, and the gain widens it back (within MAX_AMPLITUDE_GAIN); a channel equal in
+    every stride keeps gain 1."""
+    from cyclecoord.periodic.clip import MAX_AMPLITUDE_GAIN
+
+    phases, z, angles = [], [], []
+    for k in range(3):
+        ph = np.arange(240) / 60.0 + 0.1 * k
+        size = np.where(np.floor(ph) % 2 == 0, 0.8, 1.2)
+        lag = np.where(np.floor(ph) % 2 == 0, 4 / 60.0, -4 / 60.0)
+        varying = 30 * size * np.sin(2 * np.pi * (ph + lag)) ** 5
+        same = 20 * np.cos(2 * np.pi * ph)
+        phases.append(ph)
+        z.append(_loop(ph))
+        angles.append(np.column_stack([varying, same]))
+    field = PhaseField(build_graph(z, "delaunay"), phases)
+    gain = amplitude_gain(field, np.vstack(angles), 60.0)
+    assert 1.05 < gain[0] <= MAX_AMPLITUDE_GAIN
+    assert gain[1] == pytest.approx(1.0, abs=0.02)
 
 
 def test_phase_field_errors():
@@ -130,3 +211,28 @@ def test_w1_graph_default_walk_meets_the_targets(w1):
         assert q.support_slip <= 1.5 * q.source_support_slip
         assert 0.9 <= q.cadence_ratio <= 1.1
         assert check_plausibility(gen.motion, w1).new_contact_frames == []
+
+
+def test_jog_graph_keeps_the_knees_stride(cmu_dir):
+    """The 143_01 jog from its first stride (frame 4 at 60 fps), trained on its two
+    halves: the first half's coordinate fails (one cycle and a bit) and is matched to the
+    second's, and the strides are widened back.  Measured: knees 0.95 / 0.96 of the
+    take's range (0.87 / 0.87 with the phase matched but no gain; 0.88 / 0.70 against
+    the take's standing start before either), hips 0.96 / 0.85 (the take's first right
+    stride reaches 41 degrees, its others 32-34), largest accel 1.17x, slip 0.97x."""
+    take = cc.load(cmu_dir / "143" / "143_01.amc", fps=60.0)[4:]
+    half = take.n_frames // 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(
+            [take[:half], take[half:]]
+        )
+    assert any("take 0: matched" in n for n in synth.phase_notes_), synth.phase_notes_
+    gen = synth.generate(600, 0, 0)
+    q = measure_generated(gen.motion, [take])
+    assert min(q.knee_ratio) >= 0.92, q.knee_ratio
+    assert min(q.hip_ratio) >= 0.8, q.hip_ratio
+    assert q.largest_accel <= 1.5
+    assert q.support_slip <= 1.5 * q.source_support_slip
+    assert not q.freezes
+    assert check_plausibility(gen.motion, [take]).new_contact_frames == []

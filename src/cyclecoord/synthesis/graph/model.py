@@ -145,12 +145,20 @@ class MotionGraphSynth:
         self.phase_field_ = None
         self.phase_notes_: list[str] = []
         if phase:
-            from .phase import PhaseField, take_phases
+            from .phase import PhaseField, amplitude_gain, take_phases
 
             tp = take_phases(self.takes_, latent)
             self.phase_notes_ = tp.notes
             self.phase_field_ = PhaseField(self.graph_, tp.phases)
             self.residual_ = self.space_.residuals(self.takes_)
+            angles = np.vstack([self.space_.angles(m) for m in self.takes_])
+            # the strides' amplitude only: widened arms brought a thumb into the back
+            self.gain_ = np.where(
+                _leg_columns(self.takes_[0], self.space_.channels_),
+                amplitude_gain(self.phase_field_, angles, self.takes_[0].fps),
+                1.0,
+            )
+            self.angle_mean_ = angles.mean(axis=0)
         return self
 
     def _start(self, start: Motion | int, frame: int) -> tuple[Motion, int, str]:
@@ -242,6 +250,9 @@ class MotionGraphSynth:
 
             detail = np.einsum("nk,nka->na", path.weights, self.residual_[path.neighbours])
             detail = gaussian_filter1d(detail, DETAIL_SMOOTH * motion.fps, axis=0, mode="nearest")
+            # the neighbours' average is narrower than the strides it averages: widen it
+            angles = self.space_.inverse_transform(path.points) + detail
+            detail = detail + (self.gain_ - 1.0) * (angles - self.angle_mean_)
         out = self.space_.motion(path.points, self.takes_[0], root, detail)
         notes = []
         if self.carry and self.floor_ is not None:
@@ -293,6 +304,29 @@ def _analysis_takes(takes: Sequence[Motion]) -> tuple[list[Motion], Any]:
                 "takes of one rig"
             )
     return [m for m, _ in out], (None if adapter.identity else adapter)
+
+
+def _leg_columns(take: Motion, channels: Sequence) -> np.ndarray:
+    """Which ``(joint, dof)`` channels turn a leg: the hip joint (the knee's parent) of
+    each leg and every joint below it; none without a skeleton or legs."""
+    from ...errors import CycleCoordError
+    from ...quality.generated import _rig
+
+    out = np.zeros(len(channels), dtype=bool)
+    try:
+        rig = _rig(take, None)
+    except CycleCoordError:
+        return out
+    skel = take.skeleton
+    below: set[str] = set()
+    todo = list(rig.hips)
+    while todo:
+        j = todo.pop()
+        below.add(skel.names[j])
+        todo.extend(skel.children(j))
+    for i, ch in enumerate(channels):
+        out[i] = ch[0] in below
+    return out
 
 
 def _parse(method: str) -> tuple[str, bool, bool, bool]:

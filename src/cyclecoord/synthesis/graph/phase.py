@@ -23,7 +23,12 @@ state.
   towards the neighbours' own next states, which keeps it on the training data.
 
 Phases of different takes are put on one origin: each take's coordinate is shifted by
-the offset that best matches its poses to the first take's at the same phase.
+the offset that best matches its poses to the first take's at the same phase.  A take
+whose own coordinate fails or runs backwards (a take of little more than one cycle) is
+matched to the other takes' cycle instead (:func:`match_phase`): the monotone phase,
+advancing about as fast as theirs, whose poses best fit their mean pose at each phase.
+The angle of the first two latent coordinates, which dwells and jumps where the latent
+curve is not round, is the last resort, for takes none of which has a coordinate.
 """
 
 from __future__ import annotations
@@ -39,7 +44,10 @@ from ...motion import Motion
 from .build import MotionGraph
 from .paths import MAX_STEP_SCALE, GraphPath
 
-__all__ = ["PhaseField", "TakePhases", "take_phases", "align_phases", "follow_phase"]
+__all__ = [
+    "PhaseField", "TakePhases", "take_phases", "align_phases", "match_phase", "follow_phase",
+    "amplitude_gain",
+]
 
 #: Neighbours of the phase-aware field, the pull per frame towards their next states
 #: and the phase circle's radius against the latent points' RMS radius.  Chosen on set
@@ -56,6 +64,15 @@ BINS = 48
 SHORT_TURNS = 0.75
 #: Slowest phase rate kept, as a fraction of the median.
 MIN_RATE = 0.25
+#: A take's own phase is used when its frame-to-frame rate stays between 0 and this
+#: many times its median (the subject 35 walks: 0.5-2.5); otherwise :func:`match_phase`.
+IRREGULAR_RATE = 4.0
+#: :func:`match_phase`: phase bins, the largest advance per frame against the takes'
+#: median one, and the penalty on an advance away from the median (per squared relative
+#: deviation, against a pose cost normalised by the cycle's spread).
+MATCH_BINS = 96
+MATCH_MAX_RATE = 3.0
+MATCH_RATE_PENALTY = 0.05
 
 
 @dataclass
@@ -101,17 +118,28 @@ def _phase_of(result) -> np.ndarray:
     return np.asarray(result.coordinate, dtype=float)
 
 
+def _regular(u: np.ndarray) -> bool:
+    """Whether an unwrapped phase advances on every frame, at most
+    :data:`IRREGULAR_RATE` times its median rate."""
+    r = np.diff(np.asarray(u, dtype=float))
+    med = float(np.median(r)) if r.size else 0.0
+    return bool(med > 0 and r.min() > 0 and r.max() <= IRREGULAR_RATE * med)
+
+
 def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePhases:
     """Each take's gait phase from the periodic pipeline's circular coordinate.
 
     A take without a clear circle (:class:`~cyclecoord.errors.NoPeriodicMotionError` and
-    the like) falls back to the angle of its first two latent coordinates, with a note.
+    the like) or whose phase runs backwards or jumps (:func:`_regular`) is matched to the
+    other takes' cycle (:func:`match_phase`), with a note; when no take has a regular
+    phase, every take falls back to the angle of its first two latent coordinates.
     """
     from ...periodic.pipeline import extract
 
-    phases, source, notes = [], [], []
-    for i, (m, z) in enumerate(zip(takes, latent)):
-        u = None
+    own: list = []
+    notes: list = []
+    for i, m in enumerate(takes):
+        u, why = None, ""
         for turns in (None, SHORT_TURNS):  # a short take: fewer turns than extract asks
             try:
                 kw = {} if turns is None else {"min_turns": turns, "steady": False}
@@ -119,19 +147,92 @@ def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePh
             except CycleCoordError as exc:
                 why = str(exc)
                 continue
+            if u is None:
+                why = "under 3 frames with a phase"
+                continue
             if turns is not None:
                 notes.append(f"phase of take {i}: circular coordinate of a short take "
                              f"({turns} turns accepted, extract asks 1.5)")
             break
-        if u is None:
+        if u is not None and not _regular(u):
+            why = "its coordinate runs backwards or jumps"
+            u = None
+        own.append((u, why))
+    good = [i for i, (u, _) in enumerate(own) if u is not None]
+    if not good:
+        for i, (_, why) in enumerate(own):
             notes.append(f"phase of take {i}: no circular coordinate ({why}); latent angle")
+        phases = [_latent_angle(z) for z in latent]
+        return TakePhases(align_phases(phases, latent), ["latent angle"] * len(takes), notes)
+    aligned = align_phases([own[i][0] for i in good], [latent[i] for i in good])
+    phases: list = [None] * len(takes)
+    source = ["coordinate"] * len(takes)
+    for i, u in zip(good, aligned):
+        phases[i] = u
+    ref_phase = np.concatenate(aligned)
+    ref_z = np.vstack([latent[i] for i in good])
+    rate = float(np.median(np.concatenate([np.diff(u) for u in aligned])))
+    for i, (u, why) in enumerate(own):
         if u is None:
-            u, src = _latent_angle(z), "latent angle"
-        else:
-            src = "coordinate"
-        phases.append(u)
-        source.append(src)
-    return TakePhases(align_phases(phases, latent), source, notes)
+            phases[i] = match_phase(latent[i], ref_phase, ref_z, rate)
+            source[i] = "matched"
+            notes.append(f"phase of take {i}: matched to the other takes' cycle ({why})")
+    return TakePhases(phases, source, notes)
+
+
+def match_phase(
+    z: np.ndarray,
+    ref_phase: np.ndarray,
+    ref_z: np.ndarray,
+    rate: float,
+    bins: int = MATCH_BINS,
+) -> np.ndarray:
+    """A take's phase matched to other takes' cycle: monotone, in cycles.
+
+    The phase, advancing between 0 and :data:`MATCH_MAX_RATE` times ``rate`` per frame,
+    whose poses best fit the reference frames' mean latent point at each phase (a
+    dynamic-programming alignment over ``bins`` phase bins; an advance away from
+    ``rate`` costs :data:`MATCH_RATE_PENALTY` per squared relative deviation), then
+    smoothed over two frames.
+
+    Parameters
+    ----------
+    z : ndarray, shape (T, d)
+        The take's latent points.
+    ref_phase : ndarray, shape (N,)
+        Phases (in cycles, on the origin wanted) of the reference frames.
+    ref_z : ndarray, shape (N, d)
+        Their latent points.
+    rate : float
+        The reference frames' median phase advance per frame (cycles).
+    """
+    from scipy.ndimage import gaussian_filter1d
+
+    z = np.asarray(z, dtype=float)
+    T = z.shape[0]
+    ref = _binned(np.asarray(ref_phase, dtype=float), np.asarray(ref_z, dtype=float), bins)
+    spread = float(((ref - ref.mean(axis=0)) ** 2).sum(axis=1).mean()) or 1.0
+    cost = ((z[:, None, :] - ref[None, :, :]) ** 2).sum(axis=2) / spread  # (T, bins)
+    r = max(float(rate) * bins, 1e-6)  # expected advance, bins a frame
+    steps = np.arange(int(np.ceil(MATCH_MAX_RATE * r)) + 1)
+    pen = MATCH_RATE_PENALTY * ((steps - r) / r) ** 2
+    total = cost[0].copy()
+    back = np.zeros((T, bins), dtype=np.int64)
+    for t in range(1, T):
+        # arriving at bin b from b - s
+        cand = np.stack([np.roll(total, s) + pen[j] for j, s in enumerate(steps)])
+        back[t] = np.argmin(cand, axis=0)
+        total = cand[back[t], np.arange(bins)] + cost[t]
+    b = int(np.argmin(total))
+    adv = np.zeros(T)
+    for t in range(T - 1, 0, -1):
+        s = int(steps[back[t, b]])
+        adv[t] = s
+        b = (b - s) % bins
+    u = (b + 0.5 + np.cumsum(adv)) / bins
+    if T > 2:
+        u = np.maximum.accumulate(gaussian_filter1d(u, 2.0, mode="nearest"))
+    return u
 
 
 def _binned(phase: np.ndarray, z: np.ndarray, bins: int) -> np.ndarray:
@@ -306,4 +407,47 @@ def follow_phase(
         speed=s / 2.0,
         kind="field:phase:euler",
         phases=phases,
+    )
+
+
+def amplitude_gain(field: PhaseField, angles: np.ndarray, fps: float) -> np.ndarray:
+    """Per joint angle, how much the field's neighbour averaging narrows the strides.
+
+    A path's pose is a kernel average over its neighbours, which lie on different
+    repetitions; where repetitions differ in the size and timing of their extremes, the
+    average is narrower than any of them (on the 143_01 jog, two and a half strides,
+    the knees came out at 0.87 of the take's range).  Every training frame is averaged
+    over its own neighbourhood as a path's pose would be; the gain is the median range
+    of the takes over windows of one period over that of the averages
+    (:func:`cyclecoord.periodic.clip.window_ranges`, as the periodic pipeline widens its
+    averaged cycle), kept in ``[1, MAX_AMPLITUDE_GAIN]``.
+
+    Parameters
+    ----------
+    field : PhaseField
+    angles : ndarray, shape (N, A)
+        The training frames' joint angles, in the graph's take order.
+    fps : float
+        Frame rate (the running median's length against marker glitches).
+
+    Returns
+    -------
+    ndarray, shape (A,)
+    """
+    from ...periodic.clip import MAX_AMPLITUDE_GAIN, spike_frames, window_ranges
+
+    g = field.graph
+    idx, w = field.neighbours(g.points, field.phase)
+    avg = np.einsum("nk,nka->na", w, np.asarray(angles, dtype=float)[idx])
+    period = int(round(1.0 / (2.0 * float(np.median(field.rate)))))  # rate: half a frame's
+    take = g.take
+    cut = np.flatnonzero(take[1:] != take[:-1]) + 1
+    runs = list(zip(np.r_[0, cut].tolist(), np.r_[cut, take.size].tolist()))
+    spike = spike_frames(fps)
+    have = window_ranges(avg, runs, period, spike)
+    want = window_ranges(np.asarray(angles, dtype=float), runs, period, spike)
+    if have is None or want is None:
+        return np.ones(np.asarray(angles).shape[1])
+    return np.clip(
+        np.where(have > 1e-9, want / np.maximum(have, 1e-9), 1.0), 1.0, MAX_AMPLITUDE_GAIN
     )
