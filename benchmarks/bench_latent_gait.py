@@ -8,7 +8,7 @@ Run from a checkout::
 Model pairs (30 fps, every 4th frame of 120 fps captures): a synthetic walk (1.1 s leg
 cycle) and run (0.7 s) from ``cyclecoord.datasets`` (two 5 s segments each), the
 shared subject 35 walks (35_07/08/13/16) with the 143_01 jog (read at 60 fps, every 2nd
-frame from its first stride, ``JOG_START``: AMC files carry no rate, and at 120 fps the take runs at 5.9 m/s with 338 steps a
+frame: AMC files carry no rate, and at 120 fps the take runs at 5.9 m/s with 338 steps a
 minute, past a sprinter's cadence; at 60 fps it is a 2.9 m/s jog at 169), and the
 Bandai Namco walk
 and run (``../shared/data/bvh/bandai``, 30 fps takes on a static-root rig whose spine
@@ -46,10 +46,6 @@ SHARED = ROOT.parent / "shared"
 CHECKER = SHARED / "tools" / "motioncheck" / "motioncheck.py"
 #: 143_01 read at this rate (AMC files carry none): see the module text.
 JOG_FPS = 60.0
-#: 143_01 from this frame (at 60 fps): on frames 0-3 the runner stands before the first
-#: stride (right knee at 0-13 degrees), which widened the take's right knee p1-p99 range
-#: from 78 degrees over its strides to 98 (see ``bench_synthesis.JOG_START``).
-JOG_START = 4
 
 
 def synthetic_pair(quick: bool) -> dict:
@@ -70,7 +66,7 @@ def shared_pair() -> dict | None:
     jog = cmu / "143" / "143_01.amc"
     if not all(p.is_file() for p in walks + [jog]):
         return None
-    run = cc.load(jog, fps=JOG_FPS)[JOG_START :: int(JOG_FPS) // 30]
+    run = cc.load(jog, fps=JOG_FPS)[:: int(JOG_FPS) // 30]
     return {"walk": [cc.load(p)[::4] for p in walks], "run": [run]}
 
 
