@@ -426,11 +426,12 @@ def test_a_path_cross_fades_over_the_seam_between_two_stretches_of_the_take():
     values[:, 0] += 0.4 * phase + 0.5 * np.exp(-(((phase - 0.1) / 0.1) ** 2))
     rows, start, K = gait._loop(0, values)
     seam = start + K
-    assert SEAM_FADE == 0.5
+    assert SEAM_FADE == 1.0
     # the fade reaches half its length each way, as far as the take has frames
-    before, after = min(0.25, start - phase[0]), min(0.25, phase[-1] - seam)
+    half = 0.5 * SEAM_FADE
+    before, after = min(half, start - phase[0]), min(half, phase[-1] - seam)
     assert before >= 0.1 and after >= 0.1
-    u = seam + np.linspace(-0.5, 0.5, 201)
+    u = seam + np.linspace(-0.6, 0.6, 241)
     got = gait.at(values, 0, u)[:, 0]
     a = np.clip((u - seam + before) / (before + after), 0.0, 1.0)
     w = a * a * a * (a * (6 * a - 15) + 10)
@@ -445,8 +446,33 @@ def test_a_path_cross_fades_over_the_seam_between_two_stretches_of_the_take():
     assert gap > 0.2 and np.abs(np.diff(jump)).max() > 0.9 * gap
     assert np.abs(np.diff(got, 2)).max() < 0.05 * np.abs(np.diff(jump, 2)).max()
     # on the first pass, before the fade's window, the frames are played as they are
-    first = np.linspace(phase[0], seam - 0.26, 50)
+    first = np.linspace(phase[0], seam - before - 0.01, 50)
     np.testing.assert_allclose(gait.at(values, 0, first), gait.at(values, 0, first, fade=0.0))
+
+
+def test_every_part_of_a_pose_loops_at_the_seam_of_the_values_it_goes_with():
+    """Two series over one take whose best seams differ (one bumped over its first 0.3
+    cycle, the other from cycle 1.5 on): each played on its own loops at its own seam;
+    played with ``seam=`` the first, the second takes the first's loop frame for frame
+    (the synthesizer plays the latent path and every part of the gait detail at the
+    seam of the captured angles, so they loop over the same strides)."""
+    gait, phase, base = _gait(lambda p: [np.sin(2 * np.pi * p), np.cos(2 * np.pi * p)], 2.3)
+    first, second = base.copy(), base.copy()
+    first[phase <= 0.3 + 1e-9] += 0.5
+    late = phase >= 1.5 - 1e-9
+    second[late] += 0.5 * np.sin(np.pi * (phase[late] - 1.5))[:, None]
+    loop1, loop2 = gait._loop(0, first), gait._loop(0, second)
+    assert abs(loop1[1] - loop2[1]) > 0.1  # different seams on their own
+    u = np.linspace(0.0, 6.0, 121)
+    want = gait.frame_at(0, u, first)
+    assert not np.allclose(gait.frame_at(0, u, second), want)
+    got = gait.at(second, 0, u, fade=0.0, seam=first)
+    np.testing.assert_allclose(got, gait._lerp(second, want), atol=1e-12)
+    # and the cross-fade happens around the first's seam crossings only
+    _, lo, K = loop1
+    faded = np.abs(gait.at(second, 0, u, seam=first) - got).max(axis=1) > 1e-9
+    d = u - (lo + np.maximum(np.round((u - lo) / K), 1.0) * K)
+    assert faded.any() and np.all(np.abs(d[faded]) <= 0.5 + 1e-9)
 
 
 def test_the_gait_phase_advances_evenly_within_a_cycle_and_keeps_the_takes_pace():

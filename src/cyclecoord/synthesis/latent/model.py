@@ -265,6 +265,7 @@ class LatentModel:
     def _precompute(self) -> None:
         self.X_ = self.gp_.X_
         self._detail = None
+        self._frame_angles = None
         inv_w = np.where(
             self.weights_ > 0, 1.0 / np.where(self.weights_ > 0, self.weights_, 1.0), 0.0
         )
@@ -422,6 +423,14 @@ class LatentModel:
         """Joint angles (degrees) ``(T, C)`` of latent points ``(T, q)`` (Eq. 8's mean)."""
         return self.mean_ + self.kernel(X) @ self._B
 
+    def frame_angles(self) -> np.ndarray:
+        """The model's angles ``(N, C)`` of its training frames (degrees; computed once).
+        A gait loops every part of a pose at the seam these choose
+        (:meth:`~.gait.Gait.at` ``seam``)."""
+        if self._frame_angles is None:
+            self._frame_angles = self.angles(self.frames_)
+        return self._frame_angles
+
     def detail(self) -> dict[str, np.ndarray]:
         """What the model leaves out of each training frame: ``"angles"`` ``(N, C)``
         (degrees, the model's angles of :meth:`angles`) the GP mean at the frame's latent
@@ -439,7 +448,7 @@ class LatentModel:
             w = self.root_weights(self.X_)
             r = self.root_
             self._detail = {
-                "angles": self.angles(self.frames_) - self.pose(self.X_),
+                "angles": self.frame_angles() - self.pose(self.X_),
                 "height": r.height - w @ r.height,
                 "velocity": r.velocity - w @ r.velocity,
                 "turn": r.turn - w @ r.turn,

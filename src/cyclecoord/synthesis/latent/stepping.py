@@ -79,7 +79,7 @@ class GaitMixin:
         g, m = self.gait(self.current), self.models[self.current]
         n = max(1, int(round(seconds * self.fps)))
         u = u0 + self._rate(self.current, seg) * np.arange(n + 1)
-        X = g.at(m.X_, seg, u)
+        X = g.at(m.X_, seg, u, seam=m.frame_angles())
         X[0] = self.x
         self._next_cursor = (self.current, seg, float(u[-1]))
         self._path_detail = self._detail_at(self.current, seg, u)
@@ -91,8 +91,8 @@ class GaitMixin:
         synthesizer adds none)."""
         if not self.detail:
             return None
-        g = self.gait(name)
-        return {k: g.at(v, segment, u) for k, v in self.models[name].detail().items()}
+        g, m = self.gait(name), self.models[name]
+        return {k: g.at(v, segment, u, seam=m.frame_angles()) for k, v in m.detail().items()}
 
     def segment_ahead(self, seconds: float) -> tuple[np.ndarray, np.ndarray]:
         """``{"ahead": seconds}`` on a model without a gait: along the nearest training
@@ -135,7 +135,7 @@ class GaitMixin:
             cycles = np.arange(np.ceil(ph[0] - u0), np.floor(ph[-1] - u0) + 1)
             for c in cycles:
                 u = u0 + c
-                x2 = g2.at(m2.X_, s, np.array([u]))[0]
+                x2 = g2.at(m2.X_, s, np.array([u]), seam=m2.frame_angles())[0]
                 best = _better(best, (int(s), float(u), x2), m1, m2, x)
         if best is None:
             raise ParameterError(f"no frame of {to!r} at gait phase {u0 % 1:.2f}")
@@ -147,7 +147,7 @@ class GaitMixin:
         sa, ua = self._gait_place(src)
         sb, ub, dist = self._matched(src, to, ua, self.x)
         asked = blend_asked(blend, self.fps)
-        x2 = self.gait(to).at(m2.X_, sb, np.array([ub]))[0]
+        x2 = self.gait(to).at(m2.X_, sb, np.array([ub]), seam=m2.frame_angles())[0]
         need = min(self.blend_frames(src, to, self.x, x2), int(IN_STEP_LONGEST * self.fps))
         n = max(asked, need)
         if n != asked:
@@ -163,8 +163,8 @@ class GaitMixin:
         ra, rb = self._rate(src, sa), self._rate(to, sb)
         steps = (1.0 - w) * ra + w * rb
         du = np.concatenate([[0.0], np.cumsum(steps)])[1:]
-        Xa = ga.at(m1.X_, sa, ua + du)
-        Xb = gb.at(m2.X_, sb, ub + du)
+        Xa = ga.at(m1.X_, sa, ua + du, seam=m1.frame_angles())
+        Xb = gb.at(m2.X_, sb, ub + du, seam=m2.frame_angles())
         r1, r2 = self._root(m1, Xa), self._root(m2, Xb)
         root = {
             k: (1 - w.reshape((-1,) + (1,) * (r1[k].ndim - 1))) * r1[k]
