@@ -577,3 +577,34 @@ def test_siblings_exactly_the_tolerance_apart_are_one_node():
     pos = m.positions().positions[0]
     assert 1e-6 * skel.total_length() == d and np.linalg.norm(pos[1] - pos[2]) == d
     assert bones(m).names == ["root>p", "p", "q", "root>r"]
+
+
+def test_check_plausibility_cache_reuses_a_report_only_for_the_same_joint_angles(monkeypatch):
+    """With ``cache=``, a motion whose joint angles match an earlier call's (its root
+    moved elsewhere: no bone moves against another) gets that report without measuring
+    again, a copy the caller may change; other joint angles, or other references, are
+    measured afresh and read as without the cache."""
+    import cyclecoord.quality.plausibility as plaus
+
+    m = cc.datasets.make_periodic_capture(kind="walk", n_frames=80, random_state=0).motion
+    ref = cc.datasets.make_periodic_capture(kind="walk", n_frames=80, random_state=1).motion
+    calls = []
+    real = plaus.self_intersections
+    monkeypatch.setattr(plaus, "self_intersections", lambda *a, **k: calls.append(1) or real(*a, **k))
+    cache: dict = {}
+    first = plaus.check_plausibility(m, [ref], cache=cache)
+    moved = m.frames.copy()
+    root = [m.channel_index(m.skeleton.joints[0].name, d) for d in ("tx", "tz", "ry")]
+    moved[:, root] += [3.0, -2.0, 40.0]
+    again = plaus.check_plausibility(m.with_frames(moved), [ref], cache=cache)
+    assert len(calls) == 1 and again.to_dict() == first.to_dict()
+    again.notes.append("changed by the caller")
+    assert "changed by the caller" not in plaus.check_plausibility(m, [ref], cache=cache).notes
+    bent = m.frames.copy()
+    knee = m.channel_index("ltibia", "rx")
+    bent[:, knee] += 30.0
+    fresh = plaus.check_plausibility(m.with_frames(bent), [ref], cache=cache)
+    assert len(calls) == 2
+    assert fresh.to_dict() == plaus.check_plausibility(m.with_frames(bent), [ref]).to_dict()
+    other = plaus.check_plausibility(m, [ref, m], cache=cache)
+    assert len(calls) == 4 and other.to_dict() == plaus.check_plausibility(m, [ref, m]).to_dict()

@@ -599,3 +599,17 @@ def test_foot_pins_ease_over_a_tenth_of_the_quickest_leg_cycle(made):
     assert syn._lock_ease(["walk"]) == LOCK_BLEND
     assert syn._lock_ease(["walk", "run"]) == pytest.approx(cycle["run"] / 10)
     assert 0.06 < syn._lock_ease(["run"]) < 0.08
+
+
+def test_the_loop_search_is_kept_for_the_values_it_was_made_for():
+    """_loop's seam search is kept per segment for the array asked about (a script asks
+    about a thousand times for a few arrays); another array, even equal in shape, is
+    searched afresh."""
+    gait, phase, values = _gait(lambda p: [np.sin(2 * np.pi * p), np.cos(2 * np.pi * p)], 2.3)
+    values[phase <= 0.3 + 1e-9] += 0.5
+    first = gait._loop(0, values)
+    assert gait._loop(0, values) is first
+    other = values.copy()
+    other[(phase >= 1.4) & (phase <= 2.2)] += 0.5
+    assert gait._loop(0, other) is not first
+    assert gait._loop(0, other)[1] != first[1]

@@ -13,6 +13,8 @@ blend of them may repeat without being implausible.
 
 from __future__ import annotations
 
+import copy
+
 from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
 
@@ -553,11 +555,34 @@ def _reference_views(reference: Motion, motion: Motion) -> list[Motion]:
     return views
 
 
+def _signature(motion: Motion, joints_only: bool) -> tuple:
+    """A content key of a motion for :func:`check_plausibility`'s ``cache``: its frames
+    (only the non-root channels with ``joints_only``: the root's motion moves no bone
+    against another), frame numbers and skeleton."""
+    import hashlib
+
+    frames = np.asarray(motion.frames, dtype=float)
+    skel = motion.skeleton
+    if joints_only and skel is not None and skel.joints:
+        root = skel.joints[0].name
+        cols = [i for i, (j, _) in enumerate(motion.channels) if j != root]
+        frames = frames[:, cols]
+    h = hashlib.blake2b(np.ascontiguousarray(frames).tobytes(), digest_size=16)
+    if skel is not None:
+        for jt in skel.joints:
+            h.update(jt.name.encode())
+            h.update(np.asarray(jt.offset, dtype=float).tobytes())
+    h.update(repr(list(motion.channels)).encode())
+    return (motion.n_frames, int(motion.start_frame), h.hexdigest())
+
+
 def check_plausibility(
     motion: Motion,
     references: Sequence[Motion] = (),
     threshold: float | None = None,
     margin_deg: float = 5.0,
+    *,
+    cache: dict | None = None,
 ) -> PlausibilityReport:
     """Self-intersections and joint ranges of ``motion`` compared with ``references``.
 
@@ -582,6 +607,13 @@ def check_plausibility(
         Clearance (default 2 % of ``motion``'s total bone length); the references are
         checked with the same clearance scaled by their skeleton's size.
     margin_deg : float, default 5
+    cache : dict, optional
+        Kept by the caller between calls (an empty dict to start): a motion whose joint
+        angles and skeleton match an earlier call's, checked against the same
+        references, gets that call's report (the root's motion moves no bone against
+        another), and the references' closest approach of each bone pair is measured
+        once.  A latent script checks its motion up to seven times (limbs kept apart,
+        each round of foot pinning, the report).
 
     Returns
     -------
@@ -592,6 +624,13 @@ def check_plausibility(
     # in the analysis rig: a static root at the origin is no bone to the travelling hips
     motion = analysis_motion(motion)
     references = [analysis_motion(r) for r in references]
+    cache_key = None
+    ref_keys: list = [None] * len(references)
+    if cache is not None:
+        ref_keys = [_signature(r, False) for r in references]
+        cache_key = (_signature(motion, True), tuple(ref_keys), threshold, float(margin_deg))
+        if cache_key in cache:
+            return copy.deepcopy(cache[cache_key])
     inter = self_intersections(motion, threshold)
     thr = inter.threshold
     size = motion.skeleton.total_length()  # type: ignore[union-attr]
@@ -600,21 +639,31 @@ def check_plausibility(
     # the references' closest approach matters for the pairs the motion brings close only
     wanted = {names[q] for q in np.flatnonzero(inter.flagged.any(axis=0))}
     wanted |= {(k[1], k[0]) for k in wanted}
-    for r in references if wanted else ():
+    for r, rkey in zip(references, ref_keys) if wanted else ():
         if r.skeleton is None:
             continue
-        for view in _reference_views(r, motion):
+        for v, view in enumerate(_reference_views(r, motion)):
             rb = bones(view)
             rnames = rb.pair_names()
             which = np.array([k in wanted for k in rnames], dtype=bool)
             if not which.any():
                 continue
             rsize = view.skeleton.total_length()  # type: ignore[union-attr]
-            rd = _pair_distances(view, rb, which).min(axis=0) * (
-                size / rsize if rsize > 0 else 1.0
-            )
-            for key, d in zip([k for k, w in zip(rnames, which) if w], rd):
-                ref_min[key] = min(ref_min.get(key, np.inf), float(d))
+            scale = size / rsize if rsize > 0 else 1.0
+            names_in = [k for k, w in zip(rnames, which) if w]
+            known = {}
+            if cache is not None:  # each pair's closest approach in this view, once
+                vkey = ("reference pairs", rkey, v, _signature(view, False)[2], size)
+                known = cache.setdefault(vkey, {})
+                todo = np.array([w and k not in known for k, w in zip(rnames, which)])
+                if todo.any():
+                    rd = _pair_distances(view, rb, todo).min(axis=0) * scale
+                    known.update(zip([k for k, t in zip(rnames, todo) if t], map(float, rd)))
+                dists = [known[k] for k in names_in]
+            else:
+                dists = list(_pair_distances(view, rb, which).min(axis=0) * scale)
+            for pair, d in zip(names_in, dists):
+                ref_min[pair] = min(ref_min.get(pair, np.inf), float(d))
     contacts = []
     new_mask = np.zeros(inter.flagged.shape[0], dtype=bool)
     notes: list[str] = []
@@ -674,8 +723,11 @@ def check_plausibility(
         notes.append(
             f"no bones closer than {thr:.3g} and every joint angle within the inputs' range"
         )
-    return PlausibilityReport(
+    report = PlausibilityReport(
         n_frames=motion.n_frames, threshold=thr, margin_deg=float(margin_deg), contacts=contacts,
         new_contact_frames=[int(f + motion.start_frame) for f in np.flatnonzero(new_mask)],
         joint_range=violations, notes=notes,
     )
+    if cache is not None:
+        cache[cache_key] = copy.deepcopy(report)
+    return report

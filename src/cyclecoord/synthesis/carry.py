@@ -337,6 +337,7 @@ def lock_where_clean(
     bounds: tuple[np.ndarray, np.ndarray] | None = None,
     hold: np.ndarray | None = None,
     references: Sequence[Motion] | None = None,
+    plausibility_cache: dict | None = None,
 ) -> LockOutcome:
     """Pin the planted feet (leg IK) except where the pin makes a pop.
 
@@ -359,7 +360,8 @@ def lock_where_clean(
     come (:func:`~cyclecoord.quality.plausibility.check_plausibility`'s new contacts,
     where the motion before pinning had none) counts as a pop: pinned on an IDLE of
     subject 35's walk model, two script seeds in five crossed the feet (toes 0.06 units
-    apart against the captures' closest 1.23).
+    apart against the captures' closest 1.23).  ``plausibility_cache`` is passed to those
+    checks (:func:`~cyclecoord.quality.plausibility.check_plausibility` ``cache``).
     """
     from ..quality.contacts import contact_runs
     from ..quality.legs import find_feet
@@ -393,7 +395,7 @@ def lock_where_clean(
     before = _accel(motion)
     limit = np.broadcast_to(np.asarray(limit, dtype=float), before.shape)
     outside_before = _outside(motion.frames, bounds)
-    crossed_before = _crossed(motion, references)
+    crossed_before = _crossed(motion, references, plausibility_cache)
     skipped: list[tuple[int, int]] = []
     result = None
     for _ in range(6):
@@ -403,7 +405,7 @@ def lock_where_clean(
         after = _accel(trial)
         bad = (after > limit) & (after > before * 1.05)
         bad |= _outside(trial.frames, bounds) & ~outside_before
-        bad |= _crossed(trial, references) & ~crossed_before
+        bad |= _crossed(trial, references, plausibility_cache) & ~crossed_before
         bad = np.flatnonzero(bad)
         if not bad.size:
             result = trial
@@ -478,7 +480,7 @@ def _outside(frames: np.ndarray, bounds) -> np.ndarray:
     return ((frames < lo) | (frames > hi)).any(axis=1)
 
 
-def _crossed(motion: Motion, references) -> np.ndarray:
+def _crossed(motion: Motion, references, cache: dict | None = None) -> np.ndarray:
     """(T,) frames where two limbs come closer than ``references`` ever do (none
     without references)."""
     out = np.zeros(motion.n_frames, dtype=bool)
@@ -486,7 +488,9 @@ def _crossed(motion: Motion, references) -> np.ndarray:
         return out
     from ..quality.plausibility import check_plausibility
 
-    frames = np.asarray(check_plausibility(motion, references).new_contact_frames, dtype=int)
+    frames = np.asarray(
+        check_plausibility(motion, references, cache=cache).new_contact_frames, dtype=int
+    )
     out[frames - int(motion.start_frame)] = True
     return out
 

@@ -251,6 +251,9 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self.clamped = {"values": 0, "max_deg": 0.0}
         self.held: list[tuple[int, int]] = []  # frame ranges of IDLE commands
         self.notes: list[str] = []
+        # check_plausibility's cache: the motion is checked up to seven times against
+        # the same training takes (limbs kept apart, each round of foot pinning, report)
+        self._plausibility: dict = {}
         self._ranges: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._gaits: dict = {}
         # (model, segment, unwrapped phase) where the last stepping command left the

@@ -18,7 +18,7 @@ blend them in step (:meth:`~.commands.Synthesizer.gait_hop`).
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -52,6 +52,9 @@ class Gait:
     phase: np.ndarray
     period: np.ndarray
     segments: np.ndarray
+    #: ``(segment, id(values)) -> (values, loop)``: :meth:`_loop`'s search, kept while its
+    #: values live (a script asks it about a thousand times for the same few arrays)
+    _loops: dict = field(default_factory=dict, compare=False, repr=False)
 
     def has(self, segment: int) -> bool:
         return bool(np.isfinite(self.period[segment]))
@@ -75,6 +78,18 @@ class Gait:
         phase of a cycle is a candidate (with ``K`` alone a take of 6.02 cycles had only
         its last half-frame to choose from: the Bandai run's seam jumped 2.2 median
         latent steps and popped at 2.4x the training 99th percentile of acceleration)."""
+        if values is not None:
+            hit = self._loops.get((segment, id(values)))
+            if hit is not None and hit[0] is values:
+                return hit[1]
+            out = self._search_loop(segment, values)
+            self._loops[(segment, id(values))] = (values, out)
+            return out
+        return self._search_loop(segment, None)
+
+    def _search_loop(
+        self, segment: int, values: np.ndarray | None
+    ) -> tuple[np.ndarray, float, float]:
         rows = self.rows(segment)
         ph = self.phase[rows]
         lo, span = ph[0], ph[-1] - ph[0]

@@ -82,7 +82,10 @@ class OutputMixin:
         bump = u * u * (3.0 - 2.0 * u)
         pulled: set[int] = set()
         for _ in range(UNTANGLE_ROUNDS):
-            frames = np.asarray(check_plausibility(motion, takes).new_contact_frames, dtype=int)
+            frames = np.asarray(
+                check_plausibility(motion, takes, cache=self._plausibility).new_contact_frames,
+                dtype=int,
+            )
             frames = frames - int(motion.start_frame)
             frames = frames[self._on_path()[frames]] if frames.size else frames
             frames = np.array([f for f in frames if pull[f] < 1.0], dtype=int)
@@ -413,6 +416,7 @@ class OutputMixin:
                 hold=self.hold_mask(motion.n_frames),
                 blend=self._lock_ease(used),
                 references=takes,
+                plausibility_cache=self._plausibility,
             )
             self.notes.append(locked.line)
             out = locked.motion

@@ -333,11 +333,24 @@ def training_takes(models: dict[str, LatentModel], names=None) -> list:
 def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None, list[str]]:
     """The measure of generated motion (:mod:`cyclecoord.quality.generated`) against the
     training segments of the models the script used, IDLE frames counted as asked holds."""
-    from ...quality.generated import lead_lines, measure_generated
+    from ...errors import CycleCoordError
+    from ...quality.generated import lead_lines, measure_generated, source_figures
+
+    figures: dict = {}  # the sources' figures, once per set of models
+
+    def measured(names) -> tuple[list, Any]:
+        key = tuple(sorted(names))
+        if key not in figures:
+            takes = training_takes(syn.models, key)
+            try:
+                figures[key] = (takes, source_figures(takes, motion.fps, feet=feet))
+            except CycleCoordError:
+                figures[key] = (takes, None)  # measured (and refused) as before
+        return figures[key]
 
     hold = syn.hold_mask(motion.n_frames)
-    sources = training_takes(syn.models, {c.model for c in syn.chunks})
-    quality, lines = lead_lines(motion, sources, feet=feet, hold=hold)
+    sources, ref = measured({c.model for c in syn.chunks})
+    quality, lines = lead_lines(motion, sources, feet=feet, hold=hold, reference=ref)
     sections = model_sections(syn, commands)
     if quality is not None and len({s["model"] for s in sections}) > 1:
         # a walk and a run judged against their pooled captures read the run's pops
@@ -346,8 +359,8 @@ def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None,
         lines.append("  each model's frames against its own training takes:")
         for sec in sections:
             a, b = sec["start"], sec["stop"]
-            q, sub = lead_lines(motion[a:b], training_takes(syn.models, [sec["model"]]),
-                                feet=feet, hold=hold[a:b])
+            takes, ref = measured([sec["model"]])
+            q, sub = lead_lines(motion[a:b], takes, feet=feet, hold=hold[a:b], reference=ref)
             quality["by_model"].append({**sec, "quality": q})
             lines.append(f"    {sec['model']} frames {a}-{b}: "
                          + sub[0].replace("generated motion: ", ""))
@@ -360,8 +373,8 @@ def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None,
             if b - a < 3:
                 continue
             pop = min(
-                measure_generated(motion[a:b], training_takes(syn.models, [k]), feet=feet)
-                .largest_accel
+                measure_generated(motion[a:b], measured([k])[0], feet=feet,
+                                  reference=measured([k])[1]).largest_accel
                 for k in win["models"]
             )
             quality["transitions"].append({**win, "largest_accel_ratio": float(pop)})
@@ -540,5 +553,5 @@ def run_script(
             )
             for k in sorted(used)
         ]
-        report["plausibility"] = check_plausibility(motion, refs).to_dict()
+        report["plausibility"] = check_plausibility(motion, refs, cache=syn._plausibility).to_dict()
     return motion, report
