@@ -815,3 +815,12 @@ def test_memory_limit_reaches_the_readers(monkeypatch, files, script, tmp_path, 
     with pytest.raises(Reached):
         main(argv + ["--memory-limit", "500M"])
     assert seen == [500 * 1024**2]
+
+
+def test_graph_crossval_dims_auto_reaches_cross_validate(monkeypatch, takes):
+    """``graph crossval --dims auto`` passes "auto" (each fold's own dimensions); it was
+    silently 2."""
+    target = "cyclecoord.synthesis.graph.cross_validate"
+    assert reach(monkeypatch, target, "graph", "crossval", *takes).kwargs["dims"] == 2
+    got = reach(monkeypatch, target, "graph", "crossval", *takes, "--dims", "auto").kwargs
+    assert got["dims"] == "auto"

@@ -359,6 +359,32 @@ def test_target_path_keeps_to_the_data_with_squared_costs():
     assert np.all(np.diff(ang) > -0.05) and ang[-1] - ang[0] == pytest.approx(np.pi, abs=0.2)
 
 
+def test_cross_validate_phase_aware_method_and_auto_dims(walks):
+    """``delaunay+phase`` (what ``cyclecoord graph`` generates with) is cross-validated as
+    that command generates, and ``dims="auto"`` picks each fold's dimensions from its
+    training takes (the command line passed 2 for ``--dims auto`` before)."""
+    import warnings
+
+    from cyclecoord.synthesis.graph.model import auto_dims
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cv = cross_validate(walks, methods=("delaunay", "delaunay+phase"), dims="auto",
+                            topo=False, horizon=2)
+    assert set(cv.median) == {"delaunay", "delaunay+phase"} and len(cv.folds) == 6
+    assert cv.parameters["dims"] == "auto"
+    for i, name in enumerate(dict.fromkeys(f["held_out"] for f in cv.folds)):
+        want = auto_dims([m for j, m in enumerate(walks) if j != i])
+        assert {f["dims"] for f in cv.folds if f["held_out"] == name} == {want}
+    still = cv.baselines["standing_still"]["median"]
+    ours = cv.median["delaunay+phase"]
+    assert np.isfinite(ours["error_a_deg"]) and ours["error_f_deg"] < still["error_f_deg"]
+    assert ours["error_a_deg"] < cv.median["delaunay"]["error_a_deg"]
+    assert cv.long["delaunay+phase"]["freeze_folds"] == 0
+    with pytest.raises(ParameterError, match="dims"):
+        cross_validate(walks, methods=("delaunay",), dims=0)
+
+
 def test_crossval_prints_the_papers_row_for_its_set_and_a_longer_horizon(walks):
     from cyclecoord.synthesis.graph import PAPER, paper_set
 

@@ -55,7 +55,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "path's heading), e.g. delaunay+ring+agree; any of them with +phase: the phase-aware "
         "field that follows the gait's circular coordinate and never stalls (generation "
         "default delaunay+phase; 'delaunay' is the paper's field); crossval takes a comma list "
-        "(default delaunay,delaunay+ring+agree,knn,union)",
+        "(default delaunay,delaunay+ring+agree,knn,union,delaunay+phase)",
     )
     p.add_argument(
         "--dims",
@@ -237,7 +237,7 @@ def _crossval(args: argparse.Namespace, motions: list, out: Outputs) -> int:
     cv = cross_validate(
         motions,
         methods=methods,
-        dims=2 if args.dims in (None, "auto") else args.dims,
+        dims=2 if args.dims is None else args.dims,
         k=args.k,
         integrator=args.integrator,
         step_scale=args.step_scale or 1.0,

@@ -4,8 +4,9 @@ For each take: fit the latent space and build the graph on the other takes, star
 left-out take's first frame, follow the field for as many frames as the take has, and
 compare the generated path with the take.  The methods are the graph's, optionally with
 the field options of :mod:`.field` (``"delaunay+ring+agree"``); the default set
-(:data:`DEFAULT_METHODS`) holds the paper's two, that fix of the Delaunay field and
-k-Delaunay.
+(:data:`DEFAULT_METHODS`) holds the paper's two, that fix of the Delaunay field,
+k-Delaunay and the phase-aware field (:mod:`.phase`) that ``cyclecoord graph`` generates
+with, cross-validated as that command generates.
 
 * **Error F**: distance from the generated path to the take's final point at their
   closest approach.
@@ -44,7 +45,7 @@ from scipy.spatial.distance import cdist
 from ...errors import ParameterError
 from ...motion import Motion
 from .build import build_graph
-from .field import VectorField, parse_variant
+from .field import VectorField
 from .latent import PoseSpace, check_takes
 from ..._blas import one_blas_thread
 from .paths import follow_field
@@ -107,8 +108,9 @@ def paper_set(motions: Sequence[Motion]) -> str | None:
     return None
 
 
-#: The paper's two, our fix of the Delaunay field (see :mod:`.field`) and k-Delaunay.
-DEFAULT_METHODS = ("delaunay", "delaunay+ring+agree", "knn", "union")
+#: The paper's two, our fix of the Delaunay field (see :mod:`.field`), k-Delaunay, and
+#: the phase-aware field (:mod:`.phase`) ``cyclecoord graph`` generates with.
+DEFAULT_METHODS = ("delaunay", "delaunay+ring+agree", "knn", "union", "delaunay+phase")
 #: Latent coordinates the H1 barcodes are computed in.
 TOPO_DIMS = 3
 ERROR_KEYS = (
@@ -210,7 +212,7 @@ class CrossValidation:
     Attributes
     ----------
     folds : list of dict
-        ``held_out, method, error_a, error_f, error_a_deg, error_f_deg, error_topo,
+        ``held_out, method, dims, error_a, error_f, error_a_deg, error_f_deg, error_topo,
         outside_hull_steps`` (plus ``error_a_pos, error_f_pos``).
     median : dict
         ``{method: {error key: median over folds}}``.
@@ -352,7 +354,9 @@ def _graph_summary(takes: list, methods: list, dims: int, k: int, names: list) -
         "weak_components": {},
         "strong_components": {},
     }
-    for method in dict.fromkeys(parse_variant(m)[0] for m in methods):
+    from .model import _parse
+
+    for method in dict.fromkeys(_parse(m)[0] for m in methods):
         c = build_graph(latent_all, method, k, names).connectivity()
         for key in ("edges", "weak_components", "strong_components"):
             graph[key][method] = c[key]
@@ -396,8 +400,13 @@ def cross_validate(
     methods : sequence of str
         ``"delaunay"``, ``"knn"``, ``"union"``, each optionally with the field options
         ``+ring`` and ``+agree`` (:func:`~.field.parse_variant`); one graph per fold
-        serves every variant of a method.
-    dims : int, default 2
+        serves every variant of a method.  With ``+phase`` (``"delaunay+phase"``, what
+        ``cyclecoord graph`` generates with) the fold is generated as that command
+        does (:func:`_phase_row`), the root neither carried nor the feet pinned for the
+        errors.
+    dims : int or "auto", default 2
+        Latent dimensions of each fold's space (``"auto"``: :func:`~.model.auto_dims` of
+        the fold's training takes).
     k : int, default 16
     integrator : {"euler", "rk4"}
     step_scale : float, default 1 (the paper's step)
@@ -414,9 +423,14 @@ def cross_validate(
     -------
     CrossValidation
     """
+    from .model import _parse, auto_dims
+
     takes = check_takes(motions, minimum=3)
     methods = list(dict.fromkeys(str(m).strip() for m in methods))
-    variants = {m: parse_variant(m) for m in methods}
+    variants = {m: _parse(m) for m in methods}
+    if dims != "auto" and (isinstance(dims, bool) or not isinstance(dims, (int, np.integer))
+                           or dims < 1):
+        raise ParameterError(f"dims must be a whole number >= 1 or 'auto', got {dims!r}")
     if not methods:
         raise ParameterError("give at least one method")
     names = [
@@ -432,13 +446,25 @@ def cross_validate(
         order = tqdm(order, desc="folds", unit="fold")
     for i in order:
         train = [m for j, m in enumerate(takes) if j != i]
-        space = PoseSpace(dims).fit(train)
+        fold_dims = auto_dims(train) if dims == "auto" else int(dims)
+        space = PoseSpace(fold_dims).fit(train)
         ev = _Evaluator(space, takes[i], topo)
         latent_train = [space.transform(m) for m in train]
         start, n = ev.latent[0], takes[i].n_frames
         graphs: dict = {}
         for method in methods:
-            kind, ring, agree = variants[method]
+            kind, ring, agree, phase = variants[method]
+            if phase:
+                row, path, c = _phase_row(method, ev, space, train, takes[i], fold_dims, k,
+                                          integrator, step_scale, horizon)
+                row = {"held_out": names[i], "method": method, "dims": fold_dims, **row}
+                folds.append(row)
+                paths[(names[i], method)] = path
+                fold_graphs.append(
+                    {"held_out": names[i], "method": method,
+                     **{key: c[key] for key in _GRAPH_KEYS}, "H_connected": c["H"]["connected"]}
+                )
+                continue
             if kind not in graphs:
                 g = build_graph(
                     latent_train, kind, k, [names[j] for j in range(len(takes)) if j != i]
@@ -447,7 +473,7 @@ def cross_validate(
             graph, c = graphs[kind]
             field_ = VectorField(graph, ring=ring, agree=agree)
             path = follow_field(field_, start, n, integrator, step_scale)
-            row = {"held_out": names[i], "method": method}
+            row = {"held_out": names[i], "method": method, "dims": fold_dims}
             row.update(ev.errors(path.points, space.inverse_transform(path.points)))
             row["outside_hull_steps"] = path.outside_hull_steps
             if horizon and horizon > 1:
@@ -474,7 +500,8 @@ def cross_validate(
     median = {m: _median([r for r in folds if r["method"] == m]) for m in methods}
     long = _long_medians(folds, methods) if horizon and horizon > 1 else {}
     baselines = {b: {"folds": rows, "median": _median(rows)} for b, rows in base.items()}
-    graph = _graph_summary(takes, methods, dims, k, names)
+    graph = _graph_summary(takes, methods, auto_dims(takes) if dims == "auto" else dims, k,
+                           names)
     params = {
         "methods": methods,
         "dims": dims,
@@ -539,3 +566,46 @@ def _long_row(ev, space, train, take, field_, start, n, integrator, step_scale) 
         slip_ratio=q.slip_ratio,
     )
     return row
+
+
+def _phase_row(method, ev, space, train, take, dims, k, integrator, step_scale, horizon):
+    """A fold of a phase-aware method (``delaunay+phase``): :class:`~.model.MotionGraphSynth`
+    as ``cyclecoord graph`` generates (the path's pose with the neighbours' detail and the
+    strides widened back), without the root carried or the feet pinned for the errors; its
+    angles measured against the take's in the fold's space.  Returns the row (errors,
+    outside-hull steps, and the longer horizon's with the root carried), the path and the
+    graph's connectivity."""
+    import warnings
+
+    from ...errors import CycleCoordError
+    from ...quality.generated import measure_generated
+    from .model import MotionGraphSynth
+
+    n = take.n_frames
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        synth = MotionGraphSynth(
+            method=method, dims=dims, k=k, integrator=integrator, step_scale=step_scale,
+            carry=False, lock=False,
+        ).fit(train)
+    gen = synth.generate(n, take, 0)
+    angles = space.angles(gen.motion)
+    row: dict[str, Any] = dict(ev.errors(space.transform(angles), angles))
+    row["outside_hull_steps"] = gen.path.outside_hull_steps
+    if horizon and horizon > 1:
+        long_gen = synth.generate(n * int(horizon), take, 0)
+        a = space.angles(long_gen.motion)
+        errs = ev.errors(space.transform(a), a)
+        lrow: dict[str, Any] = {key: errs[key] for key in ("error_a_deg", "error_f_deg")}
+        lrow["frames"] = n * int(horizon)
+        try:
+            from ..carry import carry_by_feet
+
+            q = measure_generated(carry_by_feet(long_gen.motion), train)
+            lrow.update(longest_freeze_s=q.longest_freeze_s,
+                        freezes=[list(f) for f in q.freezes],
+                        support_slip=q.support_slip, slip_ratio=q.slip_ratio)
+        except CycleCoordError as exc:
+            lrow["not_measured"] = str(exc)
+        row["long"] = lrow
+    return row, gen.path, synth.graph_.connectivity()
