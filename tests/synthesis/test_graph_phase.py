@@ -124,6 +124,18 @@ def test_take_phases_matches_a_take_without_its_own_coordinate(walks, monkeypatc
     assert any("take 1: matched" in n and "no circle here" in n for n in out.notes)
     err = ((out.phases[1] - own.phases[1] + 0.5) % 1.0) - 0.5
     assert np.abs(err - np.median(err)).max() < 0.05 and abs(np.median(err)) < 0.05
+    # no take regular (every coordinate judged irregular): each keeps its own, none is
+    # thrown away for the latent angle
+    import cyclecoord.synthesis.graph.phase as phase_module
+
+    monkeypatch.setattr(pipeline, "extract", real)
+    monkeypatch.setattr(phase_module, "_regular", lambda u: False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        kept = take_phases(walks, latent)
+    assert kept.source == ["coordinate"] * 3
+    for a, b in zip(kept.phases, own.phases):
+        np.testing.assert_allclose(a, b)
     monkeypatch.setattr(pipeline, "extract", lambda m, **kw: (_ for _ in ()).throw(
         NoPeriodicMotionError("none")))
     assert take_phases(walks, latent).source == ["latent angle"] * 3

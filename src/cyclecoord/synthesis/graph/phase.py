@@ -131,8 +131,9 @@ def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePh
 
     A take without a clear circle (:class:`~cyclecoord.errors.NoPeriodicMotionError` and
     the like) or whose phase runs backwards or jumps (:func:`_regular`) is matched to the
-    other takes' cycle (:func:`match_phase`), with a note; when no take has a regular
-    phase, every take falls back to the angle of its first two latent coordinates.
+    other takes' cycle (:func:`match_phase`), with a note.  When no take has a regular
+    phase, the takes keep their own coordinates, irregular or not, and those without one
+    fall back to the angle of their first two latent coordinates.
     """
     from ...periodic.pipeline import extract
 
@@ -154,16 +155,20 @@ def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePh
                 notes.append(f"phase of take {i}: circular coordinate of a short take "
                              f"({turns} turns accepted, extract asks 1.5)")
             break
+        raw = u
         if u is not None and not _regular(u):
             why = "its coordinate runs backwards or jumps"
             u = None
-        own.append((u, why))
-    good = [i for i, (u, _) in enumerate(own) if u is not None]
-    if not good:
-        for i, (_, why) in enumerate(own):
-            notes.append(f"phase of take {i}: no circular coordinate ({why}); latent angle")
-        phases = [_latent_angle(z) for z in latent]
-        return TakePhases(align_phases(phases, latent), ["latent angle"] * len(takes), notes)
+        own.append((u, why, raw))
+    good = [i for i, (u, _, _) in enumerate(own) if u is not None]
+    if not good:  # nothing regular to match to: each take's own coordinate, if any
+        phases, source = [], []
+        for i, ((_, why, raw), z) in enumerate(zip(own, latent)):
+            if raw is None:
+                notes.append(f"phase of take {i}: no circular coordinate ({why}); latent angle")
+            phases.append(_latent_angle(z) if raw is None else raw)
+            source.append("latent angle" if raw is None else "coordinate")
+        return TakePhases(align_phases(phases, latent), source, notes)
     aligned = align_phases([own[i][0] for i in good], [latent[i] for i in good])
     phases: list = [None] * len(takes)
     source = ["coordinate"] * len(takes)
@@ -172,7 +177,7 @@ def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePh
     ref_phase = np.concatenate(aligned)
     ref_z = np.vstack([latent[i] for i in good])
     rate = float(np.median(np.concatenate([np.diff(u) for u in aligned])))
-    for i, (u, why) in enumerate(own):
+    for i, (u, why, _) in enumerate(own):
         if u is None:
             phases[i] = match_phase(latent[i], ref_phase, ref_z, rate)
             source[i] = "matched"
@@ -212,17 +217,21 @@ def match_phase(
     T = z.shape[0]
     ref = _binned(np.asarray(ref_phase, dtype=float), np.asarray(ref_z, dtype=float), bins)
     spread = float(((ref - ref.mean(axis=0)) ** 2).sum(axis=1).mean()) or 1.0
-    cost = ((z[:, None, :] - ref[None, :, :]) ** 2).sum(axis=2) / spread  # (T, bins)
+
+    def cost(t: int) -> np.ndarray:  # (bins,): frame t's pose against each bin's
+        return ((ref - z[t]) ** 2).sum(axis=1) / spread
+
     r = max(float(rate) * bins, 1e-6)  # expected advance, bins a frame
-    steps = np.arange(int(np.ceil(MATCH_MAX_RATE * r)) + 1)
+    steps = np.arange(min(int(np.ceil(MATCH_MAX_RATE * r)), bins - 1) + 1)
     pen = MATCH_RATE_PENALTY * ((steps - r) / r) ** 2
-    total = cost[0].copy()
-    back = np.zeros((T, bins), dtype=np.int64)
+    total = cost(0)
+    back = np.zeros((T, bins), dtype=np.int16)  # the step taken into each bin
+    cols = np.arange(bins)
     for t in range(1, T):
         # arriving at bin b from b - s
         cand = np.stack([np.roll(total, s) + pen[j] for j, s in enumerate(steps)])
         back[t] = np.argmin(cand, axis=0)
-        total = cand[back[t], np.arange(bins)] + cost[t]
+        total = cand[back[t], cols] + cost(t)
     b = int(np.argmin(total))
     adv = np.zeros(T)
     for t in range(T - 1, 0, -1):
