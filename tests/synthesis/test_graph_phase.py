@@ -124,18 +124,24 @@ def test_take_phases_matches_a_take_without_its_own_coordinate(walks, monkeypatc
     assert any("take 1: matched" in n and "no circle here" in n for n in out.notes)
     err = ((out.phases[1] - own.phases[1] + 0.5) % 1.0) - 0.5
     assert np.abs(err - np.median(err)).max() < 0.05 and abs(np.median(err)) < 0.05
-    # no take regular (every coordinate judged irregular): each keeps its own, none is
-    # thrown away for the latent angle
-    import cyclecoord.synthesis.graph.phase as phase_module
+    # a take played backwards follows the others' cycle in reverse: its match would
+    # stand still, so it gets the latent angle (which runs, if unevenly)
+    backwards = walks[1].with_frames(walks[1].frames[::-1].copy())
+    takes = [walks[0], backwards, walks[2]]
+    lat = [PoseSpace(3).fit(walks).transform(m) for m in takes]
 
-    monkeypatch.setattr(pipeline, "extract", real)
-    monkeypatch.setattr(phase_module, "_regular", lambda u: False)
+    def fails_backwards(m, **kw):
+        if m is backwards:
+            raise NoPeriodicMotionError("no circle here")
+        return real(m, **kw)
+
+    monkeypatch.setattr(pipeline, "extract", fails_backwards)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        kept = take_phases(walks, latent)
-    assert kept.source == ["coordinate"] * 3
-    for a, b in zip(kept.phases, own.phases):
-        np.testing.assert_allclose(a, b)
+        rev = take_phases(takes, lat)
+    assert rev.source == ["coordinate", "latent angle", "coordinate"]
+    assert any("do not follow the other takes' cycle" in n for n in rev.notes)
+    assert rev.phases[1][-1] - rev.phases[1][0] > 1.0
     monkeypatch.setattr(pipeline, "extract", lambda m, **kw: (_ for _ in ()).throw(
         NoPeriodicMotionError("none")))
     assert take_phases(walks, latent).source == ["latent angle"] * 3
@@ -248,3 +254,38 @@ def test_jog_graph_keeps_the_knees_stride(cmu_dir):
     assert q.support_slip <= 1.5 * q.source_support_slip
     assert not q.freezes
     assert check_plausibility(gen.motion, [take]).new_contact_frames == []
+
+
+def test_strides_are_not_widened_across_takes_of_other_gaits():
+    """The widening undoes the narrowing of averaging repetitions of one gait; a take
+    whose poses lie far from the others' at its phase (the Bandai walk backwards beside
+    its walk forwards: 19x the cycle's spread) is another gait, and then nothing is
+    widened (there the legs went to 1.3x their range and crossed)."""
+    from types import SimpleNamespace
+
+    from cyclecoord.synthesis.graph.model import OTHER_GAIT_MISFIT, _other_gait
+
+    ph = [np.arange(120) / 60.0 + s for s in (0.0, 0.3, 0.6)]
+    same = [_loop(p) for p in ph]
+    field = SimpleNamespace(
+        graph=SimpleNamespace(take=np.repeat([0, 1, 2], 120), points=np.vstack(same)),
+        unwrapped=np.concatenate(ph),
+    )
+    assert _other_gait(field, ["a", "b", "c"]) == ""
+    other = same[:2] + [_loop(ph[2])[:, [1, 0, 2]] * 2.0 + 1.0]  # another loop elsewhere
+    field.graph.points = np.vstack(other)
+    said = _other_gait(field, ["a", "b", "c"])
+    assert said.startswith("c is not the other takes' gait")
+    assert OTHER_GAIT_MISFIT == 1.0
+
+
+def test_the_synthesiser_widens_nothing_when_a_take_is_another_gait(walks, monkeypatch):
+    import cyclecoord.synthesis.graph.model as model
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        widened = MotionGraphSynth(method="delaunay+phase", dims="auto").fit(walks)
+        monkeypatch.setattr(model, "_other_gait", lambda field, names: "t is not it")
+        kept = MotionGraphSynth(method="delaunay+phase", dims="auto").fit(walks)
+    assert widened.gain_.max() > 1.0 and not any("not widened" in n for n in widened.phase_notes_)
+    assert np.all(kept.gain_ == 1.0) and "strides not widened: t is not it" in kept.phase_notes_

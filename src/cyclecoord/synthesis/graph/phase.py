@@ -24,11 +24,12 @@ state.
 
 Phases of different takes are put on one origin: each take's coordinate is shifted by
 the offset that best matches its poses to the first take's at the same phase.  A take
-whose own coordinate fails or runs backwards (a take of little more than one cycle) is
-matched to the other takes' cycle instead (:func:`match_phase`): the monotone phase,
+whose own coordinate fails (a take of little more than one cycle) is matched to the
+other takes' cycle instead (:func:`match_phase`): the monotone phase,
 advancing about as fast as theirs, whose poses best fit their mean pose at each phase.
 The angle of the first two latent coordinates, which dwells and jumps where the latent
-curve is not round, is the last resort, for takes none of which has a coordinate.
+curve is not round, is the last resort: for a take with no coordinate whose poses do
+not follow the others' cycle, or when no take has one.
 """
 
 from __future__ import annotations
@@ -45,8 +46,8 @@ from .build import MotionGraph
 from .paths import MAX_STEP_SCALE, GraphPath
 
 __all__ = [
-    "PhaseField", "TakePhases", "take_phases", "align_phases", "match_phase", "follow_phase",
-    "amplitude_gain",
+    "PhaseField", "TakePhases", "take_phases", "align_phases", "match_phase", "match_misfit",
+    "follow_phase", "amplitude_gain",
 ]
 
 #: Neighbours of the phase-aware field, the pull per frame towards their next states
@@ -64,15 +65,16 @@ BINS = 48
 SHORT_TURNS = 0.75
 #: Slowest phase rate kept, as a fraction of the median.
 MIN_RATE = 0.25
-#: A take's own phase is used when its frame-to-frame rate stays between 0 and this
-#: many times its median (the subject 35 walks: 0.5-2.5); otherwise :func:`match_phase`.
-IRREGULAR_RATE = 4.0
 #: :func:`match_phase`: phase bins, the largest advance per frame against the takes'
 #: median one, and the penalty on an advance away from the median (per squared relative
 #: deviation, against a pose cost normalised by the cycle's spread).
 MATCH_BINS = 96
 MATCH_MAX_RATE = 3.0
 MATCH_RATE_PENALTY = 0.05
+#: A matched phase is kept when the take's poses lie this close to the others' mean pose
+#: at their matched phases (:func:`match_misfit`, against the cycle's spread): a gait
+#: the others do not have, such as a walk played backwards, matches far off.
+MATCH_MAX_MISFIT = 0.25
 
 
 @dataclass
@@ -118,22 +120,16 @@ def _phase_of(result) -> np.ndarray:
     return np.asarray(result.coordinate, dtype=float)
 
 
-def _regular(u: np.ndarray) -> bool:
-    """Whether an unwrapped phase advances on every frame, at most
-    :data:`IRREGULAR_RATE` times its median rate."""
-    r = np.diff(np.asarray(u, dtype=float))
-    med = float(np.median(r)) if r.size else 0.0
-    return bool(med > 0 and r.min() > 0 and r.max() <= IRREGULAR_RATE * med)
-
-
 def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePhases:
     """Each take's gait phase from the periodic pipeline's circular coordinate.
 
     A take without a clear circle (:class:`~cyclecoord.errors.NoPeriodicMotionError` and
-    the like) or whose phase runs backwards or jumps (:func:`_regular`) is matched to the
-    other takes' cycle (:func:`match_phase`), with a note.  When no take has a regular
-    phase, the takes keep their own coordinates, irregular or not, and those without one
-    fall back to the angle of their first two latent coordinates.
+    the like; each half of the 143_01 jog, about one stride) is matched to the other
+    takes' cycle (:func:`match_phase`), with a note; where its poses do not follow that
+    cycle (the match stands still) or no take has a coordinate, it gets the angle of its
+    first two latent coordinates.  A take's own coordinate is kept even where it dwells
+    or jumps for a frame or two (the Bandai backward walk's jumps 6x its median rate
+    twice; matched to the forward walk's cycle it would stand still).
     """
     from ...periodic.pipeline import extract
 
@@ -155,20 +151,13 @@ def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePh
                 notes.append(f"phase of take {i}: circular coordinate of a short take "
                              f"({turns} turns accepted, extract asks 1.5)")
             break
-        raw = u
-        if u is not None and not _regular(u):
-            why = "its coordinate runs backwards or jumps"
-            u = None
-        own.append((u, why, raw))
-    good = [i for i, (u, _, _) in enumerate(own) if u is not None]
-    if not good:  # nothing regular to match to: each take's own coordinate, if any
-        phases, source = [], []
-        for i, ((_, why, raw), z) in enumerate(zip(own, latent)):
-            if raw is None:
-                notes.append(f"phase of take {i}: no circular coordinate ({why}); latent angle")
-            phases.append(_latent_angle(z) if raw is None else raw)
-            source.append("latent angle" if raw is None else "coordinate")
-        return TakePhases(align_phases(phases, latent), source, notes)
+        own.append((u, why))
+    good = [i for i, (u, _) in enumerate(own) if u is not None]
+    if not good:
+        for i, (_, why) in enumerate(own):
+            notes.append(f"phase of take {i}: no circular coordinate ({why}); latent angle")
+        phases = [_latent_angle(z) for z in latent]
+        return TakePhases(align_phases(phases, latent), ["latent angle"] * len(takes), notes)
     aligned = align_phases([own[i][0] for i in good], [latent[i] for i in good])
     phases: list = [None] * len(takes)
     source = ["coordinate"] * len(takes)
@@ -177,12 +166,33 @@ def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePh
     ref_phase = np.concatenate(aligned)
     ref_z = np.vstack([latent[i] for i in good])
     rate = float(np.median(np.concatenate([np.diff(u) for u in aligned])))
-    for i, (u, why, _) in enumerate(own):
-        if u is None:
-            phases[i] = match_phase(latent[i], ref_phase, ref_z, rate)
-            source[i] = "matched"
+    for i, (u, why) in enumerate(own):
+        if u is not None:
+            continue
+        m = match_phase(latent[i], ref_phase, ref_z, rate)
+        if match_misfit(latent[i], m, ref_phase, ref_z) <= MATCH_MAX_MISFIT:
+            phases[i], source[i] = m, "matched"
             notes.append(f"phase of take {i}: matched to the other takes' cycle ({why})")
+        else:  # not the others' gait (a walk backwards against walks forwards)
+            phases[i] = align_phases([ref_phase, _latent_angle(latent[i])],
+                                     [ref_z, latent[i]])[1]
+            source[i] = "latent angle"
+            notes.append(f"phase of take {i}: no circular coordinate ({why}) and its poses "
+                         "do not follow the other takes' cycle; latent angle")
     return TakePhases(phases, source, notes)
+
+
+def match_misfit(
+    z: np.ndarray, phase: np.ndarray, ref_phase: np.ndarray, ref_z: np.ndarray,
+    bins: int = MATCH_BINS,
+) -> float:
+    """Mean squared distance of a take's latent points ``z`` from the reference frames'
+    mean point at their phases, over the mean squared spread of those mean points about
+    their centre (0: on the cycle; about 1 or more: anywhere else)."""
+    ref = _binned(np.asarray(ref_phase, dtype=float), np.asarray(ref_z, dtype=float), bins)
+    spread = float(((ref - ref.mean(axis=0)) ** 2).sum(axis=1).mean()) or 1.0
+    b = np.floor((np.asarray(phase, dtype=float) % 1.0) * bins).astype(int) % bins
+    return float(((np.asarray(z, dtype=float) - ref[b]) ** 2).sum(axis=1).mean() / spread)
 
 
 def match_phase(
