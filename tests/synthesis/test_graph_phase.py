@@ -289,3 +289,33 @@ def test_the_synthesiser_widens_nothing_when_a_take_is_another_gait(walks, monke
         kept = MotionGraphSynth(method="delaunay+phase", dims="auto").fit(walks)
     assert widened.gain_.max() > 1.0 and not any("not widened" in n for n in widened.phase_notes_)
     assert np.all(kept.gain_ == 1.0) and "strides not widened: t is not it" in kept.phase_notes_
+
+
+def test_a_start_at_a_reference_first_frame_starts_at_the_motion(walks):
+    """A take whose frame 0 is a reference pose (Xsens exports: a T-pose before the
+    motion) is started at frame 1 with a note; from the reference pose the path snapped
+    into the walk at 20x the takes' 99th percentile of pose step (the Xsens walk's halves:
+    accel 45x, 3.3x after)."""
+    from cyclecoord.rig import describe_rig
+
+    frames = walks[0].frames.copy()
+    root = [walks[0].channel_index("root", d) for d in ("tx", "ty", "tz", "rx", "ry", "rz")]
+    arms = [walks[0].channel_index(j, "rz") for j in ("lhumerus", "rhumerus")]
+    rest = np.zeros_like(frames[0])
+    rest[root] = frames[1, root]
+    rest[arms] = [-90.0, 90.0]  # arms out: a T-pose
+    frames[0] = rest
+    posed = walks[0].with_frames(frames)
+    assert describe_rig(posed).reference_frame
+    takes = [posed, walks[1], walks[2]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(takes)
+    gen = synth.generate(200, 0, 0)
+    assert gen.start["frame"] == 1
+    assert any("frame 0 is a reference pose" in n for n in gen.notes)
+    q = measure_generated(gen.motion, takes[1:])
+    assert q.largest_step <= 2.0
+    # a start at any other frame, or on a take without one, is left alone
+    assert synth.generate(50, 0, 5).start["frame"] == 5
+    assert synth.generate(50, 1, 0).start["frame"] == 0

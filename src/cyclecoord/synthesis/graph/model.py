@@ -136,6 +136,7 @@ class MotionGraphSynth:
         raw = check_takes(takes, minimum=2)
         self.names_ = [take_name(m, i) for i, m in enumerate(raw)]
         self.takes_, self.rig_ = _analysis_takes(raw)
+        self.reference_frames_ = [_has_reference_frame(m) for m in raw]
         self.dims_ = auto_dims(self.takes_) if self.dims == "auto" else int(self.dims)
         self.space_ = PoseSpace(self.dims_).fit(self.takes_)
         self.floor_, self.accel_limit_ = _ground(self.takes_) if self.carry else (None, None)
@@ -191,6 +192,21 @@ class MotionGraphSynth:
             )
         return motion, int(frame) % n, name
 
+    def _past_reference(self, start: Motion | int, f: int, name: str) -> tuple[int, list]:
+        """Frame 1 instead of a start at a take's reference first frame (a T-pose before
+        the motion, as Xsens exports have; starting there, the path snapped into the walk
+        at 20x the takes' 99th percentile of pose step), with a note."""
+        if f != 0:
+            return f, []
+        if isinstance(start, Motion):
+            ref = _has_reference_frame(start)
+        else:
+            ref = self.reference_frames_[int(start)]
+        if not ref:
+            return f, []
+        return 1, [f"start: {name}'s frame 0 is a reference pose, not a pose of its motion; "
+                   "started at frame 1"]
+
     def start_point(self, start: Motion | int = 0, frame: int = 0) -> np.ndarray:
         """The latent point ``(d,)`` of a take's frame."""
         motion, f, _ = self._start(start, frame)
@@ -217,6 +233,7 @@ class MotionGraphSynth:
             D = self.takes_[0].n_channels
             check_memory(n_frames * 8.0 * (8 * D + 64), f"{n_frames:,} generated frames")
         motion, f, name = self._start(start, frame)
+        f, said = self._past_reference(start, f, name)
         x0 = self.space_.transform(motion[f])[0]
         if self.phase_field_ is not None:
             from .phase import follow_phase
@@ -224,7 +241,9 @@ class MotionGraphSynth:
             path = follow_phase(self.phase_field_, x0, n_frames, self.step_scale)
         else:
             path = follow_field(self.field_, x0, n_frames, self.integrator, self.step_scale)
-        return self._result(path, motion, f, name, x0)
+        out = self._result(path, motion, f, name, x0)
+        out.notes[:0] = said
+        return out
 
     @one_blas_thread
     def to_target(
@@ -237,11 +256,14 @@ class MotionGraphSynth:
     ) -> Generation:
         """The shortest graph path from one take's frame to another's (paper §V-A), playable."""
         motion, f, name = self._start(start, frame)
+        f, said = self._past_reference(start, f, name)
         tmotion, tf, _ = self._start(target, target_frame)
         x0 = self.space_.transform(motion[f])[0]
         x1 = self.space_.transform(tmotion[tf])[0]
         path = path_to_target(self.graph_, x0, x1, speed)
-        return self._result(path, motion, f, name, x0)
+        out = self._result(path, motion, f, name, x0)
+        out.notes[:0] = said
+        return out
 
     def _result(
         self, path: GraphPath, motion: Motion, f: int, name: str, x0: np.ndarray
@@ -285,6 +307,19 @@ class MotionGraphSynth:
             start={"take": name, "frame": f, "latent": x0.tolist()},
             notes=notes,
         )
+
+
+def _has_reference_frame(m: Motion) -> bool:
+    """Whether a take's first frame is a reference pose (:func:`cyclecoord.rig.describe_rig`)."""
+    from ...errors import CycleCoordError
+    from ...rig import describe_rig
+
+    if m.skeleton is None or m.n_frames < 3:
+        return False
+    try:
+        return bool(describe_rig(m).reference_frame)
+    except CycleCoordError:
+        return False
 
 
 def _analysis_takes(takes: Sequence[Motion]) -> tuple[list[Motion], Any]:
