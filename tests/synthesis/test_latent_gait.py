@@ -613,3 +613,34 @@ def test_the_loop_search_is_kept_for_the_values_it_was_made_for():
     other[(phase >= 1.4) & (phase <= 2.2)] += 0.5
     assert gait._loop(0, other) is not first
     assert gait._loop(0, other)[1] != first[1]
+
+
+def _with_reference_frame(m):
+    """The take with its frame 0 made a reference pose (arms out, the rest at rest),
+    as Xsens exports begin."""
+    from cyclecoord.rig import describe_rig
+
+    frames = m.frames.copy()
+    root = [m.channel_index("root", d) for d in ("tx", "ty", "tz", "rx", "ry", "rz")]
+    rest = np.zeros_like(frames[0])
+    rest[root] = frames[1, root]
+    rest[[m.channel_index(j, "rz") for j in ("lhumerus", "rhumerus")]] = [-90.0, 90.0]
+    frames[0] = rest
+    out = m.with_frames(frames)
+    assert describe_rig(out).reference_frame
+    return out
+
+
+def test_a_take_with_a_reference_first_frame_gets_a_gait():
+    """extract drops a reference first frame, so its phases were one short of the take's
+    frames and the model's fit failed with an IndexError (the Xsens walk, every fourth
+    frame: 625 phases for 626 frames); the phases are now placed on the take's frames."""
+    walk = cc.datasets.make_periodic_capture(kind="walk", n_frames=300, period=120,
+                                             random_state=0).motion
+    res = cc.extract(_with_reference_frame(walk), require_clear=False)
+    got = res.on_frames(res.phase, _with_reference_frame(walk))
+    assert got.shape == (walk.n_frames,) and np.isnan(got[0])
+    np.testing.assert_array_equal(got[1:], res.phase)
+    lm = LatentModel(gplvm={"max_iter": 30}).fit([_with_reference_frame(walk)], ["walk"])
+    g = lm.gait()
+    assert np.isfinite(g.period[0]) and np.isfinite(g.phase).all()

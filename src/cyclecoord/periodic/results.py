@@ -229,6 +229,30 @@ class ExtractionResult:
             return None
         return {**self.rig.to_dict(), "changes": list(self.rig_changes)}
 
+    def on_frames(self, values: np.ndarray, take: Motion) -> np.ndarray:
+        """Per-frame ``values`` of the analysed frames (``coordinate``, ``phase``, ...)
+        placed on the frames of ``take``, the capture passed to :func:`extract`: NaN on
+        frames the analysis left out before or after its own (a reference first frame
+        it dropped, such as an Xsens T-pose; a ``frames=`` selection).
+
+        Parameters
+        ----------
+        values : ndarray, shape (T,)
+        take : Motion
+            With ``T_take`` frames.
+
+        Returns
+        -------
+        ndarray, shape (T_take,)
+        """
+        v = np.asarray(values, dtype=float).reshape(-1)
+        off = int(self.motion.start_frame) - int(take.start_frame)
+        off = min(max(off, 0), take.n_frames)
+        out = np.full(take.n_frames, np.nan)
+        n = min(v.size, take.n_frames - off)
+        out[off : off + n] = v[:n]
+        return out
+
     @property
     def used_frames(self) -> list[tuple[int, int]]:
         """The steady stretches the cycle was built from, ``[(start, stop), ...]`` (0-based)."""

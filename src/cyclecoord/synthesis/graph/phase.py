@@ -120,20 +120,6 @@ def _phase_of(result) -> np.ndarray:
     return np.asarray(result.coordinate, dtype=float)
 
 
-def _on_frames(result, take: Motion) -> np.ndarray:
-    """:func:`_phase_of` a take's extraction, one value per frame of the take: extract
-    drops a reference first frame (an Xsens T-pose), which gets NaN here (the graph
-    failed on such a take: 2,502 phases for 2,503 frames)."""
-    c = _phase_of(result)
-    motion = getattr(result, "motion", None)
-    off = int(motion.start_frame) - int(take.start_frame) if motion is not None else 0
-    out = np.full(take.n_frames, np.nan)
-    off = min(max(off, 0), take.n_frames)
-    n = min(c.size, take.n_frames - off)
-    out[off : off + n] = c[:n]
-    return out
-
-
 def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePhases:
     """Each take's gait phase from the periodic pipeline's circular coordinate.
 
@@ -154,7 +140,9 @@ def take_phases(takes: Sequence[Motion], latent: Sequence[np.ndarray]) -> TakePh
         for turns in (None, SHORT_TURNS):  # a short take: fewer turns than extract asks
             try:
                 kw = {} if turns is None else {"min_turns": turns, "steady": False}
-                u = _fill(_on_frames(extract(m, random_state=0, **kw), m))
+                res = extract(m, random_state=0, **kw)
+                # one value per frame of the take (extract drops a reference first frame)
+                u = _fill(res.on_frames(_phase_of(res), m))
             except CycleCoordError as exc:
                 why = str(exc)
                 continue

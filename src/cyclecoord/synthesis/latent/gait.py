@@ -269,10 +269,13 @@ def training_gait(model) -> Gait:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                res = cc.extract(train[rows[0] : rows[-1] + 1], require_clear=False)
+                take = train[rows[0] : rows[-1] + 1]
+                res = cc.extract(take, require_clear=False)
         except (CycleCoordError, ValueError, np.linalg.LinAlgError):
             continue
-        p = res.phase
+        # one value per frame (extract drops a reference first frame, an Xsens T-pose:
+        # 625 phases for 626 frames failed the model's fit)
+        p = None if res.phase is None else res.on_frames(res.phase, take)
         P = float(res.period_frames)
         if p is None or not np.isfinite(P) or P <= 1 or rows.size < MIN_CYCLES * P:
             continue
