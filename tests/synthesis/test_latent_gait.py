@@ -644,3 +644,15 @@ def test_a_take_with_a_reference_first_frame_gets_a_gait():
     lm = LatentModel(gplvm={"max_iter": 30}).fit([_with_reference_frame(walk)], ["walk"])
     g = lm.gait()
     assert np.isfinite(g.period[0]) and np.isfinite(g.phase).all()
+    # a script starting there starts at the motion (the Xsens script snapped out of the
+    # T-pose at 9.8x the training p99 of acceleration; 0.23x after)
+    assert lm.is_reference_frame(0) and not lm.is_reference_frame(1)
+    for at in (None, {"frame": 0}):
+        syn = Synthesizer({"walk": lm}, fps=30)
+        syn.start("walk", at)
+        np.testing.assert_array_equal(syn.x, lm.X_[1])
+        assert any("frame 0 of 'walk' is a reference pose" in n for n in syn.notes)
+    syn = Synthesizer({"walk": lm}, fps=30)
+    syn.start("walk", {"frame": 5})
+    np.testing.assert_array_equal(syn.x, lm.X_[5])
+    assert not syn.notes

@@ -472,6 +472,20 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         """Place the particle in ``model`` (at a target, default its first training frame)."""
         m = self.model(model)
         self.current = model
+        k = None
+        if at is None:
+            k = 0
+        elif isinstance(at, dict) and set(at) == {"frame"}:
+            k = at["frame"]
+        if (
+            isinstance(k, int) and not isinstance(k, bool)
+            and 0 <= k < m.X_.shape[0] - 1 and m.is_reference_frame(k)
+        ):
+            # a T-pose before the capture's motion: the script snapped out of it at 10x
+            # the training 99th percentile of acceleration
+            self.notes.append(f"start: training frame {k} of {model!r} is a reference pose, "
+                              f"not a pose of its motion; started at frame {k + 1}")
+            at = {"frame": k + 1}
         self.x = self.target(at, model) if at is not None else m.X_[0].copy()
         self.v = np.zeros_like(self.x)
 

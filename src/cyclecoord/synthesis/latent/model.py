@@ -266,6 +266,7 @@ class LatentModel:
         self.X_ = self.gp_.X_
         self._detail = None
         self._frame_angles = None
+        self._reference_rows: set | None = None
         inv_w = np.where(
             self.weights_ > 0, 1.0 / np.where(self.weights_ > 0, self.weights_, 1.0), 0.0
         )
@@ -528,6 +529,29 @@ class LatentModel:
                 self.channels_[idx[0]][0] for idx, _, _ in self.chart()
             ],
         }
+
+    def is_reference_frame(self, k: int) -> bool:
+        """Whether training frame ``k`` is a reference pose: the first frame of a segment
+        whose capture begins with one (an Xsens T-pose; :func:`cyclecoord.rig.describe_rig`).
+        """
+        if self._reference_rows is None:
+            from ...errors import CycleCoordError
+            from ...rig import describe_rig
+
+            rows: set = set()
+            for s in np.unique(self.segments_):
+                idx = np.flatnonzero(self.segments_ == s)
+                if idx.size < 10:
+                    continue
+                seg = Motion(frames=self.frames_[idx], channels=self.all_channels_,
+                             fps=self.fps_, skeleton=self.skeleton_)
+                try:
+                    if describe_rig(seg).reference_frame:
+                        rows.add(int(idx[0]))
+                except CycleCoordError:
+                    continue
+            self._reference_rows = rows
+        return int(k) in self._reference_rows
 
     def training_motion(self) -> Motion:
         """The training frames as one motion (segments end to end)."""
