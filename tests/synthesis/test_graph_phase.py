@@ -98,6 +98,24 @@ def test_match_phase_recovers_a_short_takes_warped_phase():
     assert np.abs(err).max() < 0.03
 
 
+def _phases_without(takes, latent, bad, monkeypatch):
+    """take_phases with the periodic pipeline failing on the take ``bad``."""
+    from cyclecoord.errors import NoPeriodicMotionError
+    from cyclecoord.periodic import pipeline
+
+    real = pipeline.extract
+
+    def failing(m, **kw):
+        if m is bad:
+            raise NoPeriodicMotionError("no circle here")
+        return real(m, **kw)
+
+    with monkeypatch.context() as patch, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        patch.setattr(pipeline, "extract", failing)
+        return take_phases(takes, latent)
+
+
 def test_take_phases_matches_a_take_without_its_own_coordinate(walks, monkeypatch):
     """A take whose circular coordinate fails is matched to the others' cycle, with a
     note, not given the latent angle; with no take left, every take gets the angle."""
@@ -109,36 +127,17 @@ def test_take_phases_matches_a_take_without_its_own_coordinate(walks, monkeypatc
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         own = take_phases(walks, latent)
-    real = pipeline.extract
-
-    def failing(m, **kw):
-        if m is walks[1] or kw.get("min_turns") and m.n_frames == walks[1].n_frames:
-            raise NoPeriodicMotionError("no circle here")
-        return real(m, **kw)
-
-    monkeypatch.setattr(pipeline, "extract", failing)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        out = take_phases(walks, latent)
+    out = _phases_without(walks, latent, walks[1], monkeypatch)
     assert out.source == ["coordinate", "matched", "coordinate"]
     assert any("take 1: matched" in n and "no circle here" in n for n in out.notes)
     err = ((out.phases[1] - own.phases[1] + 0.5) % 1.0) - 0.5
     assert np.abs(err - np.median(err)).max() < 0.05 and abs(np.median(err)) < 0.05
-    # a take played backwards follows the others' cycle in reverse: its match would
-    # stand still, so it gets the latent angle (which runs, if unevenly)
+    # a take played backwards follows the others' cycle in reverse: its match lies far
+    # off (match_misfit), so it gets the latent angle (which runs, if unevenly)
     backwards = walks[1].with_frames(walks[1].frames[::-1].copy())
     takes = [walks[0], backwards, walks[2]]
     lat = [PoseSpace(3).fit(walks).transform(m) for m in takes]
-
-    def fails_backwards(m, **kw):
-        if m is backwards:
-            raise NoPeriodicMotionError("no circle here")
-        return real(m, **kw)
-
-    monkeypatch.setattr(pipeline, "extract", fails_backwards)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        rev = take_phases(takes, lat)
+    rev = _phases_without(takes, lat, backwards, monkeypatch)
     assert rev.source == ["coordinate", "latent angle", "coordinate"]
     assert any("do not follow the other takes' cycle" in n for n in rev.notes)
     assert rev.phases[1][-1] - rev.phases[1][0] > 1.0
