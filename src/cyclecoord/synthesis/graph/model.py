@@ -106,6 +106,13 @@ class MotionGraphSynth:
     field_ : VectorField
     takes_ : list of Motion
     names_ : list of str
+    reference_frames_ : list of bool
+        Per take, whether its frame 0 is a reference pose (a start there starts at 1).
+    phase_field_ : PhaseField or None
+        With ``+phase``; then also ``phase_notes_`` (how each take got its phase),
+        ``residual_`` (what the latent space leaves out of each training frame) and
+        ``gain_`` ``(A,)``, the leg angles' stride widening
+        (:func:`~.phase.amplitude_gain`; ones when a take is another gait).
     """
 
     def __init__(
@@ -153,17 +160,15 @@ class MotionGraphSynth:
             self.phase_field_ = PhaseField(self.graph_, tp.phases)
             self.residual_ = self.space_.residuals(self.takes_)
             angles = np.vstack([self.space_.angles(m) for m in self.takes_])
-            # the strides' amplitude only: widened arms brought a thumb into the back
-            self.gain_ = np.where(
-                _leg_columns(self.takes_[0], self.space_.channels_),
-                amplitude_gain(self.phase_field_, angles, self.takes_[0].fps),
-                1.0,
-            )
+            self.angle_mean_ = angles.mean(axis=0)
+            self.gain_ = np.ones(angles.shape[1])
             other = _other_gait(self.phase_field_, self.names_)
             if other:  # the averaging then mixes gaits, not strides: nothing to undo
-                self.gain_ = np.ones_like(self.gain_)
                 self.phase_notes_.append(f"strides not widened: {other}")
-            self.angle_mean_ = angles.mean(axis=0)
+            else:  # the strides' amplitude only: widened arms brought a thumb into the back
+                legs = _leg_columns(self.takes_[0], self.space_.channels_)
+                gain = amplitude_gain(self.phase_field_, angles, self.takes_[0].fps)
+                self.gain_[legs] = gain[legs]
         return self
 
     def _start(self, start: Motion | int, frame: int) -> tuple[Motion, int, str]:
