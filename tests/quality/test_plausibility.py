@@ -608,3 +608,21 @@ def test_check_plausibility_cache_reuses_a_report_only_for_the_same_joint_angles
     assert fresh.to_dict() == plaus.check_plausibility(m.with_frames(bent), [ref]).to_dict()
     other = plaus.check_plausibility(m, [ref, m], cache=cache)
     assert len(calls) == 4 and other.to_dict() == plaus.check_plausibility(m, [ref, m]).to_dict()
+
+
+def test_self_intersections_may_skip_pairs_a_body_apart():
+    """``far="skip"`` leaves out pairs whose bones never come within the clearance of
+    each other's bounding sphere: every flag and every distance under the clearance is
+    as measured, the skipped ones read infinity (they are farther apart than that)."""
+    walk = cc.datasets.make_periodic_capture(kind="walk", n_frames=120, random_state=3).motion
+    for thr in (0.5, 2.0, 6.0):
+        full = self_intersections(walk, thr)
+        quick = self_intersections(walk, thr, far="skip")
+        assert (quick.flagged == full.flagged).all()
+        skipped = np.isinf(quick.distances)
+        assert skipped.any() and (full.distances[skipped] >= thr).all()
+        np.testing.assert_array_equal(quick.distances[~skipped], full.distances[~skipped])
+        under = full.distances < thr
+        np.testing.assert_array_equal(quick.distances[under], full.distances[under])
+    with pytest.raises(ParameterError, match="far"):
+        self_intersections(walk, 1.0, far="nowhere")

@@ -285,11 +285,30 @@ class SelfIntersections:
         return out
 
 
+def _near_pairs(motion: Motion, bn: Bones, threshold: float) -> np.ndarray:
+    """(Q,) pairs whose bones come within ``threshold`` of each other's bounding sphere
+    on some frame (centred on the bone's midpoint, radius half its length): the others
+    are never closer than ``threshold``."""
+    pos = motion.positions().positions
+    mid = 0.5 * (pos[:, bn.start] + pos[:, bn.end])  # (T, B, 3)
+    half = 0.5 * np.linalg.norm(pos[:, bn.end] - pos[:, bn.start], axis=-1)  # (T, B)
+    a, b = bn.pairs[:, 0], bn.pairs[:, 1]
+    near = np.zeros(a.size, dtype=bool)
+    step = max(1, _CHUNK // max(a.size, 1))
+    for lo in range(0, pos.shape[0], step):
+        m, h = mid[lo : lo + step], half[lo : lo + step]
+        reach = threshold + h[:, a] + h[:, b]
+        d2 = ((m[:, a] - m[:, b]) ** 2).sum(axis=-1)
+        near |= (d2 < reach * reach).any(axis=0)
+    return near
+
+
 def self_intersections(
     motion: Motion,
     threshold: float | None = None,
     *,
     ignore_rest_contacts: bool = True,
+    far: str = "measure",
 ) -> SelfIntersections:
     """Frames where two bones that share no joint come closer than a clearance.
 
@@ -312,6 +331,12 @@ def self_intersections(
         such as fingers and thumb, or the upper neck and the clavicles.  Pairs further
         apart in the skeleton (a hand and a thigh) are always checked, even if they
         touch at rest.
+    far : {"measure", "skip"}, default "measure"
+        ``"skip"``: pairs whose bones never come within ``threshold`` of each other's
+        bounding sphere (:func:`_near_pairs`) are not measured; their distances and
+        closest approach read infinity.  Every flag, and every distance under the
+        threshold, is as measured (:func:`check_plausibility` needs no more; a latent
+        script's checks spent half their time on pairs a body apart).
 
     Returns
     -------
@@ -324,7 +349,15 @@ def self_intersections(
         threshold = DEFAULT_CLEARANCE * motion.skeleton.total_length()  # type: ignore[union-attr]
     if not np.isfinite(threshold) or threshold <= 0:
         raise ParameterError(f"threshold must be a positive length, got {threshold!r}")
-    dist = _pair_distances(motion, bn)
+    if far not in ("measure", "skip"):
+        raise ParameterError(f"far must be 'measure' or 'skip', got {far!r}")
+    if far == "skip":
+        near = _near_pairs(motion, bn, float(threshold))
+        dist = np.full((motion.n_frames, bn.pairs.shape[0]), np.inf)
+        if near.any():
+            dist[:, near] = _pair_distances(motion, bn, near)
+    else:
+        dist = _pair_distances(motion, bn)
     if ignore_rest_contacts:
         ignored = (bn.rest_distance < threshold) & bn.second_neighbours
     else:
@@ -631,7 +664,7 @@ def check_plausibility(
         cache_key = (_signature(motion, True), tuple(ref_keys), threshold, float(margin_deg))
         if cache_key in cache:
             return copy.deepcopy(cache[cache_key])
-    inter = self_intersections(motion, threshold)
+    inter = self_intersections(motion, threshold, far="skip")
     thr = inter.threshold
     size = motion.skeleton.total_length()  # type: ignore[union-attr]
     names = inter.bones.pair_names()
