@@ -309,6 +309,7 @@ def self_intersections(
     *,
     ignore_rest_contacts: bool = True,
     far: str = "measure",
+    bones_: Bones | None = None,
 ) -> SelfIntersections:
     """Frames where two bones that share no joint come closer than a clearance.
 
@@ -337,6 +338,8 @@ def self_intersections(
         closest approach read infinity.  Every flag, and every distance under the
         threshold, is as measured (:func:`check_plausibility` needs no more; a latent
         script's checks spent half their time on pairs a body apart).
+    bones_ : Bones, optional
+        :func:`bones` of the motion's skeleton, already made.
 
     Returns
     -------
@@ -344,7 +347,7 @@ def self_intersections(
     """
     if not isinstance(motion, Motion):
         raise ParameterError(f"expected a Motion, got {type(motion).__name__}")
-    bn = bones(motion)
+    bn = bones(motion) if bones_ is None else bones_
     if threshold is None:
         threshold = DEFAULT_CLEARANCE * motion.skeleton.total_length()  # type: ignore[union-attr]
     if not np.isfinite(threshold) or threshold <= 0:
@@ -609,6 +612,21 @@ def _signature(motion: Motion, joints_only: bool) -> tuple:
     return (motion.n_frames, int(motion.start_frame), h.hexdigest())
 
 
+def _cached_bones(motion: Motion, cache: dict | None) -> Bones:
+    """:func:`bones` of a motion's skeleton, kept in ``cache`` under its joints and
+    offsets (a latent script asked for the same skeleton's some twenty times)."""
+    if cache is None:
+        return bones(motion)
+    skel = motion.skeleton
+    key = ("bones", None if skel is None else tuple(
+        (j.name, int(j.parent), tuple(np.asarray(j.offset, dtype=float).tolist()))
+        for j in skel.joints
+    ))
+    if key not in cache:
+        cache[key] = bones(motion)
+    return cache[key]
+
+
 def check_plausibility(
     motion: Motion,
     references: Sequence[Motion] = (),
@@ -656,15 +674,23 @@ def check_plausibility(
 
     # in the analysis rig: a static root at the origin is no bone to the travelling hips
     motion = analysis_motion(motion)
-    references = [analysis_motion(r) for r in references]
     cache_key = None
     ref_keys: list = [None] * len(references)
-    if cache is not None:
+    if cache is None:
+        references = [analysis_motion(r) for r in references]
+    else:  # each reference's analysis rig once, under its own content
         ref_keys = [_signature(r, False) for r in references]
+        analysed = []
+        for r, k in zip(references, ref_keys):
+            if ("analysis", k) not in cache:
+                cache[("analysis", k)] = analysis_motion(r)
+            analysed.append(cache[("analysis", k)])
+        references = analysed
         cache_key = (_signature(motion, True), tuple(ref_keys), threshold, float(margin_deg))
         if cache_key in cache:
             return copy.deepcopy(cache[cache_key])
-    inter = self_intersections(motion, threshold, far="skip")
+    inter = self_intersections(motion, threshold, far="skip",
+                               bones_=_cached_bones(motion, cache))
     thr = inter.threshold
     size = motion.skeleton.total_length()  # type: ignore[union-attr]
     names = inter.bones.pair_names()
@@ -676,7 +702,7 @@ def check_plausibility(
         if r.skeleton is None:
             continue
         for v, view in enumerate(_reference_views(r, motion)):
-            rb = bones(view)
+            rb = _cached_bones(view, cache)
             rnames = rb.pair_names()
             which = np.array([k in wanted for k in rnames], dtype=bool)
             if not which.any():
