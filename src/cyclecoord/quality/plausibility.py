@@ -594,7 +594,8 @@ def _reference_views(reference: Motion, motion: Motion) -> list[Motion]:
 def _signature(motion: Motion, joints_only: bool) -> tuple:
     """A content key of a motion for :func:`check_plausibility`'s ``cache``: its frames
     (only the non-root channels with ``joints_only``: the root's motion moves no bone
-    against another), frame numbers and skeleton."""
+    against another; on a static-root rig the travelling hips' channels count, which
+    only costs hits), frame numbers and skeleton."""
     import hashlib
 
     frames = np.asarray(motion.frames, dtype=float)
@@ -672,23 +673,23 @@ def check_plausibility(
     """
     from ..rig import analysis_motion
 
-    # in the analysis rig: a static root at the origin is no bone to the travelling hips
-    motion = analysis_motion(motion)
     cache_key = None
     ref_keys: list = [None] * len(references)
     if cache is None:
         references = [analysis_motion(r) for r in references]
     else:  # each reference's analysis rig once, under its own content
         ref_keys = [_signature(r, False) for r in references]
+        cache_key = (_signature(motion, True), tuple(ref_keys), threshold, float(margin_deg))
+        if cache_key in cache:
+            return copy.deepcopy(cache[cache_key])
         analysed = []
         for r, k in zip(references, ref_keys):
             if ("analysis", k) not in cache:
                 cache[("analysis", k)] = analysis_motion(r)
             analysed.append(cache[("analysis", k)])
         references = analysed
-        cache_key = (_signature(motion, True), tuple(ref_keys), threshold, float(margin_deg))
-        if cache_key in cache:
-            return copy.deepcopy(cache[cache_key])
+    # in the analysis rig: a static root at the origin is no bone to the travelling hips
+    motion = analysis_motion(motion)
     inter = self_intersections(motion, threshold, far="skip",
                                bones_=_cached_bones(motion, cache))
     thr = inter.threshold

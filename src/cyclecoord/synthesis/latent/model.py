@@ -266,7 +266,7 @@ class LatentModel:
         self.X_ = self.gp_.X_
         self._detail = None
         self._frame_angles = None
-        self._reference_rows: set | None = None
+        self._reference_rows: dict | None = None
         inv_w = np.where(
             self.weights_ > 0, 1.0 / np.where(self.weights_ > 0, self.weights_, 1.0), 0.0
         )
@@ -534,24 +534,23 @@ class LatentModel:
         """Whether training frame ``k`` is a reference pose: the first frame of a segment
         whose capture begins with one (an Xsens T-pose; :func:`cyclecoord.rig.describe_rig`).
         """
-        if self._reference_rows is None:
-            from ...errors import CycleCoordError
-            from ...rig import describe_rig
+        from ...errors import CycleCoordError
+        from ...rig import describe_rig
 
-            rows: set = set()
-            for s in np.unique(self.segments_):
-                idx = np.flatnonzero(self.segments_ == s)
-                if idx.size < 10:
-                    continue
-                seg = Motion(frames=self.frames_[idx], channels=self.all_channels_,
-                             fps=self.fps_, skeleton=self.skeleton_)
-                try:
-                    if describe_rig(seg).reference_frame:
-                        rows.add(int(idx[0]))
-                except CycleCoordError:
-                    continue
-            self._reference_rows = rows
-        return int(k) in self._reference_rows
+        k = int(k)
+        idx = np.flatnonzero(self.segments_ == self.segments_[k])
+        if k != idx[0] or idx.size < 10:
+            return False
+        if self._reference_rows is None:
+            self._reference_rows = {}
+        if k not in self._reference_rows:  # each segment's capture described once
+            seg = Motion(frames=self.frames_[idx], channels=self.all_channels_,
+                         fps=self.fps_, skeleton=self.skeleton_)
+            try:
+                self._reference_rows[k] = bool(describe_rig(seg).reference_frame)
+            except CycleCoordError:
+                self._reference_rows[k] = False
+        return self._reference_rows[k]
 
     def training_motion(self) -> Motion:
         """The training frames as one motion (segments end to end)."""
