@@ -628,6 +628,42 @@ def _cached_bones(motion: Motion, cache: dict | None) -> Bones:
     return cache[key]
 
 
+def _reference_minima(
+    motion: Motion, references: Sequence[Motion], ref_keys: list, wanted: set,
+    cache: dict | None,
+) -> dict[tuple[str, str], float]:
+    """The references' closest approach of each bone pair in ``wanted`` (by bone names),
+    scaled to ``motion``'s size, over each reference's views (:func:`_reference_views`);
+    with ``cache``, each pair of each view measured once."""
+    size = motion.skeleton.total_length()  # type: ignore[union-attr]
+    ref_min: dict[tuple[str, str], float] = {}
+    for r, rkey in zip(references, ref_keys) if wanted else ():
+        if r.skeleton is None:
+            continue
+        for v, view in enumerate(_reference_views(r, motion)):
+            rb = _cached_bones(view, cache)
+            rnames = rb.pair_names()
+            which = np.array([k in wanted for k in rnames], dtype=bool)
+            if not which.any():
+                continue
+            rsize = view.skeleton.total_length()  # type: ignore[union-attr]
+            scale = size / rsize if rsize > 0 else 1.0
+            names_in = [k for k, w in zip(rnames, which) if w]
+            if cache is not None:  # each pair's closest approach in this view, once
+                vkey = ("reference pairs", rkey, v, _signature(view, False)[2], size)
+                known = cache.setdefault(vkey, {})
+                todo = np.array([w and k not in known for k, w in zip(rnames, which)])
+                if todo.any():
+                    rd = _pair_distances(view, rb, todo).min(axis=0) * scale
+                    known.update(zip([k for k, t in zip(rnames, todo) if t], map(float, rd)))
+                dists = [known[k] for k in names_in]
+            else:
+                dists = list(_pair_distances(view, rb, which).min(axis=0) * scale)
+            for pair, d in zip(names_in, dists):
+                ref_min[pair] = min(ref_min.get(pair, np.inf), float(d))
+    return ref_min
+
+
 def check_plausibility(
     motion: Motion,
     references: Sequence[Motion] = (),
@@ -693,37 +729,11 @@ def check_plausibility(
     inter = self_intersections(motion, threshold, far="skip",
                                bones_=_cached_bones(motion, cache))
     thr = inter.threshold
-    size = motion.skeleton.total_length()  # type: ignore[union-attr]
     names = inter.bones.pair_names()
-    ref_min: dict[tuple[str, str], float] = {}
     # the references' closest approach matters for the pairs the motion brings close only
     wanted = {names[q] for q in np.flatnonzero(inter.flagged.any(axis=0))}
     wanted |= {(k[1], k[0]) for k in wanted}
-    for r, rkey in zip(references, ref_keys) if wanted else ():
-        if r.skeleton is None:
-            continue
-        for v, view in enumerate(_reference_views(r, motion)):
-            rb = _cached_bones(view, cache)
-            rnames = rb.pair_names()
-            which = np.array([k in wanted for k in rnames], dtype=bool)
-            if not which.any():
-                continue
-            rsize = view.skeleton.total_length()  # type: ignore[union-attr]
-            scale = size / rsize if rsize > 0 else 1.0
-            names_in = [k for k, w in zip(rnames, which) if w]
-            known = {}
-            if cache is not None:  # each pair's closest approach in this view, once
-                vkey = ("reference pairs", rkey, v, _signature(view, False)[2], size)
-                known = cache.setdefault(vkey, {})
-                todo = np.array([w and k not in known for k, w in zip(rnames, which)])
-                if todo.any():
-                    rd = _pair_distances(view, rb, todo).min(axis=0) * scale
-                    known.update(zip([k for k, t in zip(rnames, todo) if t], map(float, rd)))
-                dists = [known[k] for k in names_in]
-            else:
-                dists = list(_pair_distances(view, rb, which).min(axis=0) * scale)
-            for pair, d in zip(names_in, dists):
-                ref_min[pair] = min(ref_min.get(pair, np.inf), float(d))
+    ref_min = _reference_minima(motion, references, ref_keys, wanted, cache)
     contacts = []
     new_mask = np.zeros(inter.flagged.shape[0], dtype=bool)
     notes: list[str] = []
