@@ -81,17 +81,23 @@ def test_cadence_ranges_and_pops_match_the_training_takes(models, made, part, co
     assert q.longest_freeze_s <= 0.2
 
 
-def _chain(models, smooth, radius=0.15):
-    """Four MOVEs ahead in the walk, a TRANSITION to the run, two MOVEs; no planting, and
-    no gait detail (the captured frames' own, which the path's smoothing leaves alone)."""
-    syn = Synthesizer(models, fps=30, seed=0, plant="off", lock=False, detail=False,
-                      params=ParticleParams(smooth=smooth, radius=radius))
+def _walk_then_hop(syn):
+    """Four MOVEs ahead in the walk from its frame 0, then a TRANSITION to the run."""
     syn.start("walk", {"frame": 0})
     for _ in range(4):
         syn.command += 1
         syn.move({"ahead": 0.3}, stop=False)
     syn.command += 1
     syn.transition("run", blend=0.4)
+    return syn
+
+
+def _chain(models, smooth, radius=0.15):
+    """Four MOVEs ahead in the walk, a TRANSITION to the run, two MOVEs; no planting, and
+    no gait detail (the captured frames' own, which the path's smoothing leaves alone)."""
+    syn = _walk_then_hop(Synthesizer(models, fps=30, seed=0, plant="off", lock=False,
+                                     detail=False,
+                                     params=ParticleParams(smooth=smooth, radius=radius)))
     for _ in range(2):
         syn.command += 1
         syn.move({"ahead": 0.3}, stop=False)
@@ -666,14 +672,8 @@ def test_an_in_step_transition_starts_where_the_particle_is(models):
     so the blend starts where the last MOVE left the pose."""
     jumps = []
     for seed in range(6):
-        syn = Synthesizer(models, fps=30, seed=seed, plant="off",
-                          params=ParticleParams().replace(random=6.0))
-        syn.start("walk", {"frame": 0})
-        for _ in range(4):
-            syn.command += 1
-            syn.move({"ahead": 0.3}, stop=False)
-        syn.command += 1
-        syn.transition("run", blend=0.4)
+        syn = _walk_then_hop(Synthesizer(models, fps=30, seed=seed, plant="off",
+                                         params=ParticleParams().replace(random=6.0)))
         angles, _ = syn._posed()
         start = syn.events[-1]["start_frame"]
         steps = np.linalg.norm(np.diff(angles, axis=0), axis=1)
