@@ -626,3 +626,49 @@ def test_self_intersections_may_skip_pairs_a_body_apart():
         np.testing.assert_array_equal(quick.distances[under], full.distances[under])
     with pytest.raises(ParameterError, match="far"):
         self_intersections(walk, 1.0, far="nowhere")
+
+
+def test_check_plausibility_base_measures_only_the_pairs_a_changed_joint_moves(monkeypatch):
+    """With ``base=`` (a motion checked before with the same cache), a motion that changes
+    some joints' channels on some frames is measured again only on the bone pairs those
+    joints move, on those frames: the report and every distance read as a fresh check's,
+    while far fewer distances are computed."""
+    import cyclecoord.quality.plausibility as plaus
+
+    m = cc.datasets.make_periodic_capture(kind="walk", n_frames=90, random_state=2).motion
+    ref = cc.datasets.make_periodic_capture(kind="walk", n_frames=90, random_state=5).motion
+    cache: dict = {}
+    plaus.check_plausibility(m, [ref], cache=cache)
+    frames = m.frames.copy()
+    frames[20:50, m.channel_index("ltibia", "rx")] += 35.0  # the left shin swings in ...
+    frames[30:40, m.channel_index("lfemur", "rz")] -= 25.0  # ... and the thigh crosses
+    trial = m.with_frames(frames)
+    sizes = []
+    real = plaus._element_distances
+    monkeypatch.setattr(plaus, "_element_distances",
+                        lambda mo, bn, which: sizes.append(int(which.sum())) or real(mo, bn, which))
+    quick = plaus.check_plausibility(trial, [ref], cache=cache, base=m)
+    assert quick.to_dict() == plaus.check_plausibility(trial, [ref]).to_dict()
+    inter = cache[("intersections", plaus._signature(trial, True), None)][1]
+    full = self_intersections(trial, inter.threshold)
+    near = np.isfinite(inter.distances)
+    np.testing.assert_array_equal(inter.distances[near], full.distances[near])
+    assert (full.distances[~near] >= inter.threshold).all()
+    assert (inter.flagged == full.flagged).all()
+    fresh = plaus._near_elements(trial, inter.bones, inter.threshold).sum()
+    assert 0 < sizes[0] < fresh / 3  # (the other frames and pairs are base's)
+    # not comparable (another length): measured afresh, the same report
+    short = m.window((0, 60))
+    assert plaus.check_plausibility(short, [ref], cache=cache, base=m).to_dict() == (
+        plaus.check_plausibility(short, [ref]).to_dict())
+
+
+def test_check_plausibility_analysed_skips_finding_the_rig_and_reads_the_same():
+    """``analysed=True`` (the motion and references already in the analysis rig) gives
+    the report the rig search would give on such a motion."""
+    m = cc.datasets.make_periodic_capture(kind="walk", n_frames=60, random_state=0).motion
+    ref = cc.datasets.make_periodic_capture(kind="walk", n_frames=60, random_state=1).motion
+    assert cc.rig.analysis_motion(m) is m
+    plain = check_plausibility(m, [ref]).to_dict()
+    assert check_plausibility(m, [ref], analysed=True).to_dict() == plain
+    assert check_plausibility(m, [ref], cache={}, analysed=True).to_dict() == plain

@@ -22,7 +22,9 @@ import numpy as np
 
 from ..errors import ImplausibleMotionError, ParameterError
 from ..motion import Motion
-from .bones import Bones, _near_pairs, _pair_distances, bones, segment_distances
+from .bones import (
+    Bones, _element_distances, _near_elements, _pair_distances, bones, segment_distances,
+)
 
 __all__ = [
     "Bones",
@@ -128,11 +130,13 @@ def self_intersections(
         apart in the skeleton (a hand and a thigh) are always checked, even if they
         touch at rest.
     far : {"measure", "skip"}, default "measure"
-        ``"skip"``: pairs whose bones never come within ``threshold`` of each other's
-        bounding sphere (:func:`_near_pairs`) are not measured; their distances and
-        closest approach read infinity.  Every flag, and every distance under the
+        ``"skip"``: a pair is measured only on the frames where its bones come within
+        ``threshold`` of each other's bounding sphere (``bones._near_elements``);
+        elsewhere its distance reads infinity, and its closest approach is over the
+        measured frames (infinity when none).  Every flag, and every distance under the
         threshold, is as measured (:func:`check_plausibility` needs no more; a latent
-        script's checks spent half their time on pairs a body apart).
+        script's checks spent half their time on pairs a body apart, and the pairs
+        that do come near are measured on about half their frames).
     bones_ : Bones, optional
         :func:`bones` of the motion's skeleton, already made.
 
@@ -150,10 +154,7 @@ def self_intersections(
     if far not in ("measure", "skip"):
         raise ParameterError(f"far must be 'measure' or 'skip', got {far!r}")
     if far == "skip":
-        near = _near_pairs(motion, bn, float(threshold))
-        dist = np.full((motion.n_frames, bn.pairs.shape[0]), np.inf)
-        if near.any():
-            dist[:, near] = _pair_distances(motion, bn, near)
+        dist = _element_distances(motion, bn, _near_elements(motion, bn, float(threshold)))
     else:
         dist = _pair_distances(motion, bn)
     if ignore_rest_contacts:
@@ -252,32 +253,61 @@ def joint_range_violations(
         raise ParameterError("joint_range_violations needs at least one reference Motion")
     if not np.isfinite(margin_deg) or margin_deg < 0:
         raise ParameterError(f"margin_deg must be a non-negative number, got {margin_deg!r}")
+    return _range_violations(motion, _channel_ranges(motion, refs, margin_deg))
+
+
+def _channel_ranges(
+    motion: Motion, refs: Sequence[Motion], margin_deg: float
+) -> list[tuple[int, float, float]]:
+    """``(column, low, high)`` of each joint angle channel of ``motion`` the references
+    have: their range in ``motion``'s conventions, on one turn, widened by the margin."""
     refs = [_in_convention_of(r, motion) for r in refs]
-    out: list[JointRangeViolation] = []
-    for c in _joint_angle_columns(motion):
-        ch = motion.channels[c]
-        vals = []
-        for r in refs:
-            if ch in r.channels:
-                vals.append(np.unwrap(r.frames[:, r.channel_index(*ch)], period=360.0))
-        if not vals:
+    cols = _joint_angle_columns(motion)
+    C = len(cols)
+    mean, low, high = (np.full((len(refs), C), np.nan) for _ in range(3))
+    for i, r in enumerate(refs):  # each reference's channels unwrapped at once
+        have = [k for k, c in enumerate(cols) if motion.channels[c] in r.channels]
+        if not have or r.n_frames == 0:
+            continue
+        rc = [r.channel_index(*motion.channels[cols[k]]) for k in have]
+        v = np.unwrap(np.asarray(r.frames, float)[:, rc], period=360.0, axis=0)
+        mean[i, have], low[i, have], high[i, have] = v.mean(axis=0), v.min(axis=0), v.max(axis=0)
+    out = []
+    for k, c in enumerate(cols):
+        known = np.flatnonzero(np.isfinite(mean[:, k]))
+        if not known.size:
             continue
         # bring every reference onto one turn (nearest the first's mean), then the range
-        centre0 = float(np.mean(vals[0]))
-        vals = [v - 360.0 * np.round((np.mean(v) - centre0) / 360.0) for v in vals]
-        lo = float(min(v.min() for v in vals)) - margin_deg
-        hi = float(max(v.max() for v in vals)) + margin_deg
-        mid = 0.5 * (lo + hi)
-        x = motion.frames[:, c]
-        x = x - 360.0 * np.round((x - mid) / 360.0)
-        excess = np.maximum(lo - x, x - hi)
-        bad = np.flatnonzero(excess > 0)
-        if bad.size:
-            k = bad[np.argmax(excess[bad])]
-            out.append(JointRangeViolation(
-                channel=ch, frames=int(bad.size), first_frame=int(bad[0] + motion.start_frame),
-                low=lo, high=hi, worst=float(x[k]), excess=float(excess[k]),
-            ))
+        shift = 360.0 * np.round((mean[known, k] - mean[known[0], k]) / 360.0)
+        lo = float((low[known, k] - shift).min()) - margin_deg
+        hi = float((high[known, k] - shift).max()) + margin_deg
+        out.append((c, lo, hi))
+    return out
+
+
+def _range_violations(
+    motion: Motion, ranges: list[tuple[int, float, float]]
+) -> list[JointRangeViolation]:
+    """The channels of ``motion`` leaving ``ranges`` (:func:`_channel_ranges`), worst
+    excess first; each value is taken on the turn nearest the middle of its range."""
+    out: list[JointRangeViolation] = []
+    if not ranges:
+        return out
+    cols = np.array([c for c, _, _ in ranges], dtype=int)
+    lo = np.array([r[1] for r in ranges])
+    hi = np.array([r[2] for r in ranges])
+    x = motion.frames[:, cols]
+    x = x - 360.0 * np.round((x - 0.5 * (lo + hi)) / 360.0)
+    excess = np.maximum(lo - x, x - hi)  # (T, channels)
+    for i in np.flatnonzero((excess > 0).any(axis=0)):
+        bad = np.flatnonzero(excess[:, i] > 0)
+        k = bad[np.argmax(excess[bad, i])]
+        out.append(JointRangeViolation(
+            channel=motion.channels[cols[i]], frames=int(bad.size),
+            first_frame=int(bad[0] + motion.start_frame),
+            low=float(lo[i]), high=float(hi[i]), worst=float(x[k, i]),
+            excess=float(excess[k, i]),
+        ))
     out.sort(key=lambda v: -v.excess)
     return out
 
@@ -423,6 +453,34 @@ def _cached_bones(motion: Motion, cache: dict | None) -> Bones:
     return cache[key]
 
 
+def _cached_views(
+    reference: Motion, rkey, motion: Motion, cache: dict | None
+) -> list[tuple[Motion, Any]]:
+    """:func:`_reference_views` of ``reference`` with each view's content key (None
+    without ``cache``); with ``cache``, made once per reference and skeleton of
+    ``motion`` (the skeleton is kept in the cache, so its ``id`` stays its own)."""
+    if cache is None:
+        return [(view, None) for view in _reference_views(reference, motion)]
+    skel = motion.skeleton
+    cache.setdefault(("skeleton", id(skel)), skel)
+    key = ("views", rkey, id(skel))
+    if key not in cache:
+        cache[key] = [(view, _signature(view, False)[2])
+                      for view in _reference_views(reference, motion)]
+    return cache[key]
+
+
+def _reference_key(reference: Motion, cache: dict) -> tuple:
+    """:func:`_signature` of a reference, found once per reference object in ``cache``
+    (which keeps the object, so its ``id`` stays its own): references are not changed
+    in place between checks."""
+    entry = cache.get(("signature", id(reference)))
+    if entry is None or entry[0] is not reference:
+        entry = (reference, _signature(reference, False))
+        cache[("signature", id(reference))] = entry
+    return entry[1]
+
+
 def _reference_minima(
     motion: Motion, references: Sequence[Motion], ref_keys: list, wanted: set,
     cache: dict | None,
@@ -435,7 +493,7 @@ def _reference_minima(
     for r, rkey in zip(references, ref_keys) if wanted else ():
         if r.skeleton is None:
             continue
-        for v, view in enumerate(_reference_views(r, motion)):
+        for v, (view, vsig) in enumerate(_cached_views(r, rkey, motion, cache)):
             rb = _cached_bones(view, cache)
             rnames = rb.pair_names()
             which = np.array([k in wanted for k in rnames], dtype=bool)
@@ -445,7 +503,7 @@ def _reference_minima(
             scale = size / rsize if rsize > 0 else 1.0
             names_in = [k for k, w in zip(rnames, which) if w]
             if cache is not None:  # each pair's closest approach in this view, once
-                vkey = ("reference pairs", rkey, v, _signature(view, False)[2], size)
+                vkey = ("reference pairs", rkey, v, vsig, size)
                 known = cache.setdefault(vkey, {})
                 todo = np.array([w and k not in known for k, w in zip(rnames, which)])
                 if todo.any():
@@ -459,6 +517,75 @@ def _reference_minima(
     return ref_min
 
 
+def _intersections(
+    motion: Motion, threshold: float | None, cache: dict | None, keys: tuple | None
+) -> SelfIntersections:
+    """:func:`self_intersections` with ``far="skip"`` of an analysed motion; with
+    ``cache``, kept under the joint signature ``keys[0]`` of the motion as given, and
+    measured again only where the motion changes the one under ``keys[1]`` (``base``
+    of :func:`check_plausibility`), when that one is kept."""
+    bn = _cached_bones(motion, cache)
+    if cache is None or keys is None:
+        return self_intersections(motion, threshold, far="skip", bones_=bn)
+    prior = None if keys[1] is None else cache.get(("intersections", keys[1], threshold))
+    inter = None if prior is None else _changed_only(motion, bn, *prior)
+    if inter is None:
+        inter = self_intersections(motion, threshold, far="skip", bones_=bn)
+    cache[("intersections", keys[0], threshold)] = (motion, inter)
+    return inter
+
+
+def _changed_only(
+    motion: Motion, bn: Bones, before: Motion, old: SelfIntersections
+) -> SelfIntersections | None:
+    """``old`` (of the analysed motion ``before``) with the pairs a changed joint moves
+    measured again on the frames it changes; None when the motions are not comparable
+    (other skeleton, channels or length)."""
+    if (motion.skeleton is not before.skeleton or list(motion.channels) != list(before.channels)
+            or motion.frames.shape != before.frames.shape):
+        return None
+    root = motion.skeleton.joints[0].name  # type: ignore[union-attr]
+    cols = [i for i, (j, _) in enumerate(motion.channels) if j != root]
+    diff = motion.frames[:, cols] != before.frames[:, cols]
+    rows = diff.any(axis=1)
+    changed = {motion.channels[cols[c]][0] for c in np.flatnonzero(diff.any(axis=0))}
+    fk = motion.positions()
+    moved = np.zeros(len(fk.names), dtype=bool)
+    for p, name in enumerate(fk.names):  # parents come before their children
+        par = fk.parents[p]
+        moved[p] = name in changed or (par >= 0 and moved[par])
+    bone = moved[bn.start] | moved[bn.end]
+    pairs = bone[bn.pairs[:, 0]] | bone[bn.pairs[:, 1]]
+    redo = rows[:, None] & pairs[None, :]
+    near = _near_elements(motion, bn, old.threshold, pairs, rows) & redo
+    dist = np.where(redo, _element_distances(motion, bn, near), old.distances)
+    return SelfIntersections(
+        threshold=old.threshold, bones=bn,
+        min_distance=dist.min(axis=0) if dist.size else np.zeros(0),
+        flagged=(dist < old.threshold) & ~old.ignored[None, :], ignored=old.ignored,
+        distances=dist, start_frame=int(motion.start_frame),
+    )
+
+
+def _cached_violations(
+    motion: Motion, references: Sequence[Motion], ref_keys: list, margin_deg: float,
+    cache: dict | None,
+) -> list[JointRangeViolation]:
+    """:func:`joint_range_violations`; with ``cache``, the references' ranges are found
+    once per set of references and convention of the motion (a latent script's checks
+    spent a fifth of their time unwrapping the same training takes)."""
+    if cache is None:
+        return joint_range_violations(motion, references, margin_deg)
+    skel = motion.skeleton
+    key = ("ranges", tuple(ref_keys), float(margin_deg), tuple(motion.channels),
+           None if skel is None else tuple(
+               (j.name, j.rotation_order, np.asarray(j.axis, float).tobytes())
+               for j in skel.joints))
+    if key not in cache:
+        cache[key] = _channel_ranges(motion, references, margin_deg)
+    return _range_violations(motion, cache[key])
+
+
 def check_plausibility(
     motion: Motion,
     references: Sequence[Motion] = (),
@@ -466,6 +593,8 @@ def check_plausibility(
     margin_deg: float = 5.0,
     *,
     cache: dict | None = None,
+    base: Motion | None = None,
+    analysed: bool = False,
 ) -> PlausibilityReport:
     """Self-intersections and joint ranges of ``motion`` compared with ``references``.
 
@@ -496,7 +625,19 @@ def check_plausibility(
         references, gets that call's report (the root's motion moves no bone against
         another), and the references' closest approach of each bone pair is measured
         once.  A latent script checks its motion up to seven times (limbs kept apart,
-        each round of foot pinning, the report).
+        each round of foot pinning, the report).  References are known by their
+        content the first time a cache meets them and by identity after that: do not
+        change a reference's frames in place between checks sharing a cache.
+    base : Motion, optional
+        A motion checked before with the same ``cache`` whose frames ``motion`` changes
+        in some joints' channels only (foot pinning's trial against the motion it pins):
+        the bone pairs those joints move are measured again on the frames they change,
+        every other distance is ``base``'s (the same numbers: a point's position depends
+        on its ancestors' channels alone).  Without ``cache`` it changes nothing.
+    analysed : bool, default False
+        ``motion`` and ``references`` are already in the analysis rig
+        (:func:`~cyclecoord.rig.analysis_motion`), as a latent model's output and
+        training takes are: their rig is not looked for again.
 
     Returns
     -------
@@ -507,22 +648,23 @@ def check_plausibility(
     cache_key = None
     ref_keys: list = [None] * len(references)
     if cache is None:
-        references = [analysis_motion(r) for r in references]
+        references = list(references) if analysed else [analysis_motion(r) for r in references]
     else:  # each reference's analysis rig once, under its own content
-        ref_keys = [_signature(r, False) for r in references]
+        ref_keys = [_reference_key(r, cache) for r in references]
         cache_key = (_signature(motion, True), tuple(ref_keys), threshold, float(margin_deg))
         if cache_key in cache:
             return copy.deepcopy(cache[cache_key])
-        analysed = []
-        for r, k in zip(references, ref_keys):
-            if ("analysis", k) not in cache:
-                cache[("analysis", k)] = analysis_motion(r)
-            analysed.append(cache[("analysis", k)])
-        references = analysed
+        refs = list(references)
+        for i, (r, k) in enumerate(zip(references, ref_keys)):
+            if not analysed:
+                if ("analysis", k) not in cache:
+                    cache[("analysis", k)] = analysis_motion(r)
+                refs[i] = cache[("analysis", k)]
+        references = refs
     # in the analysis rig: a static root at the origin is no bone to the travelling hips
-    motion = analysis_motion(motion)
-    inter = self_intersections(motion, threshold, far="skip",
-                               bones_=_cached_bones(motion, cache))
+    motion = motion if analysed else analysis_motion(motion)
+    inter = _intersections(motion, threshold, cache, None if cache_key is None else (
+        cache_key[0], None if base is None else _signature(base, True)))
     thr = inter.threshold
     names = inter.bones.pair_names()
     # the references' closest approach matters for the pairs the motion brings close only
@@ -576,7 +718,7 @@ def check_plausibility(
         )
     violations: list[JointRangeViolation] = []
     if references:
-        violations = joint_range_violations(motion, references, margin_deg)
+        violations = _cached_violations(motion, references, ref_keys, margin_deg, cache)
         if violations:
             v = violations[0]
             notes.append(
