@@ -136,6 +136,9 @@ def continuous_euler(
     else:
         prev = np.broadcast_to(np.asarray(near, dtype=float), (J, 3))
         start = 0
+    if J <= _SCALAR_JOINTS:
+        _continue_scalar(principal, alternate, out, np.asarray(prev, dtype=float), start)
+        return out
     for t in range(start, T):
         a = principal[t]
         a = a + 360.0 * np.round((prev - a) / 360.0)
@@ -145,6 +148,37 @@ def continuous_euler(
         prev = np.where(use_b[:, None], b, a)
         out[t] = prev
     return out
+
+
+#: Up to this many joints, :func:`continuous_euler` walks the frames in plain Python
+#: floats: the same choices, five to ten times faster than a dozen NumPy calls on
+#: three values a frame (a latent script makes some twenty such one-joint calls).
+_SCALAR_JOINTS = 2
+
+
+def _continue_scalar(
+    principal: np.ndarray, alternate: np.ndarray, out: np.ndarray, prev: np.ndarray,
+    start: int,
+) -> None:
+    """:func:`continuous_euler`'s frame loop, joint by joint, on Python floats."""
+    P, A = principal.tolist(), alternate.tolist()
+    for j in range(principal.shape[1]):
+        p0, p1, p2 = (float(v) for v in prev[j])
+        for t in range(start, principal.shape[0]):
+            a0, a1, a2 = P[t][j]
+            a0 += 360.0 * round((p0 - a0) / 360.0)
+            a1 += 360.0 * round((p1 - a1) / 360.0)
+            a2 += 360.0 * round((p2 - a2) / 360.0)
+            b0, b1, b2 = A[t][j]
+            b0 += 360.0 * round((p0 - b0) / 360.0)
+            b1 += 360.0 * round((p1 - b1) / 360.0)
+            b2 += 360.0 * round((p2 - b2) / 360.0)
+            to_b = abs(b0 - p0) + abs(b1 - p1) + abs(b2 - p2)
+            if to_b < abs(a0 - p0) + abs(a1 - p1) + abs(a2 - p2):
+                p0, p1, p2 = b0, b1, b2
+            else:
+                p0, p1, p2 = a0, a1, a2
+            out[t, j] = (p0, p1, p2)
 
 
 def to_bvh_convention(motion: Motion, rotation_order: str = "ZXY") -> Motion:

@@ -190,12 +190,16 @@ class Skeleton:
         return tuple((j.name, d) for j in self.joints for d in j.dofs)
 
     def total_length(self) -> float:
-        """Sum of bone lengths (offsets and end sites), a scale for tolerances."""
-        total = sum(float(np.linalg.norm(j.offset)) for j in self.joints[1:])
-        total += sum(
-            float(np.linalg.norm(j.end_site)) for j in self.joints if j.end_site is not None
-        )
-        return total
+        """Sum of bone lengths (offsets and end sites), a scale for tolerances (found
+        once: a skeleton and its joints are not changed after they are made)."""
+        known = self.__dict__.get("_total_length")
+        if known is None:
+            known = sum(float(np.linalg.norm(j.offset)) for j in self.joints[1:])
+            known += sum(
+                float(np.linalg.norm(j.end_site)) for j in self.joints if j.end_site is not None
+            )
+            object.__setattr__(self, "_total_length", known)
+        return known
 
 
 @dataclass(frozen=True)
@@ -341,13 +345,14 @@ class _Plan:
 
 
 def _mm(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Products of 3x3 matrices stored components first: ``(3, 3, ...)`` each."""
-    return x[:, 0, None] * y[0][None] + x[:, 1, None] * y[1][None] + x[:, 2, None] * y[2][None]
+    """Products of 3x3 matrices stored components first: ``(3, 3, ...)`` each (the
+    three products summed in order, as written out by hand; einsum is twice as fast)."""
+    return np.einsum("ik...,kj...->ij...", x, y)
 
 
 def _mv(x: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Matrices ``(3, 3, ...)`` times vectors ``(3, ...)``, components first."""
-    return x[:, 0] * v[0] + x[:, 1] * v[1] + x[:, 2] * v[2]
+    return np.einsum("ik...,k...->i...", x, v)
 
 
 #: plans by skeleton and channel list (skeletons and their joints are immutable)

@@ -268,3 +268,26 @@ def test_amc_to_amc_keeps_source_skeleton(tmp_path):
     assert (tmp_path / "69.asf").read_bytes() == before  # inputs are never modified
     again = load(tmp_path / "69_02.amc")
     np.testing.assert_allclose(again.select(m.channels).frames, m.frames, atol=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_continuous_euler_walks_few_joints_in_python_floats_with_the_same_choices(seed):
+    """One or two joints go through the plain-float frame loop: the same angles, to the
+    bit, as the vectorised loop, on slow and on tumbling rotations."""
+    import cyclecoord.conventions as conv
+
+    rng = np.random.default_rng(seed)
+    T, J = 150, 1 + seed % 2
+    rotvec = np.cumsum(rng.normal(size=(T, J, 3)) * [0.05, 0.3, 1.0][seed % 3], axis=0)
+    mats = Rotation.from_rotvec(rotvec.reshape(-1, 3)).as_matrix().reshape(T, J, 3, 3)
+    order = "".join(rng.permutation(list("XYZ")))
+    near = rng.normal(size=(J, 3)) * 200.0 if seed % 2 else None
+    fast = conv.continuous_euler(mats, order, near)
+    try:
+        conv._SCALAR_JOINTS, kept = 0, conv._SCALAR_JOINTS
+        slow = conv.continuous_euler(mats, order, near)
+    finally:
+        conv._SCALAR_JOINTS = kept
+    np.testing.assert_array_equal(fast, slow)
+    if seed % 3 == 0:  # small steps: no flip between frames
+        assert np.abs(np.diff(fast, axis=0)).max() < 30.0

@@ -1,5 +1,7 @@
 """Foot locking: sliding feet are pinned, only the legs move, and by little."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -351,3 +353,33 @@ def test_lock_where_clean_keeps_what_is_clear_of_a_pop(monkeypatch):
         assert hi - lo >= 3
         assert np.ptp(toes[lo:hi], axis=0).max() < 1e-3  # pinned
     assert np.ptp(toes[k - 2 : k + 3], axis=0).max() > 1e-3  # free around the pop
+
+
+def test_pin_feet_reuse_keeps_the_frames_asked_the_same_and_reads_as_fresh(monkeypatch):
+    """``pin_feet(..., reuse=)`` pinning one motion twice on contacts that differ in one
+    stretch solves only the frames whose targets changed; both results read as pins
+    without ``reuse`` (each frame is solved on its own)."""
+    import cyclecoord.synthesis.footlock as fl
+
+    m = _walkish()
+    contacts = foot_contacts(m, feet=("lfoot", "ltoes", "rfoot", "rtoes"))
+    assert contacts.planted.any()
+    solved = []
+    real = fl._solve
+    monkeypatch.setattr(fl, "_solve", lambda ik, rows, *a, **k: solved.append(rows.size)
+                        or real(ik, rows, *a, **k))
+    kept: dict = {}
+    first = fl.pin_feet(m, contacts, reuse=kept)
+    planted = contacts.planted.copy()
+    runs = contact_runs(planted[:, 0])
+    a, b = runs[len(runs) // 2]
+    planted[a:b, 0] = False  # one stretch of the left foot let go
+    fewer = fl.pin_feet(m, replace(contacts, planted=planted), reuse=kept)
+    monkeypatch.setattr(fl, "_solve", real)
+    np.testing.assert_array_equal(first.frames, fl.pin_feet(m, contacts).frames)
+    np.testing.assert_array_equal(
+        fewer.frames, fl.pin_feet(m, replace(contacts, planted=planted)).frames)
+    assert len(solved) == 3 and 0 < solved[2] < solved[0] / 2  # the left leg, near a-b
+    other = m.with_frames(m.frames + 0.0)  # another motion: nothing of the last kept
+    fl.pin_feet(other, contacts, reuse=kept)
+    assert kept["motion"] is other

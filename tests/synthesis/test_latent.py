@@ -439,3 +439,14 @@ def test_figures(walk_model, jog_model):
     fig3 = plot_pose_strip(motion, [0, 10, 19])
     assert fig3.axes
     plt.close("all")
+
+
+def test_kinv_times_is_the_inverse_kernel_product(walk_model):
+    """The particle's ``K^-1 k`` by a symmetric BLAS product equals the plain product (to
+    rounding) and solving ``K u = k`` with the kernel itself."""
+    g = walk_model.gp_
+    k = walk_model.kernel(walk_model.X_[3:4] + 0.02)[0]
+    u = g.kinv_times(k)
+    np.testing.assert_allclose(u, g.kinv_ @ k, rtol=0, atol=1e-9 * np.abs(g.kinv_ @ k).max())
+    K = walk_model.kernel(walk_model.X_) + g.noise_ * np.eye(len(k))
+    np.testing.assert_allclose(K @ u, k, rtol=0, atol=1e-6 * np.abs(k).max())

@@ -314,9 +314,17 @@ def _sample(n: int, most: int) -> np.ndarray:
     return np.unique(np.linspace(0, n - 1, min(n, most)).round().astype(int))
 
 
+def _spans(pos: np.ndarray) -> np.ndarray:
+    """``np.ptp(pos, axis=1)`` of points ``(K, P, 3)``: the body's extent per frame and
+    axis, ``(K, 3)`` (reduced along a contiguous last axis, three times faster)."""
+    p = np.ascontiguousarray(pos.transpose(0, 2, 1))
+    return p.max(axis=-1) - p.min(axis=-1)
+
+
 def _body_points(motion: Motion, frames: np.ndarray, skip_root: bool) -> np.ndarray:
     """World positions ``(K, P, 3)`` of joints and end sites at ``frames``."""
-    pos = forward_kinematics(motion[frames]).positions
+    every = frames.size == motion.n_frames and np.array_equal(frames, np.arange(frames.size))
+    pos = forward_kinematics(motion if every else motion[frames]).positions
     return pos[:, 1:] if skip_root else pos
 
 
@@ -355,13 +363,18 @@ def _up_of(motion: Motion, frames: np.ndarray, extents: np.ndarray, static: bool
     return "Z" if z > y else "Y"
 
 
-def _first_step_ratio(motion: Motion, skip_root: bool) -> tuple[float, float]:
-    """Largest point move frame 0 -> 1, and its ratio to the largest later move (200 frames)."""
+def _first_step_ratio(
+    motion: Motion, skip_root: bool, pos: np.ndarray | None = None
+) -> tuple[float, float]:
+    """Largest point move frame 0 -> 1, and its ratio to the largest later move (200
+    frames); ``pos``: the body points of those frames, already found."""
     T = motion.n_frames
     if T < 10:
         return float("nan"), float("nan")
-    pos = _body_points(motion, np.arange(min(T, 202)), skip_root)
-    steps = np.linalg.norm(np.diff(pos, axis=0), axis=2).max(axis=1)
+    if pos is None:
+        pos = _body_points(motion, np.arange(min(T, 202)), skip_root)
+    d = np.diff(pos, axis=0)
+    steps = np.sqrt(np.einsum("tpi,tpi->tp", d, d)).max(axis=1)
     later = float(steps[1:].max())
     ratio = float("inf") if later <= 0 else float(steps[0] / later)
     return float(steps[0]), ratio
@@ -412,15 +425,19 @@ def describe_rig(motion: Motion, units: Units = "auto") -> RigInfo:
     static = _static_root(motion)
     travel_index = 1 if static else 0
     T = motion.n_frames
-    pos = _body_points(motion, _sample(T, 400), static)
-    extents = np.median(np.ptp(pos, axis=1), axis=0)
-    up = _up_of(motion, _sample(T, 400), extents, static)
+    # one forward kinematics for the sampled frames and the first 202 (often all of them)
+    sample, first = _sample(T, 400), np.arange(min(T, 202))
+    union = np.union1d(sample, first)
+    points = _body_points(motion, union, static)
+    pos = points[np.searchsorted(union, sample)]
+    extents = np.median(_spans(pos), axis=0)
+    up = _up_of(motion, sample, extents, static)
     height = float(extents[AXIS_INDEX[up.lower()]])
-    step0, ratio = _first_step_ratio(motion, static)
+    step0, ratio = _first_step_ratio(motion, static, points[np.searchsorted(union, first)])
     reference = bool(np.isfinite(ratio) and ratio > 5.0 and step0 > 0.02 * height)
     if reference:  # measure the body without the reference pose
         pos = _body_points(motion, 1 + _sample(T - 1, 400), static)
-        extents = np.median(np.ptp(pos, axis=1), axis=0)
+        extents = np.median(_spans(pos), axis=0)
         up = _up_of(motion, 1 + _sample(T - 1, 400), extents, static)
         height = float(extents[AXIS_INDEX[up.lower()]])
 

@@ -469,8 +469,8 @@ class LatentModel:
         """Predictive variance ``k(x, x) - k(x)^T K^-1 k(x)`` of the noise-free GP (Eq. 8)
         at latent point ``x`` (q,) and its gradient (time quadratic in the training size)."""
         diff = x[None, :] - self.X_
-        k = self.gp_.variance_ * np.exp(-0.5 * (diff * diff).sum(1) / self._l2)
-        u = self.gp_.kinv_ @ k
+        k = self.gp_.variance_ * np.exp(-0.5 * np.einsum("ij,ij->i", diff, diff) / self._l2)
+        u = self.gp_.kinv_times(k)
         var = max(self.gp_.variance_ - float(k @ u), 0.0)
         grad = (2.0 / self._l2) * ((u * k) @ diff)
         return var, grad
