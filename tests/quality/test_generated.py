@@ -807,3 +807,29 @@ def test_source_penetration_is_the_fraction_of_frames_under_the_floor():
     assert ref.floor == pytest.approx(source_figures(sources, 64.0).floor, abs=0.01)
     assert ref.penetration == 2 / 128
     assert source_figures(sources, 64.0).penetration == 0.0
+
+
+def test_source_figures_cache_finds_each_takes_figures_once_and_reads_the_same(monkeypatch):
+    """``source_figures(..., cache=)`` on overlapping sets of takes (each model's and all
+    of them, as a latent script asks): each take's own figures are found once, and every
+    figure reads as without the cache."""
+    import cyclecoord.datasets as ds
+    import cyclecoord.quality.generated as gen
+
+    walks = [ds.make_periodic_capture(kind="walk", n_frames=100, random_state=s).motion
+             for s in (0, 1)]
+    runs = [ds.make_periodic_capture(kind="jog", n_frames=90, random_state=s).motion
+            for s in (2, 3)]
+    made = []
+    real = gen._take_figures
+    monkeypatch.setattr(gen, "_take_figures", lambda s, rig: made.append(1) or real(s, rig))
+    cache: dict = {}
+    for takes in (walks + runs, walks, runs, walks):
+        got = gen.source_figures(takes, 30.0, cache=cache)
+        plain = gen.source_figures(takes, 30.0)
+        for f in ("floor", "pose_speed_median", "accel_p99", "support_slip", "knee_range",
+                  "contact_slide", "penetration"):
+            assert getattr(got, f) == getattr(plain, f), f
+        np.testing.assert_array_equal(got.take_cycle, plain.take_cycle)
+    # 4 takes once with the cache, then 4 + 2 + 2 + 2 without it
+    assert len(made) == 4 + 10

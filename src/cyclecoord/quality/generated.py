@@ -42,7 +42,7 @@ captured take.  Distances are in metres from the sources' skeleton unit
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -311,27 +311,44 @@ class SourceFigures:
 
 
 def source_figures(
-    sources: Sequence[Motion], fps: float, feet: Sequence[str] | None = None
+    sources: Sequence[Motion], fps: float, feet: Sequence[str] | None = None,
+    *, analysed: bool = False, cache: dict | None = None,
 ) -> SourceFigures:
     """The figures of the source captures, resampled to ``fps`` (a whole-number step).
 
     A source is taken every ``k = round(source fps / fps)`` frames when ``k > 1`` and its
     rate then lands within 5 % of ``fps``; otherwise it is used at its own rate.
+    ``analysed``: the sources are already in the analysis rig
+    (:func:`~cyclecoord.rig.analysis_motion`; a latent model's training takes are).
+    ``cache``: a dict kept between calls on overlapping sets of sources (a latent script
+    measures each model's takes and all of them): each take's own figures are found
+    once per take object, rate and legs (sources are not changed in place meanwhile).
     """
     from ..rig import analysis_motion, metres_per_unit
 
     if not sources:
         raise ParameterError("the measure of generated motion needs the source captures")
-    srcs = [_resampled(analysis_motion(s), fps) for s in sources]
+    srcs = [_resampled(s if analysed else analysis_motion(s), fps) for s in sources]
     rig = _rig(srcs[0], feet)
-    kins = [_kin(s, rig) for s in srcs]
-    floors = [foot_contacts(s, rig.feet).floor for s in srcs]
-    floor = float(np.median(floors))
-    speeds = np.array([float(np.median(k.root_speed())) for k in kins])
-    cycles = np.array([k.cycle() for k in kins])
-    ps = np.concatenate([k.pose_speed() for k in kins])
-    lowest = np.concatenate([_lowest(k, rig) for k in kins])
+    rkey = (float(fps), tuple(rig.feet), tuple(rig.hips), tuple(rig.knees),
+            tuple(rig.ankles), rig.trunk, rig.leg_length)
+
+    def kept(kind, orig, make):
+        if cache is None:
+            return make()
+        key = (kind, id(orig), rkey)
+        entry = cache.get(key)
+        if entry is None or entry[0] is not orig:  # (the take is kept: its id stays its own)
+            entry = cache[key] = (orig, make())
+        return entry[1]
+
+    takes = [kept("take", o, lambda s=s: _take_figures(s, rig)) for o, s in zip(sources, srcs)]
+    floor = float(np.median([t["floor"] for t in takes]))
+    ps = np.concatenate([t["pose_speed"] for t in takes])
+    lowest = np.concatenate([t["lowest"] for t in takes])
     metres = metres_per_unit(sources[0])
+    slides = [kept(("slide", floor), o, lambda s=s: _contact_speeds(s, rig, floor)[0])
+              for o, s in zip(sources, srcs)]
     return SourceFigures(
         fps=float(fps),
         metres=metres,
@@ -339,19 +356,33 @@ def source_figures(
         floor=floor,
         pose_speed_median=float(np.median(ps)),
         step_p99=float(np.percentile(ps, 99)),
-        accel_p99=float(np.percentile(np.concatenate([k.accel() for k in kins]), 99)),
-        support_slip=float(np.median(np.concatenate([_support(k, rig) for k in kins]))),
-        knee_range=float(np.median(np.concatenate([_ranges(k.knee) for k in kins]))),
-        hip_range=float(np.median(np.concatenate([_ranges(k.hip) for k in kins]))),
-        take_speed=speeds,
-        take_cycle=cycles,
+        accel_p99=float(np.percentile(np.concatenate([t["accel"] for t in takes]), 99)),
+        support_slip=float(np.median(np.concatenate([t["support"] for t in takes]))),
+        knee_range=float(np.median(np.concatenate([t["knee"] for t in takes]))),
+        hip_range=float(np.median(np.concatenate([t["hip"] for t in takes]))),
+        take_speed=np.array([t["speed"] for t in takes]),
+        take_cycle=np.array([t["cycle"] for t in takes]),
         penetration=float(np.mean(floor - lowest > PENETRATION_M / metres)),
-        contact_slide=float(
-            np.median(np.concatenate([_contact_speeds(s, rig, floor)[0] for s in srcs]))
-        ),
-        knee_range_legs=tuple(float(x) for x in np.median([_ranges(k.knee) for k in kins], 0)),
-        hip_range_legs=tuple(float(x) for x in np.median([_ranges(k.hip) for k in kins], 0)),
+        contact_slide=float(np.median(np.concatenate(slides))),
+        knee_range_legs=tuple(float(x) for x in np.median([t["knee"] for t in takes], 0)),
+        hip_range_legs=tuple(float(x) for x in np.median([t["hip"] for t in takes], 0)),
     )
+
+
+def _take_figures(s: Motion, rig: _Rig) -> dict[str, Any]:
+    """One source take's own figures (:func:`source_figures` pools them)."""
+    k = _kin(s, rig)
+    return {
+        "floor": foot_contacts(s, rig.feet).floor,
+        "speed": float(np.median(k.root_speed())),
+        "cycle": k.cycle(),
+        "pose_speed": k.pose_speed(),
+        "lowest": _lowest(k, rig),
+        "accel": k.accel(),
+        "support": _support(k, rig),
+        "knee": _ranges(k.knee),
+        "hip": _ranges(k.hip),
+    }
 
 
 def _contact_speeds(motion: Motion, rig: _Rig, floor: float):
@@ -588,6 +619,7 @@ def measure_generated(
     feet: Sequence[str] | None = None,
     hold: np.ndarray | None = None,
     reference: SourceFigures | None = None,
+    analysed: bool = False,
 ) -> GeneratedQuality:
     """Measure a generated motion against the captures it came from.
 
@@ -604,6 +636,11 @@ def measure_generated(
         Frames where a hold was asked (IDLE): slow frames there are not freezes.
     reference : SourceFigures, optional
         The sources' figures already computed (then ``sources`` may be None).
+    analysed : bool, default False
+        ``motion`` and ``sources`` are already in the analysis rig
+        (:func:`~cyclecoord.rig.analysis_motion`): a latent model's output and training
+        takes, or a slice of a motion found to need no change (a latent script measures
+        some ten slices; finding each one's rig afresh was a tenth of the report's time).
 
     Returns
     -------
@@ -613,8 +650,9 @@ def measure_generated(
         raise ParameterError(f"the measure needs at least 3 frames, got {motion.n_frames}")
     from ..rig import analysis_motion
 
-    ref = reference if reference is not None else source_figures(sources or [], motion.fps, feet)
-    motion = analysis_motion(motion)
+    ref = reference if reference is not None else source_figures(
+        sources or [], motion.fps, feet, analysed=analysed)
+    motion = motion if analysed else analysis_motion(motion)
     rig = _rig(motion, feet)
     kin = _kin(motion, rig)
     m = ref.metres
@@ -689,16 +727,19 @@ def lead_lines(
     feet: Sequence[str] | str | None = None,
     hold: np.ndarray | None = None,
     reference: SourceFigures | None = None,
+    analysed: bool = False,
 ) -> tuple[dict | None, list[str]]:
     """The measure as a report dict and the console lines that lead a command's output;
-    ``(None, [why])`` when it cannot be measured (no skeleton, no legs found)."""
+    ``(None, [why])`` when it cannot be measured (no skeleton, no legs found).
+    Parameters as :func:`measure_generated`'s."""
     from ..errors import CycleCoordError
     from .legs import resolve_feet
 
     try:
         if isinstance(feet, str):
             feet = resolve_feet(motion.skeleton, feet)
-        q = measure_generated(motion, sources, feet=feet, hold=hold, reference=reference)
+        q = measure_generated(motion, sources, feet=feet, hold=hold, reference=reference,
+                              analysed=analysed)
     except CycleCoordError as exc:
         return None, [f"generated motion: not measured ({exc})"]
     return q.to_dict(), q.summary()

@@ -338,6 +338,7 @@ def lock_where_clean(
     hold: np.ndarray | None = None,
     references: Sequence[Motion] | None = None,
     plausibility_cache: dict | None = None,
+    analysed: bool = False,
 ) -> LockOutcome:
     """Pin the planted feet (leg IK) except where the pin makes a pop.
 
@@ -361,7 +362,8 @@ def lock_where_clean(
     where the motion before pinning had none) counts as a pop: pinned on an IDLE of
     subject 35's walk model, two script seeds in five crossed the feet (toes 0.06 units
     apart against the captures' closest 1.23).  ``plausibility_cache`` is passed to those
-    checks (:func:`~cyclecoord.quality.plausibility.check_plausibility` ``cache``).
+    checks (:func:`~cyclecoord.quality.plausibility.check_plausibility` ``cache``), and
+    ``analysed`` (the motion and references are in the analysis rig) too.
     """
     from ..quality.contacts import contact_runs
     from ..quality.legs import find_feet
@@ -395,17 +397,19 @@ def lock_where_clean(
     before = _accel(motion)
     limit = np.broadcast_to(np.asarray(limit, dtype=float), before.shape)
     outside_before = _outside(motion.frames, bounds)
-    crossed_before = _crossed(motion, references, plausibility_cache)
+    crossed_before = _crossed(motion, references, plausibility_cache, analysed=analysed)
     skipped: list[tuple[int, int]] = []
     result = None
+    solved: dict = {}  # the trials' leg solutions: frames asked the same are not solved again
     for _ in range(6):
         if not planted.any():
             break
-        trial = pin_feet(motion, replace(contacts, planted=planted), blend=blend)
+        trial = pin_feet(motion, replace(contacts, planted=planted), blend=blend, reuse=solved)
         after = _accel(trial)
         bad = (after > limit) & (after > before * 1.05)
         bad |= _outside(trial.frames, bounds) & ~outside_before
-        bad |= _crossed(trial, references, plausibility_cache) & ~crossed_before
+        bad |= _crossed(trial, references, plausibility_cache, motion,
+                        analysed) & ~crossed_before
         bad = np.flatnonzero(bad)
         if not bad.size:
             result = trial
@@ -480,16 +484,23 @@ def _outside(frames: np.ndarray, bounds) -> np.ndarray:
     return ((frames < lo) | (frames > hi)).any(axis=1)
 
 
-def _crossed(motion: Motion, references, cache: dict | None = None) -> np.ndarray:
+def _crossed(
+    motion: Motion, references, cache: dict | None = None, base: Motion | None = None,
+    analysed: bool = False,
+) -> np.ndarray:
     """(T,) frames where two limbs come closer than ``references`` ever do (none
-    without references)."""
+    without references); ``base``: the motion ``motion`` pins, checked before with
+    ``cache`` (only the legs' bone pairs are measured again); ``analysed`` as
+    :func:`~cyclecoord.quality.plausibility.check_plausibility`'s."""
     out = np.zeros(motion.n_frames, dtype=bool)
     if not references:
         return out
     from ..quality.plausibility import check_plausibility
 
     frames = np.asarray(
-        check_plausibility(motion, references, cache=cache).new_contact_frames, dtype=int
+        check_plausibility(motion, references, cache=cache, base=base,
+                           analysed=analysed).new_contact_frames,
+        dtype=int,
     )
     out[frames - int(motion.start_frame)] = True
     return out

@@ -81,9 +81,12 @@ class OutputMixin:
         u = 1.0 - np.abs(k) / (w + 1.0)
         bump = u * u * (3.0 - 2.0 * u)
         pulled: set[int] = set()
+        before = None  # the last round's motion: only its pulled frames are checked again
         for _ in range(UNTANGLE_ROUNDS):
             frames = np.asarray(
-                check_plausibility(motion, takes, cache=self._plausibility).new_contact_frames,
+                check_plausibility(
+                    motion, takes, cache=self._plausibility, base=before, analysed=True
+                ).new_contact_frames,
                 dtype=int,
             )
             frames = frames - int(motion.start_frame)
@@ -95,7 +98,7 @@ class OutputMixin:
                 a, b = max(f - w, 0), min(f + w + 1, motion.n_frames)
                 pull[a:b] = np.maximum(pull[a:b], bump[a - f + w : b - f + w])
             pulled.update(int(f) for f in frames)
-            motion = self._assemble(*self._posed(pull))
+            before, motion = motion, self._assemble(*self._posed(pull))
         if pulled:
             spans = sorted(pulled)
             where = f"frames {spans[0]}-{spans[-1]}" if len(spans) > 1 else f"frame {spans[0]}"
@@ -370,6 +373,23 @@ class OutputMixin:
             return out
         return pin_feet(out, contacts, blend=LOCK_BLEND)
 
+    def feet_of(self, motion: Motion) -> tuple[str, ...] | None:
+        """The feet named (``feet``), else those :func:`~cyclecoord.quality.legs.find_feet`
+        finds on the first motion asked, kept for the script's later steps (planting,
+        locking, the report: finding them took some 3 ms a time, asked five times a
+        script); None when none are found (each step then says why)."""
+        from ...errors import CycleCoordError
+        from ...quality.legs import find_feet
+
+        if self.feet is not None:
+            return self.feet
+        if ("feet",) not in self._acc:
+            try:
+                self._acc[("feet",)] = find_feet(motion.skeleton, motion)
+            except CycleCoordError:
+                self._acc[("feet",)] = None
+        return self._acc[("feet",)]
+
     def hold_mask(self, n_frames: int) -> np.ndarray:
         """(T,) frames an IDLE command made."""
         hold = np.zeros(n_frames, dtype=bool)
@@ -385,17 +405,18 @@ class OutputMixin:
         from ..carry import carry_by_feet, channel_bounds, lock_where_clean
 
         used = sorted({c.model for c in self.chunks})
+        feet = self.feet_of(motion)
         try:
             floor = float(
                 np.median(
-                    [foot_contacts(self.models[k].training_motion(), self.feet).floor for k in used]
+                    [foot_contacts(self.models[k].training_motion(), feet).floor for k in used]
                 )
             )
         except CycleCoordError:
             floor = None
         out = carry_by_feet(
             motion,
-            self.feet,
+            feet,
             floor=floor,
             hold=self.hold_mask(motion.n_frames),
             smooth=PLANT_SMOOTH,
@@ -411,12 +432,13 @@ class OutputMixin:
             locked = lock_where_clean(
                 out,
                 limit,
-                self.feet,
+                feet,
                 bounds=channel_bounds(takes),
                 hold=self.hold_mask(motion.n_frames),
                 blend=self._lock_ease(used),
                 references=takes,
                 plausibility_cache=self._plausibility,
+                analysed=True,  # a model's output and takes are in their analysis rig
             )
             self.notes.append(locked.line)
             out = locked.motion
@@ -462,12 +484,13 @@ class OutputMixin:
         2.3x the training 99th percentile."""
         key = ("lock", name)
         if key not in self._acc:
-            from ..carry import _accel
-
             m = self.models[name]
             train = m.training_motion()
+            p = train.positions().positions  # (every frame's points: one pass for all takes)
+            rel = p - p[:, :1]
             acc = [
-                _accel(train[rows[0] : rows[-1] + 1])[1:-1]
+                np.linalg.norm(np.diff(rel[rows[0] : rows[-1] + 1], 2, axis=0), axis=-1).max(-1)
+                * train.fps**2
                 for s in np.unique(m.segments_)
                 if (rows := np.flatnonzero(m.segments_ == s)).size > 2
             ]

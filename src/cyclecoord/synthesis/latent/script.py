@@ -332,25 +332,37 @@ def training_takes(models: dict[str, LatentModel], names=None) -> list:
 
 def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None, list[str]]:
     """The measure of generated motion (:mod:`cyclecoord.quality.generated`) against the
-    training segments of the models the script used, IDLE frames counted as asked holds."""
+    training segments of the models the script used, IDLE frames counted as asked holds.
+
+    The motion is found in the analysis rig once (:func:`~cyclecoord.rig.analysis_motion`:
+    a model's output is in its training takes' rig, which the model was fitted in), and
+    its sections are measured as slices of it."""
     from ...errors import CycleCoordError
     from ...quality.generated import lead_lines, measure_generated, source_figures
+    from ...rig import analysis_motion
+
+    motion = analysis_motion(motion)
 
     figures: dict = {}  # the sources' figures, once per set of models
+    takes_seen: dict = {}  # each take's own figures, once (source_figures' cache)
+    own: dict = {}  # each model's training takes
 
     def measured(names) -> tuple[list, Any]:
         key = tuple(sorted(names))
-        if key not in figures:
-            takes = training_takes(syn.models, key)
+        if key not in figures:  # (each model's takes made once: the cache knows them)
+            takes = [t for k in key for t in own.setdefault(k, training_takes(syn.models, [k]))]
             try:
-                figures[key] = (takes, source_figures(takes, motion.fps, feet=feet))
+                # (the takes are in the analysis rig: the model was fitted on it)
+                figures[key] = (takes, source_figures(takes, motion.fps, feet=feet,
+                                                      analysed=True, cache=takes_seen))
             except CycleCoordError:
                 figures[key] = (takes, None)  # measured (and refused) as before
         return figures[key]
 
     hold = syn.hold_mask(motion.n_frames)
     sources, ref = measured({c.model for c in syn.chunks})
-    quality, lines = lead_lines(motion, sources, feet=feet, hold=hold, reference=ref)
+    quality, lines = lead_lines(motion, sources, feet=feet, hold=hold, reference=ref,
+                                analysed=True)
     sections = model_sections(syn, commands)
     if quality is not None and len({s["model"] for s in sections}) > 1:
         # a walk and a run judged against their pooled captures read the run's pops
@@ -360,7 +372,8 @@ def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None,
         for sec in sections:
             a, b = sec["start"], sec["stop"]
             takes, ref = measured([sec["model"]])
-            q, sub = lead_lines(motion[a:b], takes, feet=feet, hold=hold[a:b], reference=ref)
+            q, sub = lead_lines(motion[a:b], takes, feet=feet, hold=hold[a:b], reference=ref,
+                                analysed=True)
             quality["by_model"].append({**sec, "quality": q})
             lines.append(f"    {sec['model']} frames {a}-{b}: "
                          + sub[0].replace("generated motion: ", ""))
@@ -374,7 +387,7 @@ def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None,
                 continue
             pop = min(
                 measure_generated(motion[a:b], measured([k])[0], feet=feet,
-                                  reference=measured([k])[1]).largest_accel
+                                  reference=measured([k])[1], analysed=True).largest_accel
                 for k in win["models"]
             )
             quality["transitions"].append({**win, "largest_accel_ratio": float(pop)})
@@ -506,6 +519,7 @@ def run_script(
             raise _fail(p, f"commands[{i}] ({c['command']})", str(exc)) from None
     total = time.perf_counter() - t0
     motion = syn.motion()
+    feet = syn.feet_of(motion)  # named, or found once for the whole script
     quality, quality_lines = script_quality(syn, motion, commands, feet)
     report: dict[str, Any] = {
         "motion_quality": quality,
@@ -553,5 +567,6 @@ def run_script(
             )
             for k in sorted(used)
         ]
-        report["plausibility"] = check_plausibility(motion, refs, cache=syn._plausibility).to_dict()
+        report["plausibility"] = check_plausibility(
+            motion, refs, cache=syn._plausibility, analysed=True).to_dict()
     return motion, report
