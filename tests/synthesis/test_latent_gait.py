@@ -432,12 +432,12 @@ def test_a_path_cross_fades_over_the_seam_between_two_stretches_of_the_take():
     values[:, 0] += 0.4 * phase + 0.5 * np.exp(-(((phase - 0.1) / 0.1) ** 2))
     rows, start, K = gait._loop(0, values)
     seam = start + K
-    assert SEAM_FADE == 1.0
+    assert SEAM_FADE == 2.0
     # the fade reaches half its length each way, as far as the take has frames
     half = 0.5 * SEAM_FADE
     before, after = min(half, start - phase[0]), min(half, phase[-1] - seam)
     assert before >= 0.1 and after >= 0.1
-    u = seam + np.linspace(-0.6, 0.6, 241)
+    u = seam + np.linspace(-1.1, 1.1, 441)
     got = gait.at(values, 0, u)[:, 0]
     a = np.clip((u - seam + before) / (before + after), 0.0, 1.0)
     w = a * a * a * (a * (6 * a - 15) + 10)
