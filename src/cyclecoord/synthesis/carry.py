@@ -513,7 +513,12 @@ def _limit_words(limit: np.ndarray) -> str:
 
 def _accel(motion: Motion) -> np.ndarray:
     """(T,) largest joint acceleration relative to the root, per frame (length units/s^2)."""
-    p = motion.positions().positions
-    rel = p - p[:, :1]
-    a = np.linalg.norm(np.diff(rel, 2, axis=0), axis=-1).max(-1) * motion.fps**2
+    return _joint_accel(motion.positions().positions, motion.fps)
+
+
+def _joint_accel(points: np.ndarray, fps: float) -> np.ndarray:
+    """(T,) largest acceleration relative to the root (point 0) of points ``(T, P, 3)``
+    per frame, length units/s^2 (the first and last frame repeat their neighbour's)."""
+    rel = points - points[:, :1]
+    a = np.linalg.norm(np.diff(rel, 2, axis=0), axis=-1).max(-1) * fps**2
     return np.r_[a[:1], a, a[-1:]]

@@ -246,6 +246,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self._bridges: dict[tuple[str, str], Bridges] = {}
         self._crossings: dict[tuple[str, str], Crossings] = {}
         self._acc: dict = {}
+        self._feet_found: list = []  # the feet feet_of found (or None), once a script
         self.sim_seconds = 0.0
         self.sim_cpu_seconds = 0.0
         self.clamped = {"values": 0, "max_deg": 0.0}

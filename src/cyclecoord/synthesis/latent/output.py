@@ -383,12 +383,12 @@ class OutputMixin:
 
         if self.feet is not None:
             return self.feet
-        if ("feet",) not in self._acc:
+        if not self._feet_found:
             try:
-                self._acc[("feet",)] = find_feet(motion.skeleton, motion)
+                self._feet_found.append(find_feet(motion.skeleton, motion))
             except CycleCoordError:
-                self._acc[("feet",)] = None
-        return self._acc[("feet",)]
+                self._feet_found.append(None)
+        return self._feet_found[0]
 
     def hold_mask(self, n_frames: int) -> np.ndarray:
         """(T,) frames an IDLE command made."""
@@ -484,13 +484,13 @@ class OutputMixin:
         2.3x the training 99th percentile."""
         key = ("lock", name)
         if key not in self._acc:
+            from ..carry import _joint_accel
+
             m = self.models[name]
             train = m.training_motion()
             p = train.positions().positions  # (every frame's points: one pass for all takes)
-            rel = p - p[:, :1]
             acc = [
-                np.linalg.norm(np.diff(rel[rows[0] : rows[-1] + 1], 2, axis=0), axis=-1).max(-1)
-                * train.fps**2
+                _joint_accel(p[rows[0] : rows[-1] + 1], train.fps)[1:-1]
                 for s in np.unique(m.segments_)
                 if (rows := np.flatnonzero(m.segments_ == s)).size > 2
             ]

@@ -350,7 +350,10 @@ def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None,
     def measured(names) -> tuple[list, Any]:
         key = tuple(sorted(names))
         if key not in figures:  # (each model's takes made once: the cache knows them)
-            takes = [t for k in key for t in own.setdefault(k, training_takes(syn.models, [k]))]
+            for k in key:
+                if k not in own:
+                    own[k] = training_takes(syn.models, [k])
+            takes = [t for k in key for t in own[k]]
             try:
                 # (the takes are in the analysis rig: the model was fitted on it)
                 figures[key] = (takes, source_figures(takes, motion.fps, feet=feet,
