@@ -239,9 +239,13 @@ def over_seeds(models: dict, d: Path, seeds: int, label: str = "") -> None:
     force differs): one seed's figure is one draw (the runs' largest acceleration ranged
     1.5-2.3x over five seeds on the shared pairs)."""
     got: dict[str, list] = {"walk": [], "run": []}
+    idle = []
     for seed in range(seeds):
         motion, rep = run_script(script(d, seed=seed))
         sec = sections(rep)
+        a, b = sec["idle"]  # the support foot once the IDLE's root stands (0.5 s)
+        idle.append(measure_generated(motion[a + 15 : b], training_takes(models, ["walk"]))
+                    .support_slip)  # (m/s)
         for part in got:
             a, b = sec[part]
             q = measure_generated(motion[a:b], training_takes(models, [part]))
@@ -258,6 +262,9 @@ def over_seeds(models: dict, d: Path, seeds: int, label: str = "") -> None:
         cells = [f"{name} {np.median(r[:, i]):.2f} [{r[:, i].min():.2f}-{r[:, i].max():.2f}]"
                  for i, name in enumerate(names)]
         print(f"  {part:7s}  " + "; ".join(cells))
+    idle = np.array(idle)
+    print(f"  IDLE     support foot after 0.5 s {np.median(idle):.3f} m/s [{idle.min():.3f}-"
+          f"{idle.max():.3f}]; {int((idle > 0.1).sum())} of {seeds} seeds over 0.1 m/s")
 
 
 def _hold(motion, sec):

@@ -119,6 +119,9 @@ def _script(folder: Path, model: Path, commands, **top) -> Path:
         ({"command": "PLAY", "segment": "a", "start": "x"}, ["commands[0] (PLAY)", "start"]),
         ({"command": "TRANSITION", "to": "walk", "blend": float("inf")}, ["commands[0]"]),
         ({"command": "IDLE", "duration": 1, "hover": float("nan")}, ["hover"]),
+        ({"command": "IDLE", "duration": 1, "sway": 1.5}, ["commands[0] (IDLE)", "sway"]),
+        ({"command": "IDLE", "duration": 1, "sway": "x"}, ["commands[0] (IDLE)", "sway"]),
+        ({"command": "IDLE", "duration": 1, "sway": False}, ["commands[0] (IDLE)", "sway"]),
         ({"command": "PLAY", "segment": ["a"]}, ["commands[0] (PLAY)", "segment"]),
     ],
 )

@@ -324,11 +324,12 @@ def test_root_follows_planted_feet_in_blend_windows(cmu_dir):
     }
 
     def run(plant, lock=False):
+        # (the IDLEs at the full random force: the particle wanders, and the feet with it)
         syn = Synthesizer(models, fps=30, seed=2, plant=plant, lock=lock)
         syn.start("jj")
-        syn.idle(duration=0.4)
+        syn.idle(duration=0.4, sway=1.0)
         syn.transition("tw", blend=0.4)
-        syn.idle(duration=0.6)
+        syn.idle(duration=0.6, sway=1.0)
         return syn, syn.motion()
 
     syn, planted = run("transitions")

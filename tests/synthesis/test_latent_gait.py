@@ -679,3 +679,39 @@ def test_an_in_step_transition_starts_where_the_particle_is(models):
         steps = np.linalg.norm(np.diff(angles, axis=0), axis=1)
         jumps.append(steps[start - 1] / np.median(steps[: start - 1]))
     assert max(jumps) < 2.0, jumps
+
+
+def test_an_idle_sways_with_a_share_of_the_random_force(models, monkeypatch):
+    """IDLE hovers with ``sway`` (default IDLE_SWAY) of the particle's random force, and
+    at 0 the pose stands still; moves between several IDLE points keep the full force;
+    a sway outside 0-1 is an error naming it."""
+    import cyclecoord.synthesis.latent.commands as commands
+
+    full = commands.ParticleParams().random
+    seen = []
+    real = commands.simulate
+    monkeypatch.setattr(commands, "simulate", lambda m, path, x, v, fps, params, *a:
+                        seen.append(params.random) or real(m, path, x, v, fps, params, *a))
+
+    def idle(**kw):
+        seen.clear()
+        syn = Synthesizer(models, fps=30, seed=3, plant="off")
+        syn.start("walk", {"frame": 20})
+        syn.idle(duration=2.0, **kw)
+        return syn, syn.motion().frames[15:]
+
+    assert 0 < commands.IDLE_SWAY < 1
+    idle()
+    assert seen == [pytest.approx(full * commands.IDLE_SWAY)]
+    idle(sway=1.0)
+    assert seen == [full]
+    _, still = idle(sway=0)
+    assert seen == [0.0] and np.abs(np.diff(still[:, 6:], axis=0)).max() < 0.1
+    syn = Synthesizer(models, fps=30, seed=3, plant="off")
+    syn.start("walk", {"frame": 20})
+    seen.clear()
+    syn.idle(at=[{"frame": 5}, {"frame": 90}], duration=3.0, hover=0.5)
+    assert full in seen and full * commands.IDLE_SWAY in seen  # moves, then hovers
+    for bad in (-0.1, 1.5, float("nan"), True, "0.3"):
+        with pytest.raises(ParameterError, match="sway"):
+            syn.idle(duration=1.0, sway=bad)

@@ -60,7 +60,7 @@ TOP_KEYS = {
 #: Each command's allowed keys (besides "command").
 COMMANDS = {
     "MOVE": {"to", "path", "duration", "speed", "radius"},
-    "IDLE": {"at", "duration", "radius", "hover"},
+    "IDLE": {"at", "duration", "radius", "hover", "sway"},
     "TRANSITION": {"to", "blend", "radius", "route", "in_step"},
     "PLAY": {"segment", "start", "stop"},
 }
@@ -168,6 +168,8 @@ def _check_command(p: Path, where: str, kind: str, c: dict, fps: float) -> float
     elif kind == "IDLE":
         if "hover" in c:
             _number(p, where, c["hover"], 1e-3, longest, "hover (seconds)")
+        if "sway" in c and c["sway"] != 0:  # (0: no random force, a still stand)
+            _number(p, where, c["sway"], 0.0, 1.0, "sway (share of the random force)")
         at = c.get("at")
         if isinstance(at, list) and len(at) > MAX_TARGETS:
             raise _fail(p, where, f"{len(at):,} targets; at most {MAX_TARGETS:,} are supported")
