@@ -432,7 +432,7 @@ def test_a_path_cross_fades_over_the_seam_between_two_stretches_of_the_take():
     values[:, 0] += 0.4 * phase + 0.5 * np.exp(-(((phase - 0.1) / 0.1) ** 2))
     rows, start, K = gait._loop(0, values)
     seam = start + K
-    assert SEAM_FADE == 2.0
+    assert SEAM_FADE == 1.0
     # the fade reaches half its length each way, as far as the take has frames
     half = 0.5 * SEAM_FADE
     before, after = min(half, start - phase[0]), min(half, phase[-1] - seam)
@@ -715,3 +715,23 @@ def test_an_idle_sways_with_a_share_of_the_random_force(models, monkeypatch):
     for bad in (-0.1, 1.5, float("nan"), True, "0.3"):
         with pytest.raises(ParameterError, match="sway"):
             syn.idle(duration=1.0, sway=bad)
+
+
+def test_each_segment_chooses_its_seam_fade(cmu_dir, bvh_dir):
+    """A segment's seam cross-fade is the one of SEAM_FADES whose looped path accelerates
+    the body least around the seam, the shorter on a tie: the 143_01 jog (50 frames at
+    30 fps, its one-cycle loop crossed every stride) takes two cycles, the Bandai run (a
+    five-cycle loop with half a cycle each side of its seam) one; chosen once."""
+    from cyclecoord.synthesis.latent.stepping import SEAM_FADES
+
+    jog = cc.load(cmu_dir / "143" / "143_01.amc", fps=60.0)[::2]
+    run = cc.load(bvh_dir / "bandai" / "dataset-1_run_happy_001.bvh")
+    fit = {"gplvm": {"max_iter": 200}}
+    models = {"jog": LatentModel(**fit).fit([jog], ["jog"]),
+              "run": LatentModel(**fit).fit([run], ["run"])}
+    syn = Synthesizer(models, fps=30)
+    assert SEAM_FADES == (1.0, 2.0)
+    assert syn.seam_fade("jog", 0) == 2.0
+    assert syn.seam_fade("run", 0) == 1.0
+    syn._fades[("run", 0)] = 1.5  # kept: not chosen again
+    assert syn.seam_fade("run", 0) == 1.5

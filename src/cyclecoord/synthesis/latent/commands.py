@@ -260,6 +260,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self._plausibility: dict = {}
         self._ranges: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._gaits: dict = {}
+        self._fades: dict = {}  # each (model, segment)'s seam cross-fade (seam_fade)
         # (model, segment, unwrapped phase) where the last stepping command left the
         # particle, and the one the MOVE being made will leave
         self._cursor = self._next_cursor = None

@@ -29,16 +29,13 @@ __all__ = ["Gait", "MIN_CYCLES", "SEAM_FADE", "even_phase", "training_gait"]
 #: A segment needs at least this many cycles for its phase to be trusted.
 MIN_CYCLES = 1.5
 #: Cycles over which a path looping a segment cross-fades across the loop's seam (as far
-#: as the segment has frames on both sides).  Half a cycle before the latent path and the
-#: detail looped at one seam; with one seam, a whole cycle took the 143_01 jog's largest
-#: acceleration from 1.53x to 1.30x its p99 and its slip from 1.00x to 0.78x the
-#: capture's (medians over 15 script seeds), the Bandai run's within 0.04.  Two cycles
-#: (in practice as far as the data reaches: the 143_01 jog's 50 frames give 0.72 of a
-#: cycle before its seam and 0.57 after) took the jog's seam off its right toes: the
-#: largest acceleration fell from 1.30 [1.23-1.61] to 1.22 [1.16-1.40] over 15 seeds
-#: (4 over 1.5x, all at the seam, to none).  The Bandai run's seam has 0.6 of a cycle
-#: after it: 2 seeds of 15 there went to 1.51 and 1.64x (0 before; not at the seam).
-SEAM_FADE = 2.0
+#: as the segment has frames on both sides) when no other is asked.  Half a cycle before
+#: the latent path and the detail looped at one seam; with one seam, a whole cycle took
+#: the 143_01 jog's largest acceleration from 1.53x to 1.30x its p99 and its slip from
+#: 1.00x to 0.78x the capture's (medians over 15 script seeds), the Bandai run's within
+#: 0.04.  The synthesizer chooses each segment's fade between this and two cycles
+#: (:meth:`~.stepping.GaitMixin.seam_fade`).
+SEAM_FADE = 1.0
 
 
 @dataclass(frozen=True)
