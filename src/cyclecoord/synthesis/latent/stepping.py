@@ -68,6 +68,8 @@ class GaitMixin:
         [1.16-1.40] its p99 over 15 seeds (4 seeds over 1.5x to none); on the Bandai run
         both fades read the same, and two cycles had put 2 seeds of 15 over 1.5x."""
         key = (name, segment)
+        if key not in self._fades and not np.isfinite(self.gait(name).period[segment]):
+            self._fades[key] = SEAM_FADES[0]  # (no gait on this segment: nothing loops)
         if key not in self._fades:
             m, g = self.models[name], self.gait(name)
             fa, det = m.frame_angles(), m.detail()["angles"]
