@@ -6,6 +6,7 @@ from scipy.spatial.transform import Rotation
 
 from cyclecoord.errors import ParameterError
 from cyclecoord.motion import Motion
+from cyclecoord.skeleton import Joint, Skeleton
 from cyclecoord.rig import (
     CMU_UNIT,
     UNITS,
@@ -70,6 +71,35 @@ def test_xsens_rig_found():
     assert "frame 0 a reference pose" in info.summary()
     d = info.to_dict()
     assert d["reference_frame"] is True and d["units"] == "mm" and d["summary"] == info.summary()
+
+
+def test_the_head_over_the_feet_names_the_up_axis():
+    """``_head_over_feet``: Y on the Xsens performer's stand (also turned a quarter turn,
+    facing along x: 1,740 mm tall, some 890 deep), Z on the synthetic walk on a Z-up rig,
+    None on a skeleton that names no head.  (A latent model's Xsens stand read under
+    twice as tall as deep and had the head and both hands at its back: the chain-end
+    count took Z and every quality figure read the feet 6 cm under the floor.)"""
+    import cyclecoord.rig.describe as describe
+
+    m = shared(XSENS)[1:300]
+    f = m.frames.copy()
+    col = {c: i for i, c in enumerate(m.channels)}
+    x, z = f[:, col[("Hips", "tx")]].copy(), f[:, col[("Hips", "tz")]].copy()
+    f[:, col[("Hips", "tx")]], f[:, col[("Hips", "tz")]] = z, -x
+    f[:, col[("Hips", "ry")]] += 90.0  # (YXZ: the first rotation, about the world's y)
+    turned = m.with_frames(f)
+    every = np.arange(0, 299, 7)
+    assert describe._head_over_feet(m, every) == "Y"
+    assert describe._head_over_feet(turned, every) == "Y"
+    info = describe_rig(turned)
+    assert info.extents[1] < 2.0 * info.extents[2] and info.up_axis == "Y"
+    up = z_up()
+    assert describe._head_over_feet(up, np.arange(up.n_frames)) == "Z"
+    joints = [Joint(f"j{k}", k - 1, [0.0, 10.0 * (k > 0), 0.0], ("rx", "ry", "rz"), "XYZ")
+              for k in range(4)]
+    plain = Motion(np.zeros((3, 12)), Skeleton(tuple(joints)).channels,
+                   skeleton=Skeleton(tuple(joints)))
+    assert describe._head_over_feet(plain, np.arange(3)) is None
 
 
 def test_cmu_rig_found(walk_69_01):

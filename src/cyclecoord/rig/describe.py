@@ -343,16 +343,61 @@ def _ends_at_bottom(motion: Motion, frames: np.ndarray) -> np.ndarray:
     return np.median(near, axis=0)
 
 
+#: The head lies this many times further from the feet along the up axis than along the
+#: other candidate (median over frames) for :func:`_head_over_feet` to decide.
+_HEAD_OVER_FEET = 3.0
+
+
+def _head_over_feet(motion: Motion, frames: np.ndarray) -> str | None:
+    """Y or Z when the skeleton names a head and a left and a right ankle (or foot, or
+    toe) and, over ``frames``, the head lies :data:`_HEAD_OVER_FEET` times further from
+    the feet' midpoint along one of the two axes than along the other; else None.
+
+    A person standing or walking keeps the head over the feet whichever way they face;
+    the extents alone do not tell when something reaches out across the other axis
+    (arms, a prop: a latent model's Xsens stand read 1,740 mm tall and 891 mm deep,
+    under twice, and three chain ends, the head and both hands, lay at its back along
+    z against the two feet at the bottom of y: Z was taken)."""
+    from ..joint_names import classify_skeleton
+
+    skel = motion.skeleton
+    roles = classify_skeleton(skel)
+    head = [j for j, r in roles.items() if r.role == "head"]
+    for kind in ("ankle", "foot", "toe"):
+        feet = {r.side: j for j, r in roles.items() if r.role == kind and r.side}
+        if {"left", "right"} <= set(feet):
+            break
+    else:
+        return None
+    if not head:
+        return None
+    fk = forward_kinematics(motion[frames])
+    pos = fk.positions
+    h = pos[:, fk.names.index(head[0])]
+    f = 0.5 * (pos[:, fk.names.index(feet["left"])] + pos[:, fk.names.index(feet["right"])])
+    sep = np.median(np.abs(h - f), axis=0)
+    if sep[1] >= _HEAD_OVER_FEET * sep[2]:
+        return "Y"
+    if sep[2] >= _HEAD_OVER_FEET * sep[1]:
+        return "Z"
+    return None
+
+
 def _up_of(motion: Motion, frames: np.ndarray, extents: np.ndarray, static: bool) -> str:
     """Y or Z, the up axis of a capture.
 
     A body at least twice as tall as it is deep or long: the axis of its larger extent (a
-    biped).  Otherwise (a dog, whose body can be longer than it is tall) the axis along
+    biped).  Then a skeleton that names a head and two feet: the axis along which the
+    head keeps clearly furthest from the feet (:func:`_head_over_feet`).  Otherwise (a
+    dog, whose body can be longer than it is tall) the axis along
     which more chain ends reach the bottom (the feet stand on the floor), then the axis the
     body travels less along, then the larger extent."""
     y, z = float(extents[1]), float(extents[2])
     if max(y, z) >= 2.0 * min(y, z):
         return "Z" if z > y else "Y"
+    named = _head_over_feet(motion, frames)
+    if named is not None:
+        return named
     at_bottom = _ends_at_bottom(motion, frames)
     if at_bottom[1] != at_bottom[2]:
         return "Z" if at_bottom[2] > at_bottom[1] else "Y"
