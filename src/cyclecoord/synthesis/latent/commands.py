@@ -577,11 +577,11 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         :data:`IDLE_SWAY`) of the model's: a stand sways, it does not step.  At the full
         force the particle wandered along a walk model's stride loop and the legs stepped
         in place (pose speed 9-34 % of the walk's median); the pins that would hold the
-        feet then crossed the legs and were let go, and the feet glided (0.45 and 0.32 m/s
-        on one script seed in 15 each of subject 35's and the Bandai walk).  At 0.3 no
-        seed of 30 glides (at most 0.001 m/s) and the pose sways at 2-10 % of the walk's
-        pose speed; ``sway=1`` gives the old behaviour.  Moves between several IDLE
-        points keep the full force."""
+        feet then crossed the legs and were let go, and the feet glided (0.45 m/s on
+        subject 35's script seed 4 of 15; 0.32 m/s on a Bandai seed with two-cycle seam
+        fades).  At 0.3 no seed of 30 glides (at most 0.001 m/s) and the pose sways at
+        2-10 % of the walk's pose speed; ``sway=1`` gives the old behaviour.  Moves
+        between several IDLE points keep the full force."""
         self._need_start("IDLE")
         sway = IDLE_SWAY if sway is None else sway
         if not (
