@@ -17,6 +17,7 @@ from cyclecoord.rig import (
     parse_units,
     rig_summary,
 )
+from cyclecoord.conventions import to_bvh_convention
 from _rigs import (  # tests/ is on the path (rootdir conftest)
     BVH,
     XSENS,
@@ -305,3 +306,20 @@ def test_up_axis_of_a_dog_longer_than_tall():
     assert extents[2] > extents[1]  # longer than tall: the extent alone would say Z
     assert describe_rig(dog).up_axis == "Y"
     assert describe_rig(_dog_turned(Z_TO_Y.T)).up_axis == "Z"
+
+
+@pytest.mark.parametrize("name", ["bandai/dataset-1_walk_normal_001.bvh",
+                                  "bandai/dataset-2_walk-turn-left_normal_011.bvh",
+                                  "xsens/S02-Trial-Walk-1.bvh"])
+def test_the_up_axis_is_found_whichever_way_the_capture_faces(name):
+    """Each shared rig in its analysis form, re-expressed with ZXY channels, turned to four
+    headings about the vertical and also laid into a Z-up world: Y, then Z, every time."""
+    from cyclecoord.rig import analysis_motion
+
+    m = analysis_motion(shared(BVH / name)[1:301])
+    b = to_bvh_convention(m, "ZXY")
+    for deg in (0, 90, 180, 270):
+        turn = Rotation.from_euler("y", deg, degrees=True).as_matrix()
+        assert describe_rig(turn_root(b, turn)).up_axis == "Y", deg
+        lay = Rotation.from_euler("x", 90, degrees=True).as_matrix() @ turn  # y -> z
+        assert describe_rig(turn_root(b, lay)).up_axis == "Z", deg
