@@ -655,7 +655,7 @@ def test_check_plausibility_base_measures_only_the_pairs_a_changed_joint_moves(m
     np.testing.assert_array_equal(inter.distances[near], full.distances[near])
     assert (full.distances[~near] >= inter.threshold).all()
     assert (inter.flagged == full.flagged).all()
-    fresh = plaus._near_elements(trial, inter.bones, inter.threshold).sum()
+    fresh = plaus._near_elements(trial.positions().positions, inter.bones, inter.threshold).sum()
     assert 0 < sizes[0] < fresh / 3  # (the other frames and pairs are base's)
     # not comparable (another length): measured afresh, the same report
     short = m.window((0, 60))

@@ -207,7 +207,7 @@ def _pair_distances(motion: Motion, bn: Bones, which: np.ndarray | None = None) 
 
 
 def _near_elements(
-    motion: Motion, bn: Bones, threshold: float, pairs: np.ndarray | None = None,
+    pos: np.ndarray, bn: Bones, threshold: float, pairs: np.ndarray | None = None,
     frames: np.ndarray | None = None,
 ) -> np.ndarray:
     """(T, Q) frames and pairs whose bones come within ``threshold`` of each other's
@@ -221,8 +221,7 @@ def _near_elements(
     sphere test is widened by a millionth of the body's extent so that the product's
     rounding can only add elements, never drop one.
     """
-    pos = motion.positions().positions
-    T = pos.shape[0]
+    T = pos.shape[0]  # (pos: the motion's points (T, P, 3), forward kinematics)
     rows = np.ones(T, bool) if frames is None else np.asarray(frames, bool)
     pos = pos[rows]
     mid = 0.5 * (pos[:, bn.start] + pos[:, bn.end])  # (t, B, 3)
@@ -240,10 +239,9 @@ def _near_elements(
     return out
 
 
-def _element_distances(motion: Motion, bn: Bones, which: np.ndarray) -> np.ndarray:
-    """Distances ``(T, Q)`` of the bone pairs on the frames ``which`` (T, Q) marks;
-    infinity elsewhere."""
-    pos = motion.positions().positions
+def _element_distances(pos: np.ndarray, bn: Bones, which: np.ndarray) -> np.ndarray:
+    """Distances ``(T, Q)`` of the bone pairs on the frames ``which`` (T, Q) marks, for
+    points ``pos`` (T, P, 3); infinity elsewhere."""
     out = np.full(which.shape, np.inf)
     t, q = np.nonzero(which)
     a, b = bn.pairs[q, 0], bn.pairs[q, 1]

@@ -154,7 +154,8 @@ def self_intersections(
     if far not in ("measure", "skip"):
         raise ParameterError(f"far must be 'measure' or 'skip', got {far!r}")
     if far == "skip":
-        dist = _element_distances(motion, bn, _near_elements(motion, bn, float(threshold)))
+        pos = motion.positions().positions
+        dist = _element_distances(pos, bn, _near_elements(pos, bn, float(threshold)))
     else:
         dist = _pair_distances(motion, bn)
     if ignore_rest_contacts:
@@ -557,8 +558,8 @@ def _changed_only(
     bone = moved[bn.start] | moved[bn.end]
     pairs = bone[bn.pairs[:, 0]] | bone[bn.pairs[:, 1]]
     redo = rows[:, None] & pairs[None, :]
-    near = _near_elements(motion, bn, old.threshold, pairs, rows) & redo
-    dist = np.where(redo, _element_distances(motion, bn, near), old.distances)
+    near = _near_elements(fk.positions, bn, old.threshold, pairs, rows) & redo
+    dist = np.where(redo, _element_distances(fk.positions, bn, near), old.distances)
     return SelfIntersections(
         threshold=old.threshold, bones=bn,
         min_distance=dist.min(axis=0) if dist.size else np.zeros(0),
