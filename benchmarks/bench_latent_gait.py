@@ -254,6 +254,8 @@ def over_seeds(models: dict, d: Path, seeds: int, label: str = "") -> None:
             got[part].append((q.largest_accel, q.slip_ratio, min(q.knee_ratio), min(q.hip_ratio),
                               q.root_ratio, min(s2.knee_ratio), min(s2.hip_ratio)))
     print(f"  over seeds 0-{seeds - 1}: median [min-max]")
+    for part in got:
+        own_strides(models, part, label)
     for part, rows in got.items():
         r = np.array(rows)
         names = ["accel x p99", "slip x capt", "knee", "hip", "root speed x capt"]
@@ -265,6 +267,29 @@ def over_seeds(models: dict, d: Path, seeds: int, label: str = "") -> None:
     idle = np.array(idle)
     print(f"  IDLE     support foot after 0.5 s {np.median(idle):.3f} m/s [{idle.min():.3f}-"
           f"{idle.max():.3f}]; {int((idle > 0.1).sum())} of {seeds} seeds over 0.1 m/s")
+
+
+def own_strides(models: dict, part: str, label: str) -> None:
+    """The control for the leg ranges: every one-cycle window of the model's own training
+    takes (from their first stride where they stand first), measured like a generated
+    section against the same takes.  A take of two or three strides has its p1-p99 range
+    set by its widest stride, or by the ends of two different ones, which one stride of
+    the capture itself does not reach."""
+    takes = stride_takes(models, part, label) or training_takes(models, [part])
+    knee, hip = [], []
+    for t in takes:
+        w = int(round(measure_generated(t, takes).cycle_s * t.fps))
+        if not 3 <= w <= t.n_frames:
+            continue
+        for s in range(0, t.n_frames - w + 1, max(1, w // 8)):
+            q = measure_generated(t[s : s + w], takes)
+            knee.append(min(q.knee_ratio))
+            hip.append(min(q.hip_ratio))
+    if not knee:
+        return
+    print(f"  {part:7s}  control, the training takes' own one-cycle windows "
+          f"({len(knee)}): knee {np.median(knee):.2f} [{min(knee):.2f}-{max(knee):.2f}]; "
+          f"hip {np.median(hip):.2f} [{min(hip):.2f}-{max(hip):.2f}]")
 
 
 def _hold(motion, sec):
