@@ -203,7 +203,24 @@ def run_set(s: dict, limbs: bool) -> dict:
     cells = [_fmt(c) for c in caps]
     span = [_span([c[i] for c in cells]) for i in range(len(HEAD) - 1)]
     rows.append((f"captures ({len(takes)})", span))
+    figures["stride windows"] = stride_control(takes, ref)
     return {"name": s["name"], "frames": s["frames"], "figures": figures, "rows": rows}
+
+
+def stride_control(takes: list, ref) -> list[float]:
+    """The control for the knee,hip range column: the smallest leg range ratio of every
+    one-cycle window of the captures (one starting every eighth of a cycle), measured
+    like a generated motion.  On a take of two or three strides the p1-p99 range is set
+    by its widest stride (or the ends of two), which one captured stride does not reach."""
+    out = []
+    for t in takes:
+        w = int(round(measure_generated(t, reference=ref).cycle_s * t.fps))
+        if not 3 <= w <= t.n_frames:
+            continue
+        for a in range(0, t.n_frames - w + 1, max(1, w // 8)):
+            q = measure_generated(t[a : a + w], reference=ref)
+            out.append(float(min(q.knee_ratio + q.hip_ratio)))
+    return out
 
 
 def ratios(fig: dict) -> list[str]:
@@ -261,6 +278,10 @@ def main(argv: list[str] | None = None) -> int:
         print(table(r["rows"]))
         print("ratios measured in this run:")
         print("\n".join(ratios(r["figures"])))
+        ctl = r["figures"]["stride windows"]
+        if ctl:
+            print(f"  control: the captures' own one-cycle windows ({len(ctl)}), knee,hip range "
+                  f"{np.median(ctl):.2f} median [{min(ctl):.2f}-{max(ctl):.2f}]")
         for label in METHODS:
             f = r["figures"][label]
             if "fit_cpu" in f:

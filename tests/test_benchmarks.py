@@ -473,3 +473,7 @@ def test_synthesis_bench_prints_every_method_on_synthetic_walks(tmp_path, capsys
         assert label in text
     figures = json.loads(out.read_text())["sets"][0]["figures"]
     assert not figures["graph (ours)"]["freezes"]
+    # the control: each capture's one-cycle windows, measured like a generated motion
+    assert "control: the captures' own one-cycle windows" in text
+    ctl = figures["stride windows"]
+    assert len(ctl) >= 4 and max(ctl) <= 1.2 and 0.8 < float(np.median(ctl)) <= 1.05
