@@ -278,6 +278,24 @@ def support(motion: Motion, feet: tuple[str, ...], floor: float | None = None) -
     return Support(carry=carry, planted=low_share * on > LOCK_SUPPORT, contacts=contacts)
 
 
+def _stays_down(planted: np.ndarray, hold: np.ndarray) -> np.ndarray:
+    """``planted`` (T, F) with each point, once down within a run of ``hold`` frames,
+    down to the run's end: a stand's feet do not lift.  (Left to the contact test, a
+    foot came and went with the stand's sway: on an IDLE of a Bandai walk model the pin
+    let go where the sway lifted a toe 1-3 cm, the released foot snapped over 0.1 s to
+    where the pose had drifted, 3-10 times the acceleration before, and was then left
+    unpinned, gliding 0.3-0.7 m/s under a still body.)"""
+    from ..quality.contacts import contact_runs
+
+    out = np.array(planted, dtype=bool)
+    for a, b in contact_runs(hold):
+        for i in range(out.shape[1]):
+            down = np.flatnonzero(out[a:b, i])
+            if down.size:
+                out[a + down[0] : b, i] = True
+    return out
+
+
 def _tidy(planted: np.ndarray, shortest: float) -> np.ndarray:
     """``planted`` (T, F) with gaps under ``shortest`` frames closed, then stretches under
     it dropped (short touches toggle and make the legs jitter)."""
@@ -380,6 +398,7 @@ def lock_where_clean(
             # alone; with the low, slow contacts, 0.41 m/s on subject 35's: they came
             # and went with the sway)
             planted |= held.contacts.planted & np.asarray(hold, dtype=bool)[:, None]
+            planted = _stays_down(planted, np.asarray(hold, dtype=bool))
     except CycleCoordError as exc:
         return LockOutcome(motion, 0, [], f"foot locking: not done ({exc})")
     contacts = held.contacts
@@ -422,6 +441,16 @@ def lock_where_clean(
                 if not near.size:
                     continue
                 dropped = True  # a pop or out of range: ...
+                part = (settled[a:b] | fallback[a:b, i]) & planted[a:b, i]
+                if part.all():
+                    part = settled[a:b] & planted[a:b, i]
+                if part.any() and not part.all() and not settled[np.clip(near, 0, len(settled) - 1)].any():
+                    # ... before a stand settles: the stand's settled part whole, and before
+                    # it what bears weight (then the settled part alone)
+                    planted[a:b, i] = part
+                    fallback[a:b, i] &= part
+                    skipped.append((a, b))
+                    continue
                 alt = fallback[a:b, i].copy()
                 fallback[a:b, i] = False
                 if alt.any() and not alt.all():  # ... a lengthened stretch: its own part
