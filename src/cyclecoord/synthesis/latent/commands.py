@@ -264,6 +264,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         # (model, segment, unwrapped phase) where the last stepping command left the
         # particle, and the one the MOVE being made will leave
         self._cursor = self._next_cursor = None
+        # whether the particle is stepping along its model's gait (a MOVE ahead, a PLAY,
+        # a TRANSITION in step) rather than idling or going to a target: an in-step
+        # TRANSITION needs a gait to step from
+        self._stepping = False
         self._path_detail: dict | None = None  # the gait detail along the MOVE's path
         widest = max(m.X_.shape[0] for m in self.models.values())
         channels = max(len(m.all_channels_) for m in self.models.values())
@@ -394,6 +398,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self.sim_seconds += time.perf_counter() - t0
         self.sim_cpu_seconds += time.process_time() - c0
         self.x, self.v = X[-1], V[-1]
+        self._stepping = False  # (a MOVE ahead says otherwise after its run)
 
     def _clip(self, name: str, angles: np.ndarray, count: bool = True) -> np.ndarray:
         """Joint limits: angles beyond the training range of model ``name`` are eased
@@ -566,6 +571,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         if along is not None:
             detail = {k: interp_rows(u, times, v)[1:] for k, v in along.items()}
         self._run(samples, radius, ride=True, detail=detail)
+        self._stepping = isinstance(to, dict) and "ahead" in to
 
     def idle(
         self, at: Any = None, duration: float = 1.0, radius: float | None = None,
@@ -687,5 +693,6 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
                 k: interp(v[idx]).reshape((len(t),) + v.shape[1:]) for k, v in m.detail().items()
             }
         self._emit(self.current, X, interp(m.angles(m.frames_[idx])), root, detail=detail)
+        self._stepping = True
         self.x = X[-1]
         self.v = (X[-1] - X[-2]) * self.fps if len(X) > 1 else np.zeros_like(self.x)

@@ -252,6 +252,7 @@ class GaitMixin:
         self.current, self.x = to, Xb[-1]
         self.v = (Xb[-1] - Xb[-2]) * self.fps if n > 1 else np.zeros_like(self.x)
         self._cursor = (to, sb, float(ub + du[-1]))
+        self._stepping = True
 
 
 def _better(best, cand, m1, m2, x):
