@@ -740,7 +740,7 @@ def test_each_segment_chooses_its_seam_fade(cmu_dir, bvh_dir):
 def test_a_transition_goes_in_step_only_from_a_stepping_particle(models):
     """In step needs a gait to step from: after MOVEs ahead, a PLAY or an in-step
     TRANSITION the hop blends the two gaits in step; after an IDLE or a MOVE to a target
-    it crosses at a bridge and says so (blended in step from there, ten seeds of a Bandai
+    it crosses as when not in step, while both idle, and says so (blended in step from there, ten seeds of a Bandai
     script popped at 1.1-6.5x the run's p99 of acceleration, 0.4-1.7x at a bridge)."""
     def hop(before):
         syn = Synthesizer(models, fps=30, seed=1, plant="off")
@@ -765,7 +765,7 @@ def test_a_transition_goes_in_step_only_from_a_stepping_particle(models):
     for name, before in idle.items():
         ev, said = hop(before)
         assert not ev.get("in_step") and len(said) == 1, name
-        assert "TRANSITION walk -> run: at a bridge" in said[0]
+        assert "TRANSITION walk -> run: not in step, crossed while both models idle" in said[0]
     # an in-step TRANSITION leaves the particle stepping in the other gait
     syn = Synthesizer(models, fps=30, seed=1, plant="off")
     _walk_then_hop(syn)

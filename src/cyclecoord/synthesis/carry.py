@@ -278,6 +278,13 @@ def support(motion: Motion, feet: tuple[str, ...], floor: float | None = None) -
     return Support(carry=carry, planted=low_share * on > LOCK_SUPPORT, contacts=contacts)
 
 
+def _lost(kept: np.ndarray, start: int) -> tuple[int, int]:
+    """The frames ``[first, last + 1)`` of a pinned stretch starting at ``start`` that
+    ``kept`` (its frames still pinned) unpins."""
+    lost = np.flatnonzero(~np.asarray(kept, dtype=bool)) + start
+    return int(lost[0]), int(lost[-1]) + 1
+
+
 def _stays_down(planted: np.ndarray, hold: np.ndarray) -> np.ndarray:
     """``planted`` (T, F) with each point, once down within a run of ``hold`` frames,
     down to the run's end: a stand's feet do not lift.  (Left to the contact test, a
@@ -449,7 +456,7 @@ def lock_where_clean(
                     # it what bears weight (then the settled part alone)
                     planted[a:b, i] = part
                     fallback[a:b, i] &= part
-                    skipped.append((a, b))
+                    skipped.append(_lost(part, a))
                     continue
                 alt = fallback[a:b, i].copy()
                 fallback[a:b, i] = False
@@ -460,7 +467,7 @@ def lock_where_clean(
                     part = settled[a:b] & planted[a:b, i]
                     if not part.all():
                         planted[a:b, i] = part
-                        skipped.append((a, b))
+                        skipped.append(_lost(part, a))
                         continue
                     # ... then what of it is clear of the pops (below)
                 keep = np.ones(b - a, dtype=bool)  # ... else what is clear of the pops
@@ -469,8 +476,7 @@ def lock_where_clean(
                 piece = np.zeros((len(planted), 1), dtype=bool)
                 piece[a:b, 0] = keep
                 planted[a:b, i] = _tidy(piece, shortest)[a:b, 0]
-                lost = np.flatnonzero(~planted[a:b, i]) + a
-                skipped.append((int(lost[0]), int(lost[-1]) + 1))
+                skipped.append(_lost(planted[a:b, i], a))
         if not dropped:  # the pops are not at a pin
             result = trial
             break

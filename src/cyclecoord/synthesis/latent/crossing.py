@@ -241,9 +241,9 @@ class CrossingMixin:
             # gaits blended in step from there popped at 1.1-6.5x the run's p99 of
             # acceleration over ten seeds of a Bandai script, 0.4-1.7x at a bridge
             self.notes.append(
-                f"commands[{self.command}] TRANSITION {src} -> {to}: at a bridge, not in "
-                "step (the particle was not stepping: in step needs a MOVE ahead, a PLAY "
-                "or a TRANSITION in step before it)"
+                f"commands[{self.command}] TRANSITION {src} -> {to}: not in step, crossed "
+                "while both models idle (the particle was not stepping: in step needs a "
+                "MOVE ahead, a PLAY or a TRANSITION in step before it)"
             )
         hops = [src, to]
         if route:
