@@ -451,7 +451,8 @@ def lock_where_clean(
                 part = (settled[a:b] | fallback[a:b, i]) & planted[a:b, i]
                 if part.all():
                     part = settled[a:b] & planted[a:b, i]
-                if part.any() and not part.all() and not settled[np.clip(near, 0, len(settled) - 1)].any():
+                early = not settled[np.clip(near, 0, len(settled) - 1)].any()
+                if early and part.any() and not part.all():
                     # ... before a stand settles: the stand's settled part whole, and before
                     # it what bears weight (then the settled part alone)
                     planted[a:b, i] = part
