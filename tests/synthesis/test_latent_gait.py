@@ -353,10 +353,30 @@ def test_blend_shorter_than_a_frame_fails_and_a_raised_one_is_said(models):
 
 
 def test_gait_survives_saving(models, tmp_path):
-    models["run"].save(tmp_path / "run.npz")
+    """The phases and each segment's seam fade (chosen at fit, as a script would choose
+    it) are kept in the model file; a file without the fades chooses them on use, and a
+    fade that is not a positive number of cycles is refused, naming the array."""
+    from cyclecoord.errors import ParseError
+    from cyclecoord.synthesis.latent.gait import SEAM_FADES, choose_seam_fade
+
+    run = models["run"]
+    g = run.gait()
+    assert g.fade is not None and set(g.fade) <= set(SEAM_FADES)
+    assert list(g.fade) == [choose_seam_fade(run, g, s) for s in range(g.period.size)]
+    run.save(tmp_path / "run.npz")
     back = LatentModel.load(tmp_path / "run.npz")
     assert back.gait_ is not None
-    np.testing.assert_allclose(back.gait().phase, models["run"].gait().phase)
+    np.testing.assert_allclose(back.gait().phase, g.phase)
+    np.testing.assert_array_equal(back.gait().fade, g.fade)
+    arrays = dict(np.load(tmp_path / "run.npz", allow_pickle=False))
+    old = {k: v for k, v in arrays.items() if k != "gait_fade"}
+    np.savez(tmp_path / "old.npz", **old)
+    syn = Synthesizer({"run": LatentModel.load(tmp_path / "old.npz")}, fps=30)
+    assert syn.gait("run").fade is None
+    assert [syn.seam_fade("run", s) for s in range(g.period.size)] == list(g.fade)
+    np.savez(tmp_path / "bad.npz", **{**arrays, "gait_fade": -g.fade})
+    with pytest.raises(ParseError, match="gait_fade"):
+        LatentModel.load(tmp_path / "bad.npz")
 
 
 # ------------------------------------------------------------- the gait's loop, by hand

@@ -602,6 +602,8 @@ class LatentModel:
         g = getattr(self, "gait_", None)
         if g is not None:
             arrays.update({"gait_phase": g.phase, "gait_period": g.period})
+            if g.fade is not None:
+                arrays["gait_fade"] = g.fade
         with atomic_write(path, "wb") as fh:
             np.savez_compressed(fh, **arrays)
 
@@ -708,7 +710,12 @@ class LatentModel:
             period = a.reals("gait_period", (S,), allow_nan=True)
             if (period <= 0).any():
                 raise a.error("gait_period", "frames per cycle are positive")
-            m.gait_ = Gait(phase, period, m.segments_)
+            fade = None  # (files written before the seam fades were kept choose on use)
+            if "gait_fade" in arrays:
+                fade = a.reals("gait_fade", (S,))
+                if (fade <= 0).any():
+                    raise a.error("gait_fade", "seam cross-fades are positive cycles")
+            m.gait_ = Gait(phase, period, m.segments_, fade)
         starts = np.flatnonzero(np.r_[True, m.segments_[1:] != m.segments_[:-1]])
         stops = np.r_[starts[1:], len(m.segments_)]
         try:

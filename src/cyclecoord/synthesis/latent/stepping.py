@@ -24,7 +24,7 @@ from ..._words import plural
 from ...errors import ParameterError
 from .crossing import BLEND_ACCELERATION, blend_asked
 from .easing import smootherstep
-from .gait import Gait
+from .gait import FADE_TIE, SEAM_FADES, Gait, choose_seam_fade
 from .influence import pose_points
 
 __all__ = ["FADE_TIE", "GaitMixin", "IN_STEP_LONGEST", "SEAM_FADES"]
@@ -34,10 +34,6 @@ __all__ = ["FADE_TIE", "GaitMixin", "IN_STEP_LONGEST", "SEAM_FADES"]
 IN_STEP_LONGEST = 1.0
 
 
-#: Seam cross-fades (cycles, :meth:`~.gait.Gait.at` ``fade``) a segment's loop chooses
-#: between, and the margin within which the shorter wins (:meth:`GaitMixin.seam_fade`).
-SEAM_FADES = (1.0, 2.0)
-FADE_TIE = 0.02
 
 
 class GaitMixin:
@@ -58,31 +54,15 @@ class GaitMixin:
                                   seam=m.frame_angles())
 
     def seam_fade(self, name: str, segment: int) -> float:
-        """The cross-fade over the seam of ``segment``'s loop (cycles): of
-        :data:`SEAM_FADES`, the one whose looped path (the pose of the path plus the gait
-        detail, as joint positions) accelerates least over the cycle each side of the
-        seam, the shorter within :data:`FADE_TIE`.  A longer fade reaches as far as the
-        take has frames, up to a cycle each side.  On the 143_01 jog (50 frames, its
-        seam crossed every stride) two cycles took the path's largest acceleration
-        there down a tenth, and the script's largest from 1.30 [1.23-1.61] to 1.22
-        [1.16-1.40] its p99 over 15 seeds (4 seeds over 1.5x to none); on the Bandai run
-        both fades read the same, and two cycles had put 2 seeds of 15 over 1.5x."""
+        """The cross-fade over the seam of ``segment``'s loop (cycles): the one the model
+        chose when it was fitted (:func:`~.gait.choose_seam_fade`), else chosen now."""
         key = (name, segment)
-        if key not in self._fades and not np.isfinite(self.gait(name).period[segment]):
-            self._fades[key] = SEAM_FADES[0]  # (no gait on this segment: nothing loops)
         if key not in self._fades:
-            m, g = self.models[name], self.gait(name)
-            fa, det = m.frame_angles(), m.detail()["angles"]
-            rows, lo, K = g._loop(segment, fa)
-            u = lo + K + np.arange(-1.2, 1.2, 1.0 / g.period[segment])
-            costs = []
-            for fade in SEAM_FADES:
-                pose = m.pose(g.at(m.X_, segment, u, fade, fa)) + g.at(det, segment, u, fade, fa)
-                pts = pose_points(m.to_channels(pose), m.channels_, m.skeleton_)
-                costs.append(float(np.linalg.norm(np.diff(pts, 2, axis=0), axis=-1).max()))
-            least = min(costs)
-            self._fades[key] = next(
-                f for f, c in zip(SEAM_FADES, costs) if c <= least * (1.0 + FADE_TIE))
+            g = self.gait(name)
+            self._fades[key] = (
+                float(g.fade[segment]) if g.fade is not None
+                else choose_seam_fade(self.models[name], g, segment)
+            )
         return self._fades[key]
 
     def _gait_place(self, name: str) -> tuple[int, float] | None:
