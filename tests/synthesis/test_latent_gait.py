@@ -844,3 +844,34 @@ def test_an_idle_after_a_run_stands_on_a_bandai_pair(bvh_dir):
     a, b = _span(syn, [syn.command])
     q = measure_generated(motion[a + 15 : b], training_takes(models, ["walk"]))
     assert q.support_slip < 0.1
+
+
+def test_a_stiff_particle_step_is_taken_again_in_parts(models, monkeypatch):
+    """A particle held at a small radius by a strong random force is stiff: one 30 fps
+    Runge-Kutta step could throw it off (one seed in twenty of a ten-second Bandai run
+    script went to 1e9 latent units and the pose leapt to the model's mean, 15x the run's
+    p99 of acceleration).  Such a step is taken again in parts: the particle stays within
+    a few radii of its path; in whole steps the same runs diverge."""
+    import cyclecoord.synthesis.latent.particle as particle
+
+    m = models["run"]
+    path = m.X_[:100]
+
+    def worst():
+        out = []
+        for seed in range(10):
+            force = particle.RandomForce(m.X_.shape[1], 0.4, random_state=seed)
+            for radius in (0.02, 0.01, 0.005):
+                params = particle.ParticleParams().replace(radius=radius, random=4.0)
+                try:
+                    X, _ = particle.simulate(m, path, path[0], np.zeros(m.X_.shape[1]), 30.0,
+                                             params, force, 0.0, True)
+                except ParameterError:
+                    out.append(np.inf)
+                    continue
+                out.append(np.linalg.norm(X - path[1:], axis=1).max() / (radius * m.speed_))
+        return max(out)
+
+    assert worst() < 10.0
+    monkeypatch.setattr(particle, "SUBSTEPS", ())
+    assert worst() == np.inf
