@@ -96,16 +96,20 @@ def bandai_pair() -> dict | None:
     return {"walk": [cc.load(walk)], "run": [cc.load(run)]}
 
 
-def script(d: Path, blend: float = 0.4, seed: int = 0) -> Path:
-    ahead = [{"command": "MOVE", "to": {"ahead": 0.3}} for _ in range(10)]
+def script(d: Path, blend: float = 0.4, seed: int = 0, ahead: float = 0.3,
+           run_s: float = 3.0) -> Path:
+    """Walk 3 s and run ``run_s`` seconds in MOVEs of ``ahead`` seconds, each gait joined
+    by a TRANSITION, then IDLE 2 s."""
+    walk = [{"command": "MOVE", "to": {"ahead": ahead}}] * int(round(3.0 / ahead))
+    run = [{"command": "MOVE", "to": {"ahead": ahead}}] * int(round(run_s / ahead))
     spec = {
         "fps": 30, "seed": seed, "models": {"walk": "walk.npz", "run": "run.npz"},
         "start": {"model": "walk", "at": {"frame": 0}},
-        "commands": ahead + [{"command": "TRANSITION", "to": "run", "blend": blend}] + ahead
+        "commands": walk + [{"command": "TRANSITION", "to": "run", "blend": blend}] + run
         + [{"command": "TRANSITION", "to": "walk", "blend": blend},
            {"command": "IDLE", "duration": 2.0}],
     }
-    p = d / f"script_{blend:g}_{seed}.json"
+    p = d / f"script_{blend:g}_{seed}_{ahead:g}_{run_s:g}.json"
     p.write_text(json.dumps(spec, indent=1))
     return p
 
@@ -126,13 +130,15 @@ def flattened(motion, models) -> int:
 def sections(report) -> dict:
     """Frames of the walk chain, the run chain, each TRANSITION and the IDLE."""
     segs = report["commands"]
+    kinds = [c["command"] for c in json.loads(Path(report["script"]).read_text())["commands"]]
+    t1, t2 = [i for i, k in enumerate(kinds) if k == "TRANSITION"]
 
     def span(cmds):
         rows = [s for s in segs if s["command"] in cmds]
         return rows[0]["start"], rows[-1]["stop"]
 
-    return {"walk": span(range(0, 10)), "T1": span([10]), "run": span(range(11, 21)),
-            "T2": span([21]), "idle": span([22])}
+    return {"walk": span(range(0, t1)), "T1": span([t1]), "run": span(range(t1 + 1, t2)),
+            "T2": span([t2]), "idle": span([t2 + 1])}
 
 
 def measure_pair(label: str, takes: dict, d: Path, quick: bool, seeds: int = 1) -> None:
@@ -267,6 +273,30 @@ def over_seeds(models: dict, d: Path, seeds: int, label: str = "") -> None:
     idle = np.array(idle)
     print(f"  IDLE     support foot after 0.5 s {np.median(idle):.3f} m/s [{idle.min():.3f}-"
           f"{idle.max():.3f}]; {int((idle > 0.1).sum())} of {seeds} seeds over 0.1 m/s")
+    long_moves(models, d, seeds)
+
+
+#: ``(ahead, run seconds)`` of the longer scripts :func:`long_moves` runs: the scripts
+#: above step in MOVEs of 0.3 s, the steadiest case (each MOVE starts its path where
+#: the particle is); a user writes ``{"ahead": 2.0}`` and runs longer.
+LONG_MOVES = ((1.0, 8.0), (2.0, 8.0))
+
+
+def long_moves(models: dict, d: Path, seeds: int) -> None:
+    """The gait sections' largest acceleration over the same seeds with longer MOVEs
+    and an 8 s run (:data:`LONG_MOVES`)."""
+    for ahead, run_s in LONG_MOVES:
+        got: dict[str, list] = {"walk": [], "run": []}
+        for seed in range(seeds):
+            motion, rep = run_script(script(d, seed=seed, ahead=ahead, run_s=run_s))
+            sec = sections(rep)
+            for part in got:
+                a, b = sec[part]
+                got[part].append(
+                    measure_generated(motion[a:b], training_takes(models, [part])).largest_accel)
+        cells = [f"{part} {np.median(v):.2f} [{min(v):.2f}-{max(v):.2f}], "
+                 f"{sum(x > 1.5 for x in v)} of {seeds} over 1.5" for part, v in got.items()]
+        print(f"  MOVEs of {ahead:g} s, run {run_s:g} s: accel x p99 " + "; ".join(cells))
 
 
 def own_strides(models: dict, part: str, label: str) -> None:
