@@ -21,6 +21,8 @@ motion is also checked by ``../shared/tools/motioncheck`` (independent kinematic
 The gait sections' pops, slip and leg ranges are then given over ``--seeds`` script
 seeds (default 5): median and range, since one seed's figure is one draw of the random
 force.
+Then the same seeds with MOVEs of 1 and 2 s and an 8 s run (``LONG_MOVES``), and a control
+for the leg ranges: the training takes' own one-cycle windows, measured alike.
 """
 
 from __future__ import annotations
