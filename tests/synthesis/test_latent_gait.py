@@ -811,22 +811,24 @@ def test_a_stand_keeps_each_foot_down_from_its_first_contact():
     assert not _stays_down(planted, np.zeros(12, bool))[3:5].any()
 
 
-def test_an_idle_after_a_run_stands_on_a_bandai_pair(bvh_dir):
-    """A Bandai walk model (the turning and the sad backward walks) and run: MOVEs to
-    segment times, a TRANSITION to the run, PLAY, MOVE ahead, TRANSITION back, IDLE.  On
-    seed 8 the IDLE's feet glided 0.28 m/s under a still body: the pins of the stand's
-    first frames popped at the blend before it, fell back to the weight-bearing frames,
-    and a toe the sway lifted let go.  A stand's settled part is now pinned whole."""
+@pytest.fixture(scope="module")
+def bandai_pair(bvh_dir):
+    """A Bandai walk model (the turning and the sad backward walks) and run."""
     bandai = bvh_dir / "bandai"
     fit = {"gplvm": {"max_iter": 200}}
-    models = {
+    return {
         "walk": LatentModel(**fit).fit(
             [cc.load(bandai / "dataset-2_walk-turn-left_normal_011.bvh"),
              cc.load(bandai / "dataset-1_walk-back_sad_001.bvh")], ["TurnL", "Back"]),
         "run": LatentModel(**fit).fit([cc.load(bandai / "dataset-1_run_happy_001.bvh")],
                                       ["Run"]),
     }
-    syn = Synthesizer(models, fps=30, seed=8)
+
+
+def _bandai_script(models, seed):
+    """MOVEs to segment times, a TRANSITION to the run, PLAY, MOVE ahead, TRANSITION
+    back, IDLE: what ``cyclecoord animate`` runs for that script."""
+    syn = Synthesizer(models, fps=30, seed=seed)
     syn.start("walk", {"segment": "TurnL", "time": 0.5})
     steps = [
         lambda: syn.move({"segment": "TurnL", "time": 4.0}, path="graph", stop=False),
@@ -840,10 +842,33 @@ def test_an_idle_after_a_run_stands_on_a_bandai_pair(bvh_dir):
     for step in steps:
         syn.command += 1
         step()
-    motion = syn.motion()
+    return syn, syn.motion()
+
+
+def test_an_idle_after_a_run_stands_on_a_bandai_pair(bandai_pair):
+    """On seed 8 of the Bandai script the IDLE's feet glided 0.28 m/s under a still
+    body: the pins of the stand's first frames popped at the blend before it, fell back
+    to the weight-bearing frames, and a toe the sway lifted let go.  A stand's settled
+    part is now pinned whole."""
+    syn, motion = _bandai_script(bandai_pair, seed=8)
     a, b = _span(syn, [syn.command])
-    q = measure_generated(motion[a + 15 : b], training_takes(models, ["walk"]))
+    q = measure_generated(motion[a + 15 : b], training_takes(bandai_pair, ["walk"]))
     assert q.support_slip < 0.1
+
+
+def test_a_frame_still_too_close_at_its_phase_takes_the_nearer_captured_frame(
+        bandai_pair):
+    """On seed 6 of the Bandai script a run frame, pulled fully to the captured pose at
+    its phase, still brought a shin and the other foot closer than the takes ever do
+    (5.1 units against 6.3: the pose between two captured frames cut the corner), and
+    animate refused the script; it now takes the nearer whole captured frame."""
+    from cyclecoord.quality.plausibility import check_plausibility
+
+    syn, motion = _bandai_script(bandai_pair, seed=6)
+    said = [n for n in syn.notes if n.startswith("limbs:")]
+    assert said and "pulled toward the captured pose" in said[0]
+    takes = [m.training_motion() for m in bandai_pair.values()]
+    assert not check_plausibility(motion, takes).new_contact_frames
 
 
 def test_a_stiff_particle_step_is_taken_again_in_parts(models, monkeypatch):
