@@ -248,9 +248,13 @@ def over_seeds(models: dict, d: Path, seeds: int, label: str = "") -> None:
     1.5-2.3x over five seeds on the shared pairs)."""
     got: dict[str, list] = {"walk": [], "run": []}
     idle = []
+    refused = []  # seeds whose motion animate would not write (limbs through each other)
     for seed in range(seeds):
         motion, rep = run_script(script(d, seed=seed))
         sec = sections(rep)
+        crossing = (rep.get("plausibility") or {}).get("new_contact_frames") or []
+        if crossing:
+            refused.append((seed, crossing[0]))
         a, b = sec["idle"]  # the support foot once the IDLE's root stands (0.5 s)
         idle.append(measure_generated(motion[a + 15 : b], training_takes(models, ["walk"]))
                     .support_slip)  # (m/s)
@@ -275,6 +279,9 @@ def over_seeds(models: dict, d: Path, seeds: int, label: str = "") -> None:
     idle = np.array(idle)
     print(f"  IDLE     support foot after 0.5 s {np.median(idle):.3f} m/s [{idle.min():.3f}-"
           f"{idle.max():.3f}]; {int((idle > 0.1).sum())} of {seeds} seeds over 0.1 m/s")
+    print(f"  limbs    `cyclecoord animate` refuses {len(refused)} of {seeds} seeds (limbs closer "
+          "than the training takes' after untangling)"
+          + (": " + ", ".join(f"seed {s} frame {f}" for s, f in refused[:5]) if refused else ""))
     long_moves(models, d, seeds)
 
 
