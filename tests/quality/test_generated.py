@@ -833,3 +833,31 @@ def test_source_figures_cache_finds_each_takes_figures_once_and_reads_the_same(m
         np.testing.assert_array_equal(got.take_cycle, plain.take_cycle)
     # 4 takes once with the cache, then 4 + 2 + 2 + 2 without it
     assert len(made) == 4 + 10
+
+
+def test_a_mixed_reference_weights_each_models_figures_by_the_frames_it_made():
+    """Scalars are frame-weighted means of the models' figures, the takes' speeds and
+    cycles are joined, per-leg ranges weighted leg by leg (none when the leg counts
+    differ); the rate, units and leg length are the first's."""
+    from dataclasses import replace
+
+    from cyclecoord.quality.generated import SourceFigures, mixed_reference
+
+    def ref(x, legs=(1.0, 2.0)):
+        return SourceFigures(
+            fps=30.0, metres=0.01, leg_length=80.0, floor=x, pose_speed_median=x,
+            step_p99=x, accel_p99=x, support_slip=x, knee_range=x, hip_range=x,
+            take_speed=np.array([x]), take_cycle=np.array([x]), penetration=x,
+            contact_slide=x, knee_range_legs=tuple(x * v for v in legs),
+            hip_range_legs=tuple(x * v for v in legs))
+
+    walk, run = ref(1.0), ref(4.0)
+    mixed = mixed_reference([(walk, 30), (run, 10)])
+    for name in ("floor", "pose_speed_median", "step_p99", "accel_p99", "support_slip",
+                 "knee_range", "hip_range", "penetration", "contact_slide"):
+        assert getattr(mixed, name) == pytest.approx(1.75), name
+    assert mixed.knee_range_legs == pytest.approx((1.75, 3.5))
+    np.testing.assert_array_equal(mixed.take_speed, [1.0, 4.0])
+    assert (mixed.fps, mixed.metres, mixed.leg_length) == (30.0, 0.01, 80.0)
+    odd = mixed_reference([(walk, 1), (replace(run, knee_range_legs=(4.0,)), 1)])
+    assert odd.knee_range_legs == () and odd.hip_range_legs == pytest.approx((2.5, 5.0))

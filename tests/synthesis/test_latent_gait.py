@@ -606,6 +606,16 @@ def test_a_script_over_two_models_is_also_measured_model_by_model(made):
                    .largest_accel for k in pair)
         assert win["largest_accel_ratio"] == pytest.approx(want)
     assert lines[-2].startswith(f"  TRANSITION walk -> run frames {t1[0] - 3}-{t1[1] + 3}: ")
+    # the whole motion leads against each model's takes weighted by the frames it made
+    # (pooled, the model with more training frames set the figures)
+    from cyclecoord.quality.generated import source_figures
+
+    refs = {k: source_figures(training_takes(syn.models, [k]), 30.0) for k in ("walk", "run")}
+    frames = {"walk": walk[1] - walk[0] + idle[1] - idle[0], "run": run[1] - run[0]}
+    want = sum(frames[k] * refs[k].support_slip for k in refs) / sum(frames.values())
+    metres = refs["walk"].metres
+    assert quality["sources_support_slip_m_per_s"] == pytest.approx(want * metres, rel=1e-6)
+    assert refs["walk"].support_slip != pytest.approx(refs["run"].support_slip, rel=0.1)
     # with no TRANSITION named, a blend's frames go to the model that made them
     assert [(s["model"], s["start"], s["stop"]) for s in model_sections(syn, [{}] * 23)] == [
         ("walk", 0, t1[0]), ("run", t1[0], t2[0]), ("walk", t2[0], motion.n_frames)]

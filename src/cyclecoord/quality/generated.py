@@ -55,6 +55,7 @@ __all__ = [
     "GeneratedQuality",
     "SourceFigures",
     "source_figures",
+    "mixed_reference",
     "measure_generated",
     "FREEZE_FRACTION",
     "FREEZE_SECONDS",
@@ -366,6 +367,47 @@ def source_figures(
         contact_slide=float(np.median(np.concatenate(slides))),
         knee_range_legs=tuple(float(x) for x in np.median([t["knee"] for t in takes], 0)),
         hip_range_legs=tuple(float(x) for x in np.median([t["hip"] for t in takes], 0)),
+    )
+
+
+def mixed_reference(parts: Sequence[tuple[SourceFigures, float]]) -> SourceFigures:
+    """The sources' figures for a motion several models made, ``parts`` each model's own
+    figures (:func:`source_figures` of its takes, at one rate) with the frames it made:
+    each figure is the frame-weighted mean of the models' (the takes' speeds and cycles
+    joined).  Pooling the takes instead judges the motion by whichever model has the
+    most training frames: a script that ran for most of its length read "feet gliding"
+    against the walk model's slip (0.01 m/s) while each model's frames, against their own
+    takes, read planted."""
+    from dataclasses import replace
+
+    refs = [r for r, _ in parts]
+    w = np.array([float(n) for _, n in parts])
+    w = w / w.sum() if w.sum() > 0 else np.full(len(refs), 1.0 / len(refs))
+
+    def mean(name: str) -> float:
+        return float(sum(wi * getattr(r, name) for r, wi in zip(refs, w)))
+
+    def legs(name: str) -> tuple[float, ...]:
+        sets = [getattr(r, name) for r in refs]
+        if not sets[0] or any(len(x) != len(sets[0]) for x in sets):
+            return ()
+        return tuple(float(v) for v in np.tensordot(w, np.asarray(sets, dtype=float), 1))
+
+    return replace(
+        refs[0],
+        floor=mean("floor"),
+        pose_speed_median=mean("pose_speed_median"),
+        step_p99=mean("step_p99"),
+        accel_p99=mean("accel_p99"),
+        support_slip=mean("support_slip"),
+        knee_range=mean("knee_range"),
+        hip_range=mean("hip_range"),
+        take_speed=np.concatenate([r.take_speed for r in refs]),
+        take_cycle=np.concatenate([r.take_cycle for r in refs]),
+        penetration=mean("penetration"),
+        contact_slide=mean("contact_slide"),
+        knee_range_legs=legs("knee_range_legs"),
+        hip_range_legs=legs("hip_range_legs"),
     )
 
 

@@ -334,13 +334,20 @@ def training_takes(models: dict[str, LatentModel], names=None) -> list:
 
 def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None, list[str]]:
     """The measure of generated motion (:mod:`cyclecoord.quality.generated`) against the
-    training segments of the models the script used, IDLE frames counted as asked holds.
+    training segments of the models the script used (over several, each model's figures
+    weighted by the frames it made: :func:`~cyclecoord.quality.generated.mixed_reference`),
+    IDLE frames counted as asked holds.
 
     The motion is found in the analysis rig once (:func:`~cyclecoord.rig.analysis_motion`:
     a model's output is in its training takes' rig, which the model was fitted in), and
     its sections are measured as slices of it."""
     from ...errors import CycleCoordError
-    from ...quality.generated import lead_lines, measure_generated, source_figures
+    from ...quality.generated import (
+        lead_lines,
+        measure_generated,
+        mixed_reference,
+        source_figures,
+    )
     from ...rig import analysis_motion
 
     motion = analysis_motion(motion)
@@ -366,9 +373,16 @@ def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None,
 
     hold = syn.hold_mask(motion.n_frames)
     sources, ref = measured({c.model for c in syn.chunks})
+    sections = model_sections(syn, commands)
+    made: dict[str, int] = {}  # frames each model made, blends left out
+    for sec in sections:
+        made[sec["model"]] = made.get(sec["model"], 0) + sec["stop"] - sec["start"]
+    parts = [(measured([k])[1], n) for k, n in sorted(made.items())]
+    if ref is not None and len(parts) > 1 and all(r is not None for r, _ in parts):
+        # the whole motion against each model's takes, weighted by the frames it made
+        ref = mixed_reference(parts)
     quality, lines = lead_lines(motion, sources, feet=feet, hold=hold, reference=ref,
                                 analysed=True)
-    sections = model_sections(syn, commands)
     if quality is not None and len({s["model"] for s in sections}) > 1:
         # a walk and a run judged against their pooled captures read the run's pops
         # against a 99th percentile the walk frames pull down: each gait on its own too
