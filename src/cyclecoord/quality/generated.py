@@ -375,9 +375,9 @@ def mixed_reference(parts: Sequence[tuple[SourceFigures, float]]) -> SourceFigur
     figures (:func:`source_figures` of its takes, at one rate) with the frames it made:
     each figure is the frame-weighted mean of the models' (the takes' speeds and cycles
     joined).  Pooling the takes instead judges the motion by whichever model has the
-    most training frames: a script that ran for most of its length read "feet gliding"
-    against the walk model's slip (0.01 m/s) while each model's frames, against their own
-    takes, read planted."""
+    most training frames: a subject 35 walk and 143_01 jog script that mostly jogged read
+    "feet gliding" (0.40 m/s against the walk-heavy 0.06) while the walk's and the jog's
+    frames, each against their own takes, read planted."""
     from dataclasses import replace
 
     refs = [r for r, _ in parts]
