@@ -36,8 +36,8 @@ MIN_CYCLES = 1.5
 #: the latent path and the detail looped at one seam; with one seam, a whole cycle took
 #: the 143_01 jog's largest acceleration from 1.53x to 1.30x its p99 and its slip from
 #: 1.00x to 0.78x the capture's (medians over 15 script seeds), the Bandai run's within
-#: 0.04.  The synthesizer chooses each segment's fade between this and two cycles
-#: (:meth:`~.stepping.GaitMixin.seam_fade`).
+#: 0.04.  Each segment's fade is chosen between this and two cycles when the model is
+#: fitted (:func:`choose_seam_fade`).
 SEAM_FADE = 1.0
 #: Seam cross-fades (cycles, :meth:`Gait.at` ``fade``) a segment's loop chooses between,
 #: and the margin within which the shorter wins (:func:`choose_seam_fade`).

@@ -34,8 +34,6 @@ __all__ = ["FADE_TIE", "GaitMixin", "IN_STEP_LONGEST", "SEAM_FADES"]
 IN_STEP_LONGEST = 1.0
 
 
-
-
 class GaitMixin:
     """Gaits, the gait cursor and the in-step TRANSITION of a Synthesizer."""
 
