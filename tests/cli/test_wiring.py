@@ -760,8 +760,16 @@ def test_animate_refuses_limbs_through_each_other_unless_allowed(monkeypatch, tm
     argv = ["animate", str(script), "-o", str(out), "--report", str(rep)]
     assert main(argv) == 1 and not out.exists()
     assert "limbs passing through each other in 3 frames" in json.loads(rep.read_text())["refused"]
+    assert "another seed may avoid it" in json.loads(rep.read_text())["refused"]
     assert main(argv + ["--allow-contacts"]) == 0 and cc.load(out).n_frames == 40
     assert "refused" not in json.loads(rep.read_text())
+    # inside a TRANSITION's blend the refusal names it and suggests another blend length
+    report["transitions"] = [{"command": 21, "transition": ["run", "walk"], "start_frame": 4,
+                              "blend_frames": 12}]
+    assert main(argv) == 1
+    why = json.loads(rep.read_text())["refused"]
+    assert 'commands[21] TRANSITION run -> walk blends there' in why
+    assert '"blend": 0.12 instead of 0.10' in why
 
 
 def test_spy_sees_what_it_replaced(monkeypatch):
