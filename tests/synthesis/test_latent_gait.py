@@ -392,6 +392,59 @@ def _gait(values_per_cycle, cycles, frames_per_cycle=10):
                 segments=np.zeros(n, dtype=int))
     return gait, phase, np.array([values_per_cycle(p % 1.0) for p in phase], dtype=float)
 
+def _ankle_lead_profile(model, segment):
+    """The left ankle's lead over the right along the direction the root travels (world
+    positions from the motion's own forward kinematics, not the model's pose points),
+    averaged in eight phase bins centred on 0, 1/8, ..."""
+    g = model.gait()
+    rows = g.rows(segment)
+    take = model.training_motion()[rows[0] : rows[-1] + 1]
+    J = take.positions()
+    lead = J["lfoot"] - J["rfoot"]
+    travel = np.gradient(J["root"], axis=0)
+    travel[:, 1] = 0.0
+    travel /= np.linalg.norm(travel, axis=1, keepdims=True)
+    s = np.einsum("ij,ij->i", lead, travel)
+    bins = np.round(g.phase[rows] * 8).astype(int) % 8
+    return np.array([s[bins == k].mean() for k in range(8)])
+
+
+def test_phase_zero_is_the_same_step_in_every_segment_and_model(models):
+    """Phase 0 is where the left ankle leads the right the most, in every segment of the
+    walk and of the run, so an in-step TRANSITION blends the same stride of both (the
+    first harmonic's sign was flipped: the segments' phase 0 fell at unrelated steps, a
+    Bandai walk and run 0.33 cycles apart, and their blend brought the feet together)."""
+    for name in ("walk", "run"):
+        for s in models[name].gait().usable:
+            prof = _ankle_lead_profile(models[name], s)
+            assert int(np.argmax(prof)) == 0, (name, s, np.round(prof, 2))
+            assert int(np.argmin(prof)) == 4, (name, s, np.round(prof, 2))
+
+
+def test_a_model_file_anchored_before_the_fix_is_mended_on_load(models, tmp_path):
+    """A file without ``gait_anchor`` (written before phase 0 meant the same step) has each
+    segment's phases shifted back to that step; a file with another anchor is refused."""
+    from cyclecoord.errors import ParseError
+
+    walk = models["walk"]
+    g = walk.gait()
+    walk.save(tmp_path / "walk.npz")
+    arrays = dict(np.load(tmp_path / "walk.npz", allow_pickle=False))
+    assert int(arrays["gait_anchor"]) == 2
+    old = {k: v for k, v in arrays.items() if k != "gait_anchor"}
+    shifted = old["gait_phase"].copy()
+    for s, off in zip(g.usable, (0.3, -0.45)):
+        shifted[g.rows(s)] += off
+    np.savez(tmp_path / "old.npz", **{**old, "gait_phase": shifted})
+    back = LatentModel.load(tmp_path / "old.npz").gait()
+    for s in g.usable:
+        d = back.phase[g.rows(s)] - g.phase[g.rows(s)]
+        assert np.ptp(d) < 1e-9 and abs(d[0] - np.round(d[0])) < 1e-6
+    np.savez(tmp_path / "bad.npz", **{**arrays, "gait_anchor": np.array(1)})
+    with pytest.raises(ParseError, match="gait_anchor"):
+        LatentModel.load(tmp_path / "bad.npz")
+
+
 
 def test_the_loop_seam_is_searched_over_a_whole_cycle_of_phases():
     """2.3 cycles: K = 2 leaves only the last 0.3 cycle to place the seam in; one cycle

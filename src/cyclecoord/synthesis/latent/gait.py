@@ -25,8 +25,8 @@ import numpy as np
 from .influence import pose_points
 
 __all__ = [
-    "FADE_TIE", "Gait", "MIN_CYCLES", "SEAM_FADE", "SEAM_FADES", "choose_seam_fade",
-    "even_phase", "training_gait",
+    "ANCHOR", "FADE_TIE", "Gait", "MIN_CYCLES", "SEAM_FADE", "SEAM_FADES", "choose_seam_fade",
+    "even_phase", "reanchored", "training_gait",
 ]
 
 #: A segment needs at least this many cycles for its phase to be trusted.
@@ -261,7 +261,9 @@ def even_phase(phase: np.ndarray, period: float) -> np.ndarray:
 
 
 def _anchor(model, rows: np.ndarray, phase: np.ndarray, leg_points: tuple[str, str]) -> float:
-    """Phase at which the first ankle is furthest ahead of the second (cycles)."""
+    """Phase at which the first ankle is furthest ahead of the second (cycles): the phase
+    of the first harmonic of their difference along its main direction, ``s ~ cos(2 pi
+    (phase - anchor))``.  Subtracting it puts that moment at phase 0 (and it is then 0)."""
     names = list(model.skeleton_.names)
     a, b = (names.index(n) for n in leg_points)
     pts = pose_points(
@@ -272,8 +274,32 @@ def _anchor(model, rows: np.ndarray, phase: np.ndarray, leg_points: tuple[str, s
     _, _, vt = np.linalg.svd(d, full_matrices=False)
     axis = vt[0] * np.sign(vt[0][np.argmax(np.abs(vt[0]))])  # the same sign on every model
     s = d @ axis
-    c = np.sum(s * np.exp(-2j * np.pi * phase))
+    c = np.sum(s * np.exp(2j * np.pi * phase))
     return float(np.angle(c) / (2 * np.pi))
+
+
+#: What :func:`training_gait`'s phase 0 means, kept in model files (``gait_anchor``): 2,
+#: the first ankle furthest ahead of the other.  Files without it (written up to
+#: 2026-11-28) were anchored with the first harmonic's sign flipped, which put phase 0 at
+#: a different step in each segment: a Bandai walk and run 0.33 cycles apart, so an
+#: in-step TRANSITION blended a walk's left stride with a run's right one (the blend's
+#: feet 4.1 units apart against the takes' closest 5.6, and ``animate`` refused the
+#: script on every seed).  :func:`reanchored` mends their phases on load.
+ANCHOR = 2
+
+
+def reanchored(model, gait: Gait) -> Gait:
+    """``gait`` with each segment's phase shifted so that phase 0 is where the first
+    ankle is furthest ahead of the other (:func:`_anchor`, as :func:`training_gait`
+    anchors it now): for phases read from a file written before :data:`ANCHOR`."""
+    legs = _legs(model)
+    if legs is None or not len(gait.usable):
+        return gait
+    phase = gait.phase.copy()
+    for s in gait.usable:
+        rows = gait.rows(s)
+        phase[rows] -= _anchor(model, rows, phase[rows], legs)
+    return Gait(phase=phase, period=gait.period, segments=gait.segments, fade=gait.fade)
 
 
 def _legs(model) -> tuple[str, str] | None:

@@ -601,7 +601,10 @@ class LatentModel:
         )
         g = getattr(self, "gait_", None)
         if g is not None:
-            arrays.update({"gait_phase": g.phase, "gait_period": g.period})
+            from .gait import ANCHOR
+
+            arrays.update({"gait_phase": g.phase, "gait_period": g.period,
+                           "gait_anchor": np.array(ANCHOR)})
             if g.fade is not None:
                 arrays["gait_fade"] = g.fade
         with atomic_write(path, "wb") as fh:
@@ -699,7 +702,7 @@ class LatentModel:
         except ParameterError as exc:
             raise ParseError(f"arrays 'X', 'hyper', 'Y': {exc}", spath) from None
         if "gait_phase" in arrays:  # files written before the gait phase compute it on use
-            from .gait import Gait
+            from .gait import ANCHOR, Gait
 
             phase = a.reals("gait_phase", (N,), allow_nan=True)  # NaN: a segment without gait
             period = a.get("gait_period")
@@ -716,6 +719,8 @@ class LatentModel:
                 if (fade <= 0).any():
                     raise a.error("gait_fade", "seam cross-fades are positive cycles")
             m.gait_ = Gait(phase, period, m.segments_, fade)
+            if "gait_anchor" in arrays:  # (else phases anchored before the fix: mended below)
+                a.integer("gait_anchor", ANCHOR, ANCHOR)
         starts = np.flatnonzero(np.r_[True, m.segments_[1:] != m.segments_[:-1]])
         stops = np.r_[starts[1:], len(m.segments_)]
         try:
@@ -733,6 +738,10 @@ class LatentModel:
         if not (np.isfinite(m.speed_) and m.speed_ > 0 and np.isfinite(m._B).all()):
             raise a.error("X", "the latent points do not move (no latent speed), or the pose "
                           "map is not finite")
+        if getattr(m, "gait_", None) is not None and "gait_anchor" not in arrays:
+            from .gait import reanchored
+
+            m.gait_ = reanchored(m, m.gait_)
         return m
 
 
