@@ -235,6 +235,42 @@ def test_frames_whose_limbs_come_too_close_are_pulled_to_the_captured_pose(model
                for n in syn.notes)
 
 
+
+def test_an_in_step_blend_frame_too_close_is_pulled_to_both_gaits_captured_poses(
+        models, monkeypatch):
+    """A new limb contact on the first frame of the run -> walk blend (where the particle's
+    stray from the run's path still shows): that frame takes both gaits' captured poses
+    at their phases blended (the chunk's first target), and when it is still too close
+    there, both gaits' nearest whole captured frames blended."""
+    from types import SimpleNamespace
+
+    import cyclecoord.quality.plausibility as P
+
+    plain = _script(models)
+    before = plain._assemble(*plain._posed())
+    k = next(i for i, c in enumerate(plain.chunks) if c.targets is not None and c.model == "walk")
+    f = sum(c.X.shape[0] for c in plain.chunks[:k])
+    calls = []
+
+    def fake(motion, refs, *a, **kw):
+        calls.append(1)
+        return SimpleNamespace(new_contact_frames=[f] if len(calls) <= 2 else [])
+
+    monkeypatch.setattr(P, "check_plausibility", fake)
+    syn = _script(models)
+    chunk = syn.chunks[k]
+    near, whole = chunk.targets
+    m = models["walk"]
+    cols = [before.channel_index(*c) for c in m.channels_]
+    assert not np.allclose(before.frames[f, cols], m.to_channels(near[:1])[0], atol=1e-3)
+    after = syn._untangled()
+    assert len(calls) == 3  # pulled, still too close: the whole frames, then clear
+    np.testing.assert_allclose(after.frames[f, cols], m.to_channels(whole[:1])[0], atol=1e-6)
+    # a neighbour in the blend eases toward the captured poses (first target), partly
+    assert not np.allclose(after.frames[f + 1, cols], before.frames[f + 1, cols])
+    assert any(n.startswith("limbs: 1 frame came closer") and f"(frame {f})" in n
+               for n in syn.notes)
+
 def test_gait_detail_is_a_checked_script_key(models, tmp_path):
     import json
 

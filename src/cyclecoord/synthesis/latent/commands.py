@@ -159,6 +159,11 @@ class _Chunk:
     #: the latent path ``(T, q)`` the particle followed along a gait (None elsewhere):
     #: its pose plus the detail is the captured frame at each frame's phase
     path: np.ndarray | None = None
+    #: for an in-step blend, the angles ``(T, C)`` (this chunk's model's chart) the
+    #: untangling pulls toward (the two gaits' captured poses at the blend's phases,
+    #: blended without the particle's stray) and, second, toward each gait's nearest
+    #: whole captured frame blended (:meth:`OutputMixin._untangled`); None elsewhere
+    targets: tuple[np.ndarray, np.ndarray] | None = None
 
 
 @dataclass
@@ -463,10 +468,13 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         particle: bool = False,
         detail=None,
         path=None,
+        targets=None,
     ) -> None:
         if clip:
             angles = self._clip(name, angles)
-        self.chunks.append(_Chunk(name, X, angles, root, self.command, particle, detail, path))
+        self.chunks.append(
+            _Chunk(name, X, angles, root, self.command, particle, detail, path, targets)
+        )
         self.t += X.shape[0] / self.fps
 
     @staticmethod

@@ -74,7 +74,7 @@ class OutputMixin:
         With the gait detail on the Bandai walk-run script, legs passed 1-2 cm closer
         than the captures on one or two frames in eight script seeds of fifteen."""
         motion = self._assemble(*self._posed())
-        if not any(c.path is not None for c in self.chunks):
+        if not self._on_path().any():
             return motion
         takes = [self.models[k].training_motion() for k in sorted({c.model for c in self.chunks})]
         from ...quality.plausibility import check_plausibility
@@ -122,7 +122,9 @@ class OutputMixin:
     def _on_path(self) -> np.ndarray:
         """(T,) frames of chunks that followed a gait's path."""
         sizes = [c.X.shape[0] for c in self.chunks]
-        return np.repeat([c.path is not None for c in self.chunks], sizes)
+        return np.repeat(
+            [c.path is not None or c.targets is not None for c in self.chunks], sizes
+        )
 
     def _assemble(self, angles: np.ndarray, root: dict[str, np.ndarray]) -> Motion:
         """A motion from every frame's joint angles and root motion (root integrated)."""
@@ -229,13 +231,9 @@ class OutputMixin:
             start = 0
             for n, c in enumerate(chunks):
                 stop = start + c.X.shape[0]
-                if c.path is not None and pull[start:stop].any():
-                    m = self.models[c.model]
-                    target = m.pose(c.path) + c.detail["angles"]
-                    if whole is not None and whole[start:stop].any():
-                        k = np.flatnonzero(whole[start:stop])
-                        target[k] = m.frame_angles()[m.nearest_frame(c.path[k])]
-                    target = self._clip(c.model, target, count=False)
+                if pull[start:stop].any() and (c.targets is not None or c.path is not None):
+                    mask = None if whole is None else whole[start:stop]
+                    target = self._untangle_target(c, mask)
                     g = pull[start:stop, None]
                     angles[n] = angles[n] + g * (target - angles[n])
                 start = stop
@@ -244,6 +242,24 @@ class OutputMixin:
         return self._continuous(np.concatenate(angles)), {
             key: np.concatenate([r[key] for r in roots]) for key in keys
         }
+
+    def _untangle_target(self, c, whole: np.ndarray | None) -> np.ndarray:
+        """The angles ``(T, C)`` untangling pulls chunk ``c``'s frames toward: along a
+        gait's path, the captured pose at each frame's phase (the path's pose plus its
+        detail), or where ``whole`` the captured frame nearest the path; in an in-step
+        blend, the same of both gaits blended (``_Chunk.targets``)."""
+        some = whole is not None and whole.any()
+        k = np.flatnonzero(whole) if some else None
+        if c.targets is not None:
+            target = c.targets[0].copy()
+            if some:
+                target[k] = c.targets[1][k]
+            return target
+        m = self.models[c.model]
+        target = m.pose(c.path) + c.detail["angles"]
+        if some:
+            target[k] = m.frame_angles()[m.nearest_frame(c.path[k])]
+        return self._clip(c.model, target, count=False)
 
     def _fade_detail(self, angles: list, roots: list) -> tuple[list, list]:
         """Each chunk's angles and root motion with the gait detail of the nearest frames

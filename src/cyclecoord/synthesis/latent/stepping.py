@@ -192,6 +192,7 @@ class GaitMixin:
         # path at the blend's first frame threw the Bandai run's hands up to 1.86x its
         # p99 of acceleration (6 script seeds in 15 over 1.5x; at most 1.40x after)
         stray = self.x - self.gait_at(src, m1.X_, sa, np.array([ua]))[0]
+        on_path = Xa
         Xa = Xa + (1.0 - w)[:, None] * stray[None, :]
         Xb = self.gait_at(to, m2.X_, sb, ub + du)
         r1, r2 = self._root(m1, Xa), self._root(m2, Xb)
@@ -212,7 +213,8 @@ class GaitMixin:
             }
             root = {k: root[k] + detail[k] for k in root}
         blended = self._mix(src, to, self._clip(src, Pa), self._clip(to, Pb), w)
-        self._emit(to, Xb, blended, root, clip=False, detail=detail)
+        self._emit(to, Xb, blended, root, clip=False, detail=detail,
+                   targets=self._hop_targets(src, to, on_path, Xb, Pb, Da, w))
         c = self.crossings_threshold(src)
         self.events.append(
             {
@@ -236,6 +238,21 @@ class GaitMixin:
         self.v = (Xb[-1] - Xb[-2]) * self.fps if n > 1 else np.zeros_like(self.x)
         self._cursor = (to, sb, float(ub + du[-1]))
         self._stepping = True
+
+    def _hop_targets(self, src, to, Xa, Xb, Pb, Da, w) -> tuple[np.ndarray, np.ndarray]:
+        """What untangling pulls an in-step blend's frames toward (``_Chunk.targets``):
+        the two gaits' poses on their paths ``Xa``, ``Xb`` (plus detail ``Da``; ``Pb``
+        is ``to``'s already) blended by ``w`` without the particle's stray, and each
+        gait's nearest whole captured frame blended.  At the first frames of a subject
+        35 run -> walk blend the stray still swung a thumb 1.68 units from the thigh
+        (the takes' closest 1.93), where the frames of a MOVE would have been pulled."""
+        m1, m2 = self.models[src], self.models[to]
+        Pa = m1.pose(Xa) + (0.0 if Da is None else Da["angles"])
+        near = self._mix(src, to, self._clip(src, Pa, count=False),
+                         self._clip(to, Pb, count=False), w)
+        whole = self._mix(src, to, m1.frame_angles()[m1.nearest_frame(Xa)],
+                          m2.frame_angles()[m2.nearest_frame(Xb)], w)
+        return near, whole
 
 
 def interp_rows(t: np.ndarray, times: np.ndarray, values: np.ndarray) -> np.ndarray:
