@@ -57,12 +57,69 @@ def test_a_hold_eases_its_steps_to_nothing_over_stand_after_seconds():
 
 def test_channel_bounds_leave_the_root_free_and_widen_the_rest():
     m = make_motion(legs_skeleton(), T=10, fps=30.0, root_speed=5.0)
-    lo, hi = carry.channel_bounds([m], margin=5.0)
+    lo, hi, angle = carry.channel_bounds([m], margin=5.0)
     for c in m.root_channels():
-        assert lo[c] == -np.inf and hi[c] == np.inf
+        assert lo[c] == -np.inf and hi[c] == np.inf and not angle[c]
     other = [i for i in range(len(m.channels)) if i not in m.root_channels()]
     np.testing.assert_allclose(lo[other], m.frames[:, other].min(axis=0) - 5.0)
     np.testing.assert_allclose(hi[other], m.frames[:, other].max(axis=0) + 5.0)
+    assert all(angle[i] == (m.channels[i][1] in ("rx", "ry", "rz")) for i in other)
+
+
+def test_angles_are_in_bounds_on_any_turn_and_each_channel_is_judged_alone():
+    """A take whose knee swings 170-190 degrees written as 170..180, -180..-170 (the
+    Euler branch flips): its range is 165-195 on one turn, and a motion at 545 degrees
+    (a turn up) or -170 is inside, 200 and -150 are not; a translation channel is
+    never wrapped.  Each channel is judged alone (``_outside`` is per channel)."""
+    m = make_motion(legs_skeleton(), T=21, fps=30.0)
+    k = m.channels.index(("ltibia", "rx"))
+    f = m.frames.copy()
+    swing = np.linspace(170.0, 190.0, 21)
+    f[:, k] = (swing + 180.0) % 360.0 - 180.0
+    take = m.with_frames(f)
+    lo, hi, angle = carry.channel_bounds([take], margin=5.0)
+    assert angle[k] and lo[k] == pytest.approx(165.0, abs=1e-9)
+    assert hi[k] == pytest.approx(195.0, abs=1e-9)
+    test = np.repeat(f[:1], 4, axis=0)
+    test[:, k] = [545.0, -170.0, 200.0, -150.0]
+    out = carry._outside(test, (lo, hi, angle))
+    assert out.shape == test.shape
+    assert out[:, k].tolist() == [False, False, True, True]
+    others = [c for c in range(test.shape[1]) if c != k]
+    assert not out[:, others].any()
+    tx = m.channels.index(("root", "tx"))
+    plain = (np.zeros_like(lo), np.ones_like(hi), np.zeros_like(angle))
+    row = np.full((1, test.shape[1]), 0.5)
+    row[0, tx] = 360.5  # 0.5 a turn away, but a length: outside
+    assert carry._outside(row, plain)[0, tx]
+
+
+def test_a_pin_that_takes_a_channel_out_of_range_is_refused_though_another_was_out():
+    """The frames before pinning have one channel out of its range everywhere; a pin that
+    twists a second channel out is still a pin that left the range (the frame-wide test
+    let every such pin through on a Bandai script: a knee twisted 21 degrees)."""
+    from test_footlock import _walkish  # noqa: E402
+
+    m = _walkish(T=120, fps=60.0)
+    lo, hi, angle = carry.channel_bounds([m], margin=5.0)
+    out_col = m.channels.index(("rfoot", "rx"))
+    lo[out_col] = hi[out_col] = m.frames[:, out_col].min() - 50.0  # out on every frame
+    twist = m.channels.index(("ltibia", "rx"))
+    import cyclecoord.synthesis.footlock as F
+
+    real = F.pin_feet
+
+    def twisting(motion, contacts, **kw):
+        got = real(motion, contacts, **kw)
+        f = got.frames.copy()
+        f[contacts.planted.any(axis=1), twist] += 40.0  # far out of the knee's range
+        return got.with_frames(f)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(F, "pin_feet", twisting)
+        res = carry.lock_where_clean(m, 1e12, bounds=(lo, hi, angle))
+    assert res.locked == 0
+    assert "left the training range" in res.line or res.line.startswith("foot locking: not")
 
 
 def test_a_lock_whose_every_pin_pops_pins_nothing_and_says_so(monkeypatch):
@@ -149,14 +206,15 @@ def test_a_pop_exactly_an_ease_and_two_frames_before_a_contact_takes_its_first_f
 
 def test_channel_bounds_default_margin_and_the_range_edges():
     m = make_motion(legs_skeleton(), T=10, fps=30.0, root_speed=5.0)
-    lo, hi = carry.channel_bounds([m])
+    lo, hi, angle = carry.channel_bounds([m])
     other = [i for i in range(len(m.channels)) if i not in m.root_channels()]
     np.testing.assert_allclose(lo[other], m.frames[:, other].min(axis=0) - carry.RANGE_MARGIN)
     assert carry.RANGE_MARGIN == 5.0
     edge = np.array([hi, lo])  # exactly on the bounds: inside
     edge[~np.isfinite(edge)] = 0.0
-    assert not carry._outside(edge, (lo, hi)).any()
-    assert carry._outside(edge + 1e-6, (lo, hi))[0]
+    assert not carry._outside(edge, (lo, hi, angle)).any()
+    assert carry._outside(edge + 1e-6, (lo, hi, angle))[0].any()
+    assert not carry._outside(edge, (lo, hi)).any()  # without the angles: plain ranges
 
 
 def test_accel_is_the_largest_root_relative_joint_acceleration_by_hand():
@@ -327,3 +385,43 @@ def test_in_flight_the_root_keeps_its_own_step():
     own = 2.0 / 30.0
     np.testing.assert_allclose(steps[24:35], own, rtol=1e-2)  # flying: its own step
     np.testing.assert_allclose(steps[5:15], 0.0, atol=1e-6 * own)  # standing: held
+
+
+def test_pops_that_move_with_every_trim_unpin_their_contact_whole_not_every_contact(
+    monkeypatch,
+):
+    """A contact whose every trimmed piece pops again at its new first frame (an IDLE's
+    stand on the Bandai benchmark script popped at 222, 226, 228, ... 242) is unpinned
+    whole after the rounds of trimming, and the other contacts stay pinned: before, the
+    lock gave up and pinned nothing anywhere."""
+    from test_footlock import _walkish  # noqa: E402
+
+    import cyclecoord.synthesis.footlock as F
+    from cyclecoord.quality.contacts import contact_runs
+
+    m = _walkish(T=120, fps=60.0)
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    planted = carry.support(m, feet).planted
+    runs = [(i, a, b) for i in range(4) for a, b in contact_runs(planted[:, i]) if b - a > 12]
+    i0, a0, b0 = max(runs, key=lambda r: r[2] - r[1])
+    seen = {}
+    real = F.pin_feet
+
+    def recording(motion, contacts, **kw):
+        seen["planted"] = contacts.planted.copy()
+        return real(motion, contacts, **kw)
+
+    def popping(motion):
+        out = np.zeros(motion.n_frames)
+        p = seen.get("planted")
+        if p is not None and p[a0:b0, i0].any():  # pops where that contact now starts
+            out[a0 + int(np.flatnonzero(p[a0:b0, i0])[0])] = 10.0
+        return out
+
+    monkeypatch.setattr(F, "pin_feet", recording)
+    monkeypatch.setattr(carry, "_accel", popping)
+    out = carry.lock_where_clean(m, 1.0, feet, min_duration=0.05, blend=0.0)
+    assert b0 - a0 > 6 * 3 + 3  # longer than six trims of 3 frames (pad 2) can clear
+    assert not out.line.startswith("foot locking: not done"), out.line
+    assert out.locked > 0 and not seen["planted"][a0:b0, i0].any()
+    assert seen["planted"].any()

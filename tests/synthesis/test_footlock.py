@@ -383,3 +383,24 @@ def test_pin_feet_reuse_keeps_the_frames_asked_the_same_and_reads_as_fresh(monke
     other = m.with_frames(m.frames + 0.0)  # another motion: nothing of the last kept
     fl.pin_feet(other, contacts, reuse=kept)
     assert kept["motion"] is other
+
+
+def test_pinned_legs_keep_their_angles_within_the_bounds_given():
+    """Pinning the sliding feet bends the knees; with bounds holding each knee within a
+    quarter degree of straight (and every other channel free), the solve keeps them there and
+    reaches the locks with the hips and ankles instead."""
+    from cyclecoord.synthesis.carry import channel_bounds
+    from cyclecoord.synthesis.footlock import pin_feet
+
+    m = _walkish()
+    c = foot_contacts(m)
+    free = pin_feet(m, c)
+    knees = [m.channels.index((j, "rx")) for j in ("ltibia", "rtibia")]
+    assert np.abs(free.frames[:, knees] - m.frames[:, knees]).max() > 1.0
+    lo, hi, angle = channel_bounds([m], margin=0.0)
+    lo[:], hi[:] = -np.inf, np.inf
+    lo[knees], hi[knees] = -0.25, 0.25
+    held = pin_feet(m, c, bounds=(lo, hi, angle))
+    assert held.frames[:, knees].min() >= -0.25 - 1e-9
+    assert held.frames[:, knees].max() <= 0.25 + 1e-9
+    assert not np.allclose(held.frames, m.frames)  # the feet were still pinned

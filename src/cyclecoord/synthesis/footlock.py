@@ -408,7 +408,24 @@ class _LegIK:
         return out, J.transpose(0, 1, 3, 2)
 
 
-def _solve(ik, rows, targets, weights, scale, iterations=_ITERATIONS):
+def _box(ik, rows: np.ndarray, bounds) -> tuple[np.ndarray, np.ndarray] | None:
+    """Per row and variable ``(n, V)`` the range the solve keeps each angle in: ``bounds``
+    (:func:`~cyclecoord.synthesis.carry.channel_bounds`) on the turn nearest the
+    angle's own value, widened to include that value (a pose already outside keeps it)."""
+    if bounds is None:
+        return None
+    cols = [c for _, _, c in ik.vars]
+    lo, hi = np.asarray(bounds[0], float)[cols], np.asarray(bounds[1], float)[cols]
+    q0 = ik.values()[rows]
+    if len(bounds) > 2:
+        turn = np.asarray(bounds[2], bool)[cols] & np.isfinite(lo) & np.isfinite(hi)
+        mid = 0.5 * (np.where(turn, lo, 0.0) + np.where(turn, hi, 0.0))
+        k = np.where(turn, np.round((q0 - mid) / 360.0), 0.0)
+        lo, hi = lo + 360.0 * k, hi + 360.0 * k
+    return np.minimum(lo, q0), np.maximum(hi, q0)
+
+
+def _solve(ik, rows, targets, weights, scale, iterations=_ITERATIONS, box=None):
     """Levenberg-Marquardt on all ``rows`` at once; returns the new variables (n, V).
 
     Minimises, per frame, ``sum (weights * (p(q) - targets) / scale)^2 +
@@ -418,7 +435,10 @@ def _solve(ik, rows, targets, weights, scale, iterations=_ITERATIONS):
     knee where the linearisation is poor), and stops once its step is under 1e-6 degrees
     or an accepted step lowers its cost by less than :data:`_FTOL` of it.
     The Jacobian is exact (:meth:`_LegIK.kinematics`), from the same forward kinematics
-    pass as the residuals.
+    pass as the residuals.  With ``box`` (:func:`_box`), every step is clipped into it:
+    with all three of a knee's channels free, a standing leg (nearly straight, where
+    bending about any axis moves the foot alike) was pinned by twisting the knee 21
+    degrees about its long axis, outside anything captured.
     """
     q0 = ik.values()[rows]
     q = q0.copy()
@@ -450,6 +470,8 @@ def _solve(ik, rows, targets, weights, scale, iterations=_ITERATIONS):
         A += mu[live, None, None] * (np.einsum("nvv->nv", A)[:, :, None] * eye)
         step = np.linalg.solve(A, -g[..., None])[..., 0]
         trial = q[live] + step
+        if box is not None:
+            trial = np.clip(trial, box[0][live], box[1][live])
         r_new, c_new, J_new = evaluate(trial, live)
         better = c_new <= c[live]
         gain = np.where(better, c[live] - c_new, np.inf)  # a refused step: try again
@@ -461,11 +483,13 @@ def _solve(ik, rows, targets, weights, scale, iterations=_ITERATIONS):
     return q
 
 
-def _solve_reusing(ik, rows, targets, weights, scale, known: dict | None):
-    """:func:`_solve`; with ``known`` (the last solve of this leg on the same motion:
-    its rows, targets, weights and solution), rows asked the same keep their answer."""
+def _solve_reusing(ik, rows, targets, weights, scale, known: dict | None, bounds=None):
+    """:func:`_solve` within ``bounds`` (:func:`_box`); with ``known`` (the last solve of
+    this leg on the same motion and bounds: its rows, targets, weights and solution),
+    rows asked the same keep their answer."""
+    box = _box(ik, rows, bounds)
     if known is None:
-        return _solve(ik, rows, targets, weights, scale)
+        return _solve(ik, rows, targets, weights, scale, box=box)
     q = np.empty((rows.size, len(ik.vars)))
     todo = np.ones(rows.size, dtype=bool)
     if known:
@@ -480,13 +504,15 @@ def _solve_reusing(ik, rows, targets, weights, scale, known: dict | None):
         q[same] = known["q"][old[same]]
         todo = ~same
     if todo.any():
-        q[todo] = _solve(ik, rows[todo], targets[todo], weights[todo], scale)
+        sub = None if box is None else (box[0][todo], box[1][todo])
+        q[todo] = _solve(ik, rows[todo], targets[todo], weights[todo], scale, box=sub)
     known.update(rows=rows.copy(), targets=targets.copy(), weights=weights.copy(), q=q.copy())
     return q
 
 
 def _lock_once(
-    motion: Motion, contacts: FootContacts, nb: int, cyclic: bool, reuse: dict | None = None
+    motion: Motion, contacts: FootContacts, nb: int, cyclic: bool, reuse: dict | None = None,
+    bounds=None,
 ) -> tuple[Motion, float]:
     """One locking pass: the edited motion and the largest horizontal lock error.
 
@@ -594,7 +620,8 @@ def _lock_once(
         if rows.size == 0:
             continue
         q = _solve_reusing(ik, rows, targets[rows], weights[rows], scale,
-                           None if reuse is None else reuse.setdefault(("leg", leg), {}))
+                           None if reuse is None else reuse.setdefault(("leg", leg), {}),
+                           bounds)
         for v, (_, _, c) in enumerate(ik.vars):
             frames[rows, c] = q[:, v]
         new = ik.positions(q, rows)
@@ -610,7 +637,7 @@ def _lock_once(
 
 def pin_feet(
     motion: Motion, contacts: FootContacts, *, blend: float = 0.1, cyclic: bool = False,
-    reuse: dict | None = None,
+    reuse: dict | None = None, bounds: tuple[np.ndarray, ...] | None = None,
 ) -> Motion:
     """:func:`lock_feet`'s motion alone, one pass on ``contacts`` (no skating figures, no
     joint changes, no fresh contact search): for callers that judge the result their
@@ -618,11 +645,15 @@ def pin_feet(
 
     ``reuse``: a dict kept by a caller that pins one motion several times on contacts
     that differ here and there (lock, judge, drop the contacts that popped, lock
-    again): frames asked the same as last time keep their solution, the same numbers."""
-    return _pinned(motion, contacts, blend, cyclic, 1, {}, reuse)[0]
+    again): frames asked the same as last time keep their solution, the same numbers.
+    ``bounds``: per-channel ranges the legs' angles are solved within
+    (:func:`~cyclecoord.synthesis.carry.channel_bounds`; an angle already outside may
+    stay where it is)."""
+    return _pinned(motion, contacts, blend, cyclic, 1, {}, reuse, bounds)[0]
 
 
-def _pinned(motion, contacts, blend, cyclic, passes, contact_options, reuse=None):
+def _pinned(motion, contacts, blend, cyclic, passes, contact_options, reuse=None,
+            bounds=None):
     """The locked motion, the contacts it was given (found when None), the options for
     finding contacts afresh and the largest lock error."""
     if not (np.isfinite(blend) and blend >= 0):
@@ -651,7 +682,7 @@ def _pinned(motion, contacts, blend, cyclic, passes, contact_options, reuse=None
             ),
             "up": "xyz"[contacts.up],
         }
-    out, worst = _lock_once(motion, contacts, nb, cyclic, reuse)
+    out, worst = _lock_once(motion, contacts, nb, cyclic, reuse, bounds)
     locked = contacts
     for _ in range(int(passes) - 1):
         again = foot_contacts(out, contacts.feet, **contact_options)
@@ -659,7 +690,7 @@ def _pinned(motion, contacts, blend, cyclic, passes, contact_options, reuse=None
         if not (foot_skating(out, again).skating & extra).any():
             break
         locked = replace(locked, planted=locked.planted | again.planted)
-        out, worst = _lock_once(out, locked, nb, cyclic)
+        out, worst = _lock_once(out, locked, nb, cyclic, bounds=bounds)
     return out, contacts, contact_options, worst
 
 
