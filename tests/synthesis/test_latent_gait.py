@@ -259,7 +259,7 @@ def test_an_in_step_blend_frame_too_close_is_pulled_to_both_gaits_captured_poses
     monkeypatch.setattr(P, "check_plausibility", fake)
     syn = _script(models)
     chunk = syn.chunks[k]
-    near, whole = chunk.targets
+    near, whole = chunk.targets()
     m = models["walk"]
     cols = [before.channel_index(*c) for c in m.channels_]
     assert not np.allclose(before.frames[f, cols], m.to_channels(near[:1])[0], atol=1e-3)

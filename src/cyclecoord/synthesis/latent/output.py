@@ -251,9 +251,10 @@ class OutputMixin:
         some = whole is not None and whole.any()
         k = np.flatnonzero(whole) if some else None
         if c.targets is not None:
-            target = c.targets[0].copy()
+            near, whole_frames = c.targets()
+            target = near.copy()
             if some:
-                target[k] = c.targets[1][k]
+                target[k] = whole_frames[k]
             return target
         m = self.models[c.model]
         target = m.pose(c.path) + c.detail["angles"]

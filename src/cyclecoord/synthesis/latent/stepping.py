@@ -16,6 +16,7 @@ between two gaits in step, a part of :class:`~.commands.Synthesizer`.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -214,7 +215,8 @@ class GaitMixin:
             root = {k: root[k] + detail[k] for k in root}
         blended = self._mix(src, to, self._clip(src, Pa), self._clip(to, Pb), w)
         self._emit(to, Xb, blended, root, clip=False, detail=detail,
-                   targets=self._hop_targets(src, to, on_path, Xb, Pb, Da, w))
+                   targets=functools.cache(
+                       functools.partial(self._hop_targets, src, to, on_path, Xb, Pb, Da, w)))
         c = self.crossings_threshold(src)
         self.events.append(
             {
