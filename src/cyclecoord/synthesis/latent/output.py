@@ -132,7 +132,15 @@ class OutputMixin:
 
         first = self.models[self.chunks[0].model]
         T = angles.shape[0]
-        theta = np.concatenate([[0.0], np.cumsum(root["turn"][:-1]) / self.fps])
+        turn = root["turn"][:-1]
+        if self.held:
+            # an IDLE stands: its heading stops turning as its ground track stops (the
+            # root's turn rate of a Bandai walk's frames turned a standing body 50
+            # degrees over a 2 s IDLE, pivoting the feet out of their pins)
+            from ..carry import _moving
+
+            turn = turn * _moving(self.hold_mask(T), self.fps)
+        theta = np.concatenate([[0.0], np.cumsum(turn) / self.fps])
         head = heading_matrix(theta)
         step = np.zeros((T, 3))
         step[:, 0], step[:, 2] = root["velocity"][:, 0], root["velocity"][:, 1]
