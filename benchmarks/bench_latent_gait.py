@@ -221,6 +221,20 @@ def measure_pair(label: str, takes: dict, d: Path, quick: bool, seeds: int = 1) 
         over_seeds(models, d, seeds, label)
 
 
+def planted_top_speed(motion, a: int, b: int) -> float:
+    """The fastest horizontal speed (m/s) of a foot point in contact (by height) over
+    frames ``a .. b``: the support foot's median hides a foot that slides for a part
+    of an IDLE."""
+    from cyclecoord.quality.contacts import foot_contacts
+
+    c = foot_contacts(motion)
+    J = motion.positions()
+    pts = np.stack([J[f][:, [0, 2]] for f in c.feet], axis=1)
+    speed = np.linalg.norm(np.diff(pts, axis=0), axis=-1) * motion.fps
+    speed = np.where(c.planted[1:] & c.planted[:-1], speed, 0.0)[a : b - 1]
+    return float(speed.max(initial=0.0)) * cc.rig.metres_per_unit(motion)
+
+
 #: Issue 24's speed target: ``animate`` at this many times real time or better.
 TARGET_REAL_TIME = 30.0
 
@@ -256,8 +270,8 @@ def over_seeds(models: dict, d: Path, seeds: int, label: str = "") -> None:
         if crossing:
             refused.append((seed, crossing[0]))
         a, b = sec["idle"]  # the support foot once the IDLE's root stands (0.5 s)
-        idle.append(measure_generated(motion[a + 15 : b], training_takes(models, ["walk"]))
-                    .support_slip)  # (m/s)
+        idle.append((measure_generated(motion[a + 15 : b], training_takes(models, ["walk"]))
+                     .support_slip, planted_top_speed(motion, a + 15, b)))  # (m/s)
         for part in got:
             a, b = sec[part]
             q = measure_generated(motion[a:b], training_takes(models, [part]))
@@ -276,9 +290,11 @@ def over_seeds(models: dict, d: Path, seeds: int, label: str = "") -> None:
         cells = [f"{name} {np.median(r[:, i]):.2f} [{r[:, i].min():.2f}-{r[:, i].max():.2f}]"
                  for i, name in enumerate(names)]
         print(f"  {part:7s}  " + "; ".join(cells))
-    idle = np.array(idle)
+    idle, top = np.array(idle)[:, 0], np.array(idle)[:, 1]
     print(f"  IDLE     support foot after 0.5 s {np.median(idle):.3f} m/s [{idle.min():.3f}-"
-          f"{idle.max():.3f}]; {int((idle > 0.1).sum())} of {seeds} seeds over 0.1 m/s")
+          f"{idle.max():.3f}]; {int((idle > 0.1).sum())} of {seeds} seeds over 0.1 m/s; "
+          f"fastest planted foot {np.median(top):.3f} m/s [{top.min():.3f}-{top.max():.3f}], "
+          f"{int((top > 0.1).sum())} seeds over 0.1 m/s")
     print(f"  limbs    `cyclecoord animate` refuses {len(refused)} of {seeds} seeds (limbs closer "
           "than the training takes' after untangling)"
           + (": " + ", ".join(f"seed {s} frame {f}" for s, f in refused[:5]) if refused else ""))

@@ -181,8 +181,7 @@ def test_a_gait_carries_its_detail_and_fades_it_into_frames_without_one(models):
     m = models["walk"]
     # the MOVEs: pose of the particle's X plus the detail at the path's phases
     moves = [c for c in on.chunks if c.detail is not None]
-    # (three MOVEs, and the IDLE's first step on to where both feet are down)
-    assert len(moves) == 4 and not any(c.detail is not None for c in off.chunks)
+    assert len(moves) == 3 and not any(c.detail is not None for c in off.chunks)
     for c in moves:
         np.testing.assert_allclose(c.angles, m.pose(c.X) + c.detail["angles"], atol=1e-9)
     # the IDLE: the detail of the last gait frame, faded, for DETAIL_FADE seconds
@@ -370,26 +369,17 @@ def test_idle_stands_and_nothing_freezes_elsewhere(models, made):
 
 
 
-def test_an_idle_after_stepping_settles_where_both_feet_are_down_and_stops_turning(
-        models, made):
-    """The IDLE after the run -> walk TRANSITION steps on along the walk and stands from
-    a frame where both legs have a foot down (judged on the written motion's own feet:
-    each leg's lowest point in contact by height), the stand
-    (held frames) starts after that, and once it stands its heading no longer turns."""
-    from cyclecoord.quality.contacts import foot_contacts
-
+def test_a_standing_idle_stops_turning(models, made):
+    """Once the IDLE stands (0.5 s in, as its ground track stops) its heading no longer
+    turns: the root's turn rate of the walk's frames turned a standing Bandai body 40-50
+    degrees over a 2 s IDLE, pivoting the feet out of their pins."""
     syn, motion = made
-    a, b = _span(syn, [syn.command])
     (h0, h1), = syn.held
-    assert a < h0 < b and h1 == b  # stepped on first, then held to the end
-    c = foot_contacts(motion, syn.feet_of(motion))
-    labels = np.array(c.leg_labels)
-    legs = [c.height[h0, labels == g].min() for g in dict.fromkeys(labels)]
-    assert max(legs) < c.height_threshold, legs
     J = motion.positions()
     hips = J["lfemur"] - J["rfemur"]
     yaw = np.degrees(np.unwrap(np.arctan2(hips[:, 0], hips[:, 2])))
     assert np.ptp(yaw[h0 + 15 : h1]) < 1.0
+
 
 def test_joint_limits_ease_and_never_flatten(models):
     syn = Synthesizer(models, fps=30)

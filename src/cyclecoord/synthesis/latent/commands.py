@@ -269,7 +269,6 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self._ranges: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._gaits: dict = {}
         self._fades: dict = {}  # each (model, segment)'s seam cross-fade (seam_fade)
-        self._stances: dict = {}  # each model's training frames' stance (GaitMixin.stance)
         # (model, segment, unwrapped phase) where the last stepping command left the
         # particle, and the one the MOVE being made will leave
         self._cursor = self._next_cursor = None
@@ -627,9 +626,6 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             else [self.target(at) if at is not None else self.x.copy()]
         )
         end = self.t + duration
-        if at is None and self._stepping:  # steps on to where both feet are down
-            self.settle(duration)
-            points = [self.x.copy()]
         first = self.n_frames
         try:
             self._idle(points, end, radius, hover, sway)

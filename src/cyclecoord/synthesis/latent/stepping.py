@@ -33,10 +33,6 @@ __all__ = ["FADE_TIE", "GaitMixin", "IN_STEP_LONGEST", "SEAM_FADES"]
 #: An in-step blend is raised (and said) up to this many seconds at most, so the
 #: TRANSITION completes within a second of the command.
 IN_STEP_LONGEST = 1.0
-#: An IDLE after stepping steps on to a stance within this share of its time
-#: (:meth:`GaitMixin.settle`), judged on a phase grid of this many bins.
-SETTLE_SHARE = 0.6
-SETTLE_BINS = 50
 
 
 class GaitMixin:
@@ -143,62 +139,6 @@ class GaitMixin:
             else None
         )
         return X, t - t0
-
-    def stance(self, name: str) -> np.ndarray | None:
-        """(N,) per training frame of model ``name``: the higher of its legs' lowest foot
-        points above their contact level (0 where every leg has a foot down); None when
-        the feet are not found."""
-        if name not in self._stances:
-            from ...errors import CycleCoordError
-            from ...quality.contacts import foot_contacts
-
-            train = self.models[name].training_motion()
-            try:
-                c = foot_contacts(train, self.feet_of(train))
-            except (CycleCoordError, TypeError):
-                self._stances[name] = None
-            else:
-                labels = np.array(c.leg_labels)
-                legs = [c.height[:, labels == g].min(axis=1) for g in dict.fromkeys(labels)]
-                self._stances[name] = np.max(legs, axis=0)
-        return self._stances[name]
-
-    def settle(self, seconds: float) -> None:
-        """Before an IDLE where the particle is, after stepping: step on along the gait
-        and ease to a stop at the nearest phase (a tenth of a cycle ahead at least, and
-        within :data:`SETTLE_SHARE` of the IDLE's ``seconds``) where the legs' feet are
-        as low as on the fifth of the training frames where they are lowest (a walk's
-        double support).  The IDLE then stands there.  Stopped wherever the gait was, a
-        Bandai walk stood on one leg mid-swing and drifted on through the swing for
-        the whole IDLE: the lifted foot rose 11 units and slid 40, the pelvis turned 40
-        degrees (seed 5 of the benchmark script)."""
-        place = self._gait_place(self.current)
-        stance = self.stance(self.current)
-        if place is None or stance is None:
-            return
-        seg, u0 = place
-        g = self.gait(self.current)
-        rows = g.rows(seg)
-        ph, st = g.phase[rows] % 1.0, stance[rows]
-        bins = np.linspace(0.0, 1.0, SETTLE_BINS + 1)
-        which = np.minimum(np.digitize(ph, bins) - 1, SETTLE_BINS - 1)
-        prof = np.array([np.median(st[which == b]) if (which == b).any() else np.inf
-                         for b in range(SETTLE_BINS)])
-        rate = self._rate(self.current, seg)  # cycles per output frame
-        ahead = np.arange(0.1, 1.1, 1.0 / SETTLE_BINS)
-        # easing to a stop takes half the ramp longer than the path at the cadence
-        frames = ahead / rate + 0.5 * self.ease * self.fps
-        ahead = ahead[frames <= SETTLE_SHARE * seconds * self.fps]
-        if not ahead.size:
-            return
-        at = prof[np.minimum(((u0 + ahead) % 1.0 * SETTLE_BINS).astype(int), SETTLE_BINS - 1)]
-        low = np.flatnonzero(at <= np.percentile(st, 20))
-        if not low.size:
-            return
-        k = low[0]
-        while k + 1 < ahead.size and k + 1 in low and at[k + 1] < at[k]:
-            k += 1
-        self.move({"ahead": float(ahead[k] / rate / self.fps)}, stop=True)
 
     def can_step_across(self, src: str, to: str) -> bool:
         """Whether a TRANSITION from ``src`` to ``to`` can go in step (both have a gait)."""
