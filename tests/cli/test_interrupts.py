@@ -254,7 +254,8 @@ def test_ctrl_c_while_the_console_script_loads_the_commands_is_one_line(monkeypa
     assert capsys.readouterr().err == "cyclecoord: interrupted\n"
 
 
-def test_a_real_ctrl_c_while_the_console_script_loads_is_held_to_the_end(monkeypatch, capsys):
+def test_a_real_ctrl_c_while_the_console_script_loads_is_held_to_the_end(
+        monkeypatch, capsys, sigint_raises):
     """A SIGINT that arrives in the middle of the imports (numpy turned one into an
     ImportError) is held until they end, then reported as the one line."""
     import importlib.abc
