@@ -470,29 +470,51 @@ def test_phase_zero_is_the_same_step_in_every_segment_and_model(models):
             assert int(np.argmin(prof)) == 4, (name, s, np.round(prof, 2))
 
 
-def test_a_model_file_anchored_before_the_fix_is_mended_on_load(models, tmp_path):
-    """A file without ``gait_anchor`` (written before phase 0 meant the same step) has each
-    segment's phases shifted back to that step; a file with another anchor is refused."""
+def test_a_model_file_from_an_older_gait_computes_its_phases_again(models, tmp_path):
+    """A file whose phases come from an older ``training_gait`` (no ``gait_version``,
+    or version 2: phase 0 anchored with the harmonic's sign flipped, gaps unwrapped as
+    under a cycle) has them computed again on first use; a newer version is refused."""
     from cyclecoord.errors import ParseError
+    from cyclecoord.synthesis.latent.gait import GAIT_VERSION
 
     walk = models["walk"]
     g = walk.gait()
     walk.save(tmp_path / "walk.npz")
     arrays = dict(np.load(tmp_path / "walk.npz", allow_pickle=False))
-    assert int(arrays["gait_anchor"]) == 2
-    old = {k: v for k, v in arrays.items() if k != "gait_anchor"}
-    shifted = old["gait_phase"].copy()
+    assert int(arrays["gait_version"]) == GAIT_VERSION == 3
+    shifted = arrays["gait_phase"].copy()
     for s, off in zip(g.usable, (0.3, -0.45)):
         shifted[g.rows(s)] += off
-    np.savez(tmp_path / "old.npz", **{**old, "gait_phase": shifted})
-    back = LatentModel.load(tmp_path / "old.npz").gait()
-    for s in g.usable:
-        d = back.phase[g.rows(s)] - g.phase[g.rows(s)]
-        assert np.ptp(d) < 1e-9 and abs(d[0] - np.round(d[0])) < 1e-6
-    np.savez(tmp_path / "bad.npz", **{**arrays, "gait_anchor": np.array(1)})
-    with pytest.raises(ParseError, match="gait_anchor"):
-        LatentModel.load(tmp_path / "bad.npz")
+    old = {k: v for k, v in arrays.items() if k != "gait_version"}
+    for name, extra in (("none", {}), ("two", {"gait_version": np.array(2)})):
+        np.savez(tmp_path / f"{name}.npz", **{**old, "gait_phase": shifted, **extra})
+        back = LatentModel.load(tmp_path / f"{name}.npz")
+        assert back.gait_ is None
+        np.testing.assert_allclose(back.gait().phase, g.phase)
+    np.savez(tmp_path / "new.npz", **{**arrays, "gait_version": np.array(GAIT_VERSION + 1)})
+    with pytest.raises(ParseError, match="gait_version"):
+        LatentModel.load(tmp_path / "new.npz")
 
+
+def test_a_gap_in_the_steady_frames_advances_by_its_whole_cycles():
+    """The pipeline leaves out a walk's turn (135 frames, 2.74 cycles of 49.25 frames):
+    across the gap the phase advances by the whole cycles nearest that (3.19 here: the
+    coordinate's 0.19 plus 3), not the 0.19 ``np.unwrap`` sees; a coordinate running
+    backwards is turned round first."""
+    from cyclecoord.synthesis.latent.gait import _unwrapped
+
+    P = 49.25
+    at = np.r_[np.arange(0, 55), np.arange(189, 262)]  # frames 55-188 left out
+    true = at / P
+    p = true % 1.0
+    u = _unwrapped(p, at, P)
+    np.testing.assert_allclose(u - u[0], true - true[0], atol=1e-9)
+    np.testing.assert_allclose(_unwrapped((-true) % 1.0, at, P) - u, -u[0], atol=1e-9)
+    # the coordinate 0.2 cycles on after the gap (a turn taken at another pace): the
+    # gap advances by the period's 2.741 cycles plus those 0.2, the nearest whole count
+    p2 = np.r_[true[:55], true[55:] + 0.2] % 1.0
+    u2 = _unwrapped(p2, at, P)
+    assert u2[55] - u2[54] == pytest.approx(135 / P + 0.2, abs=1e-9)
 
 
 def test_the_loop_seam_is_searched_over_a_whole_cycle_of_phases():
@@ -1012,3 +1034,25 @@ def test_a_stiff_particle_step_is_taken_again_in_parts(models, monkeypatch):
     assert worst() < 10.0
     monkeypatch.setattr(particle, "SUBSTEPS", ())
     assert worst() == np.inf
+
+
+def test_the_xsens_walk_with_a_turn_keeps_stepping_through_it(bvh_dir):
+    """The Xsens take stands, walks out and back with a turn between (the pipeline's
+    steady frames leave the turn out), and stands again.  Its gait phase advances at
+    about one cycle a period over the whole walk (it stalled and ran backwards over the
+    turn), so a MOVE ahead from mid-walk keeps the captured cadence."""
+    take = cc.load(bvh_dir / "xsens" / "S02-Trial-Walk-1.bvh")
+    m = LatentModel(gplvm={"max_iter": 20}).fit([take[1::3]], ["Walk"])  # (as latent fit)
+    g = m.gait()
+    rows = g.rows(0)
+    t = m.times_[rows]
+    walking = (t > 12.0) & (t < 18.0)  # the walk, its turn at about 15 s
+    rate = np.diff(g.phase[rows])[walking[1:]] * g.period[0]  # cycles per period's frame
+    assert rate.min() > 0.7 and rate.max() < 1.3, (rate.min(), rate.max())
+    syn = Synthesizer({"walk": m}, fps=30, seed=0)
+    syn.start("walk", {"segment": "Walk", "time": 13.0})
+    for i in range(10):
+        syn.command = i
+        syn.move({"ahead": 0.5}, stop=False)
+    q = measure_generated(syn.motion(), [take[1100:2000]])
+    assert abs(q.cadence_ratio - 1.0) < 0.15, q.cadence_ratio

@@ -25,8 +25,8 @@ import numpy as np
 from .influence import pose_points
 
 __all__ = [
-    "ANCHOR", "FADE_TIE", "Gait", "MIN_CYCLES", "SEAM_FADE", "SEAM_FADES", "choose_seam_fade",
-    "even_phase", "reanchored", "training_gait",
+    "FADE_TIE", "GAIT_VERSION", "Gait", "MIN_CYCLES", "SEAM_FADE", "SEAM_FADES",
+    "choose_seam_fade", "even_phase", "training_gait",
 ]
 
 #: A segment needs at least this many cycles for its phase to be trusted.
@@ -278,28 +278,36 @@ def _anchor(model, rows: np.ndarray, phase: np.ndarray, leg_points: tuple[str, s
     return float(np.angle(c) / (2 * np.pi))
 
 
-#: What :func:`training_gait`'s phase 0 means, kept in model files (``gait_anchor``): 2,
-#: the first ankle furthest ahead of the other.  Files without it (written up to
-#: 2026-11-28) were anchored with the first harmonic's sign flipped, which put phase 0 at
-#: a different step in each segment: a Bandai walk and run 0.33 cycles apart, so an
-#: in-step TRANSITION blended a walk's left stride with a run's right one (the blend's
-#: feet 4.1 units apart against the takes' closest 5.6, and ``animate`` refused the
-#: script on every seed).  :func:`reanchored` mends their phases on load.
-ANCHOR = 2
+#: The version of :func:`training_gait` a model file's phases come from (``gait_version``);
+#: phases from an older one are computed again when first used.  Files without it (written
+#: up to 2026-11-28 00:40 UTC) were anchored with the first harmonic's sign flipped, which
+#: put phase 0 at a different step in each segment (a Bandai walk and run 0.33 cycles
+#: apart, so an in-step TRANSITION blended a walk's left stride with a run's right one:
+#: the blend's feet 4.1 units apart against the takes' closest 5.6, and ``animate``
+#: refused the script on every seed); version 2 (``gait_anchor``, the same day) still took
+#: a gap in the pipeline's steady frames as under a cycle (:func:`_unwrapped`).
+GAIT_VERSION = 3
 
 
-def reanchored(model, gait: Gait) -> Gait:
-    """``gait`` with each segment's phase shifted so that phase 0 is where the first
-    ankle is furthest ahead of the other (:func:`_anchor`, as :func:`training_gait`
-    anchors it now): for phases read from a file written before :data:`ANCHOR`."""
-    legs = _legs(model)
-    if legs is None or not len(gait.usable):
-        return gait
-    phase = gait.phase.copy()
-    for s in gait.usable:
-        rows = gait.rows(s)
-        phase[rows] -= _anchor(model, rows, phase[rows], legs)
-    return Gait(phase=phase, period=gait.period, segments=gait.segments, fade=gait.fade)
+def _unwrapped(p: np.ndarray, at: np.ndarray, period: float) -> np.ndarray:
+    """The circular coordinate ``p`` (cycles, in [0, 1)) on frames ``at`` unwrapped and
+    running forwards, each gap between frames advanced by the whole number of cycles
+    that brings it nearest ``period`` frames a cycle.  ``np.unwrap`` alone took a
+    gap of 135 frames (an Xsens walk's turn, left out of the pipeline's steady frames)
+    as 0.19 of a cycle instead of 2.8: the gait's phase stalled and ran backwards over
+    the walk, and a MOVE ahead crossed those frames four times too fast (the toes at
+    9.9 m/s, 5.8x the capture's 99th percentile of acceleration)."""
+    u = np.unwrap(2 * np.pi * p) / (2 * np.pi)
+    step = np.diff(at)
+    near = step == 1
+    if near.any() and np.median(np.diff(u)[near]) < 0:  # a coordinate running backwards
+        u = -u
+    elif not near.any() and u[-1] < u[0]:
+        u = -u
+    for j in np.flatnonzero(step > 1):
+        got = u[j + 1] - u[j]
+        u[j + 1 :] += np.round(step[j] / period - got)
+    return u
 
 
 def _legs(model) -> tuple[str, str] | None:
@@ -349,9 +357,7 @@ def training_gait(model) -> Gait:
         if ok.sum() < 3:
             continue
         k = np.arange(rows.size, dtype=float)
-        u = np.unwrap(2 * np.pi * p[ok]) / (2 * np.pi)
-        if u[-1] < u[0]:  # a coordinate running backwards
-            u = -u
+        u = _unwrapped(p[ok], np.flatnonzero(ok), P)
         # fill the left-out frames along the segment's period
         full = np.interp(k, k[ok], u)
         first, last = np.flatnonzero(ok)[[0, -1]]

@@ -601,10 +601,10 @@ class LatentModel:
         )
         g = getattr(self, "gait_", None)
         if g is not None:
-            from .gait import ANCHOR
+            from .gait import GAIT_VERSION
 
             arrays.update({"gait_phase": g.phase, "gait_period": g.period,
-                           "gait_anchor": np.array(ANCHOR)})
+                           "gait_version": np.array(GAIT_VERSION)})
             if g.fade is not None:
                 arrays["gait_fade"] = g.fade
         with atomic_write(path, "wb") as fh:
@@ -701,8 +701,9 @@ class LatentModel:
             m.gp_ = GPLVM.from_arrays(X, *hyper, m.Y_)
         except ParameterError as exc:
             raise ParseError(f"arrays 'X', 'hyper', 'Y': {exc}", spath) from None
+        m.gait_ = None
         if "gait_phase" in arrays:  # files written before the gait phase compute it on use
-            from .gait import ANCHOR, Gait
+            from .gait import GAIT_VERSION, Gait
 
             phase = a.reals("gait_phase", (N,), allow_nan=True)  # NaN: a segment without gait
             period = a.get("gait_period")
@@ -718,9 +719,10 @@ class LatentModel:
                 fade = a.reals("gait_fade", (S,))
                 if (fade <= 0).any():
                     raise a.error("gait_fade", "seam cross-fades are positive cycles")
-            m.gait_ = Gait(phase, period, m.segments_, fade)
-            if "gait_anchor" in arrays:  # (else phases anchored before the fix: mended below)
-                a.integer("gait_anchor", ANCHOR, ANCHOR)
+            # phases from an older training_gait (or none said) are computed again on use
+            if "gait_version" in arrays and a.integer("gait_version", 0, GAIT_VERSION) == (
+                    GAIT_VERSION):
+                m.gait_ = Gait(phase, period, m.segments_, fade)
         starts = np.flatnonzero(np.r_[True, m.segments_[1:] != m.segments_[:-1]])
         stops = np.r_[starts[1:], len(m.segments_)]
         try:
@@ -738,10 +740,6 @@ class LatentModel:
         if not (np.isfinite(m.speed_) and m.speed_ > 0 and np.isfinite(m._B).all()):
             raise a.error("X", "the latent points do not move (no latent speed), or the pose "
                           "map is not finite")
-        if getattr(m, "gait_", None) is not None and "gait_anchor" not in arrays:
-            from .gait import reanchored
-
-            m.gait_ = reanchored(m, m.gait_)
         return m
 
 
