@@ -11,6 +11,7 @@ from cyclecoord.periodic.windings import (
     phase_average,
     retime,
     stretches,
+    unwrap_across_gaps,
 )
 
 
@@ -756,3 +757,26 @@ def test_phase_average_is_the_same_under_small_weights():
     for scale in (1.0, 1e-3):
         out = phase_average(ph, vals, 1, 0.01, weights=np.full(2, scale))
         assert out[0, 0] == pytest.approx(want)
+
+
+def test_a_gap_in_the_steady_frames_advances_by_its_whole_cycles():
+    """The pipeline leaves out a walk's turn (135 frames, 2.74 cycles of 49.25 frames):
+    across the gap the phase advances by the whole cycles nearest that (3.19 here: the
+    coordinate's 0.19 plus 3), not the 0.19 ``np.unwrap`` sees; a coordinate running
+    backwards is turned round first."""
+    P = 49.25
+    at = np.r_[np.arange(0, 55), np.arange(189, 262)]  # frames 55-188 left out
+    true = at / P
+    p = true % 1.0
+    u = unwrap_across_gaps(p, at, P)
+    np.testing.assert_allclose(u - u[0], true - true[0], atol=1e-9)
+    np.testing.assert_allclose(unwrap_across_gaps((-true) % 1.0, at, P) - u, -u[0], atol=1e-9)
+    # the coordinate 0.2 cycles on after the gap (a turn taken at another pace): the
+    # gap advances by the period's 2.741 cycles plus those 0.2, the nearest whole count
+    p2 = np.r_[true[:55], true[55:] + 0.2] % 1.0
+    u2 = unwrap_across_gaps(p2, at, P)
+    assert u2[55] - u2[54] == pytest.approx(135 / P + 0.2, abs=1e-9)
+    # the period estimated from neighbouring frames, and a backwards coordinate kept so
+    np.testing.assert_allclose(unwrap_across_gaps(p, at) - u[0], true - true[0], atol=1e-9)
+    back = unwrap_across_gaps((-true) % 1.0, at, P, forwards=False)
+    np.testing.assert_allclose(back - back[0], -(true - true[0]), atol=1e-9)

@@ -318,3 +318,17 @@ def test_a_start_at_a_reference_first_frame_starts_at_the_motion(walks):
     # a start at any other frame, or on a take without one, is left alone
     assert synth.generate(50, 0, 5).start["frame"] == 5
     assert synth.generate(50, 1, 0).start["frame"] == 0
+
+
+def test_a_take_phase_counts_the_whole_cycles_of_a_gap_in_its_coordinate():
+    """A coordinate the pipeline left undefined over 135 frames (a turn it did not count
+    as steady) is filled at the take's pace: 2.74 cycles over the gap, not the 0.19 a
+    plain unwrap sees (the graph's phase stalled there)."""
+    from cyclecoord.synthesis.graph.phase import _fill
+
+    P = 49.25
+    t = np.arange(262)
+    c = (t / P) % 1.0
+    c[55:189] = np.nan
+    u = _fill(c)
+    np.testing.assert_allclose(u - u[0], t / P, atol=1e-9)

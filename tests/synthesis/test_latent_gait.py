@@ -496,27 +496,6 @@ def test_a_model_file_from_an_older_gait_computes_its_phases_again(models, tmp_p
         LatentModel.load(tmp_path / "new.npz")
 
 
-def test_a_gap_in_the_steady_frames_advances_by_its_whole_cycles():
-    """The pipeline leaves out a walk's turn (135 frames, 2.74 cycles of 49.25 frames):
-    across the gap the phase advances by the whole cycles nearest that (3.19 here: the
-    coordinate's 0.19 plus 3), not the 0.19 ``np.unwrap`` sees; a coordinate running
-    backwards is turned round first."""
-    from cyclecoord.synthesis.latent.gait import _unwrapped
-
-    P = 49.25
-    at = np.r_[np.arange(0, 55), np.arange(189, 262)]  # frames 55-188 left out
-    true = at / P
-    p = true % 1.0
-    u = _unwrapped(p, at, P)
-    np.testing.assert_allclose(u - u[0], true - true[0], atol=1e-9)
-    np.testing.assert_allclose(_unwrapped((-true) % 1.0, at, P) - u, -u[0], atol=1e-9)
-    # the coordinate 0.2 cycles on after the gap (a turn taken at another pace): the
-    # gap advances by the period's 2.741 cycles plus those 0.2, the nearest whole count
-    p2 = np.r_[true[:55], true[55:] + 0.2] % 1.0
-    u2 = _unwrapped(p2, at, P)
-    assert u2[55] - u2[54] == pytest.approx(135 / P + 0.2, abs=1e-9)
-
-
 def test_the_loop_seam_is_searched_over_a_whole_cycle_of_phases():
     """2.3 cycles: K = 2 leaves only the last 0.3 cycle to place the seam in; one cycle
     fewer makes every phase a candidate.  The take repeats exactly except a bump over its

@@ -36,6 +36,7 @@ __all__ = [
     "edge_taper",
     "phase_average",
     "stretches",
+    "unwrap_across_gaps",
 ]
 
 #: Levels of the coordinate examined for crossings.
@@ -401,3 +402,38 @@ def phase_average(
         else:
             out[j] = w @ val3[lo:hi] / w.sum()
     return out
+
+
+def unwrap_across_gaps(
+    values: np.ndarray, frames: np.ndarray, period: float | None = None,
+    forwards: bool = True,
+) -> np.ndarray:
+    """A circular coordinate ``values`` (cycles, in [0, 1)) on increasing ``frames``
+    unwrapped, each gap between frames advanced by the whole number of cycles that
+    brings its pace nearest ``period`` frames a cycle (default: the pace between
+    neighbouring frames, their median), in the direction the coordinate runs; with
+    ``forwards``, turned round first when it runs backwards.
+
+    ``np.unwrap`` alone takes every step as under half a cycle: a gap of 135 frames (an
+    Xsens walk's turn, left out of the pipeline's steady frames) read as 0.19 of a cycle
+    instead of 2.74, and a gait phase built on it stalled and ran backwards over the
+    walk (a latent MOVE ahead then crossed those frames four times too fast).
+    """
+    values = np.asarray(values, dtype=float)
+    frames = np.asarray(frames, dtype=float)
+    u = np.unwrap(2 * np.pi * values) / (2 * np.pi)
+    if u.size < 2:
+        return u
+    step = np.diff(frames)
+    du = np.diff(u)
+    near = step == 1
+    sign = float(np.sign(np.median(du[near]))) if near.any() else float(np.sign(u[-1] - u[0]))
+    if period is None:
+        rate = float(np.median(np.abs(du[near]))) if near.any() else 0.0
+        period = 1.0 / rate if rate > 0 else np.inf
+    if np.isfinite(period) and period > 0:
+        for j in np.flatnonzero(step > 1):
+            u[j + 1 :] += np.round(sign * step[j] / period - (u[j + 1] - u[j]))
+    if forwards and sign < 0:
+        u = -u
+    return u

@@ -42,6 +42,7 @@ from scipy.spatial import cKDTree
 
 from ...errors import CycleCoordError, ParameterError
 from ...motion import Motion
+from ...periodic.windings import unwrap_across_gaps
 from .build import MotionGraph
 from .paths import MAX_STEP_SCALE, GraphPath
 
@@ -93,7 +94,8 @@ def _fill(c: np.ndarray) -> np.ndarray | None:
     ok = np.isfinite(c)
     if ok.sum() < 3:
         return None
-    u = np.unwrap(2 * np.pi * c[ok]) / (2 * np.pi)
+    # whole cycles across the gaps the pipeline left (a turn it did not count as steady)
+    u = unwrap_across_gaps(c[ok], t[ok], forwards=False)
     rate = float(np.median(np.diff(u) / np.diff(t[ok])))
     out = np.interp(t, t[ok], u)
     first, last = t[ok][0], t[ok][-1]

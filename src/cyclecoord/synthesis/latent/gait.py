@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...periodic.windings import unwrap_across_gaps
 from .influence import pose_points
 
 __all__ = [
@@ -285,29 +286,9 @@ def _anchor(model, rows: np.ndarray, phase: np.ndarray, leg_points: tuple[str, s
 #: apart, so an in-step TRANSITION blended a walk's left stride with a run's right one:
 #: the blend's feet 4.1 units apart against the takes' closest 5.6, and ``animate``
 #: refused the script on every seed); version 2 (``gait_anchor``, the same day) still took
-#: a gap in the pipeline's steady frames as under a cycle (:func:`_unwrapped`).
+#: a gap in the pipeline's steady frames as under a cycle
+#: (:func:`~cyclecoord.periodic.windings.unwrap_across_gaps`).
 GAIT_VERSION = 3
-
-
-def _unwrapped(p: np.ndarray, at: np.ndarray, period: float) -> np.ndarray:
-    """The circular coordinate ``p`` (cycles, in [0, 1)) on frames ``at`` unwrapped and
-    running forwards, each gap between frames advanced by the whole number of cycles
-    that brings it nearest ``period`` frames a cycle.  ``np.unwrap`` alone took a
-    gap of 135 frames (an Xsens walk's turn, left out of the pipeline's steady frames)
-    as 0.19 of a cycle instead of 2.8: the gait's phase stalled and ran backwards over
-    the walk, and a MOVE ahead crossed those frames four times too fast (the toes at
-    9.9 m/s, 5.8x the capture's 99th percentile of acceleration)."""
-    u = np.unwrap(2 * np.pi * p) / (2 * np.pi)
-    step = np.diff(at)
-    near = step == 1
-    if near.any() and np.median(np.diff(u)[near]) < 0:  # a coordinate running backwards
-        u = -u
-    elif not near.any() and u[-1] < u[0]:
-        u = -u
-    for j in np.flatnonzero(step > 1):
-        got = u[j + 1] - u[j]
-        u[j + 1 :] += np.round(step[j] / period - got)
-    return u
 
 
 def _legs(model) -> tuple[str, str] | None:
@@ -357,7 +338,8 @@ def training_gait(model) -> Gait:
         if ok.sum() < 3:
             continue
         k = np.arange(rows.size, dtype=float)
-        u = _unwrapped(p[ok], np.flatnonzero(ok), P)
+        # whole cycles across the gaps the pipeline left (an Xsens walk's turn)
+        u = unwrap_across_gaps(p[ok], np.flatnonzero(ok), P)
         # fill the left-out frames along the segment's period
         full = np.interp(k, k[ok], u)
         first, last = np.flatnonzero(ok)[[0, -1]]
