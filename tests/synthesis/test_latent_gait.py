@@ -236,6 +236,51 @@ def test_frames_whose_limbs_come_too_close_are_pulled_to_the_captured_pose(model
 
 
 
+
+def test_frames_that_pop_are_pulled_to_the_captured_pose_and_idle_frames_are_not(
+        models, monkeypatch):
+    """A pop (joint acceleration over POP_PULL times the training 99th percentile) at
+    frame 10 of a MOVE chain and on the IDLE after it: the gait frame is posed as the
+    captured frame at its phase, its neighbours part way, frames further than
+    UNTANGLE_WIDTH unchanged; the IDLE frame, on no gait's path, is left as it was; a
+    note says so.  Without pops nothing changes."""
+    import cyclecoord.synthesis.carry as carry
+    from cyclecoord.synthesis.latent.output import POP_PULL, UNTANGLE_WIDTH
+
+    plain = _moves_then_idle(models)
+    before = plain._assemble(*plain._posed())
+    idle = sum(c.X.shape[0] for c in plain.chunks[:-1]) + 10
+    limit = POP_PULL * plain._frame_acc99(before.n_frames)
+    calls = []
+
+    def fake(motion):
+        calls.append(1)
+        out = np.zeros(motion.n_frames)
+        if len(calls) == 1:
+            out[[10, idle]] = 1.01 * limit[[10, idle]]
+        return out
+
+    monkeypatch.setattr(carry, "_accel", fake)
+    syn = _moves_then_idle(models)
+    after = syn._untangled()
+    assert len(calls) == 2
+    m = models["walk"]
+    chunk = syn.chunks[0]
+    target = syn._clip("walk", m.pose(chunk.path) + chunk.detail["angles"], count=False)
+    cols = [after.channel_index(*c) for c in m.channels_]
+    np.testing.assert_allclose(after.frames[10, cols], m.to_channels(target)[10], atol=1e-6)
+    w = int(round(UNTANGLE_WIDTH * 30))
+    far = [f for f in range(after.n_frames) if abs(f - 10) > w]
+    np.testing.assert_allclose(after.frames[far], before.frames[far], atol=1e-9)
+    assert any(n.startswith("pops: 1 frame accelerating") and "(frame 10)" in n
+               for n in syn.notes)
+    # at exactly the limit: no pop
+    calls.clear()
+    monkeypatch.setattr(carry, "_accel", lambda motion: limit.copy())
+    quiet = _moves_then_idle(models)
+    np.testing.assert_allclose(quiet._untangled().frames, before.frames, atol=1e-12)
+    assert not any(n.startswith("pops") for n in quiet.notes)
+
 def test_an_in_step_blend_frame_too_close_is_pulled_to_both_gaits_captured_poses(
         models, monkeypatch):
     """A new limb contact on the first frame of the run -> walk blend (where the particle's
