@@ -243,7 +243,8 @@ def test_frames_that_pop_are_pulled_to_the_captured_pose_and_idle_frames_are_not
     frame 10 of a MOVE chain and on the IDLE after it: the gait frame is posed as the
     captured frame at its phase, its neighbours part way, frames further than
     UNTANGLE_WIDTH unchanged; the IDLE frame, on no gait's path, is left as it was; a
-    note says so.  Without pops nothing changes."""
+    note says so.  A pull that makes the pop worse is taken back; without pops nothing
+    changes."""
     import cyclecoord.synthesis.carry as carry
     from cyclecoord.synthesis.latent.output import POP_PULL, UNTANGLE_WIDTH
 
@@ -274,6 +275,20 @@ def test_frames_that_pop_are_pulled_to_the_captured_pose_and_idle_frames_are_not
     np.testing.assert_allclose(after.frames[far], before.frames[far], atol=1e-9)
     assert any(n.startswith("pops: 1 frame accelerating") and "(frame 10)" in n
                for n in syn.notes)
+    # a captured pose that pops worse there (a seam of the gait's loop): the pull is
+    # taken back and the particle's own pose kept
+    calls.clear()
+
+    def worse(motion):
+        calls.append(1)
+        out = np.zeros(motion.n_frames)
+        out[10] = (1.01 if len(calls) == 1 else 2.0) * limit[10]
+        return out
+
+    monkeypatch.setattr(carry, "_accel", worse)
+    kept = _moves_then_idle(models)
+    np.testing.assert_allclose(kept._untangled().frames, before.frames, atol=1e-12)
+    assert len(calls) == 2 and not any(n.startswith("pops") for n in kept.notes)
     # at exactly the limit: no pop
     calls.clear()
     monkeypatch.setattr(carry, "_accel", lambda motion: limit.copy())
