@@ -541,7 +541,7 @@ def test_a_model_file_from_an_older_gait_computes_its_phases_again(models, tmp_p
     g = walk.gait()
     walk.save(tmp_path / "walk.npz")
     arrays = dict(np.load(tmp_path / "walk.npz", allow_pickle=False))
-    assert int(arrays["gait_version"]) == GAIT_VERSION == 3
+    assert int(arrays["gait_version"]) == GAIT_VERSION == 4
     shifted = arrays["gait_phase"].copy()
     for s, off in zip(g.usable, (0.3, -0.45)):
         shifted[g.rows(s)] += off
@@ -1079,7 +1079,8 @@ def test_the_xsens_walk_with_a_turn_keeps_stepping_through_it(bvh_dir):
     """The Xsens take stands, walks out and back with a turn between (the pipeline's
     steady frames leave the turn out), and stands again.  Its gait phase advances at
     about one cycle a period over the whole walk (it stalled and ran backwards over the
-    turn), so a MOVE ahead from mid-walk keeps the captured cadence."""
+    turn), so a MOVE ahead from mid-walk keeps the captured cadence, and from the
+    standing part too."""
     take = cc.load(bvh_dir / "xsens" / "S02-Trial-Walk-1.bvh")
     m = LatentModel(gplvm={"max_iter": 20}).fit([take[1::3]], ["Walk"])  # (as latent fit)
     g = m.gait()
@@ -1088,10 +1089,16 @@ def test_the_xsens_walk_with_a_turn_keeps_stepping_through_it(bvh_dir):
     walking = (t > 12.0) & (t < 18.0)  # the walk, its turn at about 15 s
     rate = np.diff(g.phase[rows])[walking[1:]] * g.period[0]  # cycles per period's frame
     assert rate.min() > 0.7 and rate.max() < 1.3, (rate.min(), rate.max())
-    syn = Synthesizer({"walk": m}, fps=30, seed=0)
-    syn.start("walk", {"segment": "Walk", "time": 13.0})
-    for i in range(10):
-        syn.command = i
-        syn.move({"ahead": 0.5}, stop=False)
-    q = measure_generated(syn.motion(), [take[1100:2000]])
-    assert abs(q.cadence_ratio - 1.0) < 0.15, q.cadence_ratio
+    # the standing before and after the walk (over a period beyond its steady frames)
+    # has no phase: a MOVE ahead loops the walk only, from wherever it starts
+    t_gait = m.times_[rows]
+    assert 9.0 < t_gait[0] < 12.0 and 19.0 < t_gait[-1] < 22.0, (t_gait[0], t_gait[-1])
+    for start in (13.0, 3.0):  # mid-walk, and standing (it walked in place: knee 0.02)
+        syn = Synthesizer({"walk": m}, fps=30, seed=0)
+        syn.start("walk", {"segment": "Walk", "time": start})
+        for i in range(10):
+            syn.command = i
+            syn.move({"ahead": 0.5}, stop=False)
+        q = measure_generated(syn.motion(), [take[1100:2000]])
+        assert abs(q.cadence_ratio - 1.0) < 0.15, (start, q.cadence_ratio)
+        assert min(q.knee_ratio) > 0.7, (start, q.knee_ratio)

@@ -53,7 +53,8 @@ class Gait:
     Attributes
     ----------
     phase : ndarray, shape (N,)
-        NaN on segments without a gait.
+        NaN on segments without a gait, and on frames over a period before or after a
+        segment's steady ones.
     period : ndarray, shape (S,)
         Frames per cycle of each segment (model frames; NaN without a gait).
     segments : ndarray of int, shape (N,)
@@ -79,7 +80,9 @@ class Gait:
         return np.flatnonzero(np.isfinite(self.period))
 
     def rows(self, segment: int) -> np.ndarray:
-        return np.flatnonzero(self.segments == segment)
+        """The segment's frames that have a phase (one stretch: :func:`training_gait`
+        leaves frames over a period beyond the steady ones out)."""
+        return np.flatnonzero((self.segments == segment) & np.isfinite(self.phase))
 
     def _loop(
         self, segment: int, values: np.ndarray | None = None
@@ -287,8 +290,9 @@ def _anchor(model, rows: np.ndarray, phase: np.ndarray, leg_points: tuple[str, s
 #: the blend's feet 4.1 units apart against the takes' closest 5.6, and ``animate``
 #: refused the script on every seed); version 2 (``gait_anchor``, the same day) still took
 #: a gap in the pipeline's steady frames as under a cycle
-#: (:func:`~cyclecoord.periodic.windings.unwrap_across_gaps`).
-GAIT_VERSION = 3
+#: (:func:`~cyclecoord.periodic.windings.unwrap_across_gaps`); version 3 gave a phase to
+#: frames any distance before or after the steady ones.
+GAIT_VERSION = 4
 
 
 def _legs(model) -> tuple[str, str] | None:
@@ -340,13 +344,20 @@ def training_gait(model) -> Gait:
         k = np.arange(rows.size, dtype=float)
         # whole cycles across the gaps the pipeline left (an Xsens walk's turn)
         u = unwrap_across_gaps(p[ok], np.flatnonzero(ok), P)
-        # fill the left-out frames along the segment's period
+        # fill the left-out frames along the segment's period, a period beyond the
+        # steady frames at most: frames further out are not this gait (an Xsens take
+        # stands for 11 s before it walks; looping them, a MOVE ahead from the walk
+        # went on to play the standing frames at the walk's cadence)
         full = np.interp(k, k[ok], u)
         first, last = np.flatnonzero(ok)[[0, -1]]
         full[:first] = u[0] - (first - k[:first]) / P
         full[last + 1 :] = u[-1] + (k[last + 1 :] - last) / P
-        full = even_phase(full, P)
-        full -= _anchor(model, rows, full, legs)
+        keep = (k >= first - P) & (k <= last + P)
+        if keep.sum() < MIN_CYCLES * P:
+            continue
+        full[~keep] = np.nan
+        full[keep] = even_phase(full[keep], P)
+        full[keep] -= _anchor(model, rows[keep], full[keep], legs)
         phase[rows] = full
         period[s] = P
     gait = Gait(phase=phase, period=period, segments=np.asarray(model.segments_))

@@ -74,7 +74,7 @@ class GaitMixin:
         if self._cursor is not None and self._cursor[0] == name:
             return self._cursor[1], self._cursor[2]
         m = self.models[name]
-        ok = np.isin(g.segments, g.usable)
+        ok = np.isin(g.segments, g.usable) & np.isfinite(g.phase)
         d = ((m.X_ - self.x) ** 2).sum(1)
         d[~ok] = np.inf
         k = int(np.argmin(d))
