@@ -444,21 +444,22 @@ def lock_where_clean(
     solved: dict = {}  # the trials' leg solutions: frames asked the same are not solved again
     pad = int(round(blend * motion.fps)) + 2
 
-    def judge(trial: Motion) -> np.ndarray:
-        """Frames where ``trial`` pops, leaves the bounds or crosses limbs anew."""
+    def attempt() -> tuple[Motion, np.ndarray]:
+        """``planted`` pinned, and the frames where that pops, leaves the bounds or
+        crosses limbs anew."""
+        trial = pin_feet(motion, replace(contacts, planted=planted), blend=blend, reuse=solved,
+                         bounds=bounds)
         after = _accel(trial)
         bad = (after > limit) & (after > before * 1.05)
         bad |= (_outside(trial.frames, bounds) & ~outside_before).any(axis=1)
         bad |= _crossed(trial, references, plausibility_cache, motion,
                         analysed) & ~crossed_before
-        return np.flatnonzero(bad)
+        return trial, np.flatnonzero(bad)
 
     for _ in range(6):
         if not planted.any():
             break
-        trial = pin_feet(motion, replace(contacts, planted=planted), blend=blend, reuse=solved,
-                         bounds=bounds)
-        bad = judge(trial)
+        trial, bad = attempt()
         if not bad.size:
             result = trial
             break
@@ -510,9 +511,7 @@ def lock_where_clean(
         skipped += _drop_near(planted, bad, pad)
         if not planted.any():
             break
-        trial = pin_feet(motion, replace(contacts, planted=planted), blend=blend, reuse=solved,
-                         bounds=bounds)
-        bad = judge(trial)
+        trial, bad = attempt()
         if not bad.size:
             result = trial
             break

@@ -116,14 +116,17 @@ class OutputMixin:
             before, motion = motion, self._assemble(*self._posed(pull, whole))
         motion = self._unpopped(motion, pull, whole, bump)
         if pulled:
-            spans = sorted(pulled)
-            where = f"frames {spans[0]}-{spans[-1]}" if len(spans) > 1 else f"frame {spans[0]}"
-            self.notes.append(
-                f"limbs: {plural(len(spans), 'frame')} came closer than the training takes' "
-                f"and {'was' if len(spans) == 1 else 'were'} pulled toward the captured pose "
-                f"at {'its' if len(spans) == 1 else 'their'} gait phase ({where})"
-            )
+            self._note_pulled(pulled, f"limbs: {plural(len(pulled), 'frame')} came closer than "
+                              "the training takes' and")
         return motion
+
+    def _note_pulled(self, frames: set[int], lead: str) -> None:
+        """The console note for ``frames`` pulled toward the captured pose, after ``lead``."""
+        spans = sorted(frames)
+        where = f"frames {spans[0]}-{spans[-1]}" if len(spans) > 1 else f"frame {spans[0]}"
+        one = len(spans) == 1
+        self.notes.append(f"{lead} {'was' if one else 'were'} pulled toward the captured pose "
+                          f"at {'its' if one else 'their'} gait phase ({where})")
 
     def _unpopped(
         self, motion: Motion, pull: np.ndarray, whole: np.ndarray, bump: np.ndarray
@@ -167,14 +170,8 @@ class OutputMixin:
             popped.update(int(f) for f in bad)
             motion, acc = trial, after
         if popped:
-            spans = sorted(popped)
-            where = f"frames {spans[0]}-{spans[-1]}" if len(spans) > 1 else f"frame {spans[0]}"
-            self.notes.append(
-                f"pops: {plural(len(spans), 'frame')} accelerating over {POP_PULL:g}x the "
-                f"training 99th percentile {'was' if len(spans) == 1 else 'were'} pulled "
-                f"toward the captured pose at {'its' if len(spans) == 1 else 'their'} gait "
-                f"phase ({where})"
-            )
+            self._note_pulled(popped, f"pops: {plural(len(popped), 'frame')} accelerating over "
+                              f"{POP_PULL:g}x the training 99th percentile")
         return motion
 
     def _on_path(self) -> np.ndarray:
