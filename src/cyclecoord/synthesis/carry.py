@@ -115,6 +115,10 @@ STILL_SPEED = 0.3
 #: A point whose weight-bearing figure (lowness, grounded, going with the body; each in
 #: 0-1) is over this is pinned by :func:`lock_where_clean`.
 LOCK_SUPPORT = 0.5
+#: :func:`lock_where_clean` trims the contacts near pops for this many rounds, then
+#: unpins whole contacts near them for up to this many more.
+TRIM_ROUNDS = 6
+WHOLE_ROUNDS = 3
 #: An asked hold stands still after this many seconds.
 STAND_AFTER = 0.5
 #: Gaussian width (s) of the smoothing of the carried track's steps.
@@ -396,7 +400,8 @@ def lock_where_clean(
     around it is unpinned there (its frames within the ease and two frames of it; a
     hold's contact keeps only its frames after :data:`STAND_AFTER`, then what of those is
     clear of the pops; one the hold lengthened falls back to its weight-bearing frames
-    first) and the rest locked again, up to six times.  With ``references`` (the
+    first) and the rest locked again, up to :data:`TRIM_ROUNDS` times, then contacts near
+    the pops left are unpinned whole (:data:`WHOLE_ROUNDS`).  With ``references`` (the
     captures the motion came from), a pin that brings two limbs closer than those ever
     come (:func:`~cyclecoord.quality.plausibility.check_plausibility`'s new contacts,
     where the motion before pinning had none) counts as a pop: pinned on an IDLE of
@@ -456,13 +461,22 @@ def lock_where_clean(
                         analysed) & ~crossed_before
         return trial, np.flatnonzero(bad)
 
-    for _ in range(6):
+    bad = np.zeros(0, dtype=int)  # the last trial's bad frames
+    for round_ in range(TRIM_ROUNDS + WHOLE_ROUNDS):
+        if round_ >= TRIM_ROUNDS:
+            # the rounds of trimming still popped somewhere (each trim's new ease can): the
+            # contacts near the last pops go whole, and the rest is pinned if that is clean
+            # (seed 5 of the Bandai benchmark script pinned no foot at all, its IDLE
+            # gliding 0.12 m/s)
+            skipped += _drop_near(planted, bad, pad)
         if not planted.any():
             break
         trial, bad = attempt()
         if not bad.size:
             result = trial
             break
+        if round_ >= TRIM_ROUNDS:
+            continue
         dropped = False
         for i in range(planted.shape[1]):
             for a, b in contact_runs(planted[:, i]):
@@ -501,18 +515,6 @@ def lock_where_clean(
                 planted[a:b, i] = _tidy(piece, shortest)[a:b, 0]
                 skipped.append(_lost(planted[a:b, i], a))
         if not dropped:  # the pops are not at a pin
-            result = trial
-            break
-    for _ in range(3 if result is None else 0):
-        # six rounds of trimming still popped somewhere (each trim's new ease can): the
-        # contacts near the last pops go whole, and the rest is pinned if that is clean
-        # (seed 5 of the Bandai benchmark script pinned no foot at all, its IDLE gliding
-        # 0.12 m/s)
-        skipped += _drop_near(planted, bad, pad)
-        if not planted.any():
-            break
-        trial, bad = attempt()
-        if not bad.size:
             result = trial
             break
     spans = sorted(set(skipped))
