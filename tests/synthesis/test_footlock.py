@@ -404,3 +404,32 @@ def test_pinned_legs_keep_their_angles_within_the_bounds_given():
     assert held.frames[:, knees].min() >= -0.25 - 1e-9
     assert held.frames[:, knees].max() <= 0.25 + 1e-9
     assert not np.allclose(held.frames, m.frames)  # the feet were still pinned
+
+
+def test_pin_feet_asks_a_pinned_ankle_for_the_heights_given():
+    """``heights``: where finite, a pinned ankle is asked for that height (a stand's foot
+    kept on the floor; the toe follows the ankle and is asked for nothing); a wrong shape
+    is refused."""
+    from cyclecoord.synthesis.footlock import _KEPT_HEIGHT, pin_feet
+
+    m = _walkish()
+    frames = m.frames.copy()
+    for knee in ("ltibia", "rtibia"):  # (a straight knee cannot lower its ankle a little)
+        frames[:, m.channels.index((knee, "rx"))] = 20.0
+    m = m.with_frames(frames)
+    c = foot_contacts(m)
+    i = c.feet.index("lfoot")
+    on = c.planted[:, i]
+    y = m.positions()["lfoot"][:, c.up]
+    want = np.full(c.planted.shape, np.nan)
+    want[on, i] = y[on] - 0.05 * c.leg_length  # a little lower than it is
+    free = pin_feet(m, c).positions()["lfoot"][:, c.up]
+    asked = pin_feet(m, c, heights=want).positions()["lfoot"][:, c.up]
+    miss_free = np.abs(free[on] - want[on, i]).mean()
+    miss_asked = np.abs(asked[on] - want[on, i]).mean()
+    assert 0 < _KEPT_HEIGHT <= 1
+    assert miss_asked < 0.8 * miss_free  # (asked at a weight: 0.40 -> 0.28 units here)
+    np.testing.assert_allclose(  # NaN everywhere asks for nothing
+        pin_feet(m, c, heights=np.full(c.planted.shape, np.nan)).frames, pin_feet(m, c).frames)
+    with pytest.raises(ParameterError, match="heights has shape"):
+        pin_feet(m, c, heights=np.zeros((3, 3)))

@@ -984,6 +984,67 @@ def test_a_stand_keeps_each_foot_down_from_its_first_contact():
     assert not _stays_down(planted, np.zeros(12, bool))[3:5].any()
 
 
+def test_a_point_first_down_after_a_stand_settles_is_not_pinned_there():
+    """A point that first comes down over ``late`` frames into a hold (the sway lowering
+    a toe once the stand stands) is left free: pinned, the foot was pressed flat within
+    the lock's ease, the toe end at 1.1x the limit of acceleration.  One down before that,
+    or already down as the hold begins, stays down to its end."""
+    from cyclecoord.synthesis.carry import _stays_down
+
+    planted = np.zeros((12, 3), bool)
+    planted[8, 0] = True  # first down 6 frames into the hold
+    planted[3, 1] = True  # 1 frame in
+    planted[1:3, 2] = True  # down as the hold begins
+    hold = np.zeros(12, bool)
+    hold[2:10] = True
+    out = _stays_down(planted, hold, late=4)
+    assert not out[:, 0].any()
+    assert out[3:10, 1].all() and not out[10:, 1].any()
+    assert out[1:10, 2].all()
+    assert _stays_down(planted, hold)[8:10, 0].all()  # (without ``late``: pinned)
+
+
+def test_a_stand_keeps_its_pinned_heights_and_sets_a_raised_ankle_down(models):
+    """On a stand's pinned frames each point is asked for the height it had where its pin
+    began, and a landing ankle comes down from where it is to its contact level over
+    STAND_AFTER seconds (a smoothstep) from where its pin begins; but never lower than
+    puts its leg's lowest point on the floor: a foot whose toe end stays on the floor as
+    its heel rises (tiptoe) is asked for nothing lower than it is."""
+    from dataclasses import replace
+
+    from cyclecoord.quality.contacts import foot_contacts
+    from cyclecoord.synthesis.carry import STAND_AFTER, _stand_heights
+
+    c = foot_contacts(models["walk"].training_motion())
+    T, F = 60, len(c.feet)
+    height = np.tile(np.linspace(0.5, 3.0, T)[:, None], (1, F))
+    c = replace(c, height=height, planted=np.zeros((T, F), bool), fps=30.0)
+    planted = np.zeros((T, F), bool)
+    planted[10:50, 0] = True
+    planted[20:60, 1] = True
+    asked = np.zeros(T, bool)
+    asked[5:55] = True
+    land = np.zeros((T, F), bool)
+    land[5:55, 1] = True
+    lifted = c.floor + height  # the whole foot rises with the point
+    out = _stand_heights(c, planted, asked, land, lifted)
+    lv = c.contact_level
+    assert np.allclose(out[10:50, 0], lv[0] + height[10, 0]) and np.isnan(out[:10, 0]).all()
+    n = int(round(STAND_AFTER * 30))
+    assert np.isclose(out[20, 1], lv[1] + height[20, 1])  # from where it is ...
+    assert np.allclose(out[20 + n : 55, 1], lv[1])  # ... to its level, over n frames
+    u = 7 / n  # part way: the pose's height times one minus the smoothstep
+    assert np.isclose(out[27, 1], lv[1] + (1 - u * u * (3 - 2 * u)) * height[27, 1])
+    assert np.isnan(out[55:, 1]).all()  # (the hold's end)
+    tiptoe = np.full((T, F), c.floor)  # the lowest point stays on the floor
+    out = _stand_heights(c, planted, asked, land, tiptoe)
+    assert np.allclose(out[10:50, 0], lv[0] + height[10:50, 0])
+    assert np.allclose(out[20:55, 1], lv[1] + height[20:55, 1])
+    half = c.floor + 0.5 * height  # half the rise: asked down until it is on the floor
+    out = _stand_heights(c, planted, asked, land, half, floor=c.floor)
+    assert np.allclose(out[40:50, 0], lv[0] + np.maximum(height[10, 0], 0.5 * height[40:50, 0]))
+
+
 @pytest.fixture(scope="module")
 def bandai_pair(bvh_dir):
     """A Bandai walk model (the turning and the sad backward walks) and run."""
@@ -1027,6 +1088,47 @@ def test_an_idle_after_a_run_stands_on_a_bandai_pair(bandai_pair):
     a, b = _span(syn, [syn.command])
     q = measure_generated(motion[a + 15 : b], training_takes(bandai_pair, ["walk"]))
     assert q.support_slip < 0.1
+
+
+def _stance_over(motion, model, frames):
+    """The higher leg's lowest foot point above the training takes' contact level (leg
+    lengths), from forward kinematics of ``motion`` on ``frames``."""
+    from cyclecoord.quality.contacts import foot_contacts
+
+    c = foot_contacts(model.training_motion())
+    J = motion.positions()
+    H = np.stack([J[f][frames, 1] for f in c.feet], 1) - c.contact_level
+    legs = np.array(c.leg_labels)
+    return np.max([H[:, legs == g].min(1) for g in dict.fromkeys(legs)], 0) / c.leg_length
+
+
+def test_a_move_ahead_that_stops_stands_on_both_feet(bandai_pair):
+    """A MOVE ahead that comes to a stop ends at the nearest stance of the gait, and the
+    IDLE after it stands on both feet.  Stopped where its seconds ran out, a walk stood
+    on one leg for the whole IDLE, the other bent back and lifted 5-14 cm (on 3, 8 and
+    11 of 12 stops along the Bandai, subject 35 and synthetic walks).  Exactly the
+    seconds asked (``at_stance=False``), the stops here end with a leg up to 0.13 leg
+    lengths over the floor, and the stand sets it down."""
+    walk = bandai_pair["walk"]
+    for at_stance in (True, False):
+        stop, stand = [], []
+        for k in range(8):
+            syn = Synthesizer(bandai_pair, fps=30, seed=k)
+            syn.start("walk", {"segment": "TurnL", "time": 0.5})
+            syn.command += 1
+            syn.move({"ahead": 1.0 + 0.09 * k}, at_stance=at_stance)
+            syn.command += 1
+            syn.idle(duration=2.0)
+            motion = syn.motion()
+            (h0, h1), = syn.held
+            level = _stance_over(motion, walk, np.arange(h0, h1))
+            stop.append(level[0])
+            stand.append(level[15:].max())  # once the stand has settled (0.5 s)
+        if at_stance:
+            assert max(stop) < 0.02
+        else:
+            assert max(stop) > 0.08  # (the check can fail)
+        assert max(stand) < 0.06
 
 
 def test_a_frame_still_too_close_at_its_phase_takes_the_nearer_captured_frame(

@@ -269,6 +269,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self._ranges: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._gaits: dict = {}
         self._fades: dict = {}  # each (model, segment)'s seam cross-fade (seam_fade)
+        self._stances: dict = {}  # each model's training frames' stance (GaitMixin.stance)
         # (model, segment, unwrapped phase) where the last stepping command left the
         # particle, and the one the MOVE being made will leave
         self._cursor = self._next_cursor = None
@@ -521,6 +522,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         speed: float = 1.0,
         radius: float | None = None,
         stop: bool = True,
+        at_stance: bool = True,
     ) -> None:
         """MOVE to a target along a line or the command graph's shortest path, or
         ``{"ahead": seconds}`` along the gait.
@@ -531,7 +533,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         ``speed`` scales and ``duration`` sets the whole.  The particle speeds up over
         ``ease`` seconds only when it starts from rest and slows down only with ``stop``
         (a script passes ``stop=False`` when a MOVE or TRANSITION follows), so a chain of
-        MOVEs flows through its waypoints.
+        MOVEs flows through its waypoints.  A MOVE ahead that stops ends where both feet
+        are down, the nearest such phase of the gait within a quarter of a cycle of the
+        asked seconds (:meth:`~.stepping.GaitMixin.stop_ahead`; ``at_stance=False``:
+        exactly the seconds asked).
         """
         m = self._need_start("MOVE")
         if not (
@@ -542,7 +547,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         if isinstance(to, dict) and "ahead" in to:
             if set(to) != {"ahead"}:
                 raise ParameterError(f"an ahead target takes no other keys, got {sorted(to)}")
-            timed = self.ahead_path(to["ahead"]) or self.segment_ahead(to["ahead"])
+            seconds = to["ahead"]
+            if stop and at_stance and duration is None:
+                seconds = self.stop_ahead(seconds)
+            timed = self.ahead_path(seconds) or self.segment_ahead(seconds)
             poly, times = timed
             along = self._path_detail
             if radius is None:

@@ -532,6 +532,7 @@ class OutputMixin:
                 feet,
                 bounds=channel_bounds(takes),
                 hold=self.hold_mask(motion.n_frames),
+                floor=floor,
                 blend=self._lock_ease(used),
                 references=takes,
                 plausibility_cache=self._plausibility,
