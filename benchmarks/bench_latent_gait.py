@@ -217,8 +217,40 @@ def measure_pair(label: str, takes: dict, d: Path, quick: bool, seeds: int = 1) 
     said = [n for n in short["notes"] if "blend raised" in n]
     print(f"  blend 0.034 s: {said[0].split(': ', 1)[1] if said else 'not raised'}")
     _check(motion, models, d, a)
+    stops(models, d)
     if seeds > 1:
         over_seeds(models, d, seeds, label)
+
+
+def stops(models: dict, d: Path, n: int = 12) -> None:
+    """``MOVE ahead`` of 1.0-1.8 s that stops, then IDLE 2 s, along each gait (seeds 0 ..
+    n - 1): legs over 5 cm up (the lower of ankle and toe joint over the training takes'
+    contact level, forward kinematics, over the IDLE's last 1.2 s), feet sliding (the
+    fastest planted foot after 0.5 s over 0.1 m/s)."""
+    from cyclecoord.quality.contacts import foot_contacts
+
+    for part in ("walk", "run"):
+        c0 = foot_contacts(models[part].training_motion())
+        up, slid = [], []
+        for k in range(n):
+            spec = {"fps": 30, "seed": k, "models": {"walk": "walk.npz", "run": "run.npz"},
+                    "start": {"model": part, "at": {"frame": 0}},
+                    "commands": [{"command": "MOVE", "to": {"ahead": 1.0 + 0.07 * k}},
+                                 {"command": "IDLE", "duration": 2.0}]}
+            path = d / f"stop_{part}_{k}.json"
+            path.write_text(json.dumps(spec))
+            motion, rep = run_script(path)
+            a, b = rep["commands"][-1]["start"], rep["commands"][-1]["stop"]
+            J = motion.positions()
+            h = np.stack([J[f][b - 36 : b, c0.up] for f in c0.feet], 1) - c0.contact_level
+            legs = np.array(c0.leg_labels)
+            low = np.stack([h[:, legs == g].min(1) for g in dict.fromkeys(legs)], 1)
+            up.append(low.max() * cc.rig.metres_per_unit(motion))
+            slid.append(planted_top_speed(motion, a + 15, b))
+        up, slid = np.array(up), np.array(slid)
+        print(f"  stops    {part}: MOVE ahead 1.0-1.8 s then IDLE 2 s, {n} seeds: a leg over "
+              f"5 cm up on {int((up > 0.05).sum())} (median {np.median(up):.3f} m), feet "
+              f"sliding over 0.1 m/s on {int((slid > 0.1).sum())}")
 
 
 def planted_top_speed(motion, a: int, b: int) -> float:
