@@ -1045,6 +1045,46 @@ def test_a_stand_keeps_its_pinned_heights_and_sets_a_raised_ankle_down(models):
     assert np.allclose(out[40:50, 0], lv[0] + np.maximum(height[10, 0], 0.5 * height[40:50, 0]))
 
 
+def test_a_stand_sets_down_a_leg_raised_once_it_settles(models):
+    """A leg with no point pinned once a stand has settled (STAND_AFTER in), or whose
+    lowest point is then over the contact band above the floor (the motion's own
+    contact test counted a Bandai heel 13 cm up as down), has its ankle set down; a leg
+    on the floor, a short hold, or one lifted higher than LAND_HIGHEST is left alone."""
+    from dataclasses import replace
+
+    from cyclecoord.quality.contacts import foot_contacts
+    from cyclecoord.synthesis.carry import CONTACT_BAND, LAND_HIGHEST, STAND_AFTER, _landings
+
+    motion = models["walk"].training_motion()
+    c = foot_contacts(motion)
+    T, F = 60, len(c.feet)
+    c = replace(c, height=np.full((T, F), 0.1 * c.leg_length), fps=30.0)
+    n = int(round(STAND_AFTER * 30))
+    asked = np.zeros(T, bool)
+    asked[10:50] = True
+    legs = np.array(c.leg_labels)
+    first, second = (np.flatnonzero(legs == g) for g in dict.fromkeys(c.leg_labels))
+    planted = np.zeros((T, F), bool)
+    planted[:, first] = True  # one leg down, the other never
+    floor = 0.0
+    low = np.zeros((T, F))
+    low[:, second] = 0.2 * c.leg_length
+    land = _landings(motion[:T], c, planted, asked, low, floor)
+    ankle = int(second[0])  # (the least deep of the leg's points)
+    assert land[10:50, ankle].all() and not land[:10].any() and not land[50:].any()
+    assert not land[:, first].any() and land.sum() == 40
+    planted[:, second] = True  # "down" by the contact test, but 0.2 leg lengths up
+    assert _landings(motion[:T], c, planted, asked, low, floor)[10:50, ankle].all()
+    low[:, second] = 0.5 * CONTACT_BAND * c.leg_length  # on the floor: left alone
+    assert not _landings(motion[:T], c, planted, asked, low, floor).any()
+    short = np.zeros(T, bool)
+    short[10 : 10 + n] = True
+    planted[:, second] = False
+    assert not _landings(motion[:T], c, planted, short, low, floor).any()
+    high = replace(c, height=np.full((T, F), 2 * LAND_HIGHEST * c.leg_length))
+    assert not _landings(motion[:T], high, planted, asked, low, floor).any()
+
+
 @pytest.fixture(scope="module")
 def bandai_pair(bvh_dir):
     """A Bandai walk model (the turning and the sad backward walks) and run."""

@@ -334,11 +334,14 @@ LAND_HIGHEST = 0.5
 
 
 def _landings(motion: Motion, contacts: FootContacts, planted: np.ndarray,
-              asked: np.ndarray) -> np.ndarray:
+              asked: np.ndarray, low: np.ndarray | None = None,
+              floor: float | None = None) -> np.ndarray:
     """(T, F) bool: the stand frames on which a raised leg's ankle is set down.
 
     A leg none of whose points is pinned once a stand has settled (:data:`STAND_AFTER`
-    s in: a run stopped in its flight or swing, a run model has no double support)
+    s in: a run stopped in its flight or swing, a run model has no double support), or
+    whose lowest point (``low``, :func:`_leg_lowest`) is then over the contact band above
+    ``floor`` (the motion's own contact estimate counted a Bandai heel 13 cm up as down)
     has its ankle lowered to its contact level and held there
     (:func:`_stand_heights`): stopped as they were, the 143_01 jog's stands held a leg
     up for the whole IDLE (median 14 cm over 12 stops; 8 cm set down)."""
@@ -356,7 +359,10 @@ def _landings(motion: Motion, contacts: FootContacts, planted: np.ndarray,
             continue
         for g in dict.fromkeys(contacts.leg_labels):
             cols = np.flatnonzero(labels == g)
-            if planted[a + n, cols].any():  # (a foot down once the stand settles)
+            if planted[a + n, cols].any() and (  # (a foot down once the stand settles,
+                low is None or floor is None  # and on the floor, not 10 cm over it)
+                or low[a + n, cols[0]] - floor <= CONTACT_BAND * contacts.leg_length
+            ):
                 continue
             i = int(min(cols, key=lambda c: depth[contacts.feet[c]]))
             if 0 < contacts.height[a, i] <= LAND_HIGHEST * contacts.leg_length:
@@ -540,9 +546,10 @@ def lock_where_clean(
     settled = asked.copy()  # a hold's frames once its root stands (STAND_AFTER)
     for a, b in contact_runs(asked):
         settled[a : min(b, a + int(round(STAND_AFTER * motion.fps)))] = False
-    land = _landings(motion, contacts, planted, asked)  # (a stand's raised legs come down)
-    planted |= land
     low = _leg_lowest(motion, contacts) if asked.any() else None
+    # (a stand's raised legs come down)
+    land = _landings(motion, contacts, planted, asked, low, floor)
+    planted |= land
     if not planted.any():
         return LockOutcome(motion, 0, [], "foot locking: no contact long enough to pin")
     before = _accel(motion)
