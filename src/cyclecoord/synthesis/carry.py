@@ -125,13 +125,18 @@ STAND_AFTER = 0.5
 SMOOTH = 0.0
 
 
-def _lowest_points(motion: Motion, feet: tuple[str, ...]) -> np.ndarray:
-    pos = motion.positions()
-    cols = [pos.names.index(f) for f in feet]
-    cols += [
+def _with_end_sites(pos, names) -> list[int]:
+    """Columns of ``pos`` (joint positions) for the joints ``names`` and the end sites
+    under them (a toe's tip)."""
+    cols = [pos.names.index(f) for f in names]
+    return cols + [
         i for i, n in enumerate(pos.names) if n.endswith("/end") and int(pos.parents[i]) in cols
     ]
-    return pos.positions[:, cols, 1].min(axis=1)
+
+
+def _lowest_points(motion: Motion, feet: tuple[str, ...]) -> np.ndarray:
+    pos = motion.positions()
+    return pos.positions[:, _with_end_sites(pos, feet), 1].min(axis=1)
 
 
 def carry_by_feet(
@@ -378,9 +383,7 @@ def _leg_lowest(motion: Motion, contacts: FootContacts) -> np.ndarray:
     out = np.empty(contacts.planted.shape)
     for g in dict.fromkeys(contacts.leg_labels):
         mine = np.flatnonzero(labels == g)
-        cols = [pos.names.index(contacts.feet[i]) for i in mine]
-        cols += [i for i, n in enumerate(pos.names)
-                 if n.endswith("/end") and int(pos.parents[i]) in cols]
+        cols = _with_end_sites(pos, [contacts.feet[i] for i in mine])
         out[:, mine] = pos.positions[:, cols, contacts.up].min(axis=1)[:, None]
     return out
 

@@ -180,13 +180,12 @@ class GaitMixin:
             prof[b] = np.median(st[which == b])
         return prof, float(np.percentile(st, 20))
 
-    def _stance_ahead(self, lo: float, hi: float, nominal: float) -> float | None:
-        """Cycles ahead of the particle's gait place, within ``lo .. hi``, where both feet
-        are down (:meth:`_stance_profile`): the stance nearest ``nominal``, at its lowest
-        bin; None where the model has no gait or no such stance is in reach."""
-        place = self._gait_place(self.current)
-        if place is None:
-            return None
+    def _stance_ahead(self, place: tuple[int, float], lo: float, hi: float,
+                      nominal: float) -> float | None:
+        """Cycles ahead of ``place`` (the particle's ``(segment, phase)`` on its gait),
+        within ``lo .. hi``, where both feet are down (:meth:`_stance_profile`): the
+        stance nearest ``nominal``, at its lowest bin; None where no such stance is in
+        reach."""
         seg, u0 = place
         got = self._stance_profile(self.current, seg)
         if got is None:
@@ -223,7 +222,7 @@ class GaitMixin:
         nominal = float(seconds) * self.fps * rate
         # the stop's ease covers half its ramp at the cadence: no stop nearer than that
         least = max(0.5 * self.ease * self.fps * rate, rate)
-        got = self._stance_ahead(max(least, nominal - 0.25), nominal + 0.25, nominal)
+        got = self._stance_ahead(place, max(least, nominal - 0.25), nominal + 0.25, nominal)
         return seconds if got is None else got / rate / self.fps
 
     def can_step_across(self, src: str, to: str) -> bool:
