@@ -27,6 +27,27 @@ def test_the_floor_lifts_the_root_by_the_depth_of_the_lowest_foot():
     np.testing.assert_allclose(out.frames[:, ty] - m.frames[:, ty], 0.3, atol=1e-9)
 
 
+def test_a_stand_is_lowered_onto_the_floor_over_stand_after_seconds():
+    """A body standing 0.4 units over the given floor (a run stopped in its flight): on
+    an asked hold it comes down onto the floor over STAND_AFTER s (a smoothstep) and
+    back up as long after it; outside holds, or without a floor, nothing changes."""
+    m = make_motion(legs_skeleton(), T=90, fps=30.0)
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    floor = float(carry._lowest_points(m, feet).min()) - 0.4
+    hold = np.zeros(90, bool)
+    hold[20:60] = True
+    out = carry.carry_by_feet(m, feet, floor=floor, hold=hold)
+    low = carry._lowest_points(out, feet)
+    n = int(round(carry.STAND_AFTER * 30))
+    np.testing.assert_allclose(low[:20], floor + 0.4, atol=1e-9)
+    np.testing.assert_allclose(low[20 + n : 60], floor, atol=1e-9)
+    np.testing.assert_allclose(low[60 + n :], floor + 0.4, atol=1e-9)
+    u = 7 / n
+    assert low[27] == pytest.approx(floor + 0.4 * (1 - u * u * (3 - 2 * u)))
+    np.testing.assert_allclose(carry._standing(hold, 30.0)[20 + n : 60], 1.0)
+    np.testing.assert_allclose(carry.carry_by_feet(m, feet, hold=hold).frames, m.frames)
+
+
 def test_lowest_points_are_the_feet_and_their_end_sites():
     m = make_motion(legs_skeleton(), T=3, fps=30.0)
     pos = m.positions()

@@ -196,6 +196,12 @@ def carry_by_feet(
     frames = motion.frames.copy()
     frames[:, cols] = motion.frames[0, cols] + np.vstack([[0.0, 0.0], np.cumsum(steps, 0)])
     out = motion.with_frames(frames)
+    if floor is not None and hold is not None and np.any(hold):
+        ty = layout.column("ty")
+        gap = np.maximum(_lowest_points(out, feet) - floor, 0.0)
+        frames[:, ty] -= _standing(np.asarray(hold, bool), motion.fps) * gaussian_filter1d(
+            gap, STAND_AFTER * motion.fps / 4.0, mode="nearest") / _translation_scale(out, ty)
+        out = motion.with_frames(frames)
     if floor is not None:
         depth = np.maximum(floor - _lowest_points(out, feet), 0.0)
         if depth.any():
@@ -394,9 +400,9 @@ def _stand_heights(contacts: FootContacts, planted: np.ndarray, asked: np.ndarra
     """(T, F) heights asked of a stand's pinned points (:func:`pin_feet`'s ``heights``;
     NaN elsewhere):
 
-    * each run of pinned stand frames: the height it had where the run began (the sway
-      lifted a pinned foot of a walk model's stand 10-20 cm off the floor, held only
-      horizontally, while the other bore the body);
+    * each run of pinned stand frames: the lowest height it has had since the run began
+      (the sway lifted a pinned foot of a walk model's stand 10-20 cm off the floor, held
+      only horizontally, while the other bore the body);
     * a landing leg (``land``, :func:`_landings`): lowered from where it is to its
       contact level over :data:`STAND_AFTER` s from where its pin begins (a smoothstep);
 
@@ -421,8 +427,8 @@ def _stand_heights(contacts: FootContacts, planted: np.ndarray, asked: np.ndarra
             if land[a, i]:
                 u = np.clip(np.arange(b - a) / n, 0.0, 1.0)
                 want = level + (1.0 - u * u * (3 - 2 * u)) * contacts.height[a:b, i]
-            else:
-                want = np.full(b - a, own[a, i])
+            else:  # (no higher than it has been since: the stand's body is lowered)
+                want = np.minimum.accumulate(own[a:b, i])
             out[a:b, i] = np.maximum(want, deepest[a:b, i])
     return out
 
@@ -451,6 +457,25 @@ def _translation_scale(motion: Motion, col: int) -> float:
     probe = motion.with_frames(np.vstack([motion.frames[:1], moved])).positions().positions
     d = float(np.linalg.norm(probe[1, 0] - probe[0, 0]))
     return d if d > 1e-9 else 1.0
+
+
+def _standing(hold: np.ndarray, fps: float) -> np.ndarray:
+    """(T,) how far each frame stands on the floor: 0 outside holds, easing to 1 over
+    :data:`STAND_AFTER` s into each hold and back to 0 over as long after it.  The body
+    of a stand is lowered by that share of its lowest foot point's height over the floor:
+    a run stopped in its flight stood 10 cm over the floor on both feet (the synthetic
+    run; the 143_01 jog's 5-8 cm), the legs too straight for the lock to reach it."""
+    from ..quality.contacts import contact_runs
+
+    n = max(1, int(round(STAND_AFTER * fps)))
+    out = np.zeros(hold.size)
+    t = np.arange(hold.size)
+    for a, b in contact_runs(hold):
+        rise = np.clip((t - a) / n, 0.0, 1.0) * (t >= a)
+        fall = np.clip(1.0 - (t - b + 1) / n, 0.0, 1.0) if b < hold.size else 1.0
+        u = np.minimum(rise, np.where(t < b, 1.0, fall))
+        out = np.maximum(out, u * u * (3.0 - 2.0 * u))
+    return out
 
 
 def _moving(hold: np.ndarray, fps: float) -> np.ndarray:
