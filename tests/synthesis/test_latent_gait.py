@@ -5,6 +5,8 @@ freeze, IDLE standing, accelerations and leg ranges against the training takes."
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from scipy.ndimage import gaussian_filter1d
@@ -14,7 +16,7 @@ from cyclecoord.errors import ParameterError
 from cyclecoord.quality.generated import measure_generated
 from cyclecoord.synthesis.latent import LatentModel, Synthesizer
 from cyclecoord.synthesis.latent.particle import ParticleParams
-from cyclecoord.synthesis.latent.script import training_takes
+from cyclecoord.synthesis.latent.script import run_script, training_takes
 
 
 def _model(kind, period, seed):
@@ -549,8 +551,22 @@ def test_a_model_file_from_an_older_gait_computes_its_phases_again(models, tmp_p
     for name, extra in (("none", {}), ("two", {"gait_version": np.array(2)})):
         np.savez(tmp_path / f"{name}.npz", **{**old, "gait_phase": shifted, **extra})
         back = LatentModel.load(tmp_path / f"{name}.npz")
-        assert back.gait_ is None
+        assert back.gait_ is None and back.gait_stale_
         np.testing.assert_allclose(back.gait().phase, g.phase)
+        # saved again, the phases are kept and current
+        LatentModel.load(tmp_path / f"{name}.npz").save(tmp_path / f"{name}2.npz")
+        again = LatentModel.load(tmp_path / f"{name}2.npz")
+        assert not again.gait_stale_ and again.gait_ is not None
+        np.testing.assert_allclose(again.gait_.phase, g.phase)
+    assert not LatentModel.load(tmp_path / "walk.npz").gait_stale_
+    # a script over such a file says so
+    models["run"].save(tmp_path / "run.npz")
+    spec = {"models": {"walk": "two.npz", "run": "run.npz"}, "start": {"model": "walk"},
+            "commands": [{"command": "MOVE", "to": {"ahead": 0.3}}]}
+    (tmp_path / "s.json").write_text(json.dumps(spec))
+    _, report = run_script(tmp_path / "s.json", check=False)
+    said = [n for n in report["notes"] if "older cyclecoord" in n]
+    assert len(said) == 1 and "'walk' (two.npz)" in said[0]
     np.savez(tmp_path / "new.npz", **{**arrays, "gait_version": np.array(GAIT_VERSION + 1)})
     with pytest.raises(ParseError, match="gait_version"):
         LatentModel.load(tmp_path / "new.npz")

@@ -560,7 +560,9 @@ class LatentModel:
 
     # --------------------------------------------------------------- storage
     def save(self, path: str | os.PathLike[str]) -> None:
-        """Write the model and its training frames to ``path`` (``.npz``, atomic)."""
+        """Write the model and its training frames to ``path`` (``.npz``, atomic), with
+        its gait phases (computed now for a model loaded from a file whose phases came
+        from an older cyclecoord, so that they are not computed again on every load)."""
         from ...io import atomic_write
         from ...io.tabular import read_npz, write_npz  # noqa: F401
 
@@ -599,7 +601,8 @@ class LatentModel:
                 ),
             }
         )
-        g = getattr(self, "gait_", None)
+        # a file whose phases were stale gets them now, so they are not computed again
+        g = self.gait() if getattr(self, "gait_stale_", False) else getattr(self, "gait_", None)
         if g is not None:
             from .gait import GAIT_VERSION
 
@@ -702,6 +705,9 @@ class LatentModel:
         except ParameterError as exc:
             raise ParseError(f"arrays 'X', 'hyper', 'Y': {exc}", spath) from None
         m.gait_ = None
+        # phases saved by an older training_gait, or none: computed again on every load
+        # (run_script says so; saving the model again keeps them)
+        m.gait_stale_ = "gait_phase" not in arrays
         if "gait_phase" in arrays:  # files written before the gait phase compute it on use
             from .gait import GAIT_VERSION, Gait
 
@@ -723,6 +729,8 @@ class LatentModel:
             if "gait_version" in arrays and a.integer("gait_version", 0, GAIT_VERSION) == (
                     GAIT_VERSION):
                 m.gait_ = Gait(phase, period, m.segments_, fade)
+            else:
+                m.gait_stale_ = True
         starts = np.flatnonzero(np.r_[True, m.segments_[1:] != m.segments_[:-1]])
         stops = np.r_[starts[1:], len(m.segments_)]
         try:

@@ -506,6 +506,13 @@ def run_script(
         feet=feet,
         detail=spec.get("gait_detail", True),
     )
+    for name, m in models.items():
+        if getattr(m, "gait_stale_", False):
+            syn.notes.append(
+                f"model {name!r} ({spec['models'][name]}): its gait phases were saved by an "
+                "older cyclecoord and are computed again on every load (an extract per "
+                "segment); fit it again, or load and save it (LatentModel.load(p).save(p)), "
+                "to keep them")
     start = spec.get("start", {"model": next(iter(models))})
     t0 = time.perf_counter()
     try:
