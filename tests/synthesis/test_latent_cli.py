@@ -75,6 +75,20 @@ def _script(d: Path, name: str, **changes) -> Path:
 def test_fit_writes_model_and_report(workdir):
     rep = json.loads((workdir / "fit.json").read_text())
     assert rep["frames"] == 60 and rep["segments"] == ["a", "b"] and rep["latent_dims"] == 3
+    # which seconds of each segment the gait (MOVE ahead, TRANSITION in step) uses
+    gait = rep["gait"]
+    assert [g["segment"] for g in gait] == ["a", "b"]
+    model = cc.synthesis.latent.LatentModel.load(workdir / "walk.npz")
+    for s, g in enumerate(gait):
+        if not model.gait().has(s):  # (2 s segments: too few cycles for a gait)
+            assert g["cycle_s"] is None and g["phase_from_s"] is None
+            continue
+        rows = model.gait().rows(s)
+        start = model.times_[model.segments_ == s][0]
+        assert g["cycle_s"] == pytest.approx(model.gait().period[s] / model.fps_)
+        assert g["phase_from_s"] == pytest.approx(model.times_[rows[0]] - start)
+        assert g["phase_to_s"] == pytest.approx(model.times_[rows[-1]] - start)
+        assert 0 <= g["phase_from_s"] < g["phase_to_s"] <= g["seconds"]
 
 
 def test_animate_writes_bvh_and_report_reproducibly(workdir):
@@ -235,7 +249,13 @@ def test_fit_says_the_rig_and_the_joints_it_models_about_their_mean(tmp_path, ca
     assert lines[0].startswith("rig: Bandai-style rig: static root joint_Root, Hips travels")
     assert "static root joint_Root folded into Hips" in lines[0]
     assert lines[1].endswith("gimbal lock in the takes): Spine")
+    assert lines[2].startswith("gait: dataset-1_walk_normal_001: 1.0") and " s cycle, phase" in lines[2]
     report = json.loads((tmp_path / "r.json").read_text())
     assert report["joints_about_their_mean_rotation"] == ["Spine"]
     model = cc.synthesis.latent.LatentModel.load(out)
     assert model.skeleton_.joints[0].name == "Hips"  # the analysis rig
+    (g,) = report["gait"]  # the seconds of the take with a gait phase
+    rows = model.gait().rows(0)
+    assert g["phase_from_s"] == pytest.approx(model.times_[rows[0]])
+    assert g["phase_to_s"] == pytest.approx(model.times_[rows[-1]])
+    assert 0 <= g["phase_from_s"] < g["phase_to_s"] <= g["seconds"]

@@ -186,6 +186,13 @@ def run(args: argparse.Namespace) -> int:
         )
     for line in rig_lines:
         print(line)
+    for g in summary["gait"] or []:  # which frames the gait (MOVE ahead, in step) uses
+        print(
+            f"gait: {g['segment']}: "
+            + (f"{g['cycle_s']:.2f} s cycle, phase over {g['phase_from_s']:.1f}-"
+               f"{g['phase_to_s']:.1f} s of {g['seconds']:.1f} s"
+               if g["cycle_s"] is not None else "none (no steady periodic motion found)")
+        )
     print(
         f"{out}: {summary['frames']} frames in {plural(len(names), 'segment')}, "
         f"{plural(summary['pca_components'], 'PCA component')} "

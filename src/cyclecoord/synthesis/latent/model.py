@@ -528,7 +528,28 @@ class LatentModel:
             "joints_about_their_mean_rotation": [
                 self.channels_[idx[0]][0] for idx, _, _ in self.chart()
             ],
+            "gait": self._gait_summary(),
         }
+
+    def _gait_summary(self) -> list[dict] | None:
+        """Per segment: its gait's cycle (s) and the seconds of the segment whose frames
+        have a gait phase (frames a period beyond the steady ones have none: standing
+        before a walk); None where the gait is not computed yet."""
+        g = getattr(self, "gait_", None)
+        if g is None:
+            return None
+        out = []
+        for s, name in enumerate(self.segment_names_):
+            times = self.times_[self.segments_ == s]
+            rows = g.rows(s) if g.has(s) else np.zeros(0, int)
+            out.append({
+                "segment": str(name),
+                "seconds": float(times[-1] - times[0]) if times.size else 0.0,
+                "cycle_s": float(g.period[s] / self.fps_) if g.has(s) else None,
+                "phase_from_s": float(self.times_[rows[0]] - times[0]) if rows.size else None,
+                "phase_to_s": float(self.times_[rows[-1]] - times[0]) if rows.size else None,
+            })
+        return out
 
     def is_reference_frame(self, k: int) -> bool:
         """Whether training frame ``k`` is a reference pose: the first frame of a segment
