@@ -139,6 +139,9 @@ class LatentModel:
     gp_ : GPLVM
     X_ : ndarray, shape (N, q)
     root_ : RootTrack
+    gait_stale_ : bool
+        Loaded from a file whose gait phases came from an older cyclecoord (or had
+        none): they are computed again on use, and written by :meth:`save`.
     """
 
     def __init__(
@@ -248,7 +251,7 @@ class LatentModel:
             n_components=self.n_components, random_state=self.random_state, **(self.gplvm or {})
         ).fit(self.Y_, self.segments_, self.times_, progress=progress)
         self._precompute()
-        self.gait_ = None
+        self.gait_, self.gait_stale_ = None, False
         if gait:
             self.gait()
         return self
@@ -623,7 +626,7 @@ class LatentModel:
             }
         )
         # a file whose phases were stale gets them now, so they are not computed again
-        g = self.gait() if getattr(self, "gait_stale_", False) else getattr(self, "gait_", None)
+        g = self.gait() if self.gait_stale_ else getattr(self, "gait_", None)
         if g is not None:
             from .gait import GAIT_VERSION
 

@@ -507,7 +507,7 @@ def run_script(
         detail=spec.get("gait_detail", True),
     )
     for name, m in models.items():
-        if getattr(m, "gait_stale_", False):
+        if m.gait_stale_:
             syn.notes.append(
                 f"model {name!r} ({spec['models'][name]}): its gait phases were saved by an "
                 "older cyclecoord and are computed again on every load (an extract per "
