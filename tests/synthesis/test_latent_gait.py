@@ -1260,3 +1260,45 @@ def test_the_xsens_walk_with_a_turn_keeps_stepping_through_it(bvh_dir):
         q = measure_generated(syn.motion(), [take[1100:2000]])
         assert abs(q.cadence_ratio - 1.0) < 0.15, (start, q.cadence_ratio)
         assert min(q.knee_ratio) > 0.7, (start, q.knee_ratio)
+
+
+def test_a_path_across_a_gap_in_the_latent_space_mixes_the_captured_frames(models):
+    """Where the GP mean between two training frames' latent points is no pose between
+    theirs (a gap the GPLVM left: the Xsens walk's toe end accelerated 2.5x its p99
+    there), the gait detail is taken against the path's own latent points, so pose plus
+    detail is the mix of the two captured frames; along the rest of the gait the detail
+    is the training frames' own, mixed (the GP mean's curve keeps the stride's peaks)."""
+    import copy
+
+    m = copy.deepcopy(models["walk"])
+    syn = Synthesizer({"walk": m}, fps=30, seed=0)
+    g = syn.gait("walk")
+    seg = int(g.usable[0])
+    rows = g.rows(seg)
+    i = rows[len(rows) // 3]
+    mid = 0.5 * (m.X_[i] + m.X_[i + 1])
+    width = 0.1 * np.linalg.norm(m.X_[i + 1] - m.X_[i])
+    plain = m.pose
+    m.detail()  # (kept from the model as it was fitted)
+
+    def gap(X):  # a bump of 30 degrees on every angle, only between frames i and i + 1
+        X = np.atleast_2d(X)
+        d2 = ((X - mid) ** 2).sum(axis=1) / width**2
+        return plain(X) + 30.0 * np.exp(-d2)[:, None]
+
+    m.pose = gap
+    u = np.array([0.5 * (g.phase[i] + g.phase[i + 1]), g.phase[rows[len(rows) // 2]] + 0.3])
+    X = syn.gait_at("walk", m.X_, seg, u)
+    got = syn._detail_at("walk", seg, u)
+    frames = syn.gait_at("walk", m.frame_angles(), seg, u)
+    lerped = syn.gait_at("walk", m.detail()["angles"], seg, u)
+    assert np.abs(gap(X[:1]) - plain(X[:1])).max() > 25.0  # the bump is on the path
+    np.testing.assert_allclose(gap(X[:1]) + got["angles"][:1], frames[:1], atol=1e-6)
+    np.testing.assert_allclose(got["angles"][1:], lerped[1:], atol=1e-12)  # elsewhere
+    # the unpatched model's detail is the plain mix wherever its path steps
+    m.pose = plain
+    u = g.phase[rows[0]] + np.linspace(0.0, 2.0, 61)
+    np.testing.assert_allclose(
+        syn._detail_at("walk", seg, u)["angles"],
+        syn.gait_at("walk", m.detail()["angles"], seg, u), atol=1e-12,
+    )

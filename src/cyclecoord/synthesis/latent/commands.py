@@ -270,6 +270,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self._gaits: dict = {}
         self._fades: dict = {}  # each (model, segment)'s seam cross-fade (seam_fade)
         self._stances: dict = {}  # each model's training frames' stance (GaitMixin.stance)
+        self._frame_steps: dict = {}  # each model's median GP-mean step along its gait
         # (model, segment, unwrapped phase) where the last stepping command left the
         # particle, and the one the MOVE being made will leave
         self._cursor = self._next_cursor = None
