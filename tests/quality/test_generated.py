@@ -861,3 +861,29 @@ def test_a_mixed_reference_weights_each_models_figures_by_the_frames_it_made():
     assert (mixed.fps, mixed.metres, mixed.leg_length) == (30.0, 0.01, 80.0)
     odd = mixed_reference([(walk, 1), (replace(run, knee_range_legs=(4.0,)), 1)])
     assert odd.knee_range_legs == () and odd.hip_range_legs == pytest.approx((2.5, 5.0))
+
+
+def test_a_source_that_stands_before_it_walks_is_judged_by_its_walk():
+    """The sources' root speed, support foot, pose speeds and accelerations are theirs
+    while they move: the synthetic walk with 6 s of standing before it (more than half
+    the take, as the Xsens walk stands for 14 of its 25 s) reads as the walk alone, not
+    about 0 m/s.  A motion's asked hold does not count in its root speed either."""
+    import cyclecoord as cc
+    from cyclecoord.quality.generated import source_figures
+
+    walk = cc.datasets.make_periodic_capture(
+        kind="walk", n_frames=600, period=120, noise=0.3, random_state=0).motion[::4]
+    stand = np.repeat(walk.frames[:1], int(6 * walk.fps), axis=0)
+    both = walk.with_frames(np.vstack([stand, walk.frames]))
+    alone, joined = (source_figures([s], walk.fps) for s in (walk, both))
+    assert alone.root_speed > 0.5 / alone.metres  # (a walk: over 0.5 m/s)
+    assert joined.root_speed == pytest.approx(alone.root_speed, rel=0.05)
+    assert joined.pose_speed_median == pytest.approx(alone.pose_speed_median, rel=0.05)
+    assert joined.accel_p99 == pytest.approx(alone.accel_p99, rel=0.05)
+    assert joined.support_slip == pytest.approx(alone.support_slip, rel=0.25, abs=1e-3)
+    # a generated walk that then holds its last pose for 6 s: its walk's speed
+    then = walk.with_frames(np.vstack([walk.frames, np.repeat(walk.frames[-1:], len(stand), 0)]))
+    hold = np.r_[np.zeros(walk.n_frames, bool), np.ones(len(stand), bool)]
+    q, q_walk = measure_generated(then, [walk], hold=hold), measure_generated(walk, [walk])
+    assert q.root_speed == pytest.approx(q_walk.root_speed, rel=0.05)
+    assert measure_generated(then, [walk]).root_speed < 0.5 * q_walk.root_speed  # unasked

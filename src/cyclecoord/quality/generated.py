@@ -23,7 +23,12 @@ figure of the source captures (resampled to the motion's rate):
   takes' median root speeds);
 * **pops**: the largest pose step and the largest joint acceleration relative to the
   root (heading removed) against the sources' 99th percentiles;
-* **root speed**: median horizontal root speed over 0.5 s windows against the sources'.
+* **root speed**: median horizontal root speed over 0.5 s windows (outside the holds
+  asked) against the sources'.
+
+The sources' speeds, slip and accelerations are taken over the frames where each take
+moves (:func:`_moving`), so a take that stands still before and after its walk (the
+Xsens walk stands for 14 of its 25 s) is judged by its walk, not by its standing.
 
 A motion on a body of another size than its sources' (a script whose run model was
 captured on a smaller actor, written on the walk's skeleton) is compared per leg length:
@@ -81,6 +86,10 @@ PENETRATION_M = 0.02
 CONTACT_HEIGHT = 0.03
 #: In-contact speed (leg lengths/s) the old, speed-gated contact test stopped at.
 FAST_CONTACT = 0.5
+#: A take's frames count as moving where its pose speed, averaged over a second, is at
+#: least this fraction of that average's 90th percentile (:func:`_moving`): the sources'
+#: root speed, support foot, pose speeds and accelerations are theirs while they move.
+MOVING_FRACTION = 0.5
 #: Cadence search window, seconds.
 CYCLE_RANGE = (0.4, 2.5)
 #: The leg cycle is the first autocorrelation peak at least this fraction of the highest.
@@ -256,6 +265,31 @@ def _support(kin: _Kin, rig: _Rig) -> np.ndarray:
     return v[np.arange(v.shape[0]), low] * kin.fps / 2.0
 
 
+def _moving(kin: _Kin) -> np.ndarray:
+    """(T,) the frames where a take moves: its pose speed, averaged over a second, at
+    least :data:`MOVING_FRACTION` of that average's 90th percentile (every frame when
+    under a second would be left).  The Xsens walk stands still for 14 of its 25 s:
+    over every frame its root speed read 0.01 m/s, and a script walking it 51x the
+    sources'."""
+    from scipy.ndimage import uniform_filter1d
+
+    ps = kin.pose_speed()
+    every = np.ones(kin.n, dtype=bool)
+    if ps.size < 2:
+        return every
+    avg = uniform_filter1d(ps, size=max(1, min(ps.size, int(round(kin.fps)))), mode="nearest")
+    keep = avg >= MOVING_FRACTION * np.percentile(avg, 90)
+    keep = np.r_[keep, keep[-1]]
+    return keep if keep.sum() >= kin.fps else every
+
+
+def _windows(mask: np.ndarray, n: int) -> np.ndarray:
+    """``mask`` (T,) at the ``n`` windows of :meth:`_Kin.root_speed` (each flagged by its
+    middle frame)."""
+    k = mask.size - n
+    return mask[k // 2 : k // 2 + n]
+
+
 def _ranges(a: np.ndarray) -> np.ndarray:
     lo, hi = np.percentile(a, [1, 99], axis=0)
     return hi - lo
@@ -414,14 +448,16 @@ def mixed_reference(parts: Sequence[tuple[SourceFigures, float]]) -> SourceFigur
 def _take_figures(s: Motion, rig: _Rig) -> dict[str, Any]:
     """One source take's own figures (:func:`source_figures` pools them)."""
     k = _kin(s, rig)
+    moving = _moving(k)
+    rs = k.root_speed()
     return {
         "floor": foot_contacts(s, rig.feet).floor,
-        "speed": float(np.median(k.root_speed())),
+        "speed": float(np.median(rs[_windows(moving, rs.size)])),
         "cycle": k.cycle(),
-        "pose_speed": k.pose_speed(),
+        "pose_speed": k.pose_speed()[moving[:-1]],
         "lowest": _lowest(k, rig),
-        "accel": k.accel(),
-        "support": _support(k, rig),
+        "accel": k.accel()[moving[1:-1]],
+        "support": _support(k, rig)[moving[1:-1]],
         "knee": _ranges(k.knee),
         "hip": _ranges(k.hip),
     }
@@ -719,7 +755,9 @@ def measure_generated(
     # pops
     ps = kin.pose_speed()
     acc = kin.accel()
-    rs = float(np.median(kin.root_speed()))
+    rs_all = kin.root_speed()
+    free = _windows(~held, rs_all.size)  # an asked hold's stand is not the gait's speed
+    rs = float(np.median(rs_all[free] if free.any() else rs_all))
     cycle = kin.cycle()
     notes = []
     if motion.fps != ref.fps:
