@@ -887,3 +887,18 @@ def test_a_source_that_stands_before_it_walks_is_judged_by_its_walk():
     q, q_walk = measure_generated(then, [walk], hold=hold), measure_generated(walk, [walk])
     assert q.root_speed == pytest.approx(q_walk.root_speed, rel=0.05)
     assert measure_generated(then, [walk]).root_speed < 0.5 * q_walk.root_speed  # unasked
+
+
+def test_the_fast_contact_fraction_is_given_beside_the_sources():
+    """A foot in contact (by height) moving faster than FAST_CONTACT is counted for the
+    sources too (a capture's heel strikes and toe-offs make 40 % of the Bandai walks'
+    frames), and a take measured against itself reads its own fraction there."""
+    import cyclecoord as cc
+
+    walk = cc.datasets.make_periodic_capture(
+        kind="walk", n_frames=600, period=120, noise=0.3, random_state=0).motion[::4]
+    q = measure_generated(walk, [walk])
+    assert 0.0 < q.source_sliding_fraction < 1.0
+    assert q.sliding_fraction == pytest.approx(q.source_sliding_fraction)
+    assert q.to_dict()["sources_fast_contact_fraction"] == pytest.approx(q.sliding_fraction)
+    assert f"(sources {100 * q.sliding_fraction:.0f}%" in "\n".join(q.summary())

@@ -127,6 +127,8 @@ class SourceFigures:
     contact_slide: float  # units/s, median speed of foot points in contact
     knee_range_legs: tuple[float, ...] = ()  # degrees per leg, median over takes
     hip_range_legs: tuple[float, ...] = ()
+    #: fraction of frames on which a foot in contact moves faster than FAST_CONTACT
+    sliding_fraction: float = float("nan")
 
     @property
     def root_speed(self) -> float:
@@ -178,8 +180,9 @@ def source_figures(
     ps = np.concatenate([t["pose_speed"] for t in takes])
     lowest = np.concatenate([t["lowest"] for t in takes])
     metres = metres_per_unit(sources[0])
-    slides = [kept(("slide", floor), o, lambda s=s: _contact_speeds(s, rig, floor)[0])
+    slides = [kept(("slide", floor), o, lambda s=s: _contact_speeds(s, rig, floor)[0::2])
               for o, s in zip(sources, srcs)]
+    n_frames = np.array([s.n_frames for s in srcs], dtype=float)
     return SourceFigures(
         fps=float(fps),
         metres=metres,
@@ -194,7 +197,8 @@ def source_figures(
         take_speed=np.array([t["speed"] for t in takes]),
         take_cycle=np.array([t["cycle"] for t in takes]),
         penetration=float(np.mean(floor - lowest > PENETRATION_M / metres)),
-        contact_slide=float(np.median(np.concatenate(slides))),
+        contact_slide=float(np.median(np.concatenate([sl[0] for sl in slides]))),
+        sliding_fraction=float(np.average([sl[1] for sl in slides], weights=n_frames)),
         knee_range_legs=tuple(float(x) for x in np.median([t["knee"] for t in takes], 0)),
         hip_range_legs=tuple(float(x) for x in np.median([t["hip"] for t in takes], 0)),
     )
@@ -236,6 +240,7 @@ def mixed_reference(parts: Sequence[tuple[SourceFigures, float]]) -> SourceFigur
         take_cycle=np.concatenate([r.take_cycle for r in refs]),
         penetration=mean("penetration"),
         contact_slide=mean("contact_slide"),
+        sliding_fraction=mean("sliding_fraction"),
         knee_range_legs=legs("knee_range_legs"),
         hip_range_legs=legs("hip_range_legs"),
     )
@@ -325,6 +330,7 @@ class GeneratedQuality:
     #: speed, pose step, acceleration) is taken per leg length, so a motion played on a
     #: bigger body than its sources' is not a faster or more violent one
     body_scale: float = 1.0
+    source_sliding_fraction: float = float("nan")
 
     # ---- derived
     @property
@@ -382,6 +388,9 @@ class GeneratedQuality:
             + f"; a foot in contact moves {self.contact_slide:.2f} m/s (median; sources "
             f"{self.source_contact_slide:.2f}), faster than {FAST_CONTACT} leg lengths/s on "
             f"{100 * self.sliding_fraction:.0f}% of frames"
+            + ("" if not np.isfinite(self.source_sliding_fraction)
+               else f" (sources {100 * self.source_sliding_fraction:.0f}%: heel strike and "
+               "toe-off)")
         )
         lines.append(
             f"  floor: lowest foot {100 * self.penetration_m:.1f} cm under the sources' floor, "
@@ -449,6 +458,7 @@ class GeneratedQuality:
             "contact_slide_m_per_s": f(self.contact_slide),
             "sources_contact_slide_m_per_s": f(self.source_contact_slide),
             "fast_contact_fraction": f(self.sliding_fraction),
+            "sources_fast_contact_fraction": f(self.source_sliding_fraction),
             "penetration_m": f(self.penetration_m),
             "penetration_fraction": f(self.penetration_fraction),
             "sources_penetration_fraction": f(self.source_penetration_fraction),
@@ -562,6 +572,7 @@ def measure_generated(
         contact_slide=float(np.median(spd)) * m,
         source_contact_slide=ref.contact_slide * m,
         sliding_fraction=fast,
+        source_sliding_fraction=ref.sliding_fraction,
         penetration_m=max(float(depth.max()), 0.0) * m,
         penetration_fraction=float(np.mean(depth > PENETRATION_M / m)),
         source_penetration_fraction=ref.penetration,
