@@ -47,3 +47,22 @@ def test_viewer_has_no_bone_from_the_origin():
     ends = xyz[~np.isnan(xyz).any(axis=1)]
     assert np.linalg.norm(ends, axis=1).min() > 1.0
     assert len(ends) == 2 * (len(m.skeleton.joints) - 2 + 5)  # 20 bones + 5 end sites
+
+
+def test_limbs_are_coloured_by_side_in_every_naming_convention():
+    """Left blue, right red, midline grey: CMU's glued letters, Mixamo's prefixed words,
+    Bandai's suffixes; an end site or a joint the names do not place takes its parent's
+    side; a midline joint stays grey."""
+    from cyclecoord.plot.animation import _side_colours
+
+    L, R, C = "#1f77b4", "#d62728", "#333333"
+    cases = [
+        (["root", "lfemur", "ltibia", "rfemur", "rtibia", "lowerback"], [-1, 0, 1, 0, 3, 0],
+         [C, L, L, R, R, C]),
+        (["mixamorig:Hips", "mixamorig:LeftUpLeg", "mixamorig:RightUpLeg",
+          "mixamorig:Spine"], [-1, 0, 0, 0], [C, L, R, C]),
+        (["joint_Root", "Hips", "UpperLeg_L", "Foot_L", "UpperLeg_R", "Toes_R",
+          "Toes_R/end", "Prop1"], [-1, 0, 1, 2, 1, 4, 5, 3], [C, C, L, L, R, R, R, L]),
+    ]
+    for names, parents, want in cases:
+        assert _side_colours(names, np.array(parents)) == want, names

@@ -58,11 +58,20 @@ class _Track:
 
 
 def _side_colours(names: list[str], parents: np.ndarray) -> list:
-    """Left limbs blue, right limbs red, the rest dark grey (by joint-name pairs)."""
+    """Left limbs blue, right limbs red, the rest dark grey.  A joint's side is read from
+    its name in any of the common conventions (:func:`~cyclecoord.joint_names.classify_joint`:
+    ``lfoot``, ``LeftFoot``, ``mixamorig:LeftFoot``, Bandai's ``Foot_L``, ``foot_l``), else
+    from a left/right pair of names (``lhipjoint`` / ``rhipjoint``), else from the joint
+    it hangs from (an end site, a toe's end, a finger a name does not place)."""
+    from ..joint_names import classify_joint
+
     base = [n.split("/")[0] for n in names]
     lower = {b.lower() for b in base}
 
     def side(b: str) -> str:
+        role = classify_joint(b)
+        if role is not None and role.side is not None:
+            return "L" if role.side == "left" else "R"
         s = b.lower()
         for lp, rp in (("left", "right"), ("l", "r")):
             if s.startswith(lp) and rp + s[len(lp):] in lower:
@@ -71,8 +80,13 @@ def _side_colours(names: list[str], parents: np.ndarray) -> list:
                 return "R"
         return "C"
 
+    sides = [side(b) for b in base]
+    for i in range(len(sides)):  # (parents come before their children)
+        p = int(parents[i])
+        if sides[i] == "C" and 0 <= p < i and sides[p] != "C":
+            sides[i] = sides[p]
     pick = {"L": "#1f77b4", "R": "#d62728", "C": "#333333"}
-    return [pick[side(b)] for b in base]
+    return [pick[x] for x in sides]
 
 
 def _make_track(motion: "Motion", title: str | None) -> _Track:
