@@ -139,6 +139,48 @@ def test_different_skeletons_one_line(cmu_dir, capsys):
     assert "skeleton differs" in one_error_line(capsys)
 
 
+def test_a_translated_joints_offset_is_not_the_skeleton():
+    """A joint with translation channels is placed by them (BVH replaces its OFFSET), so
+    two takes differing only in that OFFSET share a skeleton; a bone's offset elsewhere
+    differing is another skeleton."""
+    from dataclasses import replace
+
+    from cyclecoord.synthesis.graph.latent import check_takes
+
+    m = cc.datasets.make_periodic_capture(kind="walk", n_frames=240, random_state=0).motion
+    skel = m.skeleton
+    k = next(i for i, j in enumerate(skel.joints) if not any(d.startswith("t") for d in j.dofs)
+             and np.linalg.norm(j.offset) > 1)
+
+    def moved(index: int):
+        joints = list(skel.joints)
+        joints[index] = replace(joints[index], offset=np.asarray(joints[index].offset) + 3.0)
+        return cc.Motion(frames=m.frames, channels=m.channels, fps=m.fps,
+                         skeleton=replace(skel, joints=tuple(joints)))
+
+    assert any(d.startswith("t") for d in skel.joints[0].dofs)
+    assert len(check_takes([m, moved(0)])) == 2  # the root: placed by its channels
+    with pytest.raises(cc.CycleCoordError, match="skeleton differs"):
+        check_takes([m, moved(k)])
+
+
+def test_bandai_takes_of_both_datasets_make_one_graph(bvh_dir, tmp_path, capsys):
+    """The Bandai dataset-1 walk and the dataset-2 turning walks: their files differ only
+    in the travelling hips' OFFSET, which the hips' channels replace; one graph of the
+    three walks keeps its feet planted, neither freezes nor pops."""
+    b = bvh_dir / "bandai"
+    takes = [b / f"{n}.bvh" for n in ("dataset-1_walk_normal_001",
+                                      "dataset-2_walk-turn-left_normal_011",
+                                      "dataset-2_walk-turn-right_normal_029")]
+    out, rep = tmp_path / "g.bvh", tmp_path / "g.json"
+    assert main(["graph", *map(str, takes), "--frames", "300", "-o", str(out),
+                 "--report", str(rep), "--no-progress"]) == 0
+    q = json.loads(rep.read_text())["motion_quality"]
+    assert q["feet_verdict"] == "planted" and q["longest_freeze_s"] < 0.2
+    assert q["largest_accel_ratio"] <= 1.5 and min(q["knee_range_ratio"]) >= 0.9
+    assert cc.load(out).n_frames == 300
+
+
 @pytest.fixture(scope="module")
 def w1(cmu_dir):
     paths = [cmu_dir / "35" / f"{n}.amc" for n in W1]
