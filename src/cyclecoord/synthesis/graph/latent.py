@@ -49,7 +49,8 @@ def _same_skeleton(a, b) -> bool:
     placed = np.array([not any(d.startswith("t") for d in j.dofs) for j in a.joints])
     off_a = np.array([j.offset for j in a.joints])[placed]
     off_b = np.array([j.offset for j in b.joints])[placed]
-    return bool(off_a.size == 0 or np.abs(off_a - off_b).max() <= 1e-3 * max(a.total_length(), 1e-9))
+    tol = 1e-3 * max(a.total_length(), 1e-9)
+    return bool(off_a.size == 0 or np.abs(off_a - off_b).max() <= tol)
 
 
 def check_takes(motions: Sequence[Motion], minimum: int = 2) -> list[Motion]:
