@@ -132,17 +132,33 @@ def test_bad_input_one_line_each(synthetic_takes, tmp_path, capsys):
     assert "need the Delaunay triangulation" in one_error_line(capsys)
 
 
-def test_different_skeletons_one_line(cmu_dir, capsys):
+def test_two_actors_on_one_rig_make_one_graph(cmu_dir, tmp_path, capsys):
+    """Subjects 35 and 69 (one CMU rig, other bone lengths): 69_01 is put on 35_16's
+    skeleton with a note saying how, and the motion keeps its feet on the floor."""
     a, b = cmu_dir / "35" / "35_16.amc", cmu_dir / "69" / "69_01.amc"
     need_data(a, b)
-    assert main(["graph", str(a), str(b)]) == 1
-    assert "skeleton differs" in one_error_line(capsys)
+    out, rep = tmp_path / "g.bvh", tmp_path / "g.json"
+    assert main(["graph", str(a), str(b), "--start", f"{b}:200", "--frames", "300",
+                 "-o", str(out), "--report", str(rep), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    line = next(x for x in text.splitlines() if x.startswith("69_01.amc: another actor"))
+    assert "legs 0.98x 35_16.amc's" in line and "travel scaled 1.02x" in line
+    r = json.loads(rep.read_text())
+    assert line in r["notes"]
+    q = r["motion_quality"]
+    assert q["support_slip_m_per_s"] <= 0.05 and q["longest_freeze_s"] < 0.2
+    g = cc.load(out)
+    assert g.skeleton.names == cc.load(a).skeleton.names
+    lowest = np.min([g.positions()[f][:, 1] for f in ("lfoot", "rfoot", "ltoes", "rtoes")], 0)
+    src = np.min([cc.load(a).positions()[f][:, 1] for f in ("lfoot", "rfoot")], 0)
+    assert abs(np.percentile(lowest, 5) - np.percentile(src, 5)) < 1.0  # the floor, not above
 
 
 def test_a_translated_joints_offset_is_not_the_skeleton():
     """A joint with translation channels is placed by them (BVH replaces its OFFSET), so
     two takes differing only in that OFFSET share a skeleton; a bone's offset elsewhere
-    differing is another skeleton."""
+    differing is another actor's proportions (put on the first's skeleton, or refused
+    without a list for the note); other joints are another rig."""
     from dataclasses import replace
 
     from cyclecoord.synthesis.graph.latent import check_takes
@@ -160,8 +176,17 @@ def test_a_translated_joints_offset_is_not_the_skeleton():
 
     assert any(d.startswith("t") for d in skel.joints[0].dofs)
     assert len(check_takes([m, moved(0)])) == 2  # the root: placed by its channels
-    with pytest.raises(cc.CycleCoordError, match="skeleton differs"):
+    with pytest.raises(cc.CycleCoordError, match="bone lengths differ"):
         check_takes([m, moved(k)])
+    notes: list[str] = []
+    assert check_takes([m, moved(k)], notes=notes)[1].skeleton is skel  # put on the first's
+    assert len(notes) == 1 and "another actor on the same rig" in notes[0]
+    joints = list(skel.joints)
+    joints[k] = replace(joints[k], name="elsewhere")
+    other = cc.Motion(frames=m.frames, channels=m.channels, fps=m.fps,
+                      skeleton=replace(skel, joints=tuple(joints)))
+    with pytest.raises(cc.CycleCoordError, match=r"skeleton differs .*\(other joints\)"):
+        check_takes([m, other], notes=[])
 
 
 def test_bandai_takes_of_both_datasets_make_one_graph(bvh_dir, tmp_path, capsys):

@@ -245,6 +245,8 @@ def _crossval(args: argparse.Namespace, motions: list, out: Outputs) -> int:
         progress=not args.no_progress,
         horizon=args.horizon,
     )
+    for note in cv.notes:
+        print(note)
     print(cv.table())
     outside = sum(f["outside_hull_steps"] for f in cv.folds)
     print(
@@ -325,7 +327,7 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         f"generated {gen.motion.n_frames} frames from {gen.start['take']}:{gen.start['frame']} "
         f"({gen.path.kind}; {gen.path.outside_hull_steps} steps outside the hull)"
     )
-    for note in synth.phase_notes_ + gen.notes:
+    for note in synth.proportion_notes_ + synth.phase_notes_ + gen.notes:
         print(note)
     payload = {
         "method": method,
@@ -342,7 +344,7 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
             key: conn[key] for key in ("nodes", "edges", "weak_components", "strong_components")
         },
         "connectivity": conn,
-        "notes": gen.notes,
+        "notes": synth.proportion_notes_ + gen.notes,
         "root": "turns, heights and tilts: weighted mean over the training frames weighing on "
         "each generated point (the field's neighbourhood), integrated from the start frame's "
         "root; ground travel "

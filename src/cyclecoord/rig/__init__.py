@@ -15,8 +15,9 @@ and a :class:`RigAdapter` whose :meth:`~RigAdapter.restore` writes any motion on
 analysis skeleton (a cycle, a blend) back with the original skeleton and channels.
 
 Finding lives in :mod:`.describe` (:func:`describe_rig`, units and up axis), undoing in
-:mod:`.normalize` (:func:`normalize_rig`, :class:`RigAdapter`); every name is importable
-from ``cyclecoord.rig``.
+:mod:`.normalize` (:func:`normalize_rig`, :class:`RigAdapter`), putting one rig's takes by
+actors of other proportions on one skeleton in :mod:`.retarget` (:func:`onto_skeleton`);
+every name is importable from ``cyclecoord.rig``.
 """
 
 from .describe import (
@@ -31,11 +32,13 @@ from .describe import (
     rig_summary,
 )
 from .normalize import RigAdapter, analysis_motion, normalize_rig
+from .retarget import Proportions, onto_skeleton, proportions_differ, same_rig
 
 __all__ = [
     "CMU_UNIT",
     "UNITS",
     "Z_TO_Y",
+    "Proportions",
     "RigAdapter",
     "RigInfo",
     "Units",
@@ -43,6 +46,9 @@ __all__ = [
     "metres_per_unit",
     "analysis_motion",
     "normalize_rig",
+    "onto_skeleton",
+    "proportions_differ",
     "parse_units",
     "rig_summary",
+    "same_rig",
 ]

@@ -141,7 +141,8 @@ class ClassicMotionGraph:
         from ..quality.legs import find_feet
         from .graph.latent import check_takes
 
-        self.takes_ = check_takes(takes, minimum=1)
+        self.notes_: list[str] = []
+        self.takes_ = check_takes(takes, minimum=1, notes=self.notes_)
         _up_check(self.takes_[0])
         fps = self.takes_[0].fps
         self.w_ = max(2, int(round(self.window * fps)))

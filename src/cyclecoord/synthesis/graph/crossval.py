@@ -224,6 +224,10 @@ class CrossValidation:
     paths : dict
         ``{(held_out, method): GraphPath}`` for figures.
     parameters : dict
+    long : dict
+        The longer horizon's medians (``horizon`` times each left-out take).
+    notes : list of str
+        Takes of another actor put on the first take's skeleton.
     """
 
     folds: list
@@ -234,6 +238,7 @@ class CrossValidation:
     fold_graphs: list = field(default_factory=list)
     parameters: dict = field(default_factory=dict)
     long: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
 
     def to_report(self) -> dict[str, Any]:
         return {
@@ -247,6 +252,7 @@ class CrossValidation:
             "paper_set": self.parameters.get("paper_set"),
             "paper": PAPER.get(self.parameters.get("paper_set") or "", None),
             "long_horizon": self.long,
+            "notes": self.notes,
         }
 
     def table(self, paper: bool = True) -> str:
@@ -425,7 +431,8 @@ def cross_validate(
     """
     from .model import _parse, auto_dims
 
-    takes = check_takes(motions, minimum=3)
+    notes: list[str] = []
+    takes = check_takes(motions, minimum=3, notes=notes)
     methods = list(dict.fromkeys(str(m).strip() for m in methods))
     variants = {m: _parse(m) for m in methods}
     if dims != "auto" and (isinstance(dims, bool) or not isinstance(dims, (int, np.integer))
@@ -528,6 +535,7 @@ def cross_validate(
         fold_graphs=fold_graphs,
         parameters=params,
         long=long,
+        notes=notes,
     )
 
 

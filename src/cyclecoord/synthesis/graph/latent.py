@@ -20,6 +20,7 @@ import numpy as np
 
 from ...errors import ParameterError
 from ...motion import Motion
+from ...rig.retarget import onto_skeleton, proportions_differ, same_rig
 
 __all__ = ["PoseSpace", "angle_columns", "check_takes"]
 
@@ -37,24 +38,19 @@ def _name(m: Motion, i: int) -> str:
     return m.source or f"take {i}"
 
 
-def _same_skeleton(a, b) -> bool:
-    """Same joints, dofs and bone offsets (to 0.1 % of the skeleton's size), the offsets
-    of joints with translation channels left out: their channels place them (in BVH they
-    replace the OFFSET), so the Bandai rig's two datasets, whose files differ only in the
-    travelling hips' OFFSET (93.9 against 93.3 cm up), pose alike."""
-    if a is None or b is None:
-        return a is None and b is None
-    if a.names != b.names or any(x.dofs != y.dofs for x, y in zip(a.joints, b.joints)):
-        return False
-    placed = np.array([not any(d.startswith("t") for d in j.dofs) for j in a.joints])
-    off_a = np.array([j.offset for j in a.joints])[placed]
-    off_b = np.array([j.offset for j in b.joints])[placed]
-    tol = 1e-3 * max(a.total_length(), 1e-9)
-    return bool(off_a.size == 0 or np.abs(off_a - off_b).max() <= tol)
+def _short(m: Motion, i: int) -> str:
+    return m.source.replace("\\", "/").rsplit("/", 1)[-1] if m.source else f"take {i}"
 
 
-def check_takes(motions: Sequence[Motion], minimum: int = 2) -> list[Motion]:
-    """The training takes, checked to share skeleton, channels and frame rate.
+def check_takes(
+    motions: Sequence[Motion], minimum: int = 2, notes: list[str] | None = None
+) -> list[Motion]:
+    """The training takes, checked to share rig, channels and frame rate.
+
+    A take of the first take's rig worn by another actor (other bone lengths) is put on
+    the first take's skeleton (:func:`cyclecoord.rig.retarget.onto_skeleton`: rotations
+    kept, travel scaled by the legs' ratio), with a line in ``notes``; without ``notes``
+    such a take is refused.
 
     Raises
     ------
@@ -89,12 +85,20 @@ def check_takes(motions: Sequence[Motion], minimum: int = 2) -> list[Motion]:
                 f"{_name(m, i)}: its {m.n_channels} channels differ from {_name(first, 0)}'s "
                 f"{first.n_channels} ({what}); every take needs the same skeleton and channels"
             )
-        if not _same_skeleton(first.skeleton, m.skeleton):
+        why = same_rig(first.skeleton, m.skeleton)
+        if why:
             raise ParameterError(
-                f"{_name(m, i)}: its skeleton differs from {_name(first, 0)}'s "
-                "(other joints or bone "
-                "offsets); train on takes of one skeleton"
+                f"{_name(m, i)}: its skeleton differs from {_name(first, 0)}'s ({why}); "
+                "train on takes of one rig"
             )
+        if proportions_differ(first.skeleton, m.skeleton):
+            if notes is None:
+                raise ParameterError(
+                    f"{_name(m, i)}: its bone lengths differ from {_name(first, 0)}'s; "
+                    "put it on one skeleton first (cyclecoord.rig.onto_skeleton)"
+                )
+            takes[i], p = onto_skeleton(m, first)
+            notes.append(p.describe(_short(m, i), _short(first, 0)))
         if abs(m.fps - first.fps) > 1e-9:
             raise ParameterError(
                 f"{_name(m, i)}: {m.fps:g} fps, {_name(first, 0)} {first.fps:g} fps; resample first"

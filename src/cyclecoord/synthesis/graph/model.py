@@ -108,6 +108,9 @@ class MotionGraphSynth:
     names_ : list of str
     reference_frames_ : list of bool
         Per take, whether its frame 0 is a reference pose (a start there starts at 1).
+    proportion_notes_ : list of str
+        One line per take of the first take's rig by an actor of other proportions, put
+        on the first take's skeleton (:func:`cyclecoord.rig.onto_skeleton`).
     phase_field_ : PhaseField or None
         With ``+phase``; then also ``phase_notes_`` (how each take got its phase),
         ``residual_`` (what the latent space leaves out of each training frame) and
@@ -140,7 +143,8 @@ class MotionGraphSynth:
             raise ParameterError(
                 f"unknown integrator {self.integrator!r}; choose from {', '.join(INTEGRATORS)}"
             )
-        raw = check_takes(takes, minimum=2)
+        self.proportion_notes_: list[str] = []
+        raw = check_takes(takes, minimum=2, notes=self.proportion_notes_)
         self.names_ = [take_name(m, i) for i, m in enumerate(raw)]
         self.takes_, self.rig_ = _analysis_takes(raw)
         self.reference_frames_ = [_has_reference_frame(m) for m in raw]
@@ -181,7 +185,7 @@ class MotionGraphSynth:
         elif isinstance(start, Motion):
             name = take_name(start)
             motion = _analysis_takes([start])[0][0] if self.rig_ is not None else start
-            check_takes([self.takes_[0], motion], minimum=2)
+            motion = check_takes([self.takes_[0], motion], minimum=2, notes=[])[1]
         else:
             raise ParameterError(
                 f"start must be a Motion or a training take's index, got {type(start).__name__}"
