@@ -373,12 +373,15 @@ def figures_line(s: dict) -> str:
     )
 
 
-def _lead(motion, sources: list, feet: str | None = None) -> dict | None:
-    """Print the measure of generated motion against ``sources`` (the console's first
-    lines) and return its report dict (None when it cannot be measured)."""
+def _lead(
+    motion, sources: list, feet: str | None = None, reference=None
+) -> dict | None:
+    """Print the measure of generated motion against ``sources`` (or their figures
+    ``reference``; the console's first lines) and return its report dict (None when it
+    cannot be measured)."""
     from ..quality.generated import lead_lines
 
-    quality, lines = lead_lines(motion, sources, feet=feet or None)
+    quality, lines = lead_lines(motion, sources, feet=feet or None, reference=reference)
     for line in lines:
         print(line)
     return quality

@@ -304,7 +304,7 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         gen = synth.generate(args.frames, start, frame)
     from .blend import _lead
 
-    quality = _lead(gen.motion, motions)
+    quality = _lead(gen.motion, motions, reference=synth.reference(gen))
     conn = synth.graph_.connectivity()
     print(
         f"{synth.graph_.method} graph ({synth.field_.name} field) over {conn['nodes']} frames of "

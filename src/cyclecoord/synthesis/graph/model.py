@@ -114,8 +114,10 @@ class MotionGraphSynth:
     phase_field_ : PhaseField or None
         With ``+phase``; then also ``phase_notes_`` (how each take got its phase),
         ``residual_`` (what the latent space leaves out of each training frame) and
-        ``gain_`` ``(A,)``, the leg angles' stride widening
-        (:func:`~.phase.amplitude_gain`; ones when a take is another gait).
+        ``gaits_`` (the takes' indices per gait, :meth:`gaits`), ``take_gait_``
+        ``(n_takes,)``, ``gain_`` ``(G, A)``, each gait's leg-angle stride widening
+        (:func:`~.phase.amplitude_gain`; ones for a gait whose averaging mixes gaits),
+        and ``angle_mean_`` ``(G, A)``, each gait's mean pose.
     """
 
     def __init__(
@@ -157,22 +159,14 @@ class MotionGraphSynth:
         self.phase_field_ = None
         self.phase_notes_: list[str] = []
         if phase:
-            from .phase import PhaseField, amplitude_gain, take_phases
+            from .phase import PhaseField, take_phases
 
             tp = take_phases(self.takes_, latent)
             self.phase_notes_ = tp.notes
             self.phase_field_ = PhaseField(self.graph_, tp.phases)
             self.residual_ = self.space_.residuals(self.takes_)
             angles = np.vstack([self.space_.angles(m) for m in self.takes_])
-            self.angle_mean_ = angles.mean(axis=0)
-            self.gain_ = np.ones(angles.shape[1])
-            other = _other_gait(self.phase_field_, self.names_)
-            if other:  # the averaging then mixes gaits, not strides: nothing to undo
-                self.phase_notes_.append(f"strides not widened: {other}")
-            else:  # the strides' amplitude only: widened arms brought a thumb into the back
-                legs = _leg_columns(self.takes_[0], self.space_.channels_)
-                gain = amplitude_gain(self.phase_field_, angles, self.takes_[0].fps)
-                self.gain_[legs] = gain[legs]
+            self._widen(angles)
         return self
 
     def _start(self, start: Motion | int, frame: int) -> tuple[Motion, int, str]:
@@ -274,6 +268,122 @@ class MotionGraphSynth:
         out.notes[:0] = said
         return out
 
+    def _widen(self, angles: np.ndarray) -> None:
+        """Per gait (:meth:`gaits`), the leg angles' stride widening
+        (:func:`~.phase.amplitude_gain` over that gait's frames) and its mean pose.
+
+        The widening undoes the narrowing of averaging repetitions of one gait; a gait
+        whose frames draw more than :data:`MIXED_NEIGHBOURS` of their neighbours' weight
+        from another gait is not widened (there the averaging mixes gaits, not strides:
+        the Bandai walk forwards beside its walk backwards went to 1.3x its leg range and
+        crossed the legs).  One gain for all the takes left a walk-and-jog graph's jog
+        unwidened, its right knee at 0.67 of the jog's range."""
+        from .phase import amplitude_gain
+
+        self.gaits_ = self.gaits()
+        g_of = np.empty(len(self.takes_), dtype=int)
+        for g, members in enumerate(self.gaits_):
+            g_of[members] = g
+        self.take_gait_ = g_of
+        frame_gait = g_of[self.graph_.take]
+        idx, w = self.phase_field_.neighbours(self.graph_.points, self.phase_field_.phase)
+        own = (w * (frame_gait[idx] == frame_gait[:, None])).sum(axis=1)
+        legs = _leg_columns(self.takes_[0], self.space_.channels_)
+        self.gain_ = np.ones((len(self.gaits_), angles.shape[1]))
+        self.angle_mean_ = np.empty_like(self.gain_)
+        for g, members in enumerate(self.gaits_):
+            mine = frame_gait == g
+            self.angle_mean_[g] = angles[mine].mean(axis=0)
+            names = "+".join(self.names_[i] for i in members)
+            mixed = 1.0 - float(np.mean(own[mine]))
+            if mixed > MIXED_NEIGHBOURS:  # its averaging mixes gaits, not strides
+                self.phase_notes_.append(
+                    f"strides not widened: {names}'s frames draw {100 * mixed:.0f} % of "
+                    "their neighbours from another gait"
+                )
+                continue
+            gain = amplitude_gain(self.phase_field_, angles, self.takes_[0].fps, mine)
+            self.gain_[g, legs] = gain[legs]
+        if len(self.gaits_) > 1:
+            self.phase_notes_.append(
+                "gaits (widened each on its own): "
+                + " | ".join("+".join(self.names_[i] for i in m) for m in self.gaits_)
+            )
+
+    def _gait_weights(self, path: GraphPath) -> np.ndarray:
+        """Per path step, its neighbours' weight per gait ``(T, G)``, rows summing to 1."""
+        nb = np.asarray(path.neighbours)
+        w = np.where(nb >= 0, np.asarray(path.weights, dtype=float), 0.0)
+        gait = self.take_gait_[self.graph_.take[np.where(nb >= 0, nb, 0)]]
+        out = np.zeros((nb.shape[0], len(self.gaits_)))
+        for g in range(len(self.gaits_)):
+            out[:, g] = (w * (gait == g)).sum(axis=1)
+        total = out.sum(axis=1, keepdims=True)
+        return np.where(total > 0, out / np.where(total > 0, total, 1.0), 1.0 / out.shape[1])
+
+    def take_shares(self, path: GraphPath) -> np.ndarray:
+        """How much a path draws on each training take ``(n_takes,)``, summing to 1: its
+        neighbours' weights per take, over its steps.  A graph of a walk and a jog that
+        jogged is judged against the jog (:meth:`reference`)."""
+        nb = np.asarray(path.neighbours)
+        w = np.where(nb >= 0, np.asarray(path.weights, dtype=float), 0.0)
+        take = self.graph_.take[np.where(nb >= 0, nb, 0)]
+        shares = np.bincount(take.ravel(), weights=w.ravel(), minlength=len(self.takes_))
+        total = shares.sum()
+        return shares / total if total > 0 else np.full(len(self.takes_), 1 / len(self.takes_))
+
+    def gaits(self) -> list[list[int]]:
+        """The training takes grouped by gait: two takes are one gait when each one's
+        poses lie within :data:`OTHER_GAIT_MISFIT` of the other's cycle at its phase
+        (:func:`~.phase.match_misfit`); one group without the phase-aware field."""
+        n = len(self.takes_)
+        if self.phase_field_ is None or n < 2:
+            return [list(range(n))]
+        from .phase import match_misfit
+
+        field = self.phase_field_
+        take, z, ph = field.graph.take, field.graph.points, field.unwrapped
+        group = list(range(n))
+
+        def root(i: int) -> int:
+            while group[i] != i:
+                i = group[i]
+            return i
+
+        for a in range(n):
+            for b in range(a + 1, n):
+                ia, ib = take == a, take == b
+                if not (ia.any() and ib.any()):
+                    continue
+                worst = max(match_misfit(z[ia], ph[ia], ph[ib], z[ib]),
+                            match_misfit(z[ib], ph[ib], ph[ia], z[ia]))
+                if worst <= OTHER_GAIT_MISFIT:
+                    group[root(b)] = root(a)
+        out: dict[int, list[int]] = {}
+        for i in range(n):
+            out.setdefault(root(i), []).append(i)
+        return list(out.values())
+
+    def reference(self, gen: Generation, feet=None):
+        """The training takes' figures to judge ``gen`` by
+        (:class:`~cyclecoord.quality.generated.SourceFigures`): each gait's takes
+        (:meth:`gaits`) pooled, the gaits weighted by how much the path drew on them
+        (:meth:`take_shares`).  Pooling every training frame judged a walk-and-jog
+        graph's jog against the walks: "feet gliding (support foot 2.11 m/s, sources
+        0.10)", where against the jog it is 1.5x the take's."""
+        from ...quality.generated import mixed_reference, source_figures
+
+        shares = self.take_shares(gen.path)
+        n, fps = gen.motion.n_frames, gen.motion.fps
+        cache: dict = {}
+        parts = [
+            (source_figures([self.takes_[i] for i in g], fps, feet, analysed=True,
+                            cache=cache), shares[g].sum() * n)
+            for g in getattr(self, "gaits_", None) or self.gaits()
+            if shares[g].sum() > 0
+        ]
+        return parts[0][0] if len(parts) == 1 else mixed_reference(parts)
+
     def _result(
         self, path: GraphPath, motion: Motion, f: int, name: str, x0: np.ndarray
     ) -> Generation:
@@ -287,7 +397,8 @@ class MotionGraphSynth:
             detail = gaussian_filter1d(detail, DETAIL_SMOOTH * motion.fps, axis=0, mode="nearest")
             # the neighbours' average is narrower than the strides it averages: widen it
             angles = self.space_.inverse_transform(path.points) + detail
-            detail = detail + (self.gain_ - 1.0) * (angles - self.angle_mean_)
+            gw = self._gait_weights(path)
+            detail = detail + (gw @ self.gain_ - 1.0) * (angles - gw @ self.angle_mean_)
         out = self.space_.motion(path.points, self.takes_[0], root, detail)
         notes = []
         if self.carry and self.floor_ is not None:
@@ -361,27 +472,9 @@ def _analysis_takes(takes: Sequence[Motion]) -> tuple[list[Motion], Any]:
 #: with its walk backwards.
 OTHER_GAIT_MISFIT = 1.0
 
-
-def _other_gait(field, names: Sequence[str]) -> str:
-    """Which take is not the others' gait (``""`` when every take is), for the stride
-    widening: it undoes the narrowing of averaging repetitions of one gait; between a
-    walk forwards and one backwards it widened the Bandai legs to 1.3x their range and
-    crossed them."""
-    from .phase import match_misfit
-
-    take, z = field.graph.take, field.graph.points
-    worst, which = 0.0, -1
-    for t in np.unique(take):
-        me = take == t
-        if me.all():
-            return ""
-        m = match_misfit(z[me], field.unwrapped[me], field.unwrapped[~me], z[~me])
-        if m > worst:
-            worst, which = m, int(t)
-    if worst <= OTHER_GAIT_MISFIT:
-        return ""
-    return (f"{names[which]} is not the other takes' gait (its poses lie {worst:.2g}x the "
-            "cycle's spread from theirs at its phase)")
+#: A gait whose training frames draw more than this share of their neighbours' weight
+#: from another gait is not widened (:meth:`MotionGraphSynth._widen`).
+MIXED_NEIGHBOURS = 0.1
 
 
 def _leg_columns(take: Motion, channels: Sequence) -> np.ndarray:

@@ -446,7 +446,9 @@ def follow_phase(
     )
 
 
-def amplitude_gain(field: PhaseField, angles: np.ndarray, fps: float) -> np.ndarray:
+def amplitude_gain(
+    field: PhaseField, angles: np.ndarray, fps: float, frames: np.ndarray | None = None
+) -> np.ndarray:
     """Per joint angle, how much the field's neighbour averaging narrows the strides.
 
     A path's pose is a kernel average over its neighbours, which lie on different
@@ -465,6 +467,8 @@ def amplitude_gain(field: PhaseField, angles: np.ndarray, fps: float) -> np.ndar
         The training frames' joint angles, in the graph's take order.
     fps : float
         Frame rate (the running median's length against marker glitches).
+    frames : ndarray of bool, shape (N,), optional
+        Only these training frames (one gait's takes) are measured, over their own period.
 
     Returns
     -------
@@ -475,10 +479,14 @@ def amplitude_gain(field: PhaseField, angles: np.ndarray, fps: float) -> np.ndar
     g = field.graph
     idx, w = field.neighbours(g.points, field.phase)
     avg = np.einsum("nk,nka->na", w, np.asarray(angles, dtype=float)[idx])
-    period = int(round(1.0 / (2.0 * float(np.median(field.rate)))))  # rate: half a frame's
+    keep = np.ones(g.take.size, dtype=bool) if frames is None else np.asarray(frames, bool)
+    rate = np.asarray(field.rate, dtype=float)
+    rate = rate[keep] if rate.shape == keep.shape else rate
+    period = int(round(1.0 / (2.0 * float(np.median(rate)))))  # rate: half a frame's
     take = g.take
     cut = np.flatnonzero(take[1:] != take[:-1]) + 1
-    runs = list(zip(np.r_[0, cut].tolist(), np.r_[cut, take.size].tolist()))
+    runs = [(a, b) for a, b in zip(np.r_[0, cut].tolist(), np.r_[cut, take.size].tolist())
+            if keep[a]]
     spike = spike_frames(fps)
     have = window_ranges(avg, runs, period, spike)
     want = window_ranges(np.asarray(angles, dtype=float), runs, period, spike)
