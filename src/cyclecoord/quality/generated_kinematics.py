@@ -1,6 +1,6 @@
 """Forward kinematics of a motion as the measure of generated motion reads it
 (:mod:`cyclecoord.quality.generated`): its legs, the pose relative to the root with the
-heading removed, the leg cycle, the support foot, the frames where a take moves."""
+heading removed, the leg cycle, the support foot, the frames where a take moves, the channels that turn a leg."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import CycleCoordError, ParameterError
 from ..motion import Motion
 from .contacts import leg_length
 from .legs import Legs, find_legs, legs_of_feet
@@ -245,3 +245,24 @@ def _lowest(kin: _Kin, rig: _Rig) -> np.ndarray:
         i for i, p in enumerate(kin.parents) if kin.names[i].endswith("/end") and p in rig.foot_cols
     ]
     return kin.pos[:, cols, 1].min(axis=1)
+
+
+def leg_channels(motion: Motion, channels: Sequence) -> np.ndarray:
+    """Which ``(joint, dof)`` channels turn a leg ``(C,)`` bool: the hip joint (the
+    knee's parent) of each of the first two legs and every joint below it; none without
+    a skeleton or legs."""
+    out = np.zeros(len(channels), dtype=bool)
+    try:
+        rig = _rig(motion, None)
+    except CycleCoordError:
+        return out
+    skel = motion.skeleton
+    below: set[str] = set()
+    todo = list(rig.hips)
+    while todo:
+        j = todo.pop()
+        below.add(skel.names[j])
+        todo.extend(skel.children(j))
+    for i, ch in enumerate(channels):
+        out[i] = ch[0] in below
+    return out

@@ -278,6 +278,7 @@ class MotionGraphSynth:
         the Bandai walk forwards beside its walk backwards went to 1.3x its leg range and
         crossed the legs).  One gain for all the takes left a walk-and-jog graph's jog
         unwidened, its right knee at 0.67 of the jog's range."""
+        from ...quality.generated_kinematics import leg_channels
         from .phase import amplitude_gain
 
         self.gaits_ = self.gaits()
@@ -288,7 +289,7 @@ class MotionGraphSynth:
         frame_gait = g_of[self.graph_.take]
         idx, w = self.phase_field_.neighbours(self.graph_.points, self.phase_field_.phase)
         own = (w * (frame_gait[idx] == frame_gait[:, None])).sum(axis=1)
-        legs = _leg_columns(self.takes_[0], self.space_.channels_)
+        legs = leg_channels(self.takes_[0], self.space_.channels_)
         self.gain_ = np.ones((len(self.gaits_), angles.shape[1]))
         self.angle_mean_ = np.empty_like(self.gain_)
         for g, members in enumerate(self.gaits_):
@@ -475,29 +476,6 @@ OTHER_GAIT_MISFIT = 1.0
 #: A gait whose training frames draw more than this share of their neighbours' weight
 #: from another gait is not widened (:meth:`MotionGraphSynth._widen`).
 MIXED_NEIGHBOURS = 0.1
-
-
-def _leg_columns(take: Motion, channels: Sequence) -> np.ndarray:
-    """Which ``(joint, dof)`` channels turn a leg: the hip joint (the knee's parent) of
-    each leg and every joint below it; none without a skeleton or legs."""
-    from ...errors import CycleCoordError
-    from ...quality.generated import _rig
-
-    out = np.zeros(len(channels), dtype=bool)
-    try:
-        rig = _rig(take, None)
-    except CycleCoordError:
-        return out
-    skel = take.skeleton
-    below: set[str] = set()
-    todo = list(rig.hips)
-    while todo:
-        j = todo.pop()
-        below.add(skel.names[j])
-        todo.extend(skel.children(j))
-    for i, ch in enumerate(channels):
-        out[i] = ch[0] in below
-    return out
 
 
 def _parse(method: str) -> tuple[str, bool, bool, bool]:

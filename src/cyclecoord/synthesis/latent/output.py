@@ -19,6 +19,7 @@ __all__ = [
     "PLANT_MARGIN",
     "PLANT_ROUNDS",
     "PLANT_SMOOTH",
+    "STAND_LEG_SWAY",
     "UNTANGLE_ROUNDS",
     "UNTANGLE_WIDTH",
 ]
@@ -48,6 +49,9 @@ UNTANGLE_ROUNDS = 3
 #: up to this many times.
 POP_PULL = 1.4
 POP_ROUNDS = 3
+#: Share of the pose's drift that a stand's legs keep once the stand has settled
+#: (:meth:`OutputMixin._stand_legs`).
+STAND_LEG_SWAY = 0.25
 
 
 class OutputMixin:
@@ -187,6 +191,7 @@ class OutputMixin:
 
         first = self.models[self.chunks[0].model]
         T = angles.shape[0]
+        angles = self._stand_legs(angles)
         turn = root["turn"][:-1]
         if self.held:
             # an IDLE stands: its heading stops turning as its ground track stops (the
@@ -227,6 +232,78 @@ class OutputMixin:
             skeleton=first.skeleton_,
             source="synthetic:latent",
         )
+
+    def _stand_legs(self, angles: np.ndarray) -> np.ndarray:
+        """``angles`` ``(T, C)`` with each IDLE's legs held near their pose where it
+        began: each leg joint's rotation keeps :data:`STAND_LEG_SWAY` of its turn away
+        from that pose, easing in over the stand's first
+        :data:`~cyclecoord.synthesis.carry.STAND_AFTER` s (and out over its last as
+        long when frames follow).  The particle's sway moves the whole pose; in the legs
+        it lifted a heel and then the foot of a standing figure (subject 35's walk model,
+        a foot 10 cm up for the last second of 5 of 12 stops), which the pins, asked no
+        lower than the toe end on the floor allows, held up."""
+        if not self.held:
+            return angles
+        from scipy.spatial.transform import Rotation
+
+        from ...conventions import continuous_euler
+        from ..carry import STAND_AFTER
+
+        first = self.models[self.chunks[0].model]
+        legs = self._leg_mask(first)
+        if not legs.any():
+            return angles
+        T = angles.shape[0]
+        n = max(1, int(round(STAND_AFTER * self.fps)))
+        keep = np.ones(T)
+        for a, b in self.held:
+            b = min(b, T)
+            if b - a < 2:
+                continue
+            t = np.arange(a, b)
+            u = np.clip((t - a) / n, 0.0, 1.0)
+            if b < T:
+                u = np.minimum(u, np.clip((b - 1 - t) / n, 0.0, 1.0))
+            u = u * u * (3.0 - 2.0 * u)
+            keep[a:b] = np.minimum(keep[a:b], 1.0 - (1.0 - STAND_LEG_SWAY) * u)
+        if np.all(keep == 1.0):
+            return angles
+        out = np.array(angles, dtype=float)
+        cols = np.flatnonzero(legs)
+        balls = [(idx, order) for idx, order in first.rotation_columns() if legs[idx].all()]
+        cache = self.__dict__.setdefault("_stand_cache", {})  # (untangling poses again)
+        for a, b in self.held:
+            b = min(b, T)
+            if b - a < 2:
+                continue
+            block = out[a:b, cols]
+            key = (a, b, block.tobytes())
+            if key not in cache:
+                k = keep[a:b, None]
+                # a joint with one or two angles: its channels eased linearly
+                held = block[0] + k * (block - block[0])
+                for idx, order in balls:  # a ball joint: its rotation turned
+                    j = np.searchsorted(cols, idx)
+                    R = Rotation.from_euler(order, block[:, j], degrees=True)
+                    R0 = Rotation.from_euler(order, block[0, j], degrees=True)
+                    turn = (R0.inv() * R).as_rotvec() * k
+                    mats = (R0 * Rotation.from_rotvec(turn)).as_matrix()
+                    held[:, j] = continuous_euler(mats[:, None], order, block[0, j])[:, 0]
+                if len(cache) > 64:
+                    cache.clear()
+                cache[key] = held
+            out[a:b, cols] = cache[key]
+        return out
+
+    def _leg_mask(self, model) -> np.ndarray:
+        """Which of ``model``'s channels turn a leg (the hip joint and below), found once."""
+        cache = self.__dict__.setdefault("_leg_masks", {})
+        key = id(model)
+        if key not in cache:
+            from ...quality.generated_kinematics import leg_channels
+
+            cache[key] = leg_channels(model.training_motion(), model.channels_)
+        return cache[key]
 
     def _posed(
         self, pull: np.ndarray | None = None, whole: np.ndarray | None = None
