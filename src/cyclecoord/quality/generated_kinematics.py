@@ -1,6 +1,7 @@
 """Forward kinematics of a motion as the measure of generated motion reads it
 (:mod:`cyclecoord.quality.generated`): its legs, the pose relative to the root with the
-heading removed, the leg cycle, the support foot, the frames where a take moves, the channels that turn a leg."""
+heading removed, the leg cycle, the support foot, the frames where a take moves, the
+channels that turn a leg."""
 
 from __future__ import annotations
 
