@@ -619,6 +619,23 @@ def test_graph_no_progress_reaches_the_loading_bar(monkeypatch, takes):
     assert tqdm.tqdm is bars  # the command reads the bar at run time (from tqdm import tqdm)
 
 
+def test_graph_fps_reaches_the_takes(monkeypatch, tmp_path):
+    """--fps: once, every AMC input (which carries no rate) is read at it; once per input,
+    each its own; the synthesiser gets the takes at those rates."""
+    amcs = []
+    for s, name in ((0, "a_01.amc"), (1, "b_01.amc")):
+        m = cc.datasets.make_periodic_capture(kind="walk", n_frames=150, period=60,
+                                              random_state=s).motion
+        cc.save(m, tmp_path / name)
+        amcs.append(tmp_path / name)
+    target = "cyclecoord.synthesis.graph.MotionGraphSynth.fit"
+    assert [m.fps for m in reach(monkeypatch, target, "graph", *amcs).args[1]] == [120, 120]
+    fit = reach(monkeypatch, target, "graph", *amcs, "--fps", "60")
+    assert [m.fps for m in fit.args[1]] == [60, 60]
+    fit = reach(monkeypatch, target, "graph", *amcs, "--fps", "120", "--fps", "60")
+    assert [m.fps for m in fit.args[1]] == [120, 60] and fit.args[1][0].n_frames == 150
+
+
 def test_graph_start_target_and_frames_reach_the_walk(monkeypatch, takes, tmp_path):
     gen = reach(monkeypatch, "cyclecoord.synthesis.graph.MotionGraphSynth.generate", "graph",
                 *takes, "--frames", "77", "--start", f"{takes[1]}:5")

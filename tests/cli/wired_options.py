@@ -148,6 +148,9 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         **dict.fromkeys(("--no-carry", "--no-lock"),
                         W + "test_graph_carry_and_lock_reach_the_synthesiser"),
         "--horizon": W + "test_graph_horizon_and_no_progress_reach_cross_validate",
+        "--fps": (W + "test_graph_fps_reaches_the_takes",
+                  "tests/synthesis/test_graph_cli.py::"
+                  "test_takes_at_a_whole_multiple_of_the_rate_are_taken_every_kth_frame"),
         "--no-progress": (W + "test_graph_horizon_and_no_progress_reach_cross_validate",
                           W + "test_graph_no_progress_reaches_the_loading_bar"),
     },

@@ -276,3 +276,33 @@ def test_w1_generated_walk_loops_and_is_plausible(w1):
     assert check_plausibility(gen.motion, w1).clean
     travel = np.linalg.norm(gen.motion.frames[-1, [0, 2]] - gen.motion.frames[0, [0, 2]])
     assert travel > 50  # it walks: about 79 units (4.4 m) in 3.75 s
+
+
+def test_takes_at_a_whole_multiple_of_the_rate_are_taken_every_kth_frame(tmp_path, capsys):
+    """A 120 fps take beside a 60 fps one (CMU's AMC rate beside subject 143's): every
+    2nd frame of the faster, with a line saying so, and a start frame given in its own
+    frames; a rate that is no whole multiple is refused naming both."""
+    def take(fps, step, seed, name):
+        m = cc.datasets.make_periodic_capture(kind="walk", n_frames=480, period=120,
+                                              random_state=seed).motion
+        m = m.with_frames(m.frames[::step], fps=fps)
+        path = tmp_path / name
+        cc.save(m, path)
+        return str(path)
+
+    fast, slow = take(120.0, 1, 0, "fast.bvh"), take(60.0, 2, 1, "slow.bvh")
+    out, rep = tmp_path / "g.bvh", tmp_path / "g.json"
+    assert main(["graph", fast, slow, "--start", f"{fast}:41", "--frames", "60", "-o", str(out),
+                 "--report", str(rep), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "fast.bvh: 120 fps, every 2nd frame taken (60 fps, the slowest take's rate)" in text
+    assert "from fast at 60 fps:20" in text
+    assert cc.load(out).fps == 60.0
+    assert json.loads(rep.read_text())["start"]["frame"] == 20
+    odd = take(90.0, 1, 2, "odd.bvh")
+    assert main(["graph", odd, slow, "-o", str(tmp_path / "h.bvh")]) == 1
+    line = one_error_line(capsys)
+    assert "odd.bvh: 90 fps" in line and "slow.bvh 60 fps; resample first (not a whole" in line
+    # --fps: one rate for every input, or one per input
+    assert main(["graph", fast, slow, "--fps", "60", "--fps", "60", "--fps", "60"]) == 1
+    assert "--fps given 3 times for 2 inputs" in one_error_line(capsys)

@@ -108,6 +108,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         action="store_true",
         help="write nothing when the motion fails the plausibility checks",
     )
+    p.add_argument(
+        "--fps",
+        type=positive_float,
+        action="append",
+        metavar="F",
+        help="frame rate of the inputs (AMC files carry none; default 120): once for every "
+        "input or once per input in order. Takes at a whole multiple of the slowest take's "
+        "rate are taken every k-th frame (a line says so); other mixed rates are refused",
+    )
     p.add_argument("--no-topo", action="store_true", help="crossval: skip the bottleneck distances")
     p.add_argument(
         "--no-progress", action="store_true",
@@ -170,21 +179,22 @@ def _take_spec(text: str) -> tuple[str, int]:
     return text, 0
 
 
-def _find(path: str, inputs: list[str], motions: list):
+def _find(path: str, inputs: list[str], motions: list, fps: float | None = None):
     """The motion ``--start``/``--target`` names: a training take when it names one, else
     the file loaded.
 
     Paths are matched as files: the same file named two ways (``35_16.amc``,
     ``./data/35_16.amc``, an absolute path or a link) is the same take; a name that is
     not a file here but is the name (or the trailing path) of one training take is that
-    take, and of two is an error naming both.
+    take, and of two is an error naming both.  ``fps``: the rate of a file loaded (an
+    AMC carries none).
     """
     given = Path(path)
     if given.is_file():
         for name, m in zip(inputs, motions):
             if Path(name).is_file() and _same_file(Path(name), given):
                 return m
-        return load_input(path)
+        return load_input(path, None, fps)
     parts = given.parts
     matches = [
         (name, m)
@@ -198,7 +208,7 @@ def _find(path: str, inputs: list[str], motions: list):
         )
     if matches:
         return matches[0][1]
-    return load_input(path)
+    return load_input(path, None, fps)
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -218,10 +228,13 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.output)
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise ParameterError(f"{args.plot}: exists and is not a folder")
+    from .blend import _per_input
+
+    rates = _per_input(args.fps, len(inputs), "--fps")
     motions = [
-        load_input(p)
-        for p in tqdm(inputs, desc="loading", unit="take",
-                      disable=len(inputs) < 4 or args.no_progress)
+        load_input(p, None, f)
+        for p, f in tqdm(list(zip(inputs, rates)), desc="loading", unit="take",
+                         disable=len(inputs) < 4 or args.no_progress)
     ]
     with Outputs() as out:  # every output moves into place at the end, or none does
         if crossval:
@@ -294,11 +307,13 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         lock=not (args.no_lock or args.no_carry),
     ).fit(motions)
     path, frame = _take_spec(args.start) if args.start else (inputs[0], 0)
-    start = _find(path, inputs, motions)
+    one_rate = args.fps[0] if args.fps and len(args.fps) == 1 else None
+    start = _find(path, inputs, motions, one_rate)
     if args.target:
         tpath, tframe = _take_spec(args.target)
         gen = synth.to_target(
-            start, frame, _find(tpath, inputs, motions), tframe, speed=(args.step_scale or 2.0) / 2
+            start, frame, _find(tpath, inputs, motions, one_rate), tframe,
+            speed=(args.step_scale or 2.0) / 2,
         )
     else:
         gen = synth.generate(args.frames, start, frame)

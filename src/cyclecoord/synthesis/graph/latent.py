@@ -38,6 +38,17 @@ def _name(m: Motion, i: int) -> str:
     return m.source or f"take {i}"
 
 
+def _ordinal(k: int) -> str:
+    return f"{k}{'nd' if k == 2 else 'rd' if k == 3 else 'th'}"
+
+
+def every_kth(motion: Motion, k: int) -> Motion:
+    """Every ``k``-th frame of a take, at ``fps / k``; the metadata records ``k`` (a start
+    frame given in the take's own frames is divided by it)."""
+    out = motion.with_frames(motion.frames[::k], fps=motion.fps / k)
+    return out.with_frames(out.frames, metadata={**motion.metadata, "frame_step": k})
+
+
 def _short(m: Motion, i: int) -> str:
     return m.source.replace("\\", "/").rsplit("/", 1)[-1] if m.source else f"take {i}"
 
@@ -47,10 +58,12 @@ def check_takes(
 ) -> list[Motion]:
     """The training takes, checked to share rig, channels and frame rate.
 
-    A take of the first take's rig worn by another actor (other bone lengths) is put on
-    the first take's skeleton (:func:`cyclecoord.rig.retarget.onto_skeleton`: rotations
-    kept, travel scaled by the legs' ratio), with a line in ``notes``; without ``notes``
-    such a take is refused.
+    With ``notes`` (a list the lines saying what was done go to): a take of the first
+    take's rig worn by another actor (other bone lengths) is put on the first take's
+    skeleton (:func:`cyclecoord.rig.retarget.onto_skeleton`: rotations kept, travel
+    scaled by the legs' ratio), and a take whose rate is a whole multiple of the slowest
+    take's (CMU's 120 fps beside a 60 fps take) has every k-th frame taken
+    (:func:`every_kth`).  Without ``notes`` such takes are refused.
 
     Raises
     ------
@@ -99,10 +112,23 @@ def check_takes(
                 )
             takes[i], p = onto_skeleton(m, first)
             notes.append(p.describe(_short(m, i), _short(first, 0)))
-        if abs(m.fps - first.fps) > 1e-9:
+    slowest = min(m.fps for m in takes)
+    for i, m in enumerate(takes):
+        if abs(m.fps - slowest) <= 1e-9:
+            continue
+        k = int(round(m.fps / slowest))
+        if notes is None or k < 2 or abs(m.fps / k - slowest) > 0.01 * slowest:
+            other = next(t for t in takes if abs(t.fps - slowest) <= 1e-9)
             raise ParameterError(
-                f"{_name(m, i)}: {m.fps:g} fps, {_name(first, 0)} {first.fps:g} fps; resample first"
+                f"{_name(m, i)}: {m.fps:g} fps, {_name(other, takes.index(other))} "
+                f"{slowest:g} fps; resample first"
+                + ("" if notes is None or k < 2 else " (not a whole multiple of the rate)")
             )
+        takes[i] = every_kth(m, k)
+        notes.append(
+            f"{_short(m, i)}: {m.fps:g} fps, every {_ordinal(k)} frame taken "
+            f"({slowest:g} fps, the slowest take's rate)"
+        )
     if angle_columns(first).size < 2:
         raise ParameterError(
             f"{_name(first, 0)}: fewer than 2 joint-angle channels besides the root"

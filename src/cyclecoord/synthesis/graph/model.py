@@ -178,21 +178,25 @@ class MotionGraphSynth:
             motion, name = self.takes_[int(start)], self.names_[int(start)]
         elif isinstance(start, Motion):
             name = take_name(start)
+            _frame_in(frame, start.n_frames, name)
             motion = _analysis_takes([start])[0][0] if self.rig_ is not None else start
             motion = check_takes([self.takes_[0], motion], minimum=2, notes=[])[1]
+            rate = self.takes_[0].fps
+            if abs(motion.fps - rate) > 1e-9:
+                raise ParameterError(
+                    f"{name}: {start.fps:g} fps, slower than the training takes' {rate:g} fps; "
+                    "start from a take at their rate"
+                )
+            step = max(1, int(round(start.fps / rate)))
+            frame = (int(frame) % start.n_frames) // step
+            if step > 1:  # (its frame numbers are now the graph's rate's)
+                name = f"{name} at {rate:g} fps"
         else:
             raise ParameterError(
                 f"start must be a Motion or a training take's index, got {type(start).__name__}"
             )
         n = motion.n_frames
-        if (
-            isinstance(frame, bool)
-            or not isinstance(frame, (int, np.integer))
-            or not -n <= frame < n
-        ):
-            raise ParameterError(
-                f"{name}: start frame {frame} is outside its {n} frames (0 to {n - 1})"
-            )
+        _frame_in(frame, n, name)
         return motion, int(frame) % n, name
 
     def _past_reference(self, start: Motion | int, f: int, name: str) -> tuple[int, list]:
@@ -427,6 +431,14 @@ class MotionGraphSynth:
             path=path,
             start={"take": name, "frame": f, "latent": x0.tolist()},
             notes=notes,
+        )
+
+
+def _frame_in(frame, n: int, name: str) -> None:
+    """Refuse a start frame that is not a whole number within a take's ``n`` frames."""
+    if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) or not -n <= frame < n:
+        raise ParameterError(
+            f"{name}: start frame {frame} is outside its {n} frames (0 to {n - 1})"
         )
 
 
