@@ -721,6 +721,29 @@ def test_latent_fit_default_step_trains_near_30_fps(monkeypatch, takes, tmp_path
     assert frames(slow, "--step", "2") == [(19, 15.0)]
 
 
+def test_latent_fit_fps_reaches_the_takes(monkeypatch, tmp_path):
+    """--fps: an AMC take (no rate of its own) read at it, once for all or once per take;
+    the step to about 30 fps follows (60 fps: every 2nd frame)."""
+    amcs = []
+    for s, name in ((0, "a_01.amc"), (1, "b_01.amc")):
+        m = cc.datasets.make_periodic_capture(kind="walk", n_frames=160, period=60,
+                                              random_state=s).motion
+        cc.save(m, tmp_path / name)
+        amcs.append(str(tmp_path / name))
+
+    def got(*extra):
+        fit = Spy(monkeypatch, "cyclecoord.synthesis.latent.model.LatentModel.fit")
+        with pytest.raises(Reached):
+            main(["latent", "fit", *amcs, "-o", str(tmp_path / "m.npz"), *extra])
+        return [(m.n_frames, m.fps) for m in fit.args[1]]
+
+    assert got() == [(40, 30.0), (40, 30.0)]
+    assert got("--fps", "60") == [(80, 30.0), (80, 30.0)]
+    assert got("--fps", "120", "--fps", "60") == [(40, 30.0), (80, 30.0)]
+    assert main(["latent", "fit", *amcs, "-o", str(tmp_path / "m.npz"), "--fps", "60",
+                 "--fps", "60", "--fps", "60"]) == 1
+
+
 def test_latent_fit_no_progress_reaches_fit(monkeypatch, takes, tmp_path):
     def progress(*extra):
         fit = Spy(monkeypatch, "cyclecoord.synthesis.latent.model.LatentModel.fit")

@@ -159,6 +159,7 @@ WIRED: dict[str, dict[str, str | tuple[str, ...]]] = {
         **dict.fromkeys(("--dims", "--variance", "--step", "--max-iter"), LATENT),
         **dict.fromkeys(("-o", "--report"), W + "test_latent_fit_writes_the_model_and_the_report"),
         "--no-progress": W + "test_latent_fit_no_progress_reaches_fit",
+        "--fps": W + "test_latent_fit_fps_reaches_the_takes",
         "--step": (LATENT, W + "test_latent_fit_default_step_trains_near_30_fps"),
     },
     "animate": {

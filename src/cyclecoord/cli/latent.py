@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ._options import add_memory_option
+from ._options import add_memory_option, positive_float
 from ._outputs import Outputs, declare
 
 __all__ = ["add_parser", "parse_take", "run"]
@@ -77,6 +77,14 @@ def add_parser(subparsers) -> None:
         help="keep every STEP-th frame (default: the step that brings each take nearest "
         "30 fps: 4 for CMU's 120 fps, 1 for a 30 fps BVH)",
     )
+    f.add_argument(
+        "--fps",
+        type=positive_float,
+        action="append",
+        metavar="F",
+        help="frame rate of the takes (AMC files carry none; default 120): once for every "
+        "take or once per take in order (subject 143's 143_01 jog is 60 fps)",
+    )
     f.add_argument("--max-iter", type=int, default=200, help="optimiser iterations (default 200)")
     f.add_argument("--report", metavar="R.json", help="also write the model's summary as JSON")
     f.add_argument("--no-progress", action="store_true",
@@ -130,11 +138,14 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError(f"{target}: folder {folder} does not exist")
     from ..rig import analysis_motion, describe_rig, normalize_rig
 
+    from .blend import _per_input
+
     segments, names = [], []
     rig_lines: list[str] = []
-    for i, text in enumerate(args.takes):
+    rates = _per_input(getattr(args, "fps", None), len(args.takes), "--fps")
+    for i, (text, rate) in enumerate(zip(args.takes, rates)):
         path, a, b, name = parse_take(text)
-        motion = load(path).window((a, b))
+        motion = load(path, fps=rate).window((a, b))
         if i == 0 and motion.skeleton is not None:
             info = describe_rig(motion)
             changes = normalize_rig(motion, info, drop_reference=False)[1].changes()
