@@ -863,6 +863,31 @@ def test_a_mixed_reference_weights_each_models_figures_by_the_frames_it_made():
     assert odd.knee_range_legs == () and odd.hip_range_legs == pytest.approx((2.5, 5.0))
 
 
+def test_lead_lines_with_shares_judge_each_source_by_its_share():
+    """A blend's weights or a transition's frames of each cycle: the motion is judged
+    against each source's own figures mixed by those shares (pooled, a walk-to-jog
+    transition's jog read against the walk's slip as gliding); one share of 0 leaves the
+    other source's figures alone."""
+    import cyclecoord as cc
+    from cyclecoord.quality.generated import lead_lines, mixed_reference, source_figures
+
+    walk = cc.datasets.make_periodic_capture(kind="walk", n_frames=480, period=120,
+                                             random_state=0).motion[::4]
+    jog = cc.datasets.make_periodic_capture(kind="jog", n_frames=320, period=80,
+                                            random_state=1).motion[::4]
+    only_walk, _ = lead_lines(jog, [walk, jog], shares=[1.0, 0.0])
+    alone, _ = lead_lines(jog, [walk])
+    assert only_walk["sources_support_slip_m_per_s"] == alone["sources_support_slip_m_per_s"]
+    mixed, _ = lead_lines(jog, [walk, jog], shares=[3.0, 1.0])
+    want = mixed_reference([(source_figures([walk], jog.fps), 3.0),
+                            (source_figures([jog], jog.fps), 1.0)])
+    assert mixed["sources_support_slip_m_per_s"] == pytest.approx(
+        want.support_slip * want.metres)
+    pooled, _ = lead_lines(jog, [walk, jog])
+    assert pooled["sources_support_slip_m_per_s"] != pytest.approx(
+        mixed["sources_support_slip_m_per_s"])
+
+
 def test_a_source_that_stands_before_it_walks_is_judged_by_its_walk():
     """The sources' root speed, support foot, pose speeds and accelerations are theirs
     while they move: the synthetic walk with 6 s of standing before it (more than half

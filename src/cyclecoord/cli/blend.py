@@ -304,7 +304,7 @@ def cmd_blend(args: argparse.Namespace) -> int:
         align_heading=not args.no_heading,
         up=args.up,
     )
-    quality = _lead(out, cycles, args.feet)
+    quality = _lead(out, cycles, args.feet, shares=out.metadata["blend"]["weights"])
     info = out.metadata["blend"]
     for i, al in enumerate(info["alignments"][1:], start=1):
         rev = ", reversed" if al["reversed"] else ""
@@ -374,14 +374,15 @@ def figures_line(s: dict) -> str:
 
 
 def _lead(
-    motion, sources: list, feet: str | None = None, reference=None
+    motion, sources: list, feet: str | None = None, reference=None, shares=None
 ) -> dict | None:
     """Print the measure of generated motion against ``sources`` (or their figures
-    ``reference``; the console's first lines) and return its report dict (None when it
-    cannot be measured)."""
+    ``reference``, or each source's mixed by ``shares``; the console's first lines) and
+    return its report dict (None when it cannot be measured)."""
     from ..quality.generated import lead_lines
 
-    quality, lines = lead_lines(motion, sources, feet=feet or None, reference=reference)
+    quality, lines = lead_lines(motion, sources, feet=feet or None, reference=reference,
+                                shares=shares)
     for line in lines:
         print(line)
     return quality
@@ -429,7 +430,8 @@ def cmd_transition(args: argparse.Namespace) -> int:
         align_heading=not args.no_heading,
         up=args.up,
     )
-    quality = _lead(clip, [a, b], args.feet)
+    w = clip.metadata["transition"]["weight"]
+    quality = _lead(clip, [a, b], args.feet, shares=[sum(1 - v for v in w), sum(w)])
     info = clip.metadata["transition"]
     al = info["alignment"]
     cont = info["continuity"]

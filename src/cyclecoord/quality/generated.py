@@ -607,16 +607,26 @@ def lead_lines(
     hold: np.ndarray | None = None,
     reference: SourceFigures | None = None,
     analysed: bool = False,
+    shares: Sequence[float] | None = None,
 ) -> tuple[dict | None, list[str]]:
     """The measure as a report dict and the console lines that lead a command's output;
     ``(None, [why])`` when it cannot be measured (no skeleton, no legs found).
-    Parameters as :func:`measure_generated`'s."""
+    Parameters as :func:`measure_generated`'s; ``shares``, one per source: how much of
+    the motion each source makes (a blend's weights, a transition's frames of each
+    cycle), so the motion is judged against each source's own figures mixed so
+    (:func:`mixed_reference`; pooled, a walk-to-jog transition read the jog's slip
+    against the walk's)."""
     from ..errors import CycleCoordError
     from .legs import resolve_feet
 
     try:
         if isinstance(feet, str):
             feet = resolve_feet(motion.skeleton, feet)
+        if reference is None and shares is not None and len(sources) > 1:
+            cache: dict = {}
+            parts = [(source_figures([src], motion.fps, feet, analysed=analysed, cache=cache),
+                      float(w)) for src, w in zip(sources, shares) if w > 0]
+            reference = parts[0][0] if len(parts) == 1 else mixed_reference(parts)
         q = measure_generated(motion, sources, feet=feet, hold=hold, reference=reference,
                               analysed=analysed)
     except CycleCoordError as exc:

@@ -26,6 +26,7 @@ from ..skeleton import Skeleton
 
 __all__ = [
     "Proportions",
+    "leg_scale",
     "onto_skeleton",
     "proportions_differ",
     "same_rig",
@@ -79,6 +80,15 @@ def _legs(skel: Skeleton, motion: Motion) -> float:
         return leg_length(skel, find_feet(skel, motion))
     except ParameterError:
         return skel.total_length()
+
+
+def leg_scale(motion: Motion, target: Motion) -> float:
+    """``target``'s leg length over ``motion``'s (each skeleton's summed bone length where
+    its feet cannot be found): what ``motion``'s travel and hip height are scaled by to
+    fit ``target``'s legs."""
+    if motion.skeleton is None or target.skeleton is None:
+        raise ParameterError("scaling travel between actors needs both skeletons")
+    return _legs(target.skeleton, target) / _legs(motion.skeleton, motion)
 
 
 @dataclass(frozen=True)
@@ -138,7 +148,7 @@ def onto_skeleton(motion: Motion, target: Motion) -> tuple[Motion, Proportions]:
             f"{motion.source or 'this take'}: its channels differ from "
             f"{target.source or 'the target'}'s"
         )
-    scale = _legs(dst, target) / _legs(src, motion)
+    scale = leg_scale(motion, target)
     frames = np.array(motion.frames, dtype=float)
     tol = TOLERANCE * max(dst.total_length(), 1e-9)
     for i, (_, dof) in enumerate(motion.channels):
