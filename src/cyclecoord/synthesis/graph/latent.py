@@ -42,13 +42,6 @@ def _ordinal(k: int) -> str:
     return f"{k}{'nd' if k == 2 else 'rd' if k == 3 else 'th'}"
 
 
-def every_kth(motion: Motion, k: int) -> Motion:
-    """Every ``k``-th frame of a take, at ``fps / k``; the metadata records ``k`` (a start
-    frame given in the take's own frames is divided by it)."""
-    out = motion.with_frames(motion.frames[::k], fps=motion.fps / k)
-    return out.with_frames(out.frames, metadata={**motion.metadata, "frame_step": k})
-
-
 def _short(m: Motion, i: int) -> str:
     return m.source.replace("\\", "/").rsplit("/", 1)[-1] if m.source else f"take {i}"
 
@@ -62,8 +55,8 @@ def check_takes(
     take's rig worn by another actor (other bone lengths) is put on the first take's
     skeleton (:func:`cyclecoord.rig.retarget.onto_skeleton`: rotations kept, travel
     scaled by the legs' ratio), and a take whose rate is a whole multiple of the slowest
-    take's (CMU's 120 fps beside a 60 fps take) has every k-th frame taken
-    (:func:`every_kth`).  Without ``notes`` such takes are refused.
+    take's (CMU's 120 fps beside a 60 fps take) has every k-th frame taken.  Without
+    ``notes`` such takes are refused.
 
     Raises
     ------
@@ -124,7 +117,7 @@ def check_takes(
                 f"{slowest:g} fps; resample first"
                 + ("" if notes is None or k < 2 else " (not a whole multiple of the rate)")
             )
-        takes[i] = every_kth(m, k)
+        takes[i] = m[::k]
         notes.append(
             f"{_short(m, i)}: {m.fps:g} fps, every {_ordinal(k)} frame taken "
             f"({slowest:g} fps, the slowest take's rate)"

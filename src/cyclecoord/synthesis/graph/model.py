@@ -315,14 +315,19 @@ class MotionGraphSynth:
                 + " | ".join("+".join(self.names_[i] for i in m) for m in self.gaits_)
             )
 
-    def _gait_weights(self, path: GraphPath) -> np.ndarray:
-        """Per path step, its neighbours' weight per gait ``(T, G)``, rows summing to 1."""
+    def _step_takes(self, path: GraphPath) -> np.ndarray:
+        """Per path step, its neighbours' weight on each training take ``(T, n_takes)``."""
         nb = np.asarray(path.neighbours)
         w = np.where(nb >= 0, np.asarray(path.weights, dtype=float), 0.0)
-        gait = self.take_gait_[self.graph_.take[np.where(nb >= 0, nb, 0)]]
-        out = np.zeros((nb.shape[0], len(self.gaits_)))
-        for g in range(len(self.gaits_)):
-            out[:, g] = (w * (gait == g)).sum(axis=1)
+        take = self.graph_.take[np.where(nb >= 0, nb, 0)]
+        out = np.zeros((nb.shape[0], len(self.takes_)))
+        np.add.at(out, (np.arange(nb.shape[0])[:, None], take), w)
+        return out
+
+    def _gait_weights(self, path: GraphPath) -> np.ndarray:
+        """Per path step, its neighbours' weight per gait ``(T, G)``, rows summing to 1."""
+        per_take = self._step_takes(path)
+        out = np.stack([per_take[:, g].sum(axis=1) for g in self.gaits_], axis=1)
         total = out.sum(axis=1, keepdims=True)
         return np.where(total > 0, out / np.where(total > 0, total, 1.0), 1.0 / out.shape[1])
 
@@ -330,10 +335,7 @@ class MotionGraphSynth:
         """How much a path draws on each training take ``(n_takes,)``, summing to 1: its
         neighbours' weights per take, over its steps.  A graph of a walk and a jog that
         jogged is judged against the jog (:meth:`reference`)."""
-        nb = np.asarray(path.neighbours)
-        w = np.where(nb >= 0, np.asarray(path.weights, dtype=float), 0.0)
-        take = self.graph_.take[np.where(nb >= 0, nb, 0)]
-        shares = np.bincount(take.ravel(), weights=w.ravel(), minlength=len(self.takes_))
+        shares = self._step_takes(path).sum(axis=0)
         total = shares.sum()
         return shares / total if total > 0 else np.full(len(self.takes_), 1 / len(self.takes_))
 
