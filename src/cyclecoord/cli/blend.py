@@ -334,7 +334,8 @@ def cmd_blend(args: argparse.Namespace) -> int:
         ],
         "weights": info["weights"],
         "output": dict(s, path=args.output),
-        "root_displacement": out.metadata["root_displacement"],
+        "root_displacement": out.metadata.get(
+            "root_displacement", out.metadata.get("travel_displacement")),
         "foot_skating": skating,
         "blend": info,
     }
