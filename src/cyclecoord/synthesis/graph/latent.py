@@ -111,9 +111,9 @@ def check_takes(
             continue
         k = int(round(m.fps / slowest))
         if notes is None or k < 2 or abs(m.fps / k - slowest) > 0.01 * slowest:
-            other = next(t for t in takes if abs(t.fps - slowest) <= 1e-9)
+            j = next(j for j, t in enumerate(takes) if abs(t.fps - slowest) <= 1e-9)
             raise ParameterError(
-                f"{_name(m, i)}: {m.fps:g} fps, {_name(other, takes.index(other))} "
+                f"{_name(m, i)}: {m.fps:g} fps, {_name(takes[j], j)} "
                 f"{slowest:g} fps; resample first"
                 + ("" if notes is None or k < 2 else " (not a whole multiple of the rate)")
             )
