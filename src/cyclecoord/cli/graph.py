@@ -45,7 +45,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "inputs",
         nargs="+",
         metavar="TRAIN",
-        help="training takes (one skeleton); 'crossval' first for the table",
+        help="training takes of one rig (other actors are put on the first take's skeleton, "
+        "a line says so); 'crossval' first for the table",
     )
     p.add_argument(
         "--method",

@@ -402,7 +402,7 @@ def cross_validate(
     Parameters
     ----------
     motions : sequence of Motion
-        At least 3 takes of one skeleton.
+        At least 3 takes of one rig (another actor's put on the first's skeleton).
     methods : sequence of str
         ``"delaunay"``, ``"knn"``, ``"union"``, each optionally with the field options
         ``+ring`` and ``+agree`` (:func:`~.field.parse_variant`); one graph per fold
