@@ -516,3 +516,22 @@ def test_a_static_root_rig_blends_and_transitions_as_the_plain_one(walk, jog):
         if "blend" in got.metadata:  # the hips' per-loop travel
             assert got.metadata["travel_displacement"] == pytest.approx(
                 want.metadata["root_displacement"], abs=1e-6)
+
+
+def test_a_z_up_rig_blends_as_its_y_up_original(walk, jog):
+    """A Z-up rig is blended in its analysis form (Y up) whatever ``up`` names: the joints
+    land where the Y-up rig's result puts them, turned to Z up."""
+    from _rigs import turn_root
+
+    from cyclecoord.conventions import to_bvh_convention
+    from cyclecoord.rig import Z_TO_Y
+
+    plain = [replace(to_bvh_convention(m, "ZXY"), fps=30.0) for m, _ in (walk, jog)]
+    zup = [turn_root(m, Z_TO_Y.T) for m in plain]
+    want = blend(plain, [0.5, 0.5]).positions()
+    for up in ("z", "y"):
+        got = blend(zup, [0.5, 0.5], up=up)
+        assert got.channels == zup[0].channels
+        pos = got.positions()
+        err = max(np.abs(pos[n] @ Z_TO_Y.T - want[n]).max() for n in want.names)
+        assert err * cc.rig.metres_per_unit(got) < 1e-3, (up, err)

@@ -243,6 +243,7 @@ def blend(
         )
     motions = [cycle_of(m, f"cycle {i}") for i, m in enumerate(cycles)]
     motions, rig = _analysis_cycles(motions)
+    up = _analysis_up(rig, up)
     w = _check_weights(weights, len(motions))
     if n_frames is not None and (
         isinstance(n_frames, bool) or not isinstance(n_frames, Integral) or n_frames < 4
@@ -333,6 +334,14 @@ def _analysis_cycles(motions: list[Motion]) -> tuple[list[Motion], Any]:
     if first.identity or any(a.changes() != first.changes() for _, a in done[1:]):
         return motions, None
     return [m for m, _ in done], first
+
+
+def _analysis_up(rig: Any, up: str) -> str:
+    """The vertical axis in the analysis rig: Y where :func:`~cyclecoord.rig.normalize_rig`
+    turned a Z-up rig Y-up (``up`` names the inputs' own), else ``up``."""
+    if rig is not None and not np.array_equal(rig.up_rotation, np.eye(3)):
+        return "y"
+    return up
 
 
 def _restored(out: Motion, rig: Any) -> Motion:
@@ -564,6 +573,7 @@ def transition(
         For bad lengths, cycles with different channels or too few frames.
     """
     (a, b), rig = _analysis_cycles([cycle_of(a, "cycle a"), cycle_of(b, "cycle b")])
+    up = _analysis_up(rig, up)
     if (frames is None) == (cycles is None):
         raise ParameterError("give exactly one of frames= and cycles= for the transition's length")
     for name, v in (("lead_in", lead_in), ("lead_out", lead_out)):
