@@ -58,7 +58,8 @@ def test_blend_writes_a_loop_and_a_report(cycles, tmp_path, capsys):
     assert walk_sk["skating_frames"] == skating_report(cc.load(walk))["skating_frames"] > 0
     line = [ln for ln in stdout.splitlines() if "foot skating" in ln]
     assert len(line) == 1 and line[0].startswith("blend foot skating: ")
-    assert f"(inputs: {walk_sk['skating_frames']}, " in line[0]
+    share = f"{100 * walk_sk['skating_fraction']:.0f}%"
+    assert f"(inputs: {walk_sk['skating_frames']} ({share}), " in line[0]
 
 
 @pytest.mark.parametrize(
