@@ -219,7 +219,7 @@ def common_frame(
 
 
 def _chart_order(m: Motion, up: int) -> str:
-    """The heading-first Euler order (the up axis first: ``"YZX"`` for Y up) in which the
+    """The heading-first Euler order (the up axis first: ``"YXZ"`` for Y up) in which the
     root's rotation is curved, or ``""`` for a root without three rotation channels.
 
     The curves extrapolate a cycle's root channels linearly from loop to loop (its turn
@@ -305,13 +305,14 @@ def _from_chart(
 def _with_next_frame(cycle: Motion, up: int = 1) -> Motion:
     """The cycle with one more frame: the next loop's first (root moved by its drift).
 
-    The root's rotation drifts in the heading-first chart (:func:`_chart_order`): per
+    Where the drift is not known (``metadata["root_displacement"]``, exact), the root's
+    rotation drift is estimated in the heading-first chart (:func:`_chart_order`): per
     Euler channel, near the middle angle's 90 degrees, the estimate of the next loop's
     rotation was off by degrees (subject 143's jog, facing along X)."""
     nxt = np.array(cycle.frames[:1], dtype=float)
     root = root_columns(cycle)
     if root.size:
-        chart = _chart_order(cycle, up)
+        chart = "" if "root_displacement" in cycle.metadata else _chart_order(cycle, up)
         if chart:
             charted = cycle.with_frames(_to_chart(cycle, chart))
             nxt[0, root] = charted.frames[0, root] + root_drift(charted)
