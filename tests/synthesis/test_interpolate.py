@@ -535,3 +535,18 @@ def test_a_z_up_rig_blends_as_its_y_up_original(walk, jog):
         pos = got.positions()
         err = max(np.abs(pos[n] @ Z_TO_Y.T - want[n]).max() for n in want.names)
         assert err * cc.rig.metres_per_unit(got) < 1e-3, (up, err)
+
+
+def test_a_blend_of_opposed_travels_says_its_strides_cancel(walk, jog):
+    """A walk forwards and the same walk backwards: the blend notes that they travel half
+    a turn apart (the Bandai walk and backward walk blended stepped nearly in place, feet
+    gliding 0.24 m/s); a walk and a jog going the same way get no such note."""
+    (w, _), (j, _) = walk, jog
+    back = blend([w, played_backwards(w)], [0.5, 0.5])
+    said = [n for n in back.metadata["blend"]["notes"] if "travel" in n]
+    assert said and "180 degrees apart" in said[0]
+    assert not [n for n in blend([w, j], [0.5, 0.5]).metadata["blend"]["notes"]
+                if "apart" in n]
+    # a weight of 0 leaves that cycle out
+    assert not [n for n in blend([w, played_backwards(w)], [1.0, 0.0]).metadata["blend"]["notes"]
+                if "apart" in n]
