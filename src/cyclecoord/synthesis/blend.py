@@ -314,7 +314,7 @@ def blend(
 
 
 def _opposed_travel(prep: Prepared, weights) -> list[str]:
-    """A note when two weighted cycles travel over half a turn apart in their headings'
+    """A note when two weighted cycles travel over 90 degrees apart in their headings'
     frames (a walk forwards and one backwards): their strides cancel in the blend, which
     steps nearly in place while its feet slide (the Bandai walk and backward walk at 0.5
     each: root 0.27 m/s, support foot 0.24 m/s against their 0.02-0.03)."""
