@@ -1367,3 +1367,18 @@ def test_a_stands_legs_keep_a_share_of_the_sway(models):
                                            np.concatenate([i for i, _ in balls])))
     assert np.allclose(held[late][:, hinge] - angles[a, hinge],
                        STAND_LEG_SWAY * (angles[late][:, hinge] - angles[a, hinge]))
+
+
+def test_an_idle_between_several_poses_keeps_its_legs_moving(models):
+    """An IDLE at several poses moves between them on purpose (a jumping jack's legs):
+    its legs are not held as a stand's are."""
+    syn = Synthesizer(models, fps=30, seed=1)
+    syn.start("walk", {"frame": 0})
+    syn.command += 1
+    syn.idle(at=[{"frame": 0}, {"frame": 40}], duration=2.0, hover=0.5)
+    assert syn.held and not syn.stands
+    angles, _ = syn._posed()
+    assert np.array_equal(syn._stand_legs(angles), angles)
+    syn.command += 1
+    syn.idle(duration=1.0)
+    assert syn.stands == syn.held[-1:]

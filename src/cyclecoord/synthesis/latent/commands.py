@@ -262,6 +262,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self.sim_cpu_seconds = 0.0
         self.clamped = {"values": 0, "max_deg": 0.0}
         self.held: list[tuple[int, int]] = []  # frame ranges of IDLE commands
+        self.stands: list[tuple[int, int]] = []  # those of IDLEs at one pose (legs held)
         self.notes: list[str] = []
         # check_plausibility's cache: the motion is checked up to seven times against
         # the same training takes (limbs kept apart, each round of foot pinning, report)
@@ -640,6 +641,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             self._idle(points, end, radius, hover, sway)
         finally:
             self.held.append((first, self.n_frames))
+            if len(points) == 1:  # (between several poses the legs move on purpose)
+                self.stands.append((first, self.n_frames))
 
     def _idle(self, points, end: float, radius, hover: float, sway: float = 1.0) -> None:
         duration = end - self.t

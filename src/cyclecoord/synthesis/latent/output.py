@@ -234,15 +234,16 @@ class OutputMixin:
         )
 
     def _stand_legs(self, angles: np.ndarray) -> np.ndarray:
-        """``angles`` ``(T, C)`` with each IDLE's legs held near their pose where it
-        began: each leg joint's rotation keeps :data:`STAND_LEG_SWAY` of its turn away
+        """``angles`` ``(T, C)`` with the legs of each IDLE at one pose (a stand; an IDLE
+        moving between several poses moves its legs on purpose) held near their pose where
+        it began: each leg joint's rotation keeps :data:`STAND_LEG_SWAY` of its turn away
         from that pose, easing in over the stand's first
         :data:`~cyclecoord.synthesis.carry.STAND_AFTER` s (and out over its last as
         long when frames follow).  The particle's sway moves the whole pose; in the legs
         it lifted a heel and then the foot of a standing figure (subject 35's walk model,
         a foot 10 cm up for the last second of 5 of 12 stops), which the pins, asked no
         lower than the toe end on the floor allows, held up."""
-        if not self.held:
+        if not self.stands:
             return angles
         from scipy.spatial.transform import Rotation
 
@@ -256,7 +257,7 @@ class OutputMixin:
         T = angles.shape[0]
         n = max(1, int(round(STAND_AFTER * self.fps)))
         keep = np.ones(T)
-        for a, b in self.held:
+        for a, b in self.stands:
             b = min(b, T)
             if b - a < 2:
                 continue
@@ -272,7 +273,7 @@ class OutputMixin:
         cols = np.flatnonzero(legs)
         balls = [(idx, order) for idx, order in first.rotation_columns() if legs[idx].all()]
         cache = self.__dict__.setdefault("_stand_cache", {})  # (untangling poses again)
-        for a, b in self.held:
+        for a, b in self.stands:
             b = min(b, T)
             if b - a < 2:
                 continue
