@@ -41,7 +41,7 @@ from ..quality.contacts import (
 )
 from ..skeleton import Skeleton, _mix
 
-__all__ = ["FootLockResult", "lock_feet", "pin_feet"]
+__all__ = ["FootLockResult", "leg_chain", "lock_feet", "pin_feet"]
 
 #: Weight of the change of the leg's angles (per radian) relative to target errors (per leg
 #: length): small enough that locks hold to about 1e-3 leg lengths even where the leg is
@@ -325,6 +325,22 @@ def _chain(skel: Skeleton, ankle: int, deepest: int) -> list[int]:
     return list(reversed(path[: path.index(thigh) + 1]))
 
 
+def leg_chain(skel: Skeleton, points: list[int]) -> tuple[list[int], list[int]]:
+    """The IK chain of one leg whose foot points are the joints ``points`` (from the thigh
+    down to the deepest point's parent, :func:`_chain`) and the points' order from the
+    least deep (the ankle) to the deepest (the toe)."""
+    depth = []
+    for p in points:
+        d, j = 0, p
+        while skel.joints[j].parent >= 0 and d <= len(skel.joints):
+            d += 1
+            j = skel.joints[j].parent
+        depth.append(d)
+    order = sorted(range(len(points)), key=lambda k: (depth[k], k))
+    deepest = max(range(len(points)), key=lambda k: depth[k])  # (the first of equals)
+    return _chain(skel, points[order[0]], points[deepest]), order
+
+
 class _LegIK:
     """Forward kinematics of one leg chain as a function of its rotation channels, with
     the exact Jacobian of the foot points (each angle turns the points below its joint
@@ -549,15 +565,8 @@ def _lock_once(
     for leg in sorted(set(labels)):
         cols = [i for i, g in enumerate(labels) if g == leg]
         pts = [skel.index(contacts.feet[i]) for i in cols]
-        depth = {p: 0 for p in pts}
-        for p in pts:
-            j = p
-            while skel.joints[j].parent >= 0:
-                depth[p] += 1
-                j = skel.joints[j].parent
-        ankle = min(pts, key=lambda p: depth[p])
-        deepest = max(pts, key=lambda p: depth[p])
-        chain = _chain(skel, ankle, deepest)
+        chain, by_depth = leg_chain(skel, pts)
+        depth = {pts[k]: d for d, k in enumerate(by_depth)}
         ik = _LegIK(motion, chain, pts, wrot, wpos)
         T = motion.n_frames
         targets = wpos[:, pts].copy()

@@ -618,7 +618,29 @@ class OutputMixin:
             )
             self.notes.append(locked.line)
             out = locked.motion
+            if self.stands and feet is not None:
+                from ..stance import close_stands
+
+                done = close_stands(out, feet, self.stands, cycle=self._cycle_at(self.stands[0][0]),
+                                    bounds=channel_bounds(takes))
+                if done.line:
+                    self.notes.append(done.line)
+                out = done.motion
         return out
+
+    def _cycle_at(self, frame: int) -> float:
+        """The leg cycle (s) of the model that made the frame before ``frame`` (nan
+        without a gait)."""
+        start = 0
+        name = self.chunks[0].model
+        for c in self.chunks:
+            if start >= frame:
+                break
+            name, start = c.model, start + c.X.shape[0]
+        g = self.gait(name)
+        if not len(g.usable):
+            return float("nan")
+        return float(np.median(g.period[g.usable])) / self.models[name].fps_
 
     def _frame_acc99(self, n_frames: int) -> np.ndarray:
         """(T,) the training 99th percentile of joint acceleration of the model that posed

@@ -1,0 +1,325 @@
+"""A stand after a gait: the closing step that brings the feet together.
+
+A gait that comes to a stop does so at double support, the feet a stride apart; held
+there, a stand is a walk frozen mid-stride (on subject 35's walk model the ankles stood
+0.6 m apart along the travel for the whole IDLE after a MOVE).  People stopping take one
+more, shorter step: the trailing foot swings forward and sets down beside the leading one,
+and the pelvis comes over the middle of the feet.  :func:`close_stands` makes that step at
+the start of each stand, by the leg IK of :mod:`.footlock` (both legs, every frame of the
+stand, within the training takes' joint ranges), the root moved forward by half the gap
+and raised back to its mid-stance height.  A stand that more frames follow ends with the
+opening step: the leading foot steps out by the same gap and the rest of the motion is
+moved forward by it, so the next stride starts from where the feet now are.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import CycleCoordError
+from ..motion import Motion
+
+__all__ = ["STEP_CLEARANCE", "STEP_LIMITS", "StandOutcome", "close_stands"]
+
+#: Seconds the closing (and opening) step takes at the least and at the most: half the
+#: gait's leg cycle (one step) within these.
+STEP_LIMITS = (0.3, 0.5)
+#: Height the stepping foot clears the floor by, in leg lengths, at the step's middle.
+STEP_CLEARANCE = 0.06
+#: Feet closer than this along the travel (leg lengths) already stand together.
+TOGETHER = 0.12
+#: Weight of the toe's horizontal target against the ankle's (its height weighs 1).
+TOE_FREEDOM = 0.2
+#: A stand whose ankles miss their targets by more than this (leg lengths) after the IK
+#: (three times this for a foot in the air), or whose toes miss theirs by twice as much,
+#: keeps its stance.
+REACH_TOLERANCE = 0.02
+
+
+@dataclass(frozen=True)
+class StandOutcome:
+    """What :func:`close_stands` did.
+
+    Attributes
+    ----------
+    motion : Motion
+        The motion with the steps made (the input where none was).
+    closed : list of (int, int)
+        The stands (frame ranges) given a closing step.
+    kept : list of (int, str)
+        Stands left in their stance: first frame and why.
+    gaps : list of float
+        The feet's distance along the travel closed at each closed stand (leg lengths).
+    """
+
+    motion: Motion
+    closed: list[tuple[int, int]] = field(default_factory=list)
+    kept: list[tuple[int, str]] = field(default_factory=list)
+    gaps: list[float] = field(default_factory=list)
+
+    @property
+    def line(self) -> str:
+        """One console line, or "" when there was no stand after a stride."""
+        if not self.closed and not self.kept:
+            return ""
+        parts = []
+        if self.closed:
+            gaps = ", ".join(f"{g:.2f}" for g in self.gaps)
+            parts.append(f"{len(self.closed)} stand(s) closed the feet with one more step "
+                         f"(gap {gaps} leg lengths)")
+        for a, why in self.kept:
+            parts.append(f"the stand at frame {a} kept its stance ({why})")
+        return "stands: " + "; ".join(parts)
+
+
+def _ease(u: np.ndarray) -> np.ndarray:
+    u = np.clip(u, 0.0, 1.0)
+    return u * u * u * (u * (6.0 * u - 15.0) + 10.0)
+
+
+def _legs(motion: Motion, contacts) -> list[tuple[list[int], list[int], list[int]]]:
+    """Per leg: the contacts' columns, the foot points' joint indices (ankle first) and
+    the IK chain (:func:`.footlock.leg_chain`)."""
+    from .footlock import leg_chain
+
+    skel = motion.skeleton
+    out = []
+    for leg in dict.fromkeys(contacts.leg_labels):
+        cols = [i for i, g in enumerate(contacts.leg_labels) if g == leg]
+        pts = [skel.index(contacts.feet[i]) for i in cols]
+        chain, order = leg_chain(skel, pts)
+        out.append(([cols[k] for k in order], [pts[k] for k in order], chain))
+    return out
+
+
+def _channel_map(motion: Motion, cols: list[int]) -> np.ndarray:
+    """(3, 3): the root's world displacement per unit of each translation channel."""
+    base = motion.frames[:1]
+    probe = np.repeat(base, 4, axis=0)
+    for k, c in enumerate(cols):
+        probe[k + 1, c] += 1.0
+    p = motion.with_frames(probe).positions().positions[:, 0]
+    return (p[1:] - p[0]).T
+
+
+def close_stands(
+    motion: Motion,
+    feet: tuple[str, ...],
+    stands: list[tuple[int, int]],
+    *,
+    cycle: float,
+    bounds: tuple[np.ndarray, ...] | None = None,
+) -> StandOutcome:
+    """Close the feet of each stand that follows a stride (see the module's text).
+
+    Parameters
+    ----------
+    motion : Motion
+        A generated motion with a 6-channel root, its feet carried and pinned.
+    feet : tuple of str
+        Foot points, two per leg (:func:`~cyclecoord.quality.legs.find_feet`).
+    stands : list of (int, int)
+        Frame ranges ``[a, b)`` of the stands (IDLEs at one pose).
+    cycle : float
+        The gait's leg cycle (seconds) before the stands: a step takes half of it,
+        within :data:`STEP_LIMITS`.
+    bounds : tuple of ndarray, optional
+        Joint ranges the IK keeps to (:func:`~cyclecoord.synthesis.carry.channel_bounds`).
+
+    Returns
+    -------
+    StandOutcome
+    """
+    from ..periodic.root import root_layout
+    from ..quality.contacts import foot_contacts
+
+    layout = root_layout(motion)
+    if layout is None or not stands or motion.skeleton is None:
+        return StandOutcome(motion)
+    try:
+        contacts = foot_contacts(motion, feet)
+        legs = _legs(motion, contacts)
+    except CycleCoordError:
+        return StandOutcome(motion)
+    if len(legs) != 2 or any(len(pts) < 1 for _, pts, _ in legs):
+        return StandOutcome(motion)  # (a quadruped's stop is not a biped's closing step)
+    fps = motion.fps
+    span = 0.5 * cycle if np.isfinite(cycle) and cycle > 0 else STEP_LIMITS[1]
+    n_step = int(round(np.clip(span, *STEP_LIMITS) * fps))
+    out = motion
+    closed, kept, gaps = [], [], []
+    for a, b in sorted(stands):
+        b = min(b, out.n_frames)
+        got = _close_one(out, contacts, legs, layout, a, b, n_step, bounds)
+        if isinstance(got, str):
+            if got:
+                kept.append((a, got))
+            continue
+        out, gap = got
+        closed.append((a, b))
+        gaps.append(gap / contacts.leg_length)
+    return StandOutcome(out, closed, kept, gaps)
+
+
+def _close_one(motion, contacts, legs, layout, a, b, n_step, bounds):
+    """One stand's closing (and opening) step: ``(motion, gap)``, or why not ("" when
+    the stand does not follow a stride).  Worked out on the stand and the second and a
+    half before it; the frames after it are moved by what the feet stepped."""
+    before = int(round(0.5 * motion.fps))
+    follows = b < motion.n_frames
+    if a < before or b - a < n_step * (2 if follows else 1) + int(round(0.2 * motion.fps)):
+        return ""
+    w0 = max(0, a - 3 * before)
+    got = _close_part(motion[w0:b], contacts, legs, layout, a - w0, n_step, bounds, follows)
+    if isinstance(got, str):
+        return got
+    part, gap_len, move = got
+    frames = np.array(motion.frames, dtype=float)
+    frames[w0:b] = part.frames
+    if follows:
+        cols = [layout.column("t" + ax) for ax in "xyz"]
+        per = _channel_map(motion, cols)
+        frames[b:, cols] += np.linalg.lstsq(per, move, rcond=None)[0]
+    return motion.with_frames(frames), gap_len
+
+
+def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
+    """:func:`_close_one` on ``motion`` whose stand runs from ``a`` to its end:
+    ``(motion, gap, move)`` or why not."""
+    from .._kinematics import world_transforms
+    from .carry import STAND_AFTER
+    from .footlock import _box, _LegIK, _solve
+
+    T, fps, up = motion.n_frames, motion.fps, contacts.up
+    b = T
+    horiz = [k for k in range(3) if k != up]
+    before = int(round(0.5 * fps))
+    wpos, wrot = world_transforms(motion)
+    root = wpos[:, 0]
+    travel = np.zeros(3)
+    travel[horiz] = root[a, horiz] - root[max(0, a - 2 * before), horiz]
+    if np.linalg.norm(travel) < 0.1 * contacts.leg_length:
+        return ""  # (not stepping before the stand)
+    # where the feet stand once the stand has settled (the body still travels, easing to
+    # a stop, over its first STAND_AFTER s, and a run stopped in its flight lands there)
+    settled = min(a + int(round(STAND_AFTER * fps)), b - 1)
+    # forward: square to the hips, the way the body travelled (the root's last half
+    # second of a synthetic walk's stop swayed more sideways than it went on)
+    across = wpos[settled, legs[1][2][0]] - wpos[settled, legs[0][2][0]]
+    f = np.zeros(3)
+    f[horiz] = [-across[horiz[1]], across[horiz[0]]]
+    if np.linalg.norm(f) < 1e-9:
+        return ""
+    f *= np.sign(f @ travel) / np.linalg.norm(f)
+    ankles = [wpos[settled, pts[0]] for _, pts, _ in legs]
+    ahead = [float(p @ f) for p in ankles]
+    lead = int(np.argmax(ahead))
+    trail = 1 - lead
+    gap_len = ahead[lead] - ahead[trail]
+    if gap_len < TOGETHER * contacts.leg_length:
+        return ""  # already together
+    gap = gap_len * f
+    # side by side at least the hips' width apart, each foot on its own side (stepped
+    # straight forward, a narrow walk's trailing foot ran into the other shin)
+    side = np.zeros(3)
+    side[horiz] = [-f[horiz[1]], f[horiz[0]]]
+    hips = [float(wpos[settled, chain[0]] @ side) for _, _, chain in legs]
+    lat = float((ankles[trail] - ankles[lead]) @ side)
+    sign = np.sign(hips[trail] - hips[lead]) or np.sign(lat) or 1.0
+    wide = sign * max(abs(lat), abs(hips[trail] - hips[lead])) - lat
+    move = gap + wide * side  # what the trailing foot travels, and the motion after
+    # flat heights: each foot point's lowest (5th percentile) over the stride before
+    lo = max(0, a - 3 * before)
+    flat = {p: float(np.percentile(wpos[lo:a, p, up], 5)) for _, pts, _ in legs for p in pts}
+    t = np.arange(T)
+    close = _ease((t - a) / n_step)  # 0 -> 1 over the closing step
+    opening = _ease((t - (b - n_step)) / n_step) if follows else np.zeros(T)
+    # sideways the closing foot moves out early and the opening one in late: each passes
+    # the other leg beside it
+    close_side = _ease(2.0 * (t - a) / n_step)
+    opening_side = _ease(2.0 * (t - (b - n_step)) / n_step - 1.0) if follows else np.zeros(T)
+    settle = close * (1.0 - opening)  # heights flat and pelvis raised, then back
+    swing = np.sin(np.pi * np.clip((t - a) / n_step, 0, 1))
+    swing_out = np.sin(np.pi * np.clip((t - (b - n_step)) / n_step, 0, 1)) if follows else 0 * t
+    # the feet's targets (they do not depend on the root)
+    rows = np.arange(a, b)
+    targets = []
+    for k, (_, pts, _) in enumerate(legs):
+        own = wpos[rows][:, pts]  # (n, P, 3): where the foot is, eased to its stand
+        base = wpos[settled, pts][None]
+        if k == trail:
+            tg = own + close[rows, None, None] * (base + gap - own) + close_side[
+                rows, None, None] * (move - gap)
+            clear = swing[rows]
+        else:
+            tg = own + close[rows, None, None] * (base - own) + opening[
+                rows, None, None] * gap + opening_side[rows, None, None] * (move - gap)
+            clear = swing_out[rows]
+        for m, p in enumerate(pts):  # heights: eased to the flat foot's, the step's lift
+            y = own[:, m, up]
+            tg[:, m, up] = y + settle[rows] * (flat[p] - y) + (
+                STEP_CLEARANCE * contacts.leg_length * clear)
+        targets.append((tg, clear))
+    # the root: half the gap over the closing step, the other half over the opening one
+    # (and the rest of the motion by the whole gap), raised towards its mid-stance height
+    # as far as the legs reach (their longest hip-to-ankle span in the stride before)
+    world = (0.5 * close + 0.5 * opening)[:, None] * move[None, :]
+    rise = max(0.0, float(root[a - before : a, up].max() - root[a, up]))
+    world[:, up] += rise * settle
+    cols = [layout.column("t" + ax) for ax in "xyz"]
+    per = _channel_map(motion, cols)
+    frames = np.array(motion.frames, dtype=float)
+    frames[a:, cols] += np.linalg.lstsq(per, world[a:].T, rcond=None)[0].T
+    mpos, _ = world_transforms(motion.with_frames(frames))
+    over = np.zeros(rows.size)
+    for (_, pts, chain), (tg, _) in zip(legs, targets):
+        span = np.linalg.norm(wpos[lo:a, pts[0]] - wpos[lo:a, chain[0]], axis=1).max()
+        hip = mpos[rows, chain[0]]
+        flat_d = np.linalg.norm((tg[:, 0] - hip)[:, horiz], axis=1)
+        top = tg[:, 0, up] + np.sqrt(np.maximum((0.99 * span) ** 2 - flat_d**2, 0.0))
+        over = np.maximum(over, hip[:, up] - top)
+    if over.max() > 0:
+        from scipy.ndimage import gaussian_filter1d, maximum_filter1d
+
+        w = max(1, n_step // 4)
+        drop = gaussian_filter1d(maximum_filter1d(over, 2 * w + 1), w / 2.0, mode="nearest")
+        lower = np.zeros((T, 3))
+        lower[rows, up] = -np.maximum(drop, over)
+        frames[:, cols] += np.linalg.lstsq(per, lower.T, rcond=None)[0].T
+    moved = motion.with_frames(frames)
+    mpos, mrot = world_transforms(moved)
+    held = (rows >= a + n_step) & (rows < (b - n_step if follows else b))
+    worst = 0.0
+    for (_, pts, chain), (tg, clear) in zip(legs, targets):
+        ik = _LegIK(moved, chain, pts, mrot, mpos)
+        # the ankle is placed; the toe is asked for its flat height, its direction left a
+        # little free (the foot's pitch in the stride made it nearer the ankle)
+        wt = np.ones(tg.shape)
+        wt[:, 1:, horiz] = TOE_FREEDOM
+        q = _solve(ik, rows, tg, wt, contacts.leg_length, box=_box(ik, rows, bounds))
+        for v, (_, _, c) in enumerate(ik.vars):
+            frames[rows, c] = q[:, v]
+        got = ik.positions(q, rows)
+        miss = np.linalg.norm((got - tg) * (wt >= 1), axis=-1)
+        miss[:, 1:] *= 0.5  # (a toe within the ankle's range pitches the foot a little)
+        miss /= np.where(clear > 0.1, 3.0, 1.0)[:, None]  # (in the air, off its path a little)
+        worst = max(worst, float(miss.max()) / contacts.leg_length)
+        if held.any():
+            # between the steps the foot stays exactly where it landed: every point held
+            # (the toe's loose direction let the foot swivel a centimetre as the body
+            # swayed, read as a slide)
+            ik = _LegIK(moved.with_frames(frames), chain, pts, mrot, mpos)
+            at = got[np.argmax(held)]
+            sub = rows[held]
+            tg = np.repeat(at[None], sub.size, axis=0)
+            q = _solve(ik, sub, tg, np.ones(tg.shape), contacts.leg_length,
+                       box=_box(ik, sub, bounds))
+            for v, (_, _, c) in enumerate(ik.vars):
+                frames[sub, c] = q[:, v]
+            miss = np.linalg.norm(ik.positions(q, sub) - tg, axis=-1)
+            worst = max(worst, float(miss.max()) / contacts.leg_length)
+    if worst > REACH_TOLERANCE:
+        return f"the legs could not reach the closed stance: {worst:.2f} leg lengths short"
+    return motion.with_frames(frames), gap_len, move

@@ -1,0 +1,142 @@
+"""The closing step of a stand after a gait (``synthesis.stance``), on a synthetic walk and
+run: the feet end side by side, planted, without a pop; a stand that more frames follow
+steps out again into them; a stand not after a stride, or one the legs cannot reach, is
+left as it was and says why."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import cyclecoord as cc
+from cyclecoord.quality.contacts import foot_contacts
+from cyclecoord.quality.generated import measure_generated
+from cyclecoord.synthesis.latent import LatentModel, Synthesizer
+from cyclecoord.synthesis.latent.script import training_takes
+from cyclecoord.synthesis.stance import STEP_CLEARANCE, TOGETHER, close_stands
+
+
+def _model(kind, period, seed):
+    m = cc.datasets.make_periodic_capture(
+        kind=kind, n_frames=960, period=period, noise=0.3, speed_variation=0.1,
+        random_state=seed,
+    ).motion
+    return LatentModel(gplvm={"max_iter": 80}).fit([m[0:480:4], m[480:960:4]], ["a", "b"])
+
+
+@pytest.fixture(scope="module")
+def models():
+    return {"walk": _model("walk", 132, 0), "run": _model("jog", 84, 1)}
+
+
+def _stop(models, part, seed, then=0):
+    """A MOVE ahead that stops, IDLE 2 s, then ``then`` MOVEs ahead of 0.5 s."""
+    syn = Synthesizer(models, fps=30, seed=seed)
+    syn.start(part, {"frame": 0})
+    syn.command += 1
+    syn.move({"ahead": 1.0 + 0.07 * seed})
+    syn.command += 1
+    syn.idle(duration=2.0)
+    for _ in range(then):
+        syn.command += 1
+        syn.move({"ahead": 0.5}, stop=False)
+    return syn, syn.motion()
+
+
+def _gaps(motion, model, frames):
+    """Along and across the body (leg lengths): the ankles' horizontal distance along the
+    line square to the hips, and across it, on ``frames``."""
+    c = foot_contacts(model.training_motion())
+    J = motion.positions()
+    legs = list(dict.fromkeys(c.leg_labels))
+    ank = np.stack([J[c.feet[list(c.leg_labels).index(g)]][frames] for g in legs], axis=1)
+    hips = np.stack([J["lfemur"][frames], J["rfemur"][frames]], axis=1)
+    across = hips[:, 1] - hips[:, 0]
+    across[:, 1] = 0.0
+    across /= np.linalg.norm(across, axis=1, keepdims=True)
+    d = ank[:, 1] - ank[:, 0]
+    d[:, 1] = 0.0
+    side = np.abs(np.einsum("ta,ta->t", d, across))
+    along = np.linalg.norm(d - side[:, None] * across * np.sign(
+        np.einsum("ta,ta->t", d, across))[:, None], axis=1)
+    return along / c.leg_length, side / c.leg_length
+
+
+@pytest.mark.parametrize("part", ["walk", "run"])
+def test_a_stop_ends_with_the_feet_side_by_side(models, part):
+    """Stopped at double support a walk stood a stride apart for the whole IDLE (0.39-0.55
+    leg lengths along the body on this walk, 0.56-0.72 on subject 35's); the closing step
+    brings the trailing foot beside the other one, the hips' width apart."""
+    closed, along, apart = 0, [], []
+    for seed in range(6):
+        syn, motion = _stop(models, part, seed)
+        (a, b), = syn.stands
+        stands = [n for n in syn.notes if n.startswith("stands:")]
+        assert stands, syn.notes
+        if "closed the feet" not in stands[0]:
+            assert "kept its stance" in stands[0]
+            continue
+        closed += 1
+        g_along, g_side = _gaps(motion, models[part], np.arange(b - 30, b))
+        along.append(g_along.max())
+        apart.append(g_side.min())
+    assert closed >= 5
+    assert max(along) < TOGETHER, np.round(along, 3)
+    assert min(apart) > 0.05, np.round(apart, 3)  # side by side, not one on the other
+
+
+def test_the_closing_step_lifts_the_foot_and_leaves_it_planted(models):
+    """The trailing foot clears the floor on its way and then stays where it landed; the
+    stand's accelerations stay within the training takes' 99th percentile."""
+    syn, motion = _stop(models, "walk", 2)
+    (a, b), = syn.stands
+    c = foot_contacts(models["walk"].training_motion())
+    J = motion.positions()
+    legs = list(dict.fromkeys(c.leg_labels))
+    ank = np.stack([J[c.feet[list(c.leg_labels).index(g)]] for g in legs], axis=1)
+    travelled = np.linalg.norm(ank[b - 1] - ank[a], axis=1)
+    mover = int(np.argmax(travelled))
+    assert travelled[mover] > 0.3 * c.leg_length  # the trailing foot stepped up
+    # the other one stood (landing still at the stand's first frames: from where it lay)
+    assert travelled[1 - mover] < 0.1 * c.leg_length
+    assert np.linalg.norm(ank[b - 1, 1 - mover] - ank[a + 15, 1 - mover]) < 0.01 * c.leg_length
+    rise = ank[a : a + 15, mover, 1] - ank[b - 1, mover, 1]
+    assert rise.max() > 0.5 * STEP_CLEARANCE * c.leg_length
+    speed = np.linalg.norm(np.diff(ank[a + 16 : b][:, :, [0, 2]], axis=0), axis=-1) * 30
+    assert speed.max() * cc.rig.metres_per_unit(motion) < 0.02  # m/s: planted
+    q = measure_generated(motion[a:b], training_takes(models, ["walk"]))
+    assert q.largest_accel <= 1.0
+
+
+def test_a_stand_that_frames_follow_steps_out_into_them(models):
+    """An IDLE between two walks: the feet close, then the leading foot steps out by the
+    same gap and the walk goes on from there, without a jump at the stand's end."""
+    syn, motion = _stop(models, "walk", 1, then=3)
+    (a, b), = syn.stands
+    assert any("closed the feet" in n for n in syn.notes), syn.notes
+    g_along, _ = _gaps(motion, models["walk"], np.arange(a + 20, b - 20))
+    assert g_along.max() < TOGETHER
+    q = measure_generated(motion[a - 15 : b + 30], training_takes(models, ["walk"]))
+    assert q.largest_step <= 1.2 and q.largest_accel <= 1.2
+    assert q.longest_freeze_s <= 2.0  # (the stand itself was asked for)
+
+
+def test_stands_not_after_a_stride_or_out_of_reach_are_left_alone(models):
+    syn = Synthesizer(models, fps=30, seed=0)
+    syn.start("walk", {"frame": 0})
+    syn.command += 1
+    syn.idle(duration=2.0)  # a stand with no stride before it
+    motion = syn.motion()
+    feet = syn.feet_of(motion)
+    out = close_stands(motion, feet, syn.stands, cycle=1.1)
+    assert out.motion is motion and not out.closed and not out.kept and out.line == ""
+    assert not [n for n in syn.notes if n.startswith("stands:")]
+    # after a stride, with every leg angle held where it is: the legs cannot step
+    syn, _ = _stop(models, "walk", 0)
+    motion = syn._untangled()
+    frozen = (motion.frames.min(axis=0), motion.frames.min(axis=0))
+    out = close_stands(motion, feet, syn.stands, cycle=1.1, bounds=frozen)
+    assert out.motion is motion and not out.closed
+    (a, why), = out.kept
+    assert a == syn.stands[0][0] and "could not reach" in why
+    assert out.line.startswith(f"stands: the stand at frame {a} kept its stance")
