@@ -226,12 +226,13 @@ def stops(models: dict, d: Path, n: int = 12) -> None:
     """``MOVE ahead`` of 1.0-1.8 s that stops, then IDLE 2 s, along each gait (seeds 0 ..
     n - 1): legs over 5 cm up (the lower of ankle and toe joint over the training takes'
     contact level, forward kinematics, over the IDLE's last 1.2 s), feet sliding (the
-    fastest planted foot after 0.5 s over 0.1 m/s)."""
+    fastest planted foot after 0.5 s over 0.1 m/s), and how far apart the ankles stand
+    at the end (horizontal, leg lengths: a stride apart before the closing step)."""
     from cyclecoord.quality.contacts import foot_contacts
 
     for part in ("walk", "run"):
         c0 = foot_contacts(models[part].training_motion())
-        up, slid = [], []
+        up, slid, apart = [], [], []
         for k in range(n):
             spec = {"fps": 30, "seed": k, "models": {"walk": "walk.npz", "run": "run.npz"},
                     "start": {"model": part, "at": {"frame": 0}},
@@ -247,10 +248,15 @@ def stops(models: dict, d: Path, n: int = 12) -> None:
             low = np.stack([h[:, legs == g].min(1) for g in dict.fromkeys(legs)], 1)
             up.append(low.max() * cc.rig.metres_per_unit(motion))
             slid.append(planted_top_speed(motion, a + 15, b))
+            ankles = [J[c0.feet[list(legs).index(g)]][b - 1] for g in dict.fromkeys(legs)]
+            gap = ankles[1] - ankles[0]
+            gap[c0.up] = 0.0
+            apart.append(float(np.linalg.norm(gap)) / c0.leg_length)
         up, slid = np.array(up), np.array(slid)
         print(f"  stops    {part}: MOVE ahead 1.0-1.8 s then IDLE 2 s, {n} seeds: a leg over "
               f"5 cm up on {int((up > 0.05).sum())} (median {np.median(up):.3f} m), feet "
-              f"sliding over 0.1 m/s on {int((slid > 0.1).sum())}")
+              f"sliding over 0.1 m/s on {int((slid > 0.1).sum())}, ankles apart at the end "
+              f"{np.median(apart):.2f} leg lengths (median; largest {max(apart):.2f})")
 
 
 def planted_top_speed(motion, a: int, b: int) -> float:
