@@ -73,10 +73,13 @@ def test_a_stop_ends_with_the_feet_side_by_side(models, part):
         (a, b), = syn.stands
         stands = [n for n in syn.notes if n.startswith("stands:")]
         assert stands, syn.notes
-        if "closed the feet" not in stands[0]:
+        if "feet with one more step" not in stands[0]:
             assert "kept its stance" in stands[0]
             continue
         closed += 1
+        (entry,) = syn.stand_steps  # (the report's "stands")
+        assert entry["start"] == a and entry["stop"] == b and entry["closed"]
+        assert entry["gap"] > TOGETHER
         g_along, g_side = _gaps(motion, models[part], np.arange(b - 30, b))
         along.append(g_along.max())
         apart.append(g_side.min())
@@ -113,7 +116,7 @@ def test_a_stand_that_frames_follow_steps_out_into_them(models):
     same gap and the walk goes on from there, without a jump at the stand's end."""
     syn, motion = _stop(models, "walk", 1, then=3)
     (a, b), = syn.stands
-    assert any("closed the feet" in n for n in syn.notes), syn.notes
+    assert any("feet with one more step" in n for n in syn.notes), syn.notes
     g_along, _ = _gaps(motion, models["walk"], np.arange(a + 20, b - 20))
     assert g_along.max() < TOGETHER
     q = measure_generated(motion[a - 15 : b + 30], training_takes(models, ["walk"]))
@@ -140,6 +143,7 @@ def test_stands_not_after_a_stride_or_out_of_reach_are_left_alone(models):
     (a, why), = out.kept
     assert a == syn.stands[0][0] and "could not reach" in why
     assert out.line.startswith(f"stands: the stand at frame {a} kept its stance")
+    assert out.to_dict() == [{"start": a, "closed": False, "why": why}]
 
 
 def test_the_benchmark_reports_how_far_apart_a_stop_stands(models, tmp_path, capsys):

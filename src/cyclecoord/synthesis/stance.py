@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._words import plural
 from ..errors import CycleCoordError
 from ..motion import Motion
 
@@ -59,6 +60,14 @@ class StandOutcome:
     kept: list[tuple[int, str]] = field(default_factory=list)
     gaps: list[float] = field(default_factory=list)
 
+    def to_dict(self) -> list[dict]:
+        """One entry per stand after a stride, for JSON reports: ``start``, ``stop``,
+        ``closed`` and the ``gap`` closed (leg lengths) or ``why`` it was not."""
+        out = [{"start": int(a), "stop": int(b), "closed": True, "gap": float(g)}
+               for (a, b), g in zip(self.closed, self.gaps)]
+        out += [{"start": int(a), "closed": False, "why": why} for a, why in self.kept]
+        return sorted(out, key=lambda e: e["start"])
+
     @property
     def line(self) -> str:
         """One console line, or "" when there was no stand after a stride."""
@@ -67,8 +76,9 @@ class StandOutcome:
         parts = []
         if self.closed:
             gaps = ", ".join(f"{g:.2f}" for g in self.gaps)
-            parts.append(f"{len(self.closed)} stand(s) closed the feet with one more step "
-                         f"(gap {gaps} leg lengths)")
+            n = len(self.closed)
+            parts.append(f"{plural(n, 'stand')} closed {'its' if n == 1 else 'their'} feet "
+                         f"with one more step (gap {gaps} leg lengths)")
         for a, why in self.kept:
             parts.append(f"the stand at frame {a} kept its stance ({why})")
         return "stands: " + "; ".join(parts)

@@ -263,6 +263,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self.clamped = {"values": 0, "max_deg": 0.0}
         self.held: list[tuple[int, int]] = []  # frame ranges of IDLE commands
         self.stands: list[tuple[int, int]] = []  # those of IDLEs at one pose (legs held)
+        #: each stand after a stride: its closing step, or why none (:meth:`motion`)
+        self.stand_steps: list[dict] = []
         self.notes: list[str] = []
         # check_plausibility's cache: the motion is checked up to seven times against
         # the same training takes (limbs kept apart, each round of foot pinning, report)

@@ -625,6 +625,7 @@ class OutputMixin:
                                     bounds=channel_bounds(takes))
                 if done.line:
                     self.notes.append(done.line)
+                self.stand_steps = done.to_dict()
                 out = done.motion
         return out
 

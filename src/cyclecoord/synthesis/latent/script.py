@@ -562,6 +562,7 @@ def run_script(
         "transitions": syn.events,
         "clamped_to_training_range": syn.clamped,
         "foot_skating": skating_report(motion, feet=feet),
+        "stands": syn.stand_steps,
         "bridges": {f"{a}->{b}": br.to_dict() for (a, b), br in syn.bridges_found().items()},
         "timing": {
             "total_s": total,
