@@ -165,3 +165,27 @@ def test_the_benchmark_reports_how_far_apart_a_stop_stands(models, tmp_path, cap
     out = capsys.readouterr().out
     apart = [float(x) for x in re.findall(r"ankles apart at the end ([0-9.]+) leg lengths", out)]
     assert len(apart) == 2 and max(apart) < 0.35, out
+
+
+def test_a_step_that_crosses_limbs_is_not_taken(models, monkeypatch):
+    """Stepped straight forward, a narrow walk's trailing foot ran through the other
+    shin and ``animate`` refused the whole script; a step whose limbs come closer than
+    the training takes' is now left out, and the stand keeps its stance."""
+    import cyclecoord.synthesis.carry as carry
+
+    seen = []
+
+    def crossed(motion, references, cache=None, base=None, analysed=False):
+        seen.append(base is not None)
+        out = np.zeros(motion.n_frames, dtype=bool)
+        if base is not None:  # (the step's trial, checked against the motion it changes)
+            out[-10:] = True
+        return out
+
+    monkeypatch.setattr(carry, "_crossed", crossed)
+    syn, motion = _stop(models, "walk", 0)
+    (entry,) = syn.stand_steps
+    assert not entry["closed"] and "closer than the training takes" in entry["why"]
+    assert True in seen and False in seen
+    g_along, _ = _gaps(motion, models["walk"], np.arange(motion.n_frames - 30, motion.n_frames))
+    assert g_along.max() > TOGETHER  # the stride's stance, as it was

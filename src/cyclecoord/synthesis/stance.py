@@ -121,6 +121,9 @@ def close_stands(
     *,
     cycle: float,
     bounds: tuple[np.ndarray, ...] | None = None,
+    references: list[Motion] | None = None,
+    plausibility_cache: dict | None = None,
+    analysed: bool = False,
 ) -> StandOutcome:
     """Close the feet of each stand that follows a stride (see the module's text).
 
@@ -137,6 +140,14 @@ def close_stands(
         within :data:`STEP_LIMITS`.
     bounds : tuple of ndarray, optional
         Joint ranges the IK keeps to (:func:`~cyclecoord.synthesis.carry.channel_bounds`).
+    references : list of Motion, optional
+        The training takes: a step that brings two limbs closer than they ever come is
+        not taken (the stand keeps its stance).  Without them no limb is checked.
+    plausibility_cache : dict, optional
+        Shared with the caller's other checks of this motion
+        (:func:`~cyclecoord.quality.plausibility.check_plausibility`'s ``cache``).
+    analysed : bool, default False
+        ``motion`` and ``references`` are in the analysis rig (a latent model's are).
 
     Returns
     -------
@@ -167,6 +178,15 @@ def close_stands(
             if got:
                 kept.append((a, got))
             continue
+        if references:
+            from .carry import _crossed
+
+            before = _crossed(out, references, plausibility_cache, analysed=analysed)
+            after = _crossed(got[0], references, plausibility_cache, out, analysed=analysed)
+            if (after & ~before)[a:].any():
+                kept.append((a, "its step brought two limbs closer than the training takes "
+                                "ever do"))
+                continue
         out, gap = got
         closed.append((a, b))
         gaps.append(gap / contacts.leg_length)

@@ -621,8 +621,11 @@ class OutputMixin:
             if self.stands and feet is not None:
                 from ..stance import close_stands
 
-                done = close_stands(out, feet, self.stands, cycle=self._cycle_at(self.stands[0][0]),
-                                    bounds=channel_bounds(takes))
+                done = close_stands(
+                    out, feet, self.stands, cycle=self._cycle_at(self.stands[0][0]),
+                    bounds=channel_bounds(takes), references=takes,
+                    plausibility_cache=self._plausibility, analysed=True,
+                )
                 if done.line:
                     self.notes.append(done.line)
                 self.stand_steps = done.to_dict()
