@@ -328,22 +328,31 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
         # little free (the foot's pitch in the stride made it nearer the ankle)
         wt = np.ones(tg.shape)
         wt[:, 1:, horiz] = TOE_FREEDOM
-        q = _solve(ik, rows, tg, wt, contacts.leg_length, box=_box(ik, rows, bounds))
+        # the steps' frames (and the first held one); the held frames from that one's pose
+        first = int(np.argmax(held)) if held.any() else -1
+        moving = ~held
+        if first >= 0:
+            moving[first] = True
+        some = rows[moving]
+        q = _solve(ik, some, tg[moving], wt[moving], contacts.leg_length,
+                   box=_box(ik, some, bounds))
         for v, (_, _, c) in enumerate(ik.vars):
-            frames[rows, c] = q[:, v]
-        got = ik.positions(q, rows)
-        miss = np.linalg.norm((got - tg) * (wt >= 1), axis=-1)
+            frames[some, c] = q[:, v]
+        got = ik.positions(q, some)
+        miss = np.linalg.norm((got - tg[moving]) * (wt[moving] >= 1), axis=-1)
         miss[:, 1:] *= 0.5  # (a toe within the ankle's range pitches the foot a little)
-        miss /= np.where(clear > 0.1, 3.0, 1.0)[:, None]  # (in the air, off its path a little)
+        miss /= np.where(clear[moving] > 0.1, 3.0, 1.0)[:, None]  # (in the air, off its path)
         worst = max(worst, float(miss.max()) / contacts.leg_length)
-        if held.any():
+        if first >= 0:
             # between the steps the foot stays exactly where it landed: every point held
             # (the toe's loose direction let the foot swivel a centimetre as the body
-            # swayed, read as a slide)
-            ik = _LegIK(moved.with_frames(frames), chain, pts, mrot, mpos)
-            at = got[np.argmax(held)]
+            # swayed, read as a slide), solved from the landing's pose
+            k = int(np.flatnonzero(rows[moving] == rows[first])[0])
             sub = rows[held]
-            tg = np.repeat(at[None], sub.size, axis=0)
+            for v, (_, _, c) in enumerate(ik.vars):
+                frames[sub, c] = q[k, v]
+            ik = _LegIK(moved.with_frames(frames), chain, pts, mrot, mpos)
+            tg = np.repeat(got[k][None], sub.size, axis=0)
             q = _solve(ik, sub, tg, np.ones(tg.shape), contacts.leg_length,
                        box=_box(ik, sub, bounds))
             for v, (_, _, c) in enumerate(ik.vars):
