@@ -189,3 +189,22 @@ def test_a_step_that_crosses_limbs_is_not_taken(models, monkeypatch):
     assert True in seen and False in seen
     g_along, _ = _gaps(motion, models["walk"], np.arange(motion.n_frames - 30, motion.n_frames))
     assert g_along.max() > TOGETHER  # the stride's stance, as it was
+
+
+def test_idles_one_after_another_are_one_stand(models):
+    """Two IDLEs in a row close the feet once and do not step out between them."""
+    syn = Synthesizer(models, fps=30, seed=4)
+    syn.start("walk", {"frame": 0})
+    syn.command += 1
+    syn.move({"ahead": 1.2})
+    for _ in range(2):
+        syn.command += 1
+        syn.idle(duration=1.5)
+    motion = syn.motion()
+    assert len(syn.stands) == 2
+    (entry,) = syn.stand_steps
+    assert entry["closed"] and entry["start"] == syn.stands[0][0]
+    assert entry["stop"] == syn.stands[1][1]
+    g_along, _ = _gaps(motion, models["walk"], np.arange(syn.stands[0][1] - 10,
+                                                         syn.stands[1][0] + 10))
+    assert g_along.max() < TOGETHER  # no step out and back in between

@@ -169,9 +169,15 @@ def close_stands(
     fps = motion.fps
     span = 0.5 * cycle if np.isfinite(cycle) and cycle > 0 else STEP_LIMITS[1]
     n_step = int(round(np.clip(span, *STEP_LIMITS) * fps))
+    merged: list[list[int]] = []  # (stands one after another are one stand)
+    for a, b in sorted(stands):
+        if merged and a <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], b)
+        else:
+            merged.append([a, b])
     out = motion
     closed, kept, gaps = [], [], []
-    for a, b in sorted(stands):
+    for a, b in merged:
         b = min(b, out.n_frames)
         got = _close_one(out, contacts, legs, layout, a, b, n_step, bounds)
         if isinstance(got, str):
