@@ -226,7 +226,6 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
     ``(motion, gap, move)`` or why not."""
     from .._kinematics import world_transforms
     from .carry import STAND_AFTER
-    from .footlock import _box, _LegIK, _solve
 
     T, fps, up = motion.n_frames, motion.fps, contacts.up
     b = T
@@ -325,8 +324,22 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
         lower[rows, up] = -np.maximum(drop, over)
         frames[:, cols] += np.linalg.lstsq(per, lower.T, rcond=None)[0].T
     moved = motion.with_frames(frames)
-    mpos, mrot = world_transforms(moved)
     held = (rows >= a + n_step) & (rows < (b - n_step if follows else b))
+    worst = _solve_legs(moved, frames, legs, targets, rows, held, horiz, contacts.leg_length,
+                        bounds)
+    if worst > REACH_TOLERANCE:
+        return f"the legs could not reach the closed stance: {worst:.2f} leg lengths short"
+    return motion.with_frames(frames), gap_len, move
+
+
+def _solve_legs(moved, frames, legs, targets, rows, held, horiz, scale, bounds) -> float:
+    """Both legs of ``moved`` (its root placed) solved onto their ``targets`` on ``rows``,
+    written into ``frames``; the held frames kept on the landing's foot points.  Returns
+    the worst miss (leg lengths; a foot in the air and a toe weigh less)."""
+    from .._kinematics import world_transforms
+    from .footlock import _box, _LegIK, _solve
+
+    mpos, mrot = world_transforms(moved)
     worst = 0.0
     for (_, pts, chain), (tg, clear) in zip(legs, targets):
         ik = _LegIK(moved, chain, pts, mrot, mpos)
@@ -340,7 +353,7 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
         if first >= 0:
             moving[first] = True
         some = rows[moving]
-        q = _solve(ik, some, tg[moving], wt[moving], contacts.leg_length,
+        q = _solve(ik, some, tg[moving], wt[moving], scale,
                    box=_box(ik, some, bounds))
         for v, (_, _, c) in enumerate(ik.vars):
             frames[some, c] = q[:, v]
@@ -348,7 +361,7 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
         miss = np.linalg.norm((got - tg[moving]) * (wt[moving] >= 1), axis=-1)
         miss[:, 1:] *= 0.5  # (a toe within the ankle's range pitches the foot a little)
         miss /= np.where(clear[moving] > 0.1, 3.0, 1.0)[:, None]  # (in the air, off its path)
-        worst = max(worst, float(miss.max()) / contacts.leg_length)
+        worst = max(worst, float(miss.max()) / scale)
         if first >= 0:
             # between the steps the foot stays exactly where it landed: every point held
             # (the toe's loose direction let the foot swivel a centimetre as the body
@@ -359,12 +372,10 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
                 frames[sub, c] = q[k, v]
             ik = _LegIK(moved.with_frames(frames), chain, pts, mrot, mpos)
             tg = np.repeat(got[k][None], sub.size, axis=0)
-            q = _solve(ik, sub, tg, np.ones(tg.shape), contacts.leg_length,
+            q = _solve(ik, sub, tg, np.ones(tg.shape), scale,
                        box=_box(ik, sub, bounds))
             for v, (_, _, c) in enumerate(ik.vars):
                 frames[sub, c] = q[:, v]
             miss = np.linalg.norm(ik.positions(q, sub) - tg, axis=-1)
-            worst = max(worst, float(miss.max()) / contacts.leg_length)
-    if worst > REACH_TOLERANCE:
-        return f"the legs could not reach the closed stance: {worst:.2f} leg lengths short"
-    return motion.with_frames(frames), gap_len, move
+            worst = max(worst, float(miss.max()) / scale)
+    return worst
