@@ -405,3 +405,55 @@ def test_bandai_turning_walks_graph_makes_no_pop(bvh_dir):
     q = measure_generated(synth.generate(600).motion, takes)
     assert q.largest_accel <= 1.5 and q.longest_freeze_s < 0.2
     assert min(q.knee_ratio) >= 0.9
+
+
+def _pose_gap(a, fa, b, fb):
+    """RMS distance of two frames' root-relative joint positions."""
+    pa, pb = a.positions().positions[fa], b.positions().positions[fb]
+    return float(np.sqrt((((pa - pa[0]) - (pb - pb[0])) ** 2).sum(-1).mean()))
+
+
+def test_a_target_on_the_gait_is_walked_to(walks):
+    """``to_target`` with the phase-aware field walks the gait at its cadence and ends at
+    the target's pose; the paper's shortest graph path hopped between takes and phases
+    (on set w1 four takes in 31 frames for 1.25 s of walk, 1.91x the takes' p99 of
+    acceleration), which the other fields still take."""
+    from cyclecoord.synthesis.graph.phase import phase_to_target
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(walks)
+        paper = MotionGraphSynth(method="delaunay", dims="auto", step_scale=2.0).fit(walks)
+    gen = synth.to_target(0, 20, 1, 120)
+    assert gen.path.kind == "field:phase:to-target"
+    q = measure_generated(gen.motion, walks)
+    assert q.largest_accel <= 1.0 and not q.freezes
+    step = np.median([_pose_gap(walks[1], f, walks[1], f + 1) for f in range(100, 140)])
+    assert _pose_gap(gen.motion, -1, walks[1], 120) < 3 * step  # ends at the target's pose
+    assert _pose_gap(gen.motion, 0, walks[0], 20) < 3 * step
+    # the path's phase ends at the target frame's (the ease puts it there)
+    field = synth.phase_field_
+    x1 = synth.space_.transform(walks[1][120])[0]
+    assert ((gen.path.phases[-1] - field.phase_of(x1) + 0.5) % 1.0 - 0.5) == pytest.approx(
+        0.0, abs=1e-9)
+    np.testing.assert_allclose(gen.path.points[-1], x1, atol=1e-9)
+    # between about a quarter and one and a quarter cycles of walking (60-frame cycle)
+    assert 15 <= gen.motion.n_frames <= 80
+    assert paper.to_target(0, 20, 1, 120).path.kind.startswith("graph:")
+    # a target the gait does not come near: None, and how near it came
+    far = synth.space_.transform(walks[1][120])[0] + 10 * field.radius
+    path, miss = phase_to_target(field, synth.space_.transform(walks[0][20])[0], far,
+                                 field.phase_of(x1))
+    assert path is None and miss > 1
+
+
+def test_a_target_in_another_gait_takes_the_graph_path_and_says_so(walks):
+    jog = cc.datasets.make_periodic_capture(kind="jog", n_frames=200, period=40,
+                                            random_state=5).motion
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(
+            walks + [jog])
+    gen = synth.to_target(0, 20, 3, 100)
+    assert gen.path.kind.startswith("graph:")
+    assert any("not on the start's gait" in n for n in gen.notes), gen.notes

@@ -261,13 +261,33 @@ class MotionGraphSynth:
         target_frame: int,
         speed: float = 1.0,
     ) -> Generation:
-        """The shortest graph path from one take's frame to another's (paper §V-A), playable."""
+        """A playable path from one take's frame to another's pose.
+
+        With the phase-aware field (``+phase``, the default) the path walks the gait at
+        its captured cadence and eases onto the target at its phase
+        (:func:`~.phase.phase_to_target`, ``speed`` times the captured speed); a target
+        the gait does not come near (another gait) takes the paper's shortest graph path
+        (§V-A, :func:`~.paths.path_to_target`), and a note says so, as do the other
+        fields always.
+        """
         motion, f, name = self._start(start, frame)
         f, said = self._past_reference(start, f, name)
-        tmotion, tf, _ = self._start(target, target_frame)
+        tmotion, tf, tname = self._start(target, target_frame)
         x0 = self.space_.transform(motion[f])[0]
         x1 = self.space_.transform(tmotion[tf])[0]
-        path = path_to_target(self.graph_, x0, x1, speed)
+        path = None
+        if self.phase_field_ is not None:
+            from .phase import phase_to_target
+
+            path, miss = phase_to_target(self.phase_field_, x0, x1,
+                                         self.phase_field_.phase_of(x1), 2.0 * float(speed))
+            if path is None:
+                said.append(
+                    f"target {tname}:{tf} is not on the start's gait (the gait comes no "
+                    f"nearer than {miss:.2f} of the latent radius): the shortest graph path "
+                    "instead, which hops between takes and may pop")
+        if path is None:
+            path = path_to_target(self.graph_, x0, x1, speed)
         out = self._result(path, motion, f, name, x0)
         out.notes[:0] = said
         return out
