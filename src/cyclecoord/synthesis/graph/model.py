@@ -266,9 +266,10 @@ class MotionGraphSynth:
         With the phase-aware field (``+phase``, the default) the path walks the gait at
         its captured cadence and eases onto the target at its phase
         (:func:`~.phase.phase_to_target`, ``speed`` times the captured speed); a target
-        the gait does not come near (another gait) takes the paper's shortest graph path
-        (§V-A, :func:`~.paths.path_to_target`), and a note says so, as do the other
-        fields always.
+        the gait does not come near (another gait) is reached by a cross-fade in step
+        into its take (:func:`~.phase.phase_across`), and failing that by the paper's
+        shortest graph path (§V-A, :func:`~.paths.path_to_target`), a note saying which;
+        the other fields always take the graph path.
         """
         motion, f, name = self._start(start, frame)
         f, said = self._past_reference(start, f, name)
@@ -282,15 +283,41 @@ class MotionGraphSynth:
             path, miss = phase_to_target(self.phase_field_, x0, x1,
                                          self.phase_field_.phase_of(x1), 2.0 * float(speed))
             if path is None:
+                from .phase import phase_across
+
+                path = phase_across(self.phase_field_, x0, x1, 2.0 * float(speed))
+                if path is not None:
+                    said.append(
+                        f"target {tname}:{tf} is on another gait (the start's comes no nearer "
+                        f"than {miss:.2f} of the latent radius): a half-cycle cross-fade in "
+                        "step into its take, then walked to it")
+            if path is None:
                 said.append(
                     f"target {tname}:{tf} is not on the start's gait (the gait comes no "
                     f"nearer than {miss:.2f} of the latent radius): the shortest graph path "
                     "instead, which hops between takes and may pop")
-        if path is None:
-            path = path_to_target(self.graph_, x0, x1, speed)
-        out = self._result(path, motion, f, name, x0)
+        out = None
+        if path is not None:
+            out = self._result(path, motion, f, name, x0)
+            if path.kind.endswith("across-to-target") and self._crosses(out.motion):
+                graph = self._result(path_to_target(self.graph_, x0, x1, speed), motion, f,
+                                     name, x0)
+                if not self._crosses(graph.motion):
+                    said[-1] = said[-1].split(": a half-cycle")[0] + (
+                        ": the shortest graph path (a cross-fade in step into its take brought "
+                        "two limbs closer than the takes ever do; the graph path hops between "
+                        "takes and may pop)")
+                    out = graph
+        if out is None:
+            out = self._result(path_to_target(self.graph_, x0, x1, speed), motion, f, name, x0)
         out.notes[:0] = said
         return out
+
+    def _crosses(self, motion: Motion) -> bool:
+        """Whether two limbs of ``motion`` come closer than the training takes ever do."""
+        from ...quality.plausibility import check_plausibility
+
+        return bool(check_plausibility(motion, self.takes_).new_contact_frames)
 
     def _widen(self, angles: np.ndarray) -> None:
         """Per gait (:meth:`gaits`), the leg angles' stride widening

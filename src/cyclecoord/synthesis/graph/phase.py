@@ -48,7 +48,7 @@ from .paths import MAX_STEP_SCALE, GraphPath
 
 __all__ = [
     "PhaseField", "TakePhases", "take_phases", "align_phases", "match_phase", "match_misfit",
-    "follow_phase", "phase_to_target", "amplitude_gain",
+    "follow_phase", "phase_to_target", "phase_across", "amplitude_gain",
 ]
 
 #: Neighbours of the phase-aware field, the pull per frame towards their next states
@@ -455,9 +455,17 @@ TARGET_EASE = 0.3
 TARGET_REACH = 0.25
 
 
+def _cycle_frames(field: PhaseField, x: np.ndarray, step_scale: float) -> int:
+    """Generated frames per cycle of the gait at latent point ``x`` (its nearest training
+    frames' phase rate: a walk's and a jog's cadences differ)."""
+    idx = field.graph.tree.query(np.asarray(x, dtype=float).reshape(-1), k=field.k)[1]
+    rate = float(np.median(field.rate[np.atleast_1d(idx)])) * float(step_scale)
+    return max(2, int(np.ceil(1.0 / rate)))
+
+
 def phase_to_target(
     field: PhaseField, start: np.ndarray, target: np.ndarray, target_phase: float,
-    step_scale: float = 2.0,
+    step_scale: float = 2.0, lead: float = TARGET_LEAD,
 ) -> tuple[GraphPath | None, float]:
     """A path that walks the gait from ``start`` to the pose ``target`` at
     ``target_phase``: :func:`follow_phase` for a little over a cycle, cut where its state
@@ -469,6 +477,7 @@ def phase_to_target(
     take's frame 50 to another's frame 200 went back and forth among four takes in 31
     frames (0.26 s for 1.25 s of the walk between the two poses) and popped 1.91x the
     takes' 99th percentile of acceleration.  This path steps at the captured cadence.
+    ``lead``: cycles the path walks at least.
 
     Returns
     -------
@@ -479,9 +488,8 @@ def phase_to_target(
         The nearest approach, in the latent points' RMS radius.
     """
     x1 = np.asarray(target, dtype=float).reshape(-1)
-    rate = float(np.median(field.rate)) * float(step_scale)  # cycles per generated frame
-    cycle = max(2, int(np.ceil(1.0 / rate)))
-    lead = max(1, int(round(TARGET_LEAD * cycle)))
+    cycle = _cycle_frames(field, start, step_scale)
+    lead = max(1, int(round(lead * cycle)))
     path = follow_phase(field, start, lead + cycle + 1, step_scale)
     lifted = field._lift(path.points, path.phases)
     goal = field._lift(x1[None], np.array([target_phase]))[0]
@@ -504,6 +512,73 @@ def phase_to_target(
         points=pts, neighbours=idx, weights=wts, inside=np.ones(n, dtype=bool),
         speed=path.speed, kind="field:phase:to-target", phases=phases,
     ), miss
+
+
+def phase_across(
+    field: PhaseField, start: np.ndarray, target: np.ndarray, step_scale: float = 2.0,
+) -> GraphPath | None:
+    """A path from ``start`` on one gait to the pose ``target`` on another, in step: the
+    start's gait is followed for half a cycle or more (until its phase is one the
+    target's take holds early enough), then cross-faded over half a cycle (quintic
+    weights, the two paths at one phase) into the target's take, walked to the target
+    (:func:`phase_to_target` from that take's frame at the phase the fade begins, at
+    least three quarters of a cycle before the target).  None when the target's take has
+    no such frame.
+
+    The cross-fade mixes the two gaits' latent points and neighbours (so their roots and
+    detail), as the latent method's in-step TRANSITION mixes its two models' poses."""
+    g = field.graph
+    x1 = np.asarray(target, dtype=float).reshape(-1)
+    node = int(g.tree.query(x1)[1])
+    cycle = _cycle_frames(field, start, step_scale)
+    half = max(1, int(round(0.5 * cycle)))
+    a = follow_phase(field, start, 2 * half + cycle + 1, step_scale)
+    take = np.flatnonzero(g.take == g.take[node])
+    u_target = float(field.unwrapped[node])
+    u = field.unwrapped[take]
+    early = u <= u_target - 0.75  # (b walks three quarters of a cycle at least)
+    tol = 1.5 / _cycle_frames(field, x1, step_scale)
+    b0 = None
+    for join in range(half, half + cycle + 1):  # the fade begins once the phases meet
+        p_join = float(a.phases[join])
+        ok = early & (np.abs(((u - p_join + 0.5) % 1.0) - 0.5) <= tol)
+        if ok.any():  # the take's latest frame at the fade's phase
+            b0 = int(take[ok][np.argmax(u[ok])])
+            break
+    if b0 is None:
+        return None
+    a = GraphPath(points=a.points[: join + half + 1], neighbours=a.neighbours[: join + half + 1],
+                  weights=a.weights[: join + half + 1], inside=a.inside[: join + half + 1],
+                  speed=a.speed, kind=a.kind, phases=a.phases[: join + half + 1])
+    b, _ = phase_to_target(field, g.points[b0], x1, field.phase[node], step_scale, lead=0.6)
+    if b is None or b.points.shape[0] <= half + 1:
+        return None
+    # a's frames join .. join + half and b's 0 .. half are the fade, at one phase
+    n = join + b.points.shape[0]
+    w = np.ones(n)
+    w[:join] = 0.0
+    v = np.arange(half + 1) / half
+    w[join : join + half + 1] = v * v * v * (v * (6.0 * v - 15.0) + 10.0)
+
+    def padded(x, before, after):
+        return np.concatenate([np.repeat(x[:1], before, axis=0), x,
+                               np.repeat(x[-1:], after, axis=0)])
+
+    after = n - a.points.shape[0]
+    pa, pb = padded(a.points, 0, after), padded(b.points, join, 0)
+    ph_a = a.phases[0] + (a.phases[-1] - a.phases[0]) / (a.phases.size - 1) * np.arange(n)
+    ph_b = padded(b.phases, join, 0)
+    ph_b = ph_b + np.round(ph_a[join] - ph_b[join])  # (b's cycles numbered as a's)
+    return GraphPath(
+        points=(1.0 - w)[:, None] * pa + w[:, None] * pb,
+        neighbours=np.hstack([padded(a.neighbours, 0, after), padded(b.neighbours, join, 0)]),
+        weights=np.hstack([(1.0 - w)[:, None] * padded(a.weights, 0, after),
+                           w[:, None] * padded(b.weights, join, 0)]),
+        inside=np.ones(n, dtype=bool),
+        speed=a.speed,
+        kind="field:phase:across-to-target",
+        phases=(1.0 - w) * ph_a + w * ph_b,
+    )
 
 
 def amplitude_gain(
