@@ -258,6 +258,48 @@ def speed(takes: list, n: int = 1200) -> dict:
     return {"fit": fit, "generate": full, "generate_no_lock": carried, "path": path}
 
 
+#: ``--target`` pairs (take, frame) -> (take, frame) on set w1 (frames at 120 fps), and
+#: on subject 35's walks 35_07 / 35_08 with the 143_01 jog (all at 60 fps; take 2 the jog).
+W1_TARGETS = ((0, 100, 1, 300), (0, 50, 2, 200), (1, 100, 3, 250), (2, 30, 0, 330),
+              (3, 80, 1, 150))
+GAIT_TARGETS = ((0, 100, 2, 60), (2, 20, 1, 150), (0, 50, 2, 90), (1, 40, 2, 70),
+                (2, 10, 0, 120))
+
+
+def targets(data: Path) -> list[dict]:
+    """``to_target`` with our default (the phase-aware field: walked in step) against the
+    paper's shortest graph path (the same graph with ``delaunay``), both measured with
+    one measure: largest acceleration and pose step over the sources' p99, frames, and
+    frames where limbs pass closer than the takes (each pair in the same run)."""
+    from cyclecoord.quality.plausibility import check_plausibility
+
+    cmu = data / "cmu"
+    w1 = [cmu / "35" / f"{n}.amc" for n in W1]
+    jog = cmu / "143" / "143_01.amc"
+    if not all(p.is_file() for p in w1 + [jog]):
+        return []
+    sets = [("w1", [cc.load(p) for p in w1], W1_TARGETS)]
+    walks = [cc.load(cmu / "35" / f"35_{n}.amc")[::2] for n in ("07", "08")]
+    walks = [m.with_frames(m.frames, fps=60.0) for m in walks]
+    sets.append(("walks + jog", walks + [cc.load(jog, fps=JOG_FPS)], GAIT_TARGETS))
+    rows = []
+    for name, takes, pairs in sets:
+        ours = MotionGraphSynth(**OURS).fit(takes)
+        paper = MotionGraphSynth(method="delaunay", dims="auto", step_scale=2.0).fit(takes)
+        for s, sf, t, tf in pairs:
+            row = {"set": name, "pair": f"{s}:{sf} -> {t}:{tf}"}
+            for label, synth in (("ours", ours), ("graph path", paper)):
+                gen = synth.to_target(s, sf, t, tf)
+                q = measure_generated(gen.motion, takes)
+                row[label] = {
+                    "kind": gen.path.kind, "frames": gen.motion.n_frames,
+                    "accel": q.largest_accel, "step": q.largest_step,
+                    "limbs": len(check_plausibility(gen.motion, takes).new_contact_frames),
+                }
+            rows.append(row)
+    return rows
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--frames", type=int, default=1200, help="walk length (the run: half)")
@@ -292,10 +334,24 @@ def main(argv: list[str] | None = None) -> int:
           f"periodic pipeline); 1,200 frames {sp['generate']:.2f} s CPU with foot pinning, "
           f"{sp['generate_no_lock']:.2f} s without, path alone {sp['path']:.2f} s "
           "(target: 1,200 frames under 1 CPU-s)")
+    tg = targets(args.data)
+    if tg:
+        print("\n--target: ours (phase-aware, walked in step) against the paper's shortest "
+              "graph path, same graph; accel and step over the sources' p99, limb frames")
+        for r in tg:
+            o, g = r["ours"], r["graph path"]
+            print(f"  {r['set']:11s} {r['pair']:17s} ours {o['frames']:4d} frames, accel "
+                  f"{o['accel']:.2f}, step {o['step']:.2f}, limbs {o['limbs']} "
+                  f"({o['kind']}) | graph path {g['frames']:4d} frames, accel {g['accel']:.2f}, "
+                  f"step {g['step']:.2f}, limbs {g['limbs']}")
+        worst = [max(r[k]["accel"] for r in tg) for k in ("ours", "graph path")]
+        print(f"  largest accel over every pair: ours {worst[0]:.2f}, graph path {worst[1]:.2f} "
+              f"({worst[0] / worst[1]:.2f}x)")
     if args.json:
         with atomic_write(args.json, "w") as fh:
             json.dump({"sets": [{k: v for k, v in r.items() if k != "rows"} for r in results],
-                       "speed": sp, "python": sys.version}, fh, indent=1, default=str)
+                       "speed": sp, "targets": tg, "python": sys.version}, fh, indent=1,
+                      default=str)
         print(f"wrote {args.json}")
     return 0
 

@@ -477,3 +477,23 @@ def test_synthesis_bench_prints_every_method_on_synthetic_walks(tmp_path, capsys
     assert "control: the captures' own one-cycle windows" in text
     ctl = figures["stride windows"]
     assert len(ctl) >= 4 and max(ctl) <= 1.2 and 0.8 < float(np.median(ctl)) <= 1.05
+
+
+def test_synthesis_bench_targets_ours_against_the_graph_path(cmu_dir, monkeypatch):
+    """``targets``: one w1 pair and one walk-to-jog pair, ours (walked in step) against the
+    paper's shortest graph path on the same takes: ours pops less on both (measured 0.65
+    against 1.91 on w1, 0.70-0.94 against 2.0-2.9 into the jog)."""
+    spec = importlib.util.spec_from_file_location(
+        "bench_synthesis", BENCH.parent / "bench_synthesis.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["bench_synthesis"] = module
+    spec.loader.exec_module(module)
+    monkeypatch.setattr(module, "W1_TARGETS", ((0, 50, 2, 200),))
+    monkeypatch.setattr(module, "GAIT_TARGETS", ((2, 20, 1, 150),))
+    rows = module.targets(cmu_dir.parent)
+    assert [r["set"] for r in rows] == ["w1", "walks + jog"]
+    for r in rows:
+        assert r["ours"]["kind"].startswith("field:phase:")
+        assert r["graph path"]["kind"].startswith("graph:")
+        assert r["ours"]["accel"] < r["graph path"]["accel"]
+        assert r["ours"]["accel"] <= 1.0 and r["ours"]["limbs"] == 0
