@@ -30,9 +30,11 @@ limbs pass through each other that the captures never do (``--no-limbs`` skips t
 check).  Then ratios of ours against each baseline measured in the same run, and CPU
 seconds: fitting, and generating 1,200 frames (target under 1 CPU-s), with and without
 the foot pinning.  The 143_01 jog is one take: our graph (two takes at least) is trained
-on its two halves; a walk-run-walk-idle script needs walks and runs of one skeleton,
-which the shared data does not hold.  Without the CMU data it runs on synthetic walks
-and says so.  Speed is printed, never asserted.
+on its two halves.  The graph takes no script: the walk, run, walk, idle script is the
+latent method's (``bench_latent_gait.py``); here the walk-to-jog and jog-to-walk paths are
+``--target`` pairs on subject 35's walks with the jog (another actor, put on 35's skeleton),
+ours against the paper's shortest graph path (:func:`targets`).  Without the CMU data it
+runs on synthetic walks and says so.  Speed is printed, never asserted.
 """
 
 from __future__ import annotations
