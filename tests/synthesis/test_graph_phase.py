@@ -474,9 +474,26 @@ def test_a_target_in_another_gait_is_reached_in_step(walks, monkeypatch):
     on_jog = (w * (synth.graph_.take[np.asarray(gen.path.neighbours)] == 3)).sum(axis=1)
     assert on_jog[0] < 0.05 and on_jog[-1] > 0.95 and np.all(np.diff(on_jog) > -0.05)
     assert share[3] > 0.3
-    # limbs too close in the fade: the graph path
+    # limbs too close in the fade: a fade a half or a whole cycle later, else the graph path
+    import cyclecoord.synthesis.graph.phase as phase_module
+
+    asked = []
+    across = phase_module.phase_across
+
+    def later_fades(*args, **kw):
+        asked.append(args[4] if len(args) > 4 else kw.get("later", 0.0))
+        return across(*args, **kw)
+
+    monkeypatch.setattr(phase_module, "phase_across", later_fades)
     monkeypatch.setattr(MotionGraphSynth, "_crosses",
                         lambda self, m: m.n_frames == gen.motion.n_frames)
+    again = synth.to_target(0, 20, 3, 150)
+    assert asked == [0.0, 0.5, 1.0]
+    assert again.path.kind == "field:phase:across-to-target"
+    assert again.motion.n_frames != gen.motion.n_frames  # a later fade
+    monkeypatch.setattr(phase_module, "phase_across",
+                        lambda *a, **k: None if k.get("later", a[4] if len(a) > 4 else 0.0)
+                        else across(*a, **k))
     again = synth.to_target(0, 20, 3, 150)
     assert again.path.kind.startswith("graph:")
     assert any("brought two limbs closer" in n for n in again.notes), again.notes

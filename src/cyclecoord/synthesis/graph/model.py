@@ -300,14 +300,23 @@ class MotionGraphSynth:
         if path is not None:
             out = self._result(path, motion, f, name, x0)
             if path.kind.endswith("across-to-target") and self._crosses(out.motion):
-                graph = self._result(path_to_target(self.graph_, x0, x1, speed), motion, f,
-                                     name, x0)
-                if not self._crosses(graph.motion):
-                    said[-1] = said[-1].split(": a half-cycle")[0] + (
-                        ": the shortest graph path (a cross-fade in step into its take brought "
-                        "two limbs closer than the takes ever do; the graph path hops between "
-                        "takes and may pop)")
-                    out = graph
+                # the fade brought two limbs too close: a fade a half or a whole cycle
+                # later, else the graph path
+                from .phase import phase_across
+
+                tries = [phase_across(self.phase_field_, x0, x1, 2.0 * float(speed), later)
+                         for later in (0.5, 1.0)]
+                tries = [self._result(p, motion, f, name, x0) for p in tries if p is not None]
+                tries.append(self._result(path_to_target(self.graph_, x0, x1, speed), motion,
+                                          f, name, x0))
+                clean = [t for t in tries if not self._crosses(t.motion)]
+                if clean:
+                    out = clean[0]
+                    if out.path.kind.startswith("graph:"):
+                        said[-1] = said[-1].split(": a half-cycle")[0] + (
+                            ": the shortest graph path (cross-fades in step into its take "
+                            "brought two limbs closer than the takes ever do; the graph path "
+                            "hops between takes and may pop)")
         if out is None:
             out = self._result(path_to_target(self.graph_, x0, x1, speed), motion, f, name, x0)
         out.notes[:0] = said

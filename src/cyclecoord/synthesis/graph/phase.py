@@ -516,6 +516,7 @@ def phase_to_target(
 
 def phase_across(
     field: PhaseField, start: np.ndarray, target: np.ndarray, step_scale: float = 2.0,
+    later: float = 0.0,
 ) -> GraphPath | None:
     """A path from ``start`` on one gait to the pose ``target`` on another, in step: the
     start's gait is followed for half a cycle or more (until its phase is one the
@@ -526,20 +527,23 @@ def phase_across(
     no such frame.
 
     The cross-fade mixes the two gaits' latent points and neighbours (so their roots and
-    detail), as the latent method's in-step TRANSITION mixes its two models' poses."""
+    detail), as the latent method's in-step TRANSITION mixes its two models' poses.
+    ``later``: cycles more the start's gait is followed before the fade may begin (another
+    try where one fade brought two limbs too close)."""
     g = field.graph
     x1 = np.asarray(target, dtype=float).reshape(-1)
     node = int(g.tree.query(x1)[1])
     cycle = _cycle_frames(field, start, step_scale)
     half = max(1, int(round(0.5 * cycle)))
-    a = follow_phase(field, start, 2 * half + cycle + 1, step_scale)
+    first = half + int(round(later * cycle))
+    a = follow_phase(field, start, first + half + cycle + 1, step_scale)
     take = np.flatnonzero(g.take == g.take[node])
     u_target = float(field.unwrapped[node])
     u = field.unwrapped[take]
     early = u <= u_target - 0.75  # (b walks three quarters of a cycle at least)
     tol = 1.5 / _cycle_frames(field, x1, step_scale)
     b0 = None
-    for join in range(half, half + cycle + 1):  # the fade begins once the phases meet
+    for join in range(first, first + cycle + 1):  # the fade begins once the phases meet
         p_join = float(a.phases[join])
         ok = early & (np.abs(((u - p_join + 0.5) % 1.0) - 0.5) <= tol)
         if ok.any():  # the take's latest frame at the fade's phase
