@@ -2,14 +2,16 @@
 
 A gait that comes to a stop does so at double support, the feet a stride apart; held
 there, a stand is a walk frozen mid-stride (on subject 35's walk model the ankles stood
-0.6 m apart along the travel for the whole IDLE after a MOVE).  People stopping take one
+0.56-0.72 leg lengths apart for the whole IDLE after a MOVE).  People stopping take one
 more, shorter step: the trailing foot swings forward and sets down beside the leading one,
 and the pelvis comes over the middle of the feet.  :func:`close_stands` makes that step at
 the start of each stand, by the leg IK of :mod:`.footlock` (both legs, every frame of the
 stand, within the training takes' joint ranges), the root moved forward by half the gap
-and raised back to its mid-stance height.  A stand that more frames follow ends with the
-opening step: the leading foot steps out by the same gap and the rest of the motion is
-moved forward by it, so the next stride starts from where the feet now are.
+and raised back towards its mid-stance height as far as the legs reach.  A stand that more
+frames follow ends with the opening step: the leading foot steps out by the same gap and
+the rest of the motion is moved forward by it, so the next stride starts from where the
+feet now are.  A step the legs cannot reach, or that brings two limbs closer than the
+training takes ever do, is not made: that stand keeps its stance, and says why.
 """
 
 from __future__ import annotations
@@ -22,7 +24,10 @@ from .._words import plural
 from ..errors import CycleCoordError
 from ..motion import Motion
 
-__all__ = ["STEP_CLEARANCE", "STEP_LIMITS", "StandOutcome", "close_stands"]
+__all__ = [
+    "REACH_TOLERANCE", "STEP_CLEARANCE", "STEP_LIMITS", "TOE_FREEDOM", "TOGETHER",
+    "StandOutcome", "close_stands",
+]
 
 #: Seconds the closing (and opening) step takes at the least and at the most: half the
 #: gait's leg cycle (one step) within these.
