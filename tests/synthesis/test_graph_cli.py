@@ -63,6 +63,8 @@ def test_generate_writes_motion_report_and_figures(synthetic_takes, tmp_path, ca
     assert r["graph"]["nodes"] == 420
     assert "plausibility" in r and "root" in r
     assert sorted(p.name for p in figs.iterdir()) == ["field.png", "graph.png", "path.png"]
+    # the console names the field the path followed (the default's phase-aware one)
+    assert "delaunay graph (phase-aware field) over" in capsys.readouterr().out
 
 
 def test_crossval_report_keys(synthetic_takes, tmp_path, capsys):

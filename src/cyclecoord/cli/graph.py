@@ -322,8 +322,9 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
 
     quality = _lead(gen.motion, motions, reference=synth.reference(gen))
     conn = synth.graph_.connectivity()
+    field = ("phase-aware" if synth.phase_field_ is not None else synth.field_.name)
     print(
-        f"{synth.graph_.method} graph ({synth.field_.name} field) over {conn['nodes']} frames of "
+        f"{synth.graph_.method} graph ({field} field) over {conn['nodes']} frames of "
         f"{len(motions)} takes: "
         f"{conn['edges']} edges, "
         f"{conn['weak_components']} weak / {conn['strong_components']} strong components; "
