@@ -14,22 +14,15 @@ from scipy.ndimage import gaussian_filter1d
 import cyclecoord as cc
 from cyclecoord.errors import ParameterError
 from cyclecoord.quality.generated import measure_generated
+from _gait_models import gait_pair  # tests/ is on the path (rootdir conftest)
 from cyclecoord.synthesis.latent import LatentModel, Synthesizer
 from cyclecoord.synthesis.latent.particle import ParticleParams
 from cyclecoord.synthesis.latent.script import run_script, training_takes
 
 
-def _model(kind, period, seed):
-    m = cc.datasets.make_periodic_capture(
-        kind=kind, n_frames=960, period=period, noise=0.3, speed_variation=0.1,
-        random_state=seed,
-    ).motion
-    return LatentModel(gplvm={"max_iter": 80}).fit([m[0:480:4], m[480:960:4]], ["a", "b"])
-
-
 @pytest.fixture(scope="module")
 def models():
-    return {"walk": _model("walk", 132, 0), "run": _model("jog", 84, 1)}
+    return gait_pair()
 
 
 def _script(models, blend=0.4, plant="all"):

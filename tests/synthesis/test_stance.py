@@ -11,22 +11,15 @@ import pytest
 import cyclecoord as cc
 from cyclecoord.quality.contacts import foot_contacts
 from cyclecoord.quality.generated import measure_generated
-from cyclecoord.synthesis.latent import LatentModel, Synthesizer
+from _gait_models import gait_pair  # tests/ is on the path (rootdir conftest)
+from cyclecoord.synthesis.latent import Synthesizer
 from cyclecoord.synthesis.latent.script import training_takes
 from cyclecoord.synthesis.stance import STEP_CLEARANCE, TOGETHER, close_stands
 
 
-def _model(kind, period, seed):
-    m = cc.datasets.make_periodic_capture(
-        kind=kind, n_frames=960, period=period, noise=0.3, speed_variation=0.1,
-        random_state=seed,
-    ).motion
-    return LatentModel(gplvm={"max_iter": 80}).fit([m[0:480:4], m[480:960:4]], ["a", "b"])
-
-
 @pytest.fixture(scope="module")
 def models():
-    return {"walk": _model("walk", 132, 0), "run": _model("jog", 84, 1)}
+    return gait_pair()
 
 
 def _stop(models, part, seed, then=0):
