@@ -19,3 +19,20 @@ def gait_model(kind: str, period: int, seed: int) -> LatentModel:
 def gait_pair() -> dict[str, LatentModel]:
     """``{"walk": ..., "run": ...}``."""
     return {"walk": gait_model("walk", 132, 0), "run": gait_model("jog", 84, 1)}
+
+
+def stop(models: dict, part: str, seed: int, then: int = 0):
+    """A MOVE ahead of ``1.0 + 0.07 seed`` s that comes to a stop, IDLE 2 s, then ``then``
+    MOVEs ahead of 0.5 s: the synthesizer and its motion."""
+    from cyclecoord.synthesis.latent import Synthesizer
+
+    syn = Synthesizer(models, fps=30, seed=seed)
+    syn.start(part, {"frame": 0})
+    syn.command += 1
+    syn.move({"ahead": 1.0 + 0.07 * seed})
+    syn.command += 1
+    syn.idle(duration=2.0)
+    for _ in range(then):
+        syn.command += 1
+        syn.move({"ahead": 0.5}, stop=False)
+    return syn, syn.motion()

@@ -14,7 +14,7 @@ from scipy.ndimage import gaussian_filter1d
 import cyclecoord as cc
 from cyclecoord.errors import ParameterError
 from cyclecoord.quality.generated import measure_generated
-from _gait_models import gait_pair  # tests/ is on the path (rootdir conftest)
+from _gait_models import gait_pair, stop  # tests/ is on the path (rootdir conftest)
 from cyclecoord.synthesis.latent import LatentModel, Synthesizer
 from cyclecoord.synthesis.latent.particle import ParticleParams
 from cyclecoord.synthesis.latent.script import run_script, training_takes
@@ -1311,13 +1311,7 @@ def test_a_stop_stands_on_both_legs(models, part):
     labels = np.array(c0.leg_labels)
     up = []
     for seed in range(8):
-        syn = Synthesizer(models, fps=30, seed=seed)
-        syn.start(part, {"frame": 0})
-        syn.command += 1
-        syn.move({"ahead": 1.0 + 0.07 * seed})
-        syn.command += 1
-        syn.idle(duration=2.0)
-        motion = syn.motion()
+        _, motion = stop(models, part, seed)
         J = motion.positions()
         h = np.stack([J[f][-30:, c0.up] for f in c0.feet], 1) - c0.contact_level
         low = np.stack([h[:, labels == g].min(1) for g in dict.fromkeys(c0.leg_labels)], 1)

@@ -11,7 +11,7 @@ import pytest
 import cyclecoord as cc
 from cyclecoord.quality.contacts import foot_contacts
 from cyclecoord.quality.generated import measure_generated
-from _gait_models import gait_pair  # tests/ is on the path (rootdir conftest)
+from _gait_models import gait_pair, stop  # tests/ is on the path (rootdir conftest)
 from cyclecoord.synthesis.latent import Synthesizer
 from cyclecoord.synthesis.latent.script import training_takes
 from cyclecoord.synthesis.stance import STEP_CLEARANCE, TOGETHER, close_stands
@@ -20,20 +20,6 @@ from cyclecoord.synthesis.stance import STEP_CLEARANCE, TOGETHER, close_stands
 @pytest.fixture(scope="module")
 def models():
     return gait_pair()
-
-
-def _stop(models, part, seed, then=0):
-    """A MOVE ahead that stops, IDLE 2 s, then ``then`` MOVEs ahead of 0.5 s."""
-    syn = Synthesizer(models, fps=30, seed=seed)
-    syn.start(part, {"frame": 0})
-    syn.command += 1
-    syn.move({"ahead": 1.0 + 0.07 * seed})
-    syn.command += 1
-    syn.idle(duration=2.0)
-    for _ in range(then):
-        syn.command += 1
-        syn.move({"ahead": 0.5}, stop=False)
-    return syn, syn.motion()
 
 
 def _gaps(motion, model, frames):
@@ -62,7 +48,7 @@ def test_a_stop_ends_with_the_feet_side_by_side(models, part):
     brings the trailing foot beside the other one, the hips' width apart."""
     closed, along, apart = 0, [], []
     for seed in range(6):
-        syn, motion = _stop(models, part, seed)
+        syn, motion = stop(models, part, seed)
         (a, b), = syn.stands
         stands = [n for n in syn.notes if n.startswith("stands:")]
         assert stands, syn.notes
@@ -84,7 +70,7 @@ def test_a_stop_ends_with_the_feet_side_by_side(models, part):
 def test_the_closing_step_lifts_the_foot_and_leaves_it_planted(models):
     """The trailing foot clears the floor on its way and then stays where it landed; the
     stand's accelerations stay within the training takes' 99th percentile."""
-    syn, motion = _stop(models, "walk", 2)
+    syn, motion = stop(models, "walk", 2)
     (a, b), = syn.stands
     c = foot_contacts(models["walk"].training_motion())
     J = motion.positions()
@@ -107,7 +93,7 @@ def test_the_closing_step_lifts_the_foot_and_leaves_it_planted(models):
 def test_a_stand_that_frames_follow_steps_out_into_them(models):
     """An IDLE between two walks: the feet close, then the leading foot steps out by the
     same gap and the walk goes on from there, without a jump at the stand's end."""
-    syn, motion = _stop(models, "walk", 1, then=3)
+    syn, motion = stop(models, "walk", 1, then=3)
     (a, b), = syn.stands
     assert any("feet with one more step" in n for n in syn.notes), syn.notes
     g_along, _ = _gaps(motion, models["walk"], np.arange(a + 20, b - 20))
@@ -128,7 +114,7 @@ def test_stands_not_after_a_stride_or_out_of_reach_are_left_alone(models):
     assert out.motion is motion and not out.closed and not out.kept and out.line == ""
     assert not [n for n in syn.notes if n.startswith("stands:")]
     # after a stride, with every leg angle held where it is: the legs cannot step
-    syn, _ = _stop(models, "walk", 0)
+    syn, _ = stop(models, "walk", 0)
     motion = syn._untangled()
     frozen = (motion.frames.min(axis=0), motion.frames.min(axis=0))
     out = close_stands(motion, feet, syn.stands, cycle=1.1, bounds=frozen)
@@ -176,7 +162,7 @@ def test_a_step_that_crosses_limbs_is_not_taken(models, monkeypatch):
         return out
 
     monkeypatch.setattr(carry, "_crossed", crossed)
-    syn, motion = _stop(models, "walk", 0)
+    syn, motion = stop(models, "walk", 0)
     (entry,) = syn.stand_steps
     assert not entry["closed"] and "closer than the training takes" in entry["why"]
     assert True in seen and False in seen
