@@ -14,6 +14,10 @@ __all__ = ["Motion", "DEFAULT_FPS"]
 
 #: CMU captures are recorded at 120 Hz; AMC files do not store a rate.
 DEFAULT_FPS = 120.0
+#: Largest positions array (values: frames x points x 3) :meth:`Motion.positions` keeps
+#: with its motion: 3 million values, 24 MB (a minute at 120 fps of a 100-point rig);
+#: longer motions have their positions made on each call.
+FK_KEPT_VALUES = 3_000_000
 
 Channel = tuple[str, str]
 
@@ -223,8 +227,20 @@ class Motion:
     # ---------------------------------------------------------- conveniences
     def positions(self):
         """Forward kinematics: world positions of every joint (see
-        :func:`cyclecoord.skeleton.forward_kinematics`)."""
-        return forward_kinematics(self)
+        :func:`cyclecoord.skeleton.forward_kinematics`).
+
+        Made once per motion up to :data:`FK_KEPT_VALUES` position values and kept
+        read-only (the frames and the skeleton never change, so neither do they): a
+        latent script asked for the same motion's positions twice as often as for
+        another's, a twentieth of its time.  Copy the array to change it."""
+        kept = self.__dict__.get("_positions")
+        if kept is not None:
+            return kept
+        fk = forward_kinematics(self)
+        if fk.positions.size <= FK_KEPT_VALUES:
+            fk.positions.flags.writeable = False
+            object.__setattr__(self, "_positions", fk)
+        return fk
 
     def root_channels(self) -> list[int]:
         """Columns of the root joint's translation and rotation channels.

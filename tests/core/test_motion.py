@@ -97,3 +97,22 @@ def test_skeleton_does_not_import_motion():
     assert not {".motion", "cyclecoord.motion"} & imported, imported
     m = cc.datasets.example_capture().motion
     assert m.positions().positions.shape[0] == m.n_frames  # Motion.positions still works
+
+
+def test_positions_are_made_once_and_kept_read_only(monkeypatch):
+    sk = two_joint()
+    frames = np.random.default_rng(0).uniform(-90, 90, (50, 8))
+    m = cc.Motion(frames, sk.channels, skeleton=sk)
+    p = m.positions()
+    assert m.positions() is p  # kept: the frames and skeleton never change
+    np.testing.assert_array_equal(p.positions, forward_kinematics(m).positions)
+    with pytest.raises(ValueError, match="read-only"):
+        p.positions[0, 0, 0] = 1.0  # a caller changing them would change every later call's
+    other = m.with_frames(frames[::-1].copy())
+    np.testing.assert_array_equal(other.positions().positions, p.positions[::-1])
+    # a motion over the limit has its positions made on each call (memory)
+    monkeypatch.setattr(cc.motion, "FK_KEPT_VALUES", 50 * 3 * 3 - 1)
+    big = cc.Motion(frames, sk.channels, skeleton=sk)
+    a, b = big.positions(), big.positions()
+    assert a is not b and a.positions.flags.writeable
+    np.testing.assert_array_equal(a.positions, b.positions)
