@@ -163,8 +163,10 @@ def source_figures(
         raise ParameterError("the measure of generated motion needs the source captures")
     srcs = [_resampled(s if analysed else analysis_motion(s), fps) for s in sources]
     rig = _rig(srcs[0], feet)
-    rkey = (float(fps), tuple(rig.feet), tuple(rig.hips), tuple(rig.knees),
-            tuple(rig.ankles), rig.trunk, rig.leg_length)
+    # what a take's figures use of the rig: its joints (not the first source's leg length:
+    # a walk and a jog of two actors had the jog's takes measured once for each)
+    rkey = (float(fps), tuple(rig.feet), tuple(rig.foot_cols), tuple(rig.hips),
+            tuple(rig.knees), tuple(rig.ankles), rig.trunk)
 
     def kept(kind, orig, make):
         if cache is None:
