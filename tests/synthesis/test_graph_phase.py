@@ -497,3 +497,44 @@ def test_a_target_in_another_gait_is_reached_in_step(walks, monkeypatch):
     again = synth.to_target(0, 20, 3, 150)
     assert again.path.kind.startswith("graph:")
     assert any("brought two limbs closer" in n for n in again.notes), again.notes
+
+
+def test_moving_frames_leave_out_a_takes_stand():
+    """A take that stands still for its first 1.3 s (CMU 69_01) has a phase extrapolated
+    over the stand: those frames are not where a path crosses into it in step."""
+    from cyclecoord.synthesis.graph.phase import moving_frames
+
+    t = np.arange(300)
+    walk = t >= 100
+    a = 2 * np.pi * np.maximum(t - 100, 0) / 40.0
+    points = np.stack([np.cos(a), np.sin(a)], axis=1)
+    points[~walk] = [3.0, 0.0]  # the stand: a pose off the cycle, held
+    points[~walk] += 0.001 * np.random.default_rng(0).normal(size=(100, 2))
+    moving = moving_frames(points, np.full(300, 1 / 40.0))
+    assert not moving[:80].any() and moving[120:].all()
+    # all of a take that moves, or that would leave under a cycle: every frame
+    assert moving_frames(points[100:], np.full(200, 1 / 40.0)).all()
+    assert moving_frames(points[:110], np.full(110, 1 / 40.0)).all()
+
+
+def test_a_target_after_a_takes_stand_is_reached_without_standing(cmu_dir):
+    """Subject 35's walk 35_07 and subject 69's 69_01, which stands for its first 1.3 s:
+    a target 0.45 s into 69_01's walk was reached by a cross-fade into its stand (the
+    frames at the fade's phase three quarters of a cycle before the target), and the
+    figure stood 0.28 s mid-path.  The fade now goes into the frames where the take moves
+    (from under a cycle before the target where it moves no longer): no freeze, largest
+    acceleration 0.50x the takes' p99."""
+    a = cc.load(cmu_dir / "35" / "35_07.amc")
+    b = cc.load(cmu_dir / "69" / "69_01.amc")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(
+            [a, b])
+        gen = synth.to_target(0, 0, 1, 200)
+        q = measure_generated(gen.motion, reference=synth.reference(gen))
+    assert gen.path.kind == "field:phase:across-to-target"
+    assert not q.freezes and q.largest_accel <= 1.0, (q.freezes, q.largest_accel)
+    on_stand = (np.asarray(gen.path.weights)
+                * (np.asarray(gen.path.neighbours) - 360 < 130)
+                * (np.asarray(gen.path.neighbours) >= 360)).sum(axis=1)
+    assert on_stand.max() < 0.05

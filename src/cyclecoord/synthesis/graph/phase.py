@@ -514,6 +514,31 @@ def phase_to_target(
     ), miss
 
 
+#: A take's frames where it moves (:func:`moving_frames`): its latent speed, averaged over
+#: a cycle, at least this fraction of that average's 90th percentile.
+MOVING_FRACTION = 0.5
+
+
+def moving_frames(points: np.ndarray, rate: np.ndarray) -> np.ndarray:
+    """``(T,)`` bool: the frames of one take (latent points ``(T, d)`` in frame order, phase
+    rate per frame ``(T,)``, cycles per frame) where its pose moves, its latent speed
+    averaged over a cycle at least :data:`MOVING_FRACTION` of that average's 90th
+    percentile; every frame when that would leave under a cycle.  A phase is extrapolated
+    over the stand a take begins with (CMU 69_01 stands for its first 1.3 s): a path
+    crossing into the take "in step" there stood still for 0.28 s."""
+    from scipy.ndimage import uniform_filter1d
+
+    T = points.shape[0]
+    every = np.ones(T, dtype=bool)
+    if T < 3:
+        return every
+    speed = np.linalg.norm(np.gradient(np.asarray(points, dtype=float), axis=0), axis=1)
+    cycle = int(round(1.0 / max(float(np.median(rate)), 1e-9)))
+    avg = uniform_filter1d(speed, size=max(1, min(T, cycle)), mode="nearest")
+    keep = avg >= MOVING_FRACTION * np.percentile(avg, 90)
+    return keep if keep.sum() >= min(T, cycle) else every
+
+
 def phase_across(
     field: PhaseField, start: np.ndarray, target: np.ndarray, step_scale: float = 2.0,
     later: float = 0.0,
@@ -540,23 +565,34 @@ def phase_across(
     take = np.flatnonzero(g.take == g.take[node])
     u_target = float(field.unwrapped[node])
     u = field.unwrapped[take]
-    early = u <= u_target - 0.75  # (b walks three quarters of a cycle at least)
+    moving = moving_frames(g.points[take], field.rate[take])
     tol = 1.5 / _cycle_frames(field, x1, step_scale)
-    b0 = None
-    for join in range(first, first + cycle + 1):  # the fade begins once the phases meet
-        p_join = float(a.phases[join])
-        ok = early & (np.abs(((u - p_join + 0.5) % 1.0) - 0.5) <= tol)
-        if ok.any():  # the take's latest frame at the fade's phase
-            b0 = int(take[ok][np.argmax(u[ok])])
+    b = None
+    # b walks the take to the target: three quarters of a cycle where it moves; a quarter
+    # where it moved no longer before the target (a take that stands first); else from
+    # its stand
+    for early in (moving & (u <= u_target - 0.75), moving & (u <= u_target - 0.25),
+                  u <= u_target - 0.75):
+        b0 = None
+        for join in range(first, first + cycle + 1):  # the fade begins once phases meet
+            ok = early & (np.abs(((u - float(a.phases[join]) + 0.5) % 1.0) - 0.5) <= tol)
+            if ok.any():  # the take's latest frame at the fade's phase
+                b0 = int(take[ok][np.argmax(u[ok])])
+                break
+        if b0 is None:
+            continue
+        # (b0 under a cycle before the target: the cut is looked for from before it)
+        lead = min(0.6, max(0.1, u_target - float(field.unwrapped[b0]) - 0.15))
+        b, _ = phase_to_target(field, g.points[b0], x1, field.phase[node], step_scale,
+                               lead=lead)
+        if b is not None and b.points.shape[0] > half + 1:
             break
-    if b0 is None:
+        b = None
+    if b is None:
         return None
     a = GraphPath(points=a.points[: join + half + 1], neighbours=a.neighbours[: join + half + 1],
                   weights=a.weights[: join + half + 1], inside=a.inside[: join + half + 1],
                   speed=a.speed, kind=a.kind, phases=a.phases[: join + half + 1])
-    b, _ = phase_to_target(field, g.points[b0], x1, field.phase[node], step_scale, lead=0.6)
-    if b is None or b.points.shape[0] <= half + 1:
-        return None
     # a's frames join .. join + half and b's 0 .. half are the fade, at one phase
     n = join + b.points.shape[0]
     w = np.ones(n)
