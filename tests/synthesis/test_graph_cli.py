@@ -63,8 +63,12 @@ def test_generate_writes_motion_report_and_figures(synthetic_takes, tmp_path, ca
     assert r["graph"]["nodes"] == 420
     assert "plausibility" in r and "root" in r
     assert sorted(p.name for p in figs.iterdir()) == ["field.png", "graph.png", "path.png"]
-    # the console names the field the path followed (the default's phase-aware one)
-    assert "delaunay graph (phase-aware field) over" in capsys.readouterr().out
+    # the console names the field the path followed (the default's phase-aware one) and
+    # how much the path drew on each take (the report too, summing to 1)
+    text = capsys.readouterr().out
+    assert "delaunay graph (phase-aware field) over" in text
+    assert any(x.startswith("the path drew on ") for x in text.splitlines())
+    assert abs(sum(r["take_shares"].values()) - 1.0) < 1e-3
 
 
 def test_crossval_report_keys(synthetic_takes, tmp_path, capsys):
@@ -151,6 +155,12 @@ def test_two_actors_on_one_rig_make_one_graph(cmu_dir, tmp_path, capsys):
     assert q["support_slip_m_per_s"] <= 0.05 and q["longest_freeze_s"] < 0.2
     g = cc.load(out)
     assert g.skeleton.names == cc.load(a).skeleton.names
+    # the two actors' walks lie apart: the console says the path kept to 69_01, and how
+    # to cross to 35_16; the report gives the shares
+    drew = next(x for x in text.splitlines() if x.startswith("the path drew on"))
+    assert drew.startswith("the path drew on 69_01 100 %; not on 35_16:"), drew
+    assert f"--target {a.name}:FRAME crosses to it in step" in drew
+    assert r["take_shares"] == {"35_16": 0.0, "69_01": 1.0} and drew in r["notes"]
     lowest = np.min([g.positions()[f][:, 1] for f in ("lfoot", "rfoot", "ltoes", "rtoes")], 0)
     src = np.min([cc.load(a).positions()[f][:, 1] for f in ("lfoot", "rfoot")], 0)
     assert abs(np.percentile(lowest, 5) - np.percentile(src, 5)) < 1.0  # the floor, not above

@@ -288,6 +288,29 @@ def _crossval(args: argparse.Namespace, motions: list, out: Outputs) -> int:
     return EXIT_OK
 
 
+def _drew_on(synth, gen, inputs: list[str]) -> tuple[str, dict[str, float]]:
+    """The console line saying how much the path drew on each take (none for one take),
+    naming the takes it left alone that are another gait, and the report's shares by take.
+    Two actors' walks lie apart in the pose space and the path stays with the one it
+    starts in: "over 829 frames of 2 takes" alone read as if it mixed them."""
+    shares = synth.take_shares(gen.path)
+    by_take = {name: round(float(x), 4) for name, x in zip(synth.names_, shares)}
+    if len(shares) < 2:
+        return "", by_take
+    line = "the path drew on " + ", ".join(
+        f"{name} {100 * x:.0f} %" for name, x in zip(synth.names_, shares) if x >= 0.005)
+    gaits = getattr(synth, "gaits_", None) or [list(range(len(shares)))]
+    used = {g for g, members in enumerate(gaits) if shares[members].sum() >= 0.005}
+    apart = [i for g, members in enumerate(gaits) if g not in used for i in members]
+    if apart:
+        names = ", ".join(synth.names_[i] for i in apart)
+        first = Path(inputs[apart[0]]).name
+        line += (f"; not on {names}: {'its' if len(apart) == 1 else 'their'} poses lie apart "
+                 f"from the path's gait (another gait or actor); --target {first}:FRAME "
+                 "crosses to it in step")
+    return line, by_take
+
+
 def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: Outputs) -> int:
     from ..quality.plausibility import check_plausibility
     from ..synthesis.graph import MotionGraphSynth
@@ -346,6 +369,9 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
     )
     for note in synth.proportion_notes_ + synth.phase_notes_ + gen.notes:
         print(note)
+    drew, shares = _drew_on(synth, gen, inputs)
+    if drew:
+        print(drew)
     payload = {
         "method": method,
         "dims": synth.dims_,
@@ -361,7 +387,8 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
             key: conn[key] for key in ("nodes", "edges", "weak_components", "strong_components")
         },
         "connectivity": conn,
-        "notes": synth.proportion_notes_ + gen.notes,
+        "take_shares": shares,
+        "notes": synth.proportion_notes_ + gen.notes + ([drew] if drew else []),
         "root": "turns, heights and tilts: weighted mean over the training frames weighing on "
         "each generated point (the field's neighbourhood), integrated from the start frame's "
         "root; ground travel "
