@@ -538,3 +538,25 @@ def test_a_target_after_a_takes_stand_is_reached_without_standing(cmu_dir):
                 * (np.asarray(gen.path.neighbours) - 360 < 130)
                 * (np.asarray(gen.path.neighbours) >= 360)).sum(axis=1)
     assert on_stand.max() < 0.05
+
+
+def test_a_target_at_the_start_of_another_gaits_take_is_reached_in_step(walks):
+    """A target a few frames into its take has no frames before it to walk from: the
+    cross-fade goes into a later cycle of the take at the fade's phase, walked to the
+    nearest pose at the target's phase and eased onto the target.  The graph path was
+    taken instead: on subject 35's walks and the 143_01 jog (35_16:13 -> 143_01:28 at 60
+    fps) it popped 2.54x the takes' p99, in step 0.74x; Bandai's turning walk to the
+    straight walk's frame 15, 2.27x -> 0.97x."""
+    jog = cc.datasets.make_periodic_capture(kind="jog", n_frames=200, period=40,
+                                            random_state=5).motion
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(
+            walks + [jog])
+    for start, frame, take, target, other in ((0, 20, 3, 3, jog), (3, 100, 0, 4, walks[0])):
+        gen = synth.to_target(start, frame, take, target)
+        assert gen.path.kind == "field:phase:across-to-target", (target, gen.notes)
+        q = measure_generated(gen.motion, walks + [jog])
+        assert q.largest_accel <= 0.6 and not q.freezes, (q.largest_accel, q.freezes)
+        step = np.median([_pose_gap(other, f, other, f + 1) for f in range(20, 60)])
+        assert _pose_gap(gen.motion, -1, other, target) < 3 * step

@@ -547,9 +547,11 @@ def phase_across(
     start's gait is followed for half a cycle or more (until its phase is one the
     target's take holds early enough), then cross-faded over half a cycle (quintic
     weights, the two paths at one phase) into the target's take, walked to the target
-    (:func:`phase_to_target` from that take's frame at the phase the fade begins, at
-    least three quarters of a cycle before the target).  None when the target's take has
-    no such frame.
+    (:func:`phase_to_target` from that take's frame at the phase the fade begins: where
+    the take moves (:func:`moving_frames`), at least three quarters of a cycle before the
+    target, else a quarter; else from a stand the take begins with; else, for a target
+    under a quarter cycle into its take, from a later cycle, cut at the nearest pose at
+    the target's phase and eased onto it).  None when no such walk reaches the target.
 
     The cross-fade mixes the two gaits' latent points and neighbours (so their roots and
     detail), as the latent method's in-step TRANSITION mixes its two models' poses.
@@ -570,19 +572,24 @@ def phase_across(
     b = None
     # b walks the take to the target: three quarters of a cycle where it moves; a quarter
     # where it moved no longer before the target (a take that stands first); else from
-    # its stand
-    for early in (moving & (u <= u_target - 0.75), moving & (u <= u_target - 0.25),
-                  u <= u_target - 0.75):
+    # its stand; else (a target under a quarter cycle into its take) from a later cycle,
+    # to the nearest pose at the target's phase, eased onto the target
+    for n, early in enumerate((moving & (u <= u_target - 0.75),
+                               moving & (u <= u_target - 0.25),
+                               u <= u_target - 0.75, moving & (u > u_target))):
         b0 = None
         for join in range(first, first + cycle + 1):  # the fade begins once phases meet
             ok = early & (np.abs(((u - float(a.phases[join]) + 0.5) % 1.0) - 0.5) <= tol)
-            if ok.any():  # the take's latest frame at the fade's phase
-                b0 = int(take[ok][np.argmax(u[ok])])
+            if ok.any():  # the take's latest frame at the fade's phase (a later cycle's first)
+                b0 = int(take[ok][np.argmin(u[ok]) if n == 3 else np.argmax(u[ok])])
                 break
         if b0 is None:
             continue
         # (b0 under a cycle before the target: the cut is looked for from before it)
-        lead = min(0.6, max(0.1, u_target - float(field.unwrapped[b0]) - 0.15))
+        if n < 3:
+            lead = min(0.6, max(0.1, u_target - float(field.unwrapped[b0]) - 0.15))
+        else:  # (long enough for the fade: a walk's half cycle is more than a jog's)
+            lead = max(0.6, (half + 2) / _cycle_frames(field, g.points[b0], step_scale))
         b, _ = phase_to_target(field, g.points[b0], x1, field.phase[node], step_scale,
                                lead=lead)
         if b is not None and b.points.shape[0] > half + 1:
