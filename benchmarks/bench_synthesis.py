@@ -3,7 +3,7 @@
 Run from a checkout::
 
     python benchmarks/bench_synthesis.py [--frames 1200] [--json out.json] [--data DIR]
-                                         [--no-limbs] [--jog-from 4]
+                                         [--no-limbs] [--jog-from 4] [--pairs 20]
 
 For each set -- subject 35's walks (set w1: 35_16, 35_07, 35_08, 35_13; a walk of
 ``--frames`` frames) and the 143_01 jog (one 100-frame take, read at 60 fps: see
@@ -33,8 +33,10 @@ the foot pinning.  The 143_01 jog is one take: our graph (two takes at least) is
 on its two halves.  The graph takes no script: the walk, run, walk, idle script is the
 latent method's (``bench_latent_gait.py``); here the walk-to-jog and jog-to-walk paths are
 ``--target`` pairs on subject 35's walks with the jog (another actor, put on 35's skeleton),
-ours against the paper's shortest graph path (:func:`targets`).  Without the CMU data it
-runs on synthetic walks and says so.  Speed is printed, never asserted.
+ours against the paper's shortest graph path (:func:`targets`), then ``--pairs`` random
+start/target pairs on four sets (w1, walks with the jog, two actors, the Bandai turning
+walks: :func:`random_targets`), pairs in a take's stand summed apart.  Without the CMU data
+it runs on synthetic walks and says so.  Speed is printed, never asserted.
 """
 
 from __future__ import annotations
@@ -55,6 +57,7 @@ from cyclecoord.io import atomic_write
 from cyclecoord.quality.generated import measure_generated, source_figures
 from cyclecoord.synthesis.classic_graph import THRESHOLD, ClassicMotionGraph, replay_nearest
 from cyclecoord.synthesis.graph import MotionGraphSynth
+from cyclecoord.synthesis.graph.phase import moving_frames
 
 DATA_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 W1 = ("35_16", "35_07", "35_08", "35_13")
@@ -302,12 +305,101 @@ def targets(data: Path) -> list[dict]:
     return rows
 
 
+def target_sets(data: Path) -> list[tuple[str, list]]:
+    """The sets :func:`random_targets` draws pairs on: subject 35's w1 walks, two walks
+    with the 143_01 jog (60 fps), two actors' walks (35_07 and 69_01, which stands for
+    its first 1.3 s), and the Bandai straight and turning walks; those whose files are
+    there."""
+    cmu, bandai = data / "cmu", data / "bvh" / "bandai"
+    sets = []
+    w1 = [cmu / "35" / f"{n}.amc" for n in W1]
+    if all(p.is_file() for p in w1):
+        sets.append(("w1", [cc.load(p) for p in w1]))
+    jog = cmu / "143" / "143_01.amc"
+    if all(p.is_file() for p in w1[1:3] + [jog]):
+        walks = [cc.load(p) for p in w1[1:3]]
+        walks = [m.with_frames(m.frames[::2], fps=60.0) for m in walks]
+        sets.append(("walks + jog", walks + [cc.load(jog, fps=JOG_FPS)]))
+    actors = [cmu / "35" / "35_07.amc", cmu / "69" / "69_01.amc"]
+    if all(p.is_file() for p in actors):
+        sets.append(("two actors", [cc.load(p) for p in actors]))
+    turns = [bandai / f"{n}.bvh" for n in ("dataset-1_walk_normal_001",
+                                         "dataset-2_walk-turn-left_normal_011",
+                                         "dataset-2_walk-turn-right_normal_029")]
+    if all(p.is_file() for p in turns):
+        sets.append(("Bandai walks", [cc.load(p) for p in turns]))
+    return sets
+
+
+def random_targets(data: Path, pairs: int, seed: int = 1) -> list[dict]:
+    """``to_target`` over ``pairs`` random start and target frames per set
+    (:func:`target_sets`; any take to any take, seeded), ours against the paper's
+    shortest graph path on the same graph: how often each pops (largest acceleration
+    over 1.5x the sources' p99), freezes (:func:`measure_generated`'s), and, ours only,
+    which path it took.  The fixed pairs of :func:`targets` were chosen once; these
+    find what they miss (a take that begins with a stand, a target a few frames into
+    its take)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for name, takes in target_sets(data):
+        ours = MotionGraphSynth(**OURS).fit(takes)
+        paper = MotionGraphSynth(method="delaunay", dims="auto", step_scale=2.0).fit(takes)
+        n = len(ours.takes_)
+        figs: dict = {"ours": [], "graph path": [], "kinds": [], "stand": []}
+        field, take = ours.phase_field_, ours.phase_field_.graph.take
+        moving = [moving_frames(field.graph.points[take == i], field.rate[take == i])
+                  for i in range(n)]
+        for _ in range(pairs):
+            s, t = int(rng.integers(n)), int(rng.integers(n))
+            sf = int(rng.integers(ours.takes_[s].n_frames))
+            tf = int(rng.integers(ours.takes_[t].n_frames))
+            figs["stand"].append(not (moving[s][sf] and moving[t][tf]))
+            for label, synth in (("ours", ours), ("graph path", paper)):
+                gen = synth.to_target(s, sf, t, tf)
+                if gen.motion.n_frames < 3:  # a target beside the start: nothing to pop
+                    figs[label].append((0.0, False))
+                else:
+                    q = measure_generated(gen.motion, reference=synth.reference(gen))
+                    figs[label].append((q.largest_accel, bool(q.freezes)))
+                if label == "ours":
+                    figs["kinds"].append(gen.path.kind.split(":")[-1] if gen.path.kind.startswith(
+                        "field") else "graph path")
+        out.append({"set": name, **figs})
+    return out
+
+
+def _random_lines(rows: list[dict]) -> list[str]:
+    """Per set, the pairs whose start and target lie where their takes move, then (when
+    there are any) those with one in a stand a take begins or ends with."""
+    lines = []
+    for r in rows:
+        stand = np.array(r["stand"], dtype=bool)
+        for part, keep in (("", ~stand), ("  with a stand", stand)):
+            if not keep.any():
+                continue
+            cells = []
+            for label in ("ours", "graph path"):
+                acc = np.array([a for a, _ in r[label]])[keep]
+                frozen = int(np.array([f for _, f in r[label]])[keep].sum())
+                cells.append(f"{label} accel median {np.median(acc):.2f}, largest "
+                             f"{acc.max():.2f}, over 1.5x {int((acc > 1.5).sum())}, freezes "
+                             f"{frozen}")
+            kinds = [k for k, x in zip(r["kinds"], keep) if x]
+            count = {k: kinds.count(k) for k in sorted(set(kinds))}
+            lines.append(f"  {r['set'] + part:26s} {int(keep.sum()):2d} pairs: "
+                         + " | ".join(cells) + "; ours by "
+                         + ", ".join(f"{k} {v}" for k, v in count.items()))
+    return lines
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--frames", type=int, default=1200, help="walk length (the run: half)")
     p.add_argument("--data", type=Path, default=DATA_DIR, help="the shared data folder")
     p.add_argument("--json", default=None, help="also write every figure as JSON")
     p.add_argument("--no-limbs", action="store_true", help="skip the limb-contact check")
+    p.add_argument("--pairs", type=int, default=20,
+                   help="random --target pairs per set (0: none; default %(default)s)")
     p.add_argument("--jog-from", type=int, default=JOG_START,
                    help="first frame of 143_01 used (default %(default)s: its first stride)")
     args = p.parse_args(argv)
@@ -349,10 +441,17 @@ def main(argv: list[str] | None = None) -> int:
         worst = [max(r[k]["accel"] for r in tg) for k in ("ours", "graph path")]
         print(f"  largest accel over every pair: ours {worst[0]:.2f}, graph path {worst[1]:.2f} "
               f"({worst[0] / worst[1]:.2f}x)")
+    rt = random_targets(args.data, args.pairs) if args.pairs > 0 else []
+    if rt:
+        print(f"\n--target over {args.pairs} random start/target pairs per set (seed 1), "
+              "accel over the sources' p99 (target <= 1.5), freezes of over 0.2 s; pairs with "
+              "a start or target in a take's stand apart (no capture walks into a stand)")
+        print("\n".join(_random_lines(rt)))
     if args.json:
         with atomic_write(args.json, "w") as fh:
             json.dump({"sets": [{k: v for k, v in r.items() if k != "rows"} for r in results],
-                       "speed": sp, "targets": tg, "python": sys.version}, fh, indent=1,
+                       "speed": sp, "targets": tg, "random_targets": rt,
+                       "python": sys.version}, fh, indent=1,
                       default=str)
         print(f"wrote {args.json}")
     return 0

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import cyclecoord as cc
 from cyclecoord.errors import ParameterError
 from _skips import need_data
 from _measured import at_most
@@ -477,6 +478,36 @@ def test_synthesis_bench_prints_every_method_on_synthetic_walks(tmp_path, capsys
     assert "control: the captures' own one-cycle windows" in text
     ctl = figures["stride windows"]
     assert len(ctl) >= 4 and max(ctl) <= 1.2 and 0.8 < float(np.median(ctl)) <= 1.05
+
+
+def test_synthesis_bench_random_targets_split_pairs_by_stand(monkeypatch):
+    """``random_targets``: seeded random start/target pairs on each set, ours and the
+    paper's graph path measured alike, and the summary keeps pairs that start or end in
+    a take's stand apart (no capture walks into a stand; a take that stands first is
+    crossed through it)."""
+    spec = importlib.util.spec_from_file_location(
+        "bench_synthesis", BENCH.parent / "bench_synthesis.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["bench_synthesis"] = module
+    spec.loader.exec_module(module)
+    walks = [cc.datasets.make_periodic_capture(kind="walk", n_frames=n, period=60,
+                                               random_state=s).motion
+             for s, n in enumerate((240, 260))]
+    jog = cc.datasets.make_periodic_capture(kind="jog", n_frames=200, period=40,
+                                            random_state=5).motion
+    monkeypatch.setattr(module, "target_sets", lambda data: [("synthetic", walks + [jog])])
+    rows = module.random_targets(Path("unused"), 6)
+    again = module.random_targets(Path("unused"), 6)
+    assert rows[0]["ours"] == again[0]["ours"]  # seeded
+    r = rows[0]
+    assert r["set"] == "synthetic" and len(r["ours"]) == len(r["graph path"]) == 6
+    assert len(r["kinds"]) == len(r["stand"]) == 6 and not any(r["stand"])
+    assert max(a for a, _ in r["ours"]) <= 1.5 and not any(f for _, f in r["ours"])
+    (line,) = module._random_lines(rows)
+    assert line.split()[:3] == ["synthetic", "6", "pairs:"] and "| graph path accel" in line
+    r["stand"][0] = True  # a pair in a stand is summed apart
+    lines = module._random_lines(rows)
+    assert len(lines) == 2 and " 5 pairs:" in lines[0] and "with a stand" in lines[1]
 
 
 def test_synthesis_bench_targets_ours_against_the_graph_path(cmu_dir, monkeypatch):
