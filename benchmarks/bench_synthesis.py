@@ -359,7 +359,8 @@ def random_targets(data: Path, pairs: int, seed: int = 1) -> list[dict]:
                 if gen.motion.n_frames < 3:  # a target beside the start: nothing to pop
                     figs[label].append((0.0, False))
                 else:
-                    q = measure_generated(gen.motion, reference=synth.reference(gen))
+                    # (both judged alike: by the gaits the path drew on, ours' grouping)
+                    q = measure_generated(gen.motion, reference=ours.reference(gen))
                     figs[label].append((q.largest_accel, bool(q.freezes)))
                 if label == "ours":
                     figs["kinds"].append(gen.path.kind.split(":")[-1] if gen.path.kind.startswith(
