@@ -793,6 +793,46 @@ def test_a_script_over_two_models_is_also_measured_model_by_model(made):
         ("walk", 0, t1[0]), ("run", t1[0], t2[0]), ("walk", t2[0], motion.n_frames)]
 
 
+def test_a_script_is_judged_by_the_models_that_made_its_frames(models):
+    """A run that ends in a TRANSITION to the walk made its frames in one model (the
+    blend left out): it is judged against the run's takes.  The report pooled both
+    models' takes, the walk's many frames setting the figures: "feet gliding (support
+    foot 0.62 m/s, sources 0.06)" for subject 35's jog, whose takes slip 0.55.  A model
+    whose run of frames is under ``MIN_SECTION`` counts too."""
+    from cyclecoord.quality.generated import mixed_reference, source_figures
+    from cyclecoord.synthesis.latent.script import model_sections, script_quality
+
+    refs = {k: source_figures(training_takes(models, [k]), 30.0) for k in ("walk", "run")}
+    metres = refs["run"].metres
+    syn = Synthesizer(models, fps=30, seed=0)
+    syn.start("run", {"frame": 0})
+    syn.command = 0  # (as run_script numbers them)
+    syn.move({"ahead": 1.2}, stop=False)
+    syn.command = 1
+    syn.transition("walk", blend=0.4)
+    commands = [{"command": "MOVE"}, {"command": "TRANSITION"}]
+    quality, _ = script_quality(syn, syn.motion(), commands)
+    assert quality["sources_support_slip_m_per_s"] == pytest.approx(
+        refs["run"].support_slip * metres, rel=1e-9)
+    assert refs["walk"].support_slip != pytest.approx(refs["run"].support_slip, rel=0.1)
+    # a walk under half a second before the run: both, weighted by their frames
+    syn = Synthesizer(models, fps=30, seed=0)
+    syn.start("walk", {"frame": 0})
+    for syn.command, call in enumerate((
+            lambda: syn.move({"ahead": 0.3}, stop=False, at_stance=False),
+            lambda: syn.transition("run", blend=0.4), lambda: syn.move({"ahead": 2.0}))):
+        call()
+    commands = [{"command": "MOVE"}, {"command": "TRANSITION"}, {"command": "MOVE"}]
+    assert [s["model"] for s in model_sections(syn, commands)] == ["run"]
+    made = {s["model"]: s["stop"] - s["start"]
+            for s in model_sections(syn, commands, shortest=0.0)}
+    assert set(made) == {"walk", "run"} and made["walk"] < 15
+    quality, _ = script_quality(syn, syn.motion(), commands)
+    want = mixed_reference([(refs["run"], made["run"]), (refs["walk"], made["walk"])])
+    assert quality["sources_support_slip_m_per_s"] == pytest.approx(
+        want.support_slip * metres, rel=1e-9)
+
+
 def test_foot_pins_ease_over_a_tenth_of_the_quickest_leg_cycle(made):
     """LOCK_BLEND (0.1 s) for the walk alone (its cycle is 1.1 s); with the run, a tenth of
     the run's cycle (0.7 s): a run's stance at 30 fps is 5-7 frames."""

@@ -374,13 +374,17 @@ def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None,
     hold = syn.hold_mask(motion.n_frames)
     sources, ref = measured({c.model for c in syn.chunks})
     sections = model_sections(syn, commands)
-    made: dict[str, int] = {}  # frames each model made, blends left out
-    for sec in sections:
+    # frames each model made, blends left out, runs too short to be measured on their own
+    # counted too (a run of three short MOVEs then a TRANSITION to the walk was judged
+    # against the walk's and the jog's takes pooled, the walk's many frames setting the
+    # slip: "feet gliding (support foot 0.62 m/s, sources 0.06)" for a jog's 0.55)
+    made: dict[str, int] = {}
+    for sec in model_sections(syn, commands, shortest=0.0):
         made[sec["model"]] = made.get(sec["model"], 0) + sec["stop"] - sec["start"]
     parts = [(measured([k])[1], n) for k, n in sorted(made.items())]
-    if ref is not None and len(parts) > 1 and all(r is not None for r, _ in parts):
+    if ref is not None and parts and all(r is not None for r, _ in parts):
         # the whole motion against each model's takes, weighted by the frames it made
-        ref = mixed_reference(parts)
+        ref = parts[0][0] if len(parts) == 1 else mixed_reference(parts)
     quality, lines = lead_lines(motion, sources, feet=feet, hold=hold, reference=ref,
                                 analysed=True)
     if quality is not None and len({s["model"] for s in sections}) > 1:
@@ -439,9 +443,9 @@ def transition_windows(syn, commands: list) -> list[dict[str, Any]]:
     return out
 
 
-def model_sections(syn, commands: list) -> list[dict[str, Any]]:
+def model_sections(syn, commands: list, shortest: float = MIN_SECTION) -> list[dict[str, Any]]:
     """Runs of frames that one model made, TRANSITIONs left out (a blend is two models'),
-    of at least :data:`MIN_SECTION` seconds: ``[{"model", "start", "stop"}]``."""
+    of at least ``shortest`` seconds: ``[{"model", "start", "stop"}]``."""
     out: list[dict[str, Any]] = []
     for seg in syn.segments():
         k = seg["command"]
@@ -452,8 +456,8 @@ def model_sections(syn, commands: list) -> list[dict[str, Any]]:
             out[-1]["stop"] = seg["stop"]
         else:
             out.append({"model": seg["model"], "start": seg["start"], "stop": seg["stop"]})
-    shortest = MIN_SECTION * syn.fps
-    return [s for s in out if s["model"] is not None and s["stop"] - s["start"] >= shortest]
+    return [s for s in out
+            if s["model"] is not None and s["stop"] - s["start"] >= shortest * syn.fps]
 
 
 @one_blas_thread
