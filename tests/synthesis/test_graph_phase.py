@@ -447,19 +447,27 @@ def test_a_target_on_the_gait_is_walked_to(walks):
     assert path is None and miss > 1
 
 
-def test_a_target_in_another_gait_is_reached_in_step(walks, monkeypatch):
-    """A jog's pose from a walk: the walk's path never comes near it, so the walk is
-    followed until its phase is one the jog's take holds, then cross-faded over half a
-    cycle into that take at the same phase and walked (jogged) to the target.  On subject
-    35's walks and the 143_01 jog the graph path popped 2.0-2.9x the takes' p99, the fade
-    0.65-0.94x.  Where the fade brings two limbs closer than the takes ever do, the graph
-    path is taken instead, and the note says why."""
+@pytest.fixture(scope="module")
+def walks_and_jog(walks):
+    """A phase-aware graph over the synthetic walks and a jog (the fourth take), and the
+    jog."""
     jog = cc.datasets.make_periodic_capture(kind="jog", n_frames=200, period=40,
                                             random_state=5).motion
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(
             walks + [jog])
+    return synth, jog
+
+
+def test_a_target_in_another_gait_is_reached_in_step(walks, walks_and_jog, monkeypatch):
+    """A jog's pose from a walk: the walk's path never comes near it, so the walk is
+    followed until its phase is one the jog's take holds, then cross-faded over half a
+    cycle into that take at the same phase and walked (jogged) to the target.  On subject
+    35's walks and the 143_01 jog the graph path popped 2.0-2.9x the takes' p99, the fade
+    0.65-0.94x.  Where the fade brings two limbs closer than the takes ever do, the graph
+    path is taken instead, and the note says why."""
+    synth, jog = walks_and_jog
     gen = synth.to_target(0, 20, 3, 150)
     assert gen.path.kind == "field:phase:across-to-target"
     assert any("cross-fade in step" in n for n in gen.notes), gen.notes
@@ -540,19 +548,14 @@ def test_a_target_after_a_takes_stand_is_reached_without_standing(cmu_dir):
     assert on_stand.max() < 0.05
 
 
-def test_a_target_at_the_start_of_another_gaits_take_is_reached_in_step(walks):
+def test_a_target_at_the_start_of_another_gaits_take_is_reached_in_step(walks, walks_and_jog):
     """A target a few frames into its take has no frames before it to walk from: the
     cross-fade goes into a later cycle of the take at the fade's phase, walked to the
     nearest pose at the target's phase and eased onto the target.  The graph path was
     taken instead: on subject 35's walks and the 143_01 jog (35_16:13 -> 143_01:28 at 60
     fps) it popped 2.54x the takes' p99, in step 0.74x; Bandai's turning walk to the
     straight walk's frame 15, 2.27x -> 0.97x."""
-    jog = cc.datasets.make_periodic_capture(kind="jog", n_frames=200, period=40,
-                                            random_state=5).motion
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(
-            walks + [jog])
+    synth, jog = walks_and_jog
     for start, frame, take, target, other in ((0, 20, 3, 3, jog), (3, 100, 0, 4, walks[0])):
         gen = synth.to_target(start, frame, take, target)
         assert gen.path.kind == "field:phase:across-to-target", (target, gen.notes)
