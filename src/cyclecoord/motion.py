@@ -231,8 +231,8 @@ class Motion:
 
         Made once per motion up to :data:`FK_KEPT_VALUES` position values and kept
         read-only (the frames and the skeleton never change, so neither do they): a
-        latent script asked for the same motion's positions twice as often as for
-        another's, a twentieth of its time.  Copy the array to change it."""
+        latent script asked 79 times for the positions of 34 motions.  Copy the array to
+        change it."""
         kept = self.__dict__.get("_positions")
         if kept is not None:
             return kept
