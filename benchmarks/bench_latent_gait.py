@@ -4,7 +4,7 @@ transitions in step, joints not flattened, freezes, IDLE, slip, pops, leg ranges
 
 Run from a checkout::
 
-    python benchmarks/bench_latent_gait.py [--quick] [--no-shared] [--seeds N]
+    python benchmarks/bench_latent_gait.py [--quick] [--no-shared] [--seeds N] [--random N]
 
 Model pairs (30 fps, every 4th frame of 120 fps captures): a synthetic walk (1.1 s leg
 cycle) and run (0.7 s) from ``cyclecoord.datasets`` (two 5 s segments each), the
@@ -22,7 +22,8 @@ The gait sections' pops, slip and leg ranges are then given over ``--seeds`` scr
 seeds (default 5): median and range, since one seed's figure is one draw of the random
 force.
 Then the same seeds with MOVEs of 1 and 2 s and an 8 s run (``LONG_MOVES``), and a control
-for the leg ranges: the training takes' own one-cycle windows, measured alike.
+for the leg ranges: the training takes' own one-cycle windows, measured alike.  Then
+``--random`` scripts no one chose (:func:`random_scripts`), judged by their own reports.
 """
 
 from __future__ import annotations
@@ -143,7 +144,8 @@ def sections(report) -> dict:
             "T2": span([t2]), "idle": span([t2 + 1])}
 
 
-def measure_pair(label: str, takes: dict, d: Path, quick: bool, seeds: int = 1) -> None:
+def measure_pair(label: str, takes: dict, d: Path, quick: bool, seeds: int = 1,
+                 scripts: int = 0) -> None:
     models = {}
     for name, segs in takes.items():
         t = time.perf_counter()
@@ -218,8 +220,104 @@ def measure_pair(label: str, takes: dict, d: Path, quick: bool, seeds: int = 1) 
     print(f"  blend 0.034 s: {said[0].split(': ', 1)[1] if said else 'not raised'}")
     _check(motion, models, d, a)
     stops(models, d)
+    if scripts > 0:
+        random_scripts(models, d, scripts)
     if seeds > 1:
         over_seeds(models, d, seeds, label)
+
+
+def random_script(models: dict, rng: np.random.Generator) -> dict:
+    """One script no one chose: 2-5 commands (MOVE ahead 0.3-3 s, some at 0.7-1.3x speed;
+    MOVE to a training frame along a line or the graph; IDLE 0.5-2.5 s; TRANSITION to the
+    other model, blend 0.3-0.8 s) from a random frame of a random model, its own seed."""
+    frames = {k: m.X_.shape[0] for k, m in models.items()}
+    model = cur = str(rng.choice(sorted(models)))
+    commands = []
+    for _ in range(int(rng.integers(2, 6))):
+        r = rng.random()
+        if r < 0.45:
+            c = {"command": "MOVE", "to": {"ahead": round(float(rng.uniform(0.3, 3.0)), 2)}}
+            if rng.random() < 0.3:
+                c["speed"] = round(float(rng.uniform(0.7, 1.3)), 2)
+        elif r < 0.6:
+            c = {"command": "MOVE", "to": {"frame": int(rng.integers(frames[cur]))},
+                 "path": str(rng.choice(["line", "graph"]))}
+        elif r < 0.8:
+            c = {"command": "IDLE", "duration": round(float(rng.uniform(0.5, 2.5)), 2)}
+        else:
+            cur = [k for k in sorted(models) if k != cur][0]
+            c = {"command": "TRANSITION", "to": cur,
+                 "blend": round(float(rng.uniform(0.3, 0.8)), 2)}
+        commands.append(c)
+    return {"fps": 30, "seed": int(rng.integers(100)),
+            "models": {k: f"{k}.npz" for k in sorted(models)},
+            "start": {"model": model, "at": {"frame": int(rng.integers(frames[model]))}},
+            "commands": commands}
+
+
+def _own_accel(motion, rep: dict, spec: dict, refs: dict) -> float:
+    """The largest acceleration of a script's motion, each run of one model's frames over
+    its own takes' p99 and each TRANSITION's over the faster model's (a frame and its
+    neighbours: the whole motion over its models' mix read a short run's strides against
+    the walk's p99)."""
+    runs: list[list] = []  # [model or None, start, stop, models]
+    for seg in rep["commands"]:
+        blend = spec["commands"][seg["command"]]["command"] == "TRANSITION"
+        key = None if blend else seg["model"]
+        if runs and runs[-1][0] == key and runs[-1][2] == seg["start"] and key is not None:
+            runs[-1][2] = seg["stop"]
+        elif runs and blend and runs[-1][0] is None and runs[-1][2] == seg["start"]:
+            runs[-1][2] = seg["stop"]
+            runs[-1][3].add(seg["model"])
+        else:
+            before = {runs[-1][0] or next(iter(runs[-1][3]))} if runs and blend else set()
+            runs.append([key, seg["start"], seg["stop"], {seg["model"]} | before])
+    worst = 0.0
+    for key, a, b, models in runs:
+        a, b = max(a - 1, 0), min(b + 1, motion.n_frames)
+        if b - a < 3:
+            continue
+        ref = refs[key] if key is not None else max((refs[k] for k in models),
+                                                   key=lambda r: r.accel_p99)
+        worst = max(worst, measure_generated(motion[a:b], reference=ref).largest_accel)
+    return worst
+
+
+def random_scripts(models: dict, d: Path, n: int, seed: int = 11) -> None:
+    """``n`` seeded :func:`random_script` scripts, run as ``cyclecoord animate`` runs them
+    and judged by their reports (against the models that made their frames; the largest
+    acceleration of each model's frames against its own takes and of each blend against
+    the faster model's, :func:`_own_accel`): how many pop
+    (largest acceleration over 1.5x the sources' p99), slip (support foot over 1.5x the
+    sources'), freeze outside an IDLE, or bring limbs closer than the takes (``animate``
+    refuses to write those).  The fixed script above never starts mid-take, stands
+    before a TRANSITION or ends in one; these do, and found a report that judged a jog by
+    the walk's takes (10-17x "slip")."""
+    from cyclecoord.quality.generated import source_figures
+
+    rng = np.random.default_rng(seed)
+    refs = {k: source_figures(training_takes(models, [k]), 30.0) for k in models}
+    acc, slip, frozen, limbs, failed, worst = [], [], 0, 0, 0, []
+    for i in range(n):
+        path = d / f"random_{i}.json"
+        path.write_text(json.dumps(random_script(models, rng)))
+        try:
+            motion, rep = run_script(path)
+        except cc.errors.CycleCoordError:
+            failed += 1
+            continue
+        q = rep["motion_quality"] or {}
+        acc.append(_own_accel(motion, rep, json.loads(path.read_text()), refs))
+        slip.append(q.get("support_slip_ratio") or 0.0)
+        frozen += bool(q.get("freezes"))
+        limbs += bool((rep.get("plausibility") or {}).get("new_contact_frames"))
+        worst.append((acc[-1], i))
+    acc, slip = np.array(acc), np.array(slip)
+    top = ", ".join(f"#{i} {a:.2f}x" for a, i in sorted(worst, reverse=True)[:3])
+    print(f"  random scripts ({n}, seed {seed}): largest accel median {np.median(acc):.2f}x "
+          f"p99, over 1.5x on {int((acc > 1.5).sum())} (worst {top}); slip over 1.5x the "
+          f"sources' on {int((slip > 1.5).sum())}; a freeze outside IDLE on {frozen}; new "
+          f"limb contacts (refused by animate) on {limbs}; failed {failed}")
 
 
 def stops(models: dict, d: Path, n: int = 12) -> None:
@@ -418,6 +516,8 @@ def main(argv=None) -> int:
     ap.add_argument("--no-shared", action="store_true", help="the synthetic pair only")
     ap.add_argument("--seeds", type=int, default=5,
                     help="script seeds the gait sections are also measured over (1: none)")
+    ap.add_argument("--random", type=int, default=20,
+                    help="random scripts per model pair (0: none; default %(default)s)")
     args = ap.parse_args(argv)
     pairs = [("synthetic walk + run", synthetic_pair(args.quick))]
     if not args.no_shared:
@@ -430,7 +530,7 @@ def main(argv=None) -> int:
     for label, takes in pairs:
         print(label)
         with tempfile.TemporaryDirectory() as tmp:
-            measure_pair(label, takes, Path(tmp), args.quick, args.seeds)
+            measure_pair(label, takes, Path(tmp), args.quick, args.seeds, args.random)
     return 0
 
 

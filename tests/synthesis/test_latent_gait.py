@@ -778,12 +778,15 @@ def test_a_script_over_two_models_is_also_measured_model_by_model(made):
                    .largest_accel for k in pair)
         assert win["largest_accel_ratio"] == pytest.approx(want)
     assert lines[-2].startswith(f"  TRANSITION walk -> run frames {t1[0] - 3}-{t1[1] + 3}: ")
-    # the whole motion leads against each model's takes weighted by the frames it made
-    # (pooled, the model with more training frames set the figures)
+    # the whole motion leads against each model's takes weighted by the frames it made,
+    # each TRANSITION's shared by its two (pooled, the model with more training frames set
+    # the figures)
     from cyclecoord.quality.generated import source_figures
 
     refs = {k: source_figures(training_takes(syn.models, [k]), 30.0) for k in ("walk", "run")}
-    frames = {"walk": walk[1] - walk[0] + idle[1] - idle[0], "run": run[1] - run[0]}
+    blends = (t1[1] - t1[0] + t2[1] - t2[0]) / 2
+    frames = {"walk": walk[1] - walk[0] + idle[1] - idle[0] + blends,
+              "run": run[1] - run[0] + blends}
     want = sum(frames[k] * refs[k].support_slip for k in refs) / sum(frames.values())
     metres = refs["walk"].metres
     assert quality["sources_support_slip_m_per_s"] == pytest.approx(want * metres, rel=1e-6)
@@ -794,13 +797,17 @@ def test_a_script_over_two_models_is_also_measured_model_by_model(made):
 
 
 def test_a_script_is_judged_by_the_models_that_made_its_frames(models):
-    """A run that ends in a TRANSITION to the walk made its frames in one model (the
-    blend left out): it is judged against the run's takes.  The report pooled both
-    models' takes, the walk's many frames setting the figures: "feet gliding (support
-    foot 0.62 m/s, sources 0.06)" for subject 35's jog, whose takes slip 0.55.  A model
-    whose run of frames is under ``MIN_SECTION`` counts too."""
+    """A run that ends in a TRANSITION to the walk is judged against the run's takes and,
+    for half the blend's frames, the walk's.  The report pooled both models' takes, the
+    walk's many frames setting the figures: "feet gliding (support foot 0.62 m/s, sources
+    0.06)" for subject 35's jog, whose takes slip 0.55.  A model whose run of frames is
+    under ``MIN_SECTION`` counts too."""
     from cyclecoord.quality.generated import mixed_reference, source_figures
-    from cyclecoord.synthesis.latent.script import model_sections, script_quality
+    from cyclecoord.synthesis.latent.script import (
+        model_sections,
+        script_quality,
+        transition_windows,
+    )
 
     refs = {k: source_figures(training_takes(models, [k]), 30.0) for k in ("walk", "run")}
     metres = refs["run"].metres
@@ -812,10 +819,17 @@ def test_a_script_is_judged_by_the_models_that_made_its_frames(models):
     syn.transition("walk", blend=0.4)
     commands = [{"command": "MOVE"}, {"command": "TRANSITION"}]
     quality, _ = script_quality(syn, syn.motion(), commands)
+    (run,) = model_sections(syn, commands, shortest=0.0)
+    (win,) = transition_windows(syn, commands)
+    half = (win["stop"] - win["start"]) / 2
+    want = mixed_reference([(refs["run"], run["stop"] - run["start"] + half),
+                            (refs["walk"], half)])
     assert quality["sources_support_slip_m_per_s"] == pytest.approx(
-        refs["run"].support_slip * metres, rel=1e-9)
+        want.support_slip * metres, rel=1e-9)
+    assert want.support_slip > 0.8 * refs["run"].support_slip  # the run's, mostly
     assert refs["walk"].support_slip != pytest.approx(refs["run"].support_slip, rel=0.1)
-    # a walk under half a second before the run: both, weighted by their frames
+    # a walk under half a second before the run: both, weighted by their frames (the
+    # blend's shared)
     syn = Synthesizer(models, fps=30, seed=0)
     syn.start("walk", {"frame": 0})
     for syn.command, call in enumerate((
@@ -827,10 +841,49 @@ def test_a_script_is_judged_by_the_models_that_made_its_frames(models):
     made = {s["model"]: s["stop"] - s["start"]
             for s in model_sections(syn, commands, shortest=0.0)}
     assert set(made) == {"walk", "run"} and made["walk"] < 15
+    (win,) = transition_windows(syn, commands)
+    for k in ("walk", "run"):
+        made[k] += (win["stop"] - win["start"]) / 2
     quality, _ = script_quality(syn, syn.motion(), commands)
     want = mixed_reference([(refs["run"], made["run"]), (refs["walk"], made["walk"])])
     assert quality["sources_support_slip_m_per_s"] == pytest.approx(
         want.support_slip * metres, rel=1e-9)
+
+
+def test_the_benchmark_runs_scripts_no_one_chose(models, tmp_path, capsys):
+    """``bench_latent_gait.random_scripts``: seeded scripts that ``run_script`` takes, and
+    a script's largest acceleration judged run by run against the model that made it (one
+    model's script: the whole motion against its takes)."""
+    import importlib.util
+    import re
+    import sys
+    from pathlib import Path
+
+    from cyclecoord.quality.generated import source_figures
+
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_latent_gait.py"
+    spec = importlib.util.spec_from_file_location("bench_latent_gait", path)
+    bench = importlib.util.module_from_spec(spec)
+    sys.modules["bench_latent_gait"] = bench
+    spec.loader.exec_module(bench)
+    for name, m in models.items():
+        m.save(tmp_path / f"{name}.npz")
+    one = [bench.random_script(models, np.random.default_rng(3)) for _ in range(2)]
+    assert one[0] == bench.random_script(models, np.random.default_rng(3))  # seeded
+    assert all(2 <= len(x["commands"]) <= 5 for x in one)
+    bench.random_scripts(models, tmp_path, 3)
+    out = capsys.readouterr().out
+    assert re.search(r"random scripts \(3, seed 11\): largest accel median [0-9.]+x", out), out
+    assert "failed 0" in out
+    walk = {"fps": 30, "seed": 0, "models": {"walk": "walk.npz", "run": "run.npz"},
+            "start": {"model": "walk", "at": {"frame": 0}},
+            "commands": [{"command": "MOVE", "to": {"ahead": 2.0}}]}
+    p = tmp_path / "walk.json"
+    p.write_text(json.dumps(walk))
+    motion, rep = run_script(p)
+    refs = {k: source_figures(training_takes(models, [k]), 30.0) for k in models}
+    assert bench._own_accel(motion, rep, walk, refs) == pytest.approx(
+        measure_generated(motion, reference=refs["walk"]).largest_accel)
 
 
 def test_foot_pins_ease_over_a_tenth_of_the_quickest_leg_cycle(made):

@@ -375,13 +375,18 @@ def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None,
     sources, ref = measured({c.model for c in syn.chunks})
     runs = model_sections(syn, commands, shortest=0.0)
     sections = [s for s in runs if s["stop"] - s["start"] >= MIN_SECTION * syn.fps]
-    # frames each model made, blends left out, runs too short to be measured on their own
-    # counted too, one model alone too (a jog's MOVEs then a TRANSITION to the walk was
-    # judged against the walk's and the jog's takes pooled, the walk's many frames setting
-    # the slip: "feet gliding (support foot 0.62 m/s, sources 0.06)" for a jog's 0.55)
-    made: dict[str, int] = {}
+    # frames each model made, runs too short to be measured on their own counted too, one
+    # model alone too (a jog's MOVEs then a TRANSITION to the walk was judged against the
+    # walk's and the jog's takes pooled, the walk's many frames setting the slip: "feet
+    # gliding (support foot 0.62 m/s, sources 0.06)" for a jog's 0.55), and each blend's
+    # frames shared by its models (a walk that went into the run and back was judged
+    # against the walk alone)
+    made: dict[str, float] = {}
     for sec in runs:
         made[sec["model"]] = made.get(sec["model"], 0) + sec["stop"] - sec["start"]
+    for win in transition_windows(syn, commands):
+        for k in win["models"]:
+            made[k] = made.get(k, 0) + (win["stop"] - win["start"]) / len(win["models"])
     parts = [(measured([k])[1], n) for k, n in sorted(made.items())]
     if ref is not None and parts and all(r is not None for r, _ in parts):
         # the whole motion against each model's takes, weighted by the frames it made
