@@ -577,17 +577,12 @@ class LatentModel:
         return self._reference_rows[k]
 
     def training_motion(self) -> Motion:
-        """The training frames as one motion (segments end to end), made once per
-        ``frames_`` array: a script asked for it some ten times, and each new object had
-        its joint positions, contacts and content keys found again."""
-        kept = self.__dict__.get("_training_motion")
-        if kept is not None and kept[0] is self.frames_:
-            return kept[1]
-        motion = Motion(
-            frames=self.frames_, channels=self.all_channels_, fps=self.fps_, skeleton=self.skeleton_
-        )
-        self._training_motion = (self.frames_, motion)
-        return motion
+        """The training frames as one motion (segments end to end), made once per ``frames_``
+        array (a script asked some ten times, each object's positions found again)."""
+        if self.__dict__.get("_train", (None,))[0] is not self.frames_:
+            self._train = (self.frames_, Motion(self.frames_, self.all_channels_, self.fps_,
+                                                self.skeleton_))
+        return self._train[1]
 
     # --------------------------------------------------------------- storage
     def save(self, path: str | os.PathLike[str]) -> None:
