@@ -854,18 +854,13 @@ def test_the_benchmark_runs_scripts_no_one_chose(models, tmp_path, capsys):
     """``bench_latent_gait.random_scripts``: seeded scripts that ``run_script`` takes, and
     a script's largest acceleration judged run by run against the model that made it (one
     model's script: the whole motion against its takes)."""
-    import importlib.util
     import re
-    import sys
-    from pathlib import Path
+
+    from _bench import load_bench
 
     from cyclecoord.quality.generated import source_figures
 
-    path = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_latent_gait.py"
-    spec = importlib.util.spec_from_file_location("bench_latent_gait", path)
-    bench = importlib.util.module_from_spec(spec)
-    sys.modules["bench_latent_gait"] = bench
-    spec.loader.exec_module(bench)
+    bench = load_bench("bench_latent_gait")
     for name, m in models.items():
         m.save(tmp_path / f"{name}.npz")
     one = [bench.random_script(models, np.random.default_rng(3)) for _ in range(2)]

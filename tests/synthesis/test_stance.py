@@ -128,16 +128,11 @@ def test_stands_not_after_a_stride_or_out_of_reach_are_left_alone(models):
 def test_the_benchmark_reports_how_far_apart_a_stop_stands(models, tmp_path, capsys):
     """``bench_latent_gait.stops`` prints the ankles' distance at the stand's end (it
     crashed on its first run: a name reused for the folder)."""
-    import importlib.util
     import re
-    import sys
-    from pathlib import Path
 
-    path = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_latent_gait.py"
-    spec = importlib.util.spec_from_file_location("bench_latent_gait", path)
-    bench = importlib.util.module_from_spec(spec)
-    sys.modules["bench_latent_gait"] = bench
-    spec.loader.exec_module(bench)
+    from _bench import load_bench
+
+    bench = load_bench("bench_latent_gait")
     for name, m in models.items():
         m.save(tmp_path / f"{name}.npz")
     bench.stops(models, tmp_path, n=1)
