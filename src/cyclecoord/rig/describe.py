@@ -324,7 +324,7 @@ def _spans(pos: np.ndarray) -> np.ndarray:
 def _body_points(motion: Motion, frames: np.ndarray, skip_root: bool) -> np.ndarray:
     """World positions ``(K, P, 3)`` of joints and end sites at ``frames``."""
     every = frames.size == motion.n_frames and np.array_equal(frames, np.arange(frames.size))
-    pos = forward_kinematics(motion if every else motion[frames]).positions
+    pos = (motion if every else motion[frames]).positions().positions  # (kept: read only)
     return pos[:, 1:] if skip_root else pos
 
 

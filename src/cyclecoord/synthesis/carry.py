@@ -201,7 +201,7 @@ def carry_by_feet(
         gap = np.maximum(_lowest_points(out, feet) - floor, 0.0)
         frames[:, ty] -= _standing(np.asarray(hold, bool), motion.fps) * gaussian_filter1d(
             gap, STAND_AFTER * motion.fps / 4.0, mode="nearest") / _translation_scale(out, ty)
-        out = motion.with_frames(frames)
+        out = out.with_frames(frames)
     if floor is not None:
         depth = np.maximum(floor - _lowest_points(out, feet), 0.0)
         if depth.any():
@@ -210,7 +210,7 @@ def carry_by_feet(
             lift = np.maximum(lift, depth)
             ty = layout.column("ty")
             frames[:, ty] += lift / _translation_scale(out, ty)
-            out = motion.with_frames(frames)
+            out = out.with_frames(frames)
     return out
 
 
@@ -549,19 +549,19 @@ def lock_where_clean(
     from ..quality.legs import find_feet
     from .footlock import pin_feet
 
+    asked = np.zeros(motion.n_frames, bool) if hold is None else np.asarray(hold, dtype=bool)
     try:
         feet = find_feet(motion.skeleton, motion) if feet is None else tuple(feet)
         held = support(motion, feet)
         planted = held.planted.copy()
-        if hold is not None and np.any(hold):
+        if asked.any():
             # where a stand was asked, every point in the contact band too: the root is
             # held, so every sway of the pose is a foot speed over the ground (an IDLE's
             # feet glided 0.35 m/s on the Bandai script with the weight-bearing points
             # alone; with the low, slow contacts, 0.41 m/s on subject 35's: they came
             # and went with the sway)
-            planted |= held.contacts.planted & np.asarray(hold, dtype=bool)[:, None]
-            planted = _stays_down(planted, np.asarray(hold, dtype=bool),
-                                  late=int(round(STAND_AFTER * motion.fps)))
+            planted |= held.contacts.planted & asked[:, None]
+            planted = _stays_down(planted, asked, late=int(round(STAND_AFTER * motion.fps)))
     except CycleCoordError as exc:
         return LockOutcome(motion, 0, [], f"foot locking: not done ({exc})")
     contacts = held.contacts
@@ -570,7 +570,6 @@ def lock_where_clean(
     # a stretch the hold's contacts lengthened that pops falls back to its weight-bearing
     # frames before it is dropped
     fallback = _tidy(held.planted, shortest) & planted
-    asked = np.zeros(len(planted), bool) if hold is None else np.asarray(hold, dtype=bool)
     settled = asked.copy()  # a hold's frames once its root stands (STAND_AFTER)
     for a, b in contact_runs(asked):
         settled[a : min(b, a + int(round(STAND_AFTER * motion.fps)))] = False
@@ -587,6 +586,7 @@ def lock_where_clean(
     skipped: list[tuple[int, int]] = []
     result = None
     solved: dict = {}  # the trials' leg solutions: frames asked the same are not solved again
+    trials: list[Motion] = []  # the last trial
     pad = int(round(blend * motion.fps)) + 2
 
     def attempt() -> tuple[Motion, np.ndarray]:
@@ -595,6 +595,9 @@ def lock_where_clean(
         trial = pin_feet(motion, replace(contacts, planted=planted), blend=blend, reuse=solved,
                          bounds=bounds, heights=_stand_heights(contacts, planted, asked, land, low,
                                                          floor))
+        # from the last trial, which differs on a few frames: positions found on those only
+        trial = trials.pop().with_frames(trial.frames) if trials else trial
+        trials.append(trial)
         after = _accel(trial)
         bad = (after > limit) & (after > before * 1.05)
         bad |= (_outside(trial.frames, bounds) & ~outside_before).any(axis=1)

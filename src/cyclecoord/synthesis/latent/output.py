@@ -117,7 +117,7 @@ class OutputMixin:
                 pull[a:b] = np.maximum(pull[a:b], bump[a - f + w : b - f + w])
             whole[stuck] = True
             pulled.update(int(f) for f in frames)
-            before, motion = motion, self._assemble(*self._posed(pull, whole))
+            before, motion = motion, self._assemble(*self._posed(pull, whole), like=motion)
         motion = self._unpopped(motion, pull, whole, bump)
         if pulled:
             self._note_pulled(pulled, f"limbs: {plural(len(pulled), 'frame')} came closer than "
@@ -163,7 +163,7 @@ class OutputMixin:
             for f in bad:
                 a, b = max(f - w, 0), min(f + w + 1, motion.n_frames)
                 pull[a:b] = np.maximum(pull[a:b], bump[a - f + w : b - f + w])
-            trial = self._assemble(*self._posed(pull, whole))
+            trial = self._assemble(*self._posed(pull, whole), like=motion)
             near = pull > was
             after = _accel(trial)
             if (after[near] / limit[near]).max() > (acc[near] / limit[near]).max():
@@ -185,8 +185,12 @@ class OutputMixin:
             [c.path is not None or c.targets is not None for c in self.chunks], sizes
         )
 
-    def _assemble(self, angles: np.ndarray, root: dict[str, np.ndarray]) -> Motion:
-        """A motion from every frame's joint angles and root motion (root integrated)."""
+    def _assemble(
+        self, angles: np.ndarray, root: dict[str, np.ndarray], like: Motion | None = None
+    ) -> Motion:
+        """A motion from every frame's joint angles and root motion (root integrated);
+        ``like``: an earlier assembly, which it changes on some frames (its positions
+        are then found again on those only, :meth:`~cyclecoord.motion.Motion.with_frames`)."""
         from ...conventions import continuous_euler
 
         first = self.models[self.chunks[0].model]
@@ -225,6 +229,8 @@ class OutputMixin:
             frames[:, col[(rj.name, "r" + ax)]] = euler[:, k]
         for k, c in enumerate(first.channels_):
             frames[:, col[c]] = angles[:, k]
+        if like is not None:
+            return like.with_frames(frames)
         return Motion(
             frames=frames,
             channels=channels,
@@ -303,7 +309,9 @@ class OutputMixin:
         if key not in cache:
             from ...quality.generated_kinematics import leg_channels
 
-            cache[key] = leg_channels(model.training_motion(), model.channels_)
+            train = model.training_motion()
+            train.positions()  # kept: the limb checks measure the takes too
+            cache[key] = leg_channels(train, model.channels_)
         return cache[key]
 
     def _posed(

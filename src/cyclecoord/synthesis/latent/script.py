@@ -313,22 +313,15 @@ def load_script(path: str | Path) -> tuple[dict[str, Any], dict[str, LatentModel
 
 def training_takes(models: dict[str, LatentModel], names=None) -> list:
     """The training segments of ``models`` (all, or those in ``names``) as motions."""
-    from ...motion import Motion
-
     out = []
     for k in sorted(models if names is None else names):
         m = models[k]
+        train = m.training_motion()
+        train.positions()  # once per model: each take keeps its rows
         for seg in np.unique(m.segments_):
             rows = np.flatnonzero(m.segments_ == seg)
             if rows.size >= 3:
-                out.append(
-                    Motion(
-                        frames=m.frames_[rows],
-                        channels=m.all_channels_,
-                        fps=m.fps_,
-                        skeleton=m.skeleton_,
-                    )
-                )
+                out.append(train[rows])
     return out
 
 
