@@ -182,3 +182,37 @@ def test_idles_one_after_another_are_one_stand(models):
     g_along, _ = _gaps(motion, models["walk"], np.arange(syn.stands[0][1] - 10,
                                                          syn.stands[1][0] + 10))
     assert g_along.max() < TOGETHER  # no step out and back in between
+
+
+def test_the_opening_step_ends_where_the_frames_after_the_stand_have_the_feet(models,
+                                                                           monkeypatch):
+    """A stand whose feet shift in the motion given (here the root drifts 0.2 leg lengths
+    over the stand, and the frames after keep the drift): the opening step takes the feet
+    to where the frames after the stand have them, with no jump at the stand's end (a
+    random subject 35 script jumped both feet 1.5-2 units there, 7.9x the median
+    acceleration)."""
+    import cyclecoord.synthesis.stance as stance
+    from cyclecoord.periodic.root import root_layout
+
+    seen = {}
+    real = stance.close_stands
+
+    def spy(motion, feet, stands, **kw):
+        seen.update(motion=motion, feet=feet, stands=stands, kw=kw)
+        return real(motion, feet, stands, **kw)
+
+    monkeypatch.setattr(stance, "close_stands", spy)
+    syn, _ = stop(models, "walk", 1, then=3)
+    motion, (a, b) = seen["motion"], seen["stands"][0]
+    leg = foot_contacts(models["walk"].training_motion()).leg_length
+    frames = motion.frames.copy()
+    t = np.arange(motion.n_frames)
+    drift = 0.2 * leg * np.clip((t - (a + 20)) / (b - a - 30), 0.0, 1.0)
+    frames[:, root_layout(motion).column("tx")] += drift
+    done = real(motion.with_frames(frames), seen["feet"], seen["stands"], **seen["kw"])
+    assert done.closed == [(a, b)]
+    J = done.motion.positions()
+    ank = np.stack([J[f] for f in seen["feet"][::2]], axis=1)  # (T, 2, 3)
+    step = np.linalg.norm(np.diff(ank, axis=0), axis=-1) / leg  # leg lengths a frame
+    assert step[b - 1].max() < 0.05, np.round(step[b - 4 : b + 2], 3)
+    assert step[b - 1].max() < 2.0 * step[b - 10 : b - 1].max() + 0.01
