@@ -258,6 +258,9 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self._crossings: dict[tuple[str, str], Crossings] = {}
         self._acc: dict = {}
         self._feet_found: list = []  # the feet feet_of found (or None), once a script
+        #: the models start() sized to the output skeleton: the scale of each
+        self.sizes: dict[str, float] = {}
+        self._size_notes: dict[str, str] = {}  # (said once a model's frames are made)
         self.sim_seconds = 0.0
         self.sim_cpu_seconds = 0.0
         self.clamped = {"values": 0, "max_deg": 0.0}
@@ -478,6 +481,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         path=None,
         targets=None,
     ) -> None:
+        if name in self._size_notes:  # said once a model's frames are made
+            self.notes.append(self._size_notes.pop(name))
         if clip:
             angles = self._clip(name, angles)
         self.chunks.append(
@@ -498,8 +503,16 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
 
     # --------------------------------------------------------------- commands
     def start(self, model: str, at: Any = None) -> None:
-        """Place the particle in ``model`` (at a target, default its first training frame)."""
+        """Place the particle in ``model`` (at a target, default its first training frame).
+
+        The first start also sizes the other models' root tracks to this model's skeleton,
+        on which the frames are written (:func:`~.sizing.sized_roots`)."""
         m = self.model(model)
+        if not self.chunks and self.current is None:
+            from .sizing import size_note, sized_roots
+
+            self.models, self.sizes = sized_roots(self.models, model, self.feet)
+            self._size_notes = {k: size_note(k, s, model) for k, s in self.sizes.items()}
         self.current = model
         k = None
         if at is None:

@@ -711,7 +711,9 @@ class OutputMixin:
                 for s in np.unique(m.segments_)
                 if (rows := np.flatnonzero(m.segments_ == s)).size > 2
             ]
-            self._acc[key] = float(np.percentile(np.concatenate(acc), 99))
+            # (a model sized to the output skeleton moves its joints that much more or less)
+            self._acc[key] = float(np.percentile(np.concatenate(acc), 99)) * self.sizes.get(
+                name, 1.0)
         return self._acc[key]
 
     def segments(self) -> list[dict[str, Any]]:
