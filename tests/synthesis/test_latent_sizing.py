@@ -82,3 +82,12 @@ def test_a_script_that_starts_on_the_smaller_actor_keeps_the_other_actors_feet_d
     start = sum(ch.X.shape[0] for ch in syn.chunks[:-1])
     assert abs(c.floor - floor) < 0.05 * c.leg_length
     assert c.planted[start:].any(axis=1).mean() > 0.8  # a foot down on most frames
+
+
+def test_a_second_start_before_any_frame_sizes_to_its_own_model(models):
+    syn = Synthesizer(dict(models), fps=30, seed=0)
+    syn.start("small", {"frame": 0})
+    assert syn.sizes == {"big": pytest.approx(K)}
+    syn.start("big", {"frame": 0})
+    assert syn.sizes == {"small": pytest.approx(1.0 / K)}
+    assert syn.models["big"] is models["big"]

@@ -258,6 +258,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self._crossings: dict[tuple[str, str], Crossings] = {}
         self._acc: dict = {}
         self._feet_found: list = []  # the feet feet_of found (or None), once a script
+        self._given_models = self.models  # (start() sizes them to its model's skeleton)
         #: the models start() sized to the output skeleton: the scale of each
         self.sizes: dict[str, float] = {}
         self._size_notes: dict[str, str] = {}  # (said once a model's frames are made)
@@ -508,10 +509,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         The first start also sizes the other models' root tracks to this model's skeleton,
         on which the frames are written (:func:`~.sizing.sized_roots`)."""
         m = self.model(model)
-        if not self.chunks and self.current is None:
+        if not self.chunks:  # (a start before any frame may name another first model)
             from .sizing import size_note, sized_roots
 
-            self.models, self.sizes = sized_roots(self.models, model, self.feet)
+            self.models, self.sizes = sized_roots(self._given_models, model, self.feet)
             self._size_notes = {k: size_note(k, s, model) for k, s in self.sizes.items()}
         self.current = model
         k = None
