@@ -176,7 +176,11 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
     Parameters
     ----------
     models : dict of str to LatentModel
-        Same joint-angle channels for any two models a TRANSITION joins.
+        Same joint-angle channels for any two models a TRANSITION joins.  The frames
+        are written on the skeleton of the model :meth:`start` names; a model of another
+        actor on the same rig has its root track sized to it
+        (:func:`~.sizing.sized_roots`; the dict and models given are not changed, the
+        scales are in ``sizes``).
     fps : float
         Output frame rate (one particle step a frame).
     seed : int
