@@ -584,19 +584,10 @@ def run_script(
             f"the output uses {syn.chunks[0].model!r}'s"
         ]
     if check:
-        from ...motion import Motion
         from ...quality.plausibility import check_plausibility
 
         used = {c.model for c in syn.chunks}
-        refs = [
-            Motion(
-                frames=models[k].frames_,
-                channels=models[k].all_channels_,
-                fps=models[k].fps_,
-                skeleton=models[k].skeleton_,
-            )
-            for k in sorted(used)
-        ]
+        refs = [models[k].training_motion() for k in sorted(used)]
         report["plausibility"] = check_plausibility(
             motion, refs, cache=syn._plausibility, analysed=True).to_dict()
     return motion, report
