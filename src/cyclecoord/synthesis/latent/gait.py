@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...errors import ParameterError
 from ...periodic.windings import unwrap_across_gaps
 from .influence import pose_points
 
@@ -171,38 +172,67 @@ class Gait:
         the synthetic run the particle's likelihood force then threw the pose 3.9x the
         training 99th percentile of acceleration; the jump itself, at the best seam,
         threw the Bandai run's toes 1.6x.)"""
-        seam = values if seam is None else seam
-        out = self._lerp(values, self.frame_at(segment, u, seam))
+        return self.sampler(segment, u, fade, values if seam is None else seam)(values)
+
+    def sampler(
+        self, segment: int, u: np.ndarray, fade: float = SEAM_FADE, seam: np.ndarray | None = None
+    ):
+        """:meth:`at` at phases ``u`` for any per-training-frame values: a function of
+        the values ``(N, ...)``, the frames and the seam's cross-fade found once (a gait
+        step samples a dozen arrays at one set of phases: the path, each part of the
+        detail, the GP means).  ``seam`` as :meth:`at`'s (here required)."""
+        n = len(self.segments)  # (values are per training frame)
+        main = self._weights(self.frame_at(segment, u, seam), n)
         rows, lo, K = self._loop(segment, seam)
         ph = self.phase[rows]
         # how far the loop's end plays on past the seam, and its start back before it
         after = min(0.5 * fade, ph[-1] - (lo + K))
         before = min(0.5 * fade, lo - ph[0])
-        if after + before <= 0:
-            return out
-        u = np.asarray(u, dtype=float)
-        n = np.maximum(np.round((u - lo) / K), 1.0)
-        d = u - (lo + n * K)  # from the nearest seam crossing
-        near = (d >= -before) & (d < after)
-        if not near.any():
-            return out
-        idx = np.arange(rows.size, dtype=float)
-        late = rows[0] + np.interp(lo + K + d[near], ph, idx)
-        early = rows[0] + np.interp(lo + d[near], ph, idx)
-        a = (d[near] + before) / (before + after)
-        w = a * a * a * (a * (6.0 * a - 15.0) + 10.0)  # quintic: no jump in acceleration
-        w = w.reshape((-1,) + (1,) * (np.ndim(values) - 1))
-        out = np.array(out, dtype=float, copy=True)
-        out[near] = (1.0 - w) * self._lerp(values, late) + w * self._lerp(values, early)
-        return out
+        near = late = early = w = None
+        if after + before > 0:
+            u = np.asarray(u, dtype=float)
+            c = np.maximum(np.round((u - lo) / K), 1.0)
+            d = u - (lo + c * K)  # from the nearest seam crossing
+            near = (d >= -before) & (d < after)
+            if near.any():
+                idx = np.arange(rows.size, dtype=float)
+                late = self._weights(rows[0] + np.interp(lo + K + d[near], ph, idx), n)
+                early = self._weights(rows[0] + np.interp(lo + d[near], ph, idx), n)
+                a = (d[near] + before) / (before + after)
+                w = a * a * a * (a * (6.0 * a - 15.0) + 10.0)  # quintic: no jump in accel
+            else:
+                near = None
 
-    def _lerp(self, values: np.ndarray, frames: np.ndarray) -> np.ndarray:
+        def sample(values: np.ndarray) -> np.ndarray:
+            if len(values) != n:
+                raise ParameterError(f"gait values of {len(values)} frames; the model has {n}")
+            out = self._mixed(values, main)
+            if near is None:
+                return out
+            ww = w.reshape((-1,) + (1,) * (np.ndim(values) - 1))
+            out = np.array(out, dtype=float, copy=True)
+            out[near] = (1.0 - ww) * self._mixed(values, late) + ww * self._mixed(values, early)
+            return out
+
+        return sample
+
+    def _weights(self, frames: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The two training frames either side of fractional ``frames`` (within one
+        segment) and the weight of the later."""
         f = np.asarray(frames, dtype=float)
         a = np.floor(f).astype(int)
-        b = np.minimum(a + 1, len(values) - 1)
+        b = np.minimum(a + 1, n - 1)
         b = np.where(self.segments[b] == self.segments[a], b, a)
-        w = (f - a).reshape((-1,) + (1,) * (np.ndim(values) - 1))
+        return a, b, f - a
+
+    @staticmethod
+    def _mixed(values: np.ndarray, abw) -> np.ndarray:
+        a, b, w = abw
+        w = w.reshape((-1,) + (1,) * (np.ndim(values) - 1))
         return (1.0 - w) * values[a] + w * values[b]
+
+    def _lerp(self, values: np.ndarray, frames: np.ndarray) -> np.ndarray:
+        return self._mixed(values, self._weights(frames, len(values)))
 
     def points(self, X: np.ndarray, frames: np.ndarray) -> np.ndarray:
         """Latent points ``(T, q)`` at fractional training frames (linear in between)."""

@@ -56,9 +56,13 @@ class GaitMixin:
         """Model ``name``'s per-frame ``values`` at unwrapped phases ``u`` of ``segment``,
         looped at the seam of its captured angles with the segment's own cross-fade
         (:meth:`seam_fade`)."""
-        m = self.models[name]
-        return self.gait(name).at(values, segment, u, fade=self.seam_fade(name, segment),
-                                  seam=m.frame_angles())
+        return self.gait_sampler(name, segment, u)(values)
+
+    def gait_sampler(self, name: str, segment: int, u: np.ndarray):
+        """:meth:`gait_at` at phases ``u`` as a function of the values (the frames found
+        once for the several arrays a step samples)."""
+        return self.gait(name).sampler(segment, u, fade=self.seam_fade(name, segment),
+                                       seam=self.models[name].frame_angles())
 
     def seam_fade(self, name: str, segment: int) -> float:
         """The cross-fade over the seam of ``segment``'s loop (cycles): the one the model
@@ -108,20 +112,22 @@ class GaitMixin:
         m = self.models[self.current]
         n = max(1, int(round(seconds * self.fps)))
         u = u0 + self._rate(self.current, seg) * np.arange(n + 1)
-        X = self.gait_at(self.current, m.X_, seg, u)
-        X[0] = self.x
+        at = self.gait_sampler(self.current, seg, u)
+        X = at(m.X_)
         self._next_cursor = (self.current, seg, float(u[-1]))
-        self._path_detail = self._detail_at(self.current, seg, u)
+        self._path_detail = self._detail_at(self.current, seg, u, at)
+        X[0] = self.x
         return X, np.arange(n + 1) / self.fps
 
-    def _detail_at(self, name: str, segment: int, u: np.ndarray) -> dict | None:
+    def _detail_at(self, name: str, segment: int, u: np.ndarray, at=None) -> dict | None:
         """Model ``name``'s gait detail (:meth:`~.model.LatentModel.detail`, each part
         ``(len(u), ...)``) at unwrapped phases ``u`` of ``segment`` (None when the
-        synthesizer adds none)."""
+        synthesizer adds none); ``at``: :meth:`gait_sampler` of those phases, if made."""
         if not self.detail:
             return None
         m = self.models[name]
-        out = {k: self.gait_at(name, v, segment, u) for k, v in m.detail().items()}
+        at = self.gait_sampler(name, segment, u) if at is None else at
+        out = {k: at(v) for k, v in m.detail().items()}
         # Between two training frames the path's latent point is their latents' mix.
         # Where the GPLVM put consecutive frames far apart (the Xsens walk at 16.41 s:
         # 3x its neighbours' latent step), the GP mean there is no pose between theirs
@@ -132,10 +138,10 @@ class GaitMixin:
         # Not everywhere: elsewhere the GP mean's curve between frames keeps a stride's
         # peaks, which the frames' chord cuts (knee ranges 0.02-0.04 lower over the
         # benchmark's script seeds; a Catmull-Rom mix kept them but accelerated more).
-        X = self.gait_at(name, m.X_, segment, u)
+        X = at(m.X_)
         detail = m.detail()
         means = m.frame_angles() - detail["angles"]  # the GP mean at each training frame
-        off = self.gait_at(name, means, segment, u) - m.pose(X)
+        off = at(means) - m.pose(X)
         a = np.clip((np.sqrt((off**2).mean(axis=1)) / self._frame_step(name, means) - GAP_FROM)
                     / (GAP_FULL - GAP_FROM), 0.0, 1.0)
         w = a * a * (3.0 - 2.0 * a)
@@ -145,7 +151,7 @@ class GaitMixin:
         for key, value in self._root(m, X).items():
             # the root weights at each training frame's latent point: raw minus detail
             at_frames = getattr(m.root_, key) - detail[key]
-            mixed = self.gait_at(name, at_frames, segment, u)
+            mixed = at(at_frames)
             out[key] = out[key] + w.reshape((-1,) + (1,) * (value.ndim - 1)) * (mixed - value)
         return out
 
@@ -315,21 +321,22 @@ class GaitMixin:
         ra, rb = self._rate(src, sa), self._rate(to, sb)
         steps = (1.0 - w) * ra + w * rb
         du = np.concatenate([[0.0], np.cumsum(steps)])[1:]
-        Xa = self.gait_at(src, m1.X_, sa, ua + du)
+        at_a, at_b = self.gait_sampler(src, sa, ua + du), self.gait_sampler(to, sb, ub + du)
+        Xa = at_a(m1.X_)
         # the particle's stray from the path fades over the blend: jumping back onto the
         # path at the blend's first frame threw the Bandai run's hands up to 1.86x its
         # p99 of acceleration (6 script seeds in 15 over 1.5x; at most 1.40x after)
         stray = self.x - self.gait_at(src, m1.X_, sa, np.array([ua]))[0]
         on_path = Xa
         Xa = Xa + (1.0 - w)[:, None] * stray[None, :]
-        Xb = self.gait_at(to, m2.X_, sb, ub + du)
+        Xb = at_b(m2.X_)
         r1, r2 = self._root(m1, Xa), self._root(m2, Xb)
         root = {
             k: (1 - w.reshape((-1,) + (1,) * (r1[k].ndim - 1))) * r1[k]
             + w.reshape((-1,) + (1,) * (r1[k].ndim - 1)) * r2[k]
             for k in r1
         }
-        Da, Db = self._detail_at(src, sa, ua + du), self._detail_at(to, sb, ub + du)
+        Da, Db = self._detail_at(src, sa, ua + du, at_a), self._detail_at(to, sb, ub + du, at_b)
         Pa, Pb = m1.pose(Xa), m2.pose(Xb)
         detail = None
         if Da is not None:
