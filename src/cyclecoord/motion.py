@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Iterable, Sequence
+from typing import Any, Callable, Hashable, Iterable, Sequence
 
 import numpy as np
 
@@ -269,6 +269,20 @@ class Motion:
             object.__setattr__(self, "_fk_of", (frames.copy(), fk))
         self.__dict__.pop("_fk_base", None)
         return fk
+
+    def derived(self, key: Hashable, make: Callable[[], Any]) -> Any:
+        """``make()``, found once per ``key`` for this motion and kept: a value that
+        depends only on its frames and skeleton (which never change), such as its legs
+        or foot contacts (a latent script found its training takes' legs and contacts
+        twice each).  Arrays in the value are made read-only."""
+        memo = self.__dict__.setdefault("_derived", {})
+        if key not in memo:
+            value = make()
+            for a in getattr(value, "__dict__", {}).values():
+                if isinstance(a, np.ndarray):
+                    a.flags.writeable = False
+            memo[key] = value
+        return memo[key]
 
     def root_channels(self) -> list[int]:
         """Columns of the root joint's translation and rotation channels.

@@ -118,6 +118,29 @@ def test_positions_are_made_once_and_kept_read_only(monkeypatch):
     np.testing.assert_array_equal(a.positions, b.positions)
 
 
+def test_derived_values_are_found_once_per_key_and_kept_read_only():
+    """Legs and foot contacts are found once per motion and settings (a latent script
+    measured its training takes' twice); a caller cannot change the kept arrays."""
+    from cyclecoord.quality.contacts import foot_contacts
+    from cyclecoord.quality.legs import find_legs
+
+    m = cc.datasets.example_capture().motion[:90]
+    calls = []
+    assert m.derived("k", lambda: calls.append(1) or 5) == 5
+    assert m.derived("k", lambda: calls.append(1) or 6) == 5 and len(calls) == 1
+    legs = find_legs(m.skeleton, m)
+    assert find_legs(m.skeleton, m) is legs
+    c = foot_contacts(m)
+    assert foot_contacts(m, legs.feet) is c  # the same feet given by name: the same contacts
+    d = foot_contacts(m, speed=None)
+    assert d is not c and d.planted.sum() >= c.planted.sum()  # other settings: found anew
+    with pytest.raises(ValueError, match="read-only"):
+        c.planted[0, 0] = not c.planted[0, 0]
+    # a copy with other frames has its own
+    other = m.with_frames(m.frames[::-1].copy())
+    assert foot_contacts(other) is not c
+
+
 def test_derived_motions_positions_equal_forward_kinematics_bit_for_bit():
     """Slices and copies with a few frames changed take their unchanged frames' positions
     from the motion they came from: the same bits as forward kinematics on all frames."""

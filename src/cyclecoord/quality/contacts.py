@@ -381,6 +381,14 @@ def foot_contacts(
     legs: Legs = (
         find_legs(skel, motion, up=up) if feet is None else legs_of_feet(skel, feet, motion, up=up)
     )
+    # once per motion and settings (a latent script measured its takes' contacts twice)
+    key = ("contacts", legs.legs, float(height), speed, float(min_duration), up, floor)
+    return motion.derived(key, lambda: _contacts(
+        motion, skel, legs, height, speed, min_duration, up, floor))
+
+
+def _contacts(motion: Motion, skel, legs: Legs, height: float, speed: float | None,
+              min_duration: float, up: str, floor: float | None) -> FootContacts:
     feet = legs.feet
     axis = _UP[up]
     horiz = [k for k in range(3) if k != axis]

@@ -599,6 +599,14 @@ def find_legs(skeleton: Skeleton, motion: Motion | None = None, *, up: str = "y"
     """
     if up not in _UP:
         raise ParameterError(f"up axis must be one of x, y, z, got {up!r}")
+    if motion is None:
+        return _find_legs(skeleton, None, up)
+    # once per motion and skeleton (kept with the legs, so its id stays its own)
+    return motion.derived(("legs", id(skeleton), up),
+                          lambda: (skeleton, _find_legs(skeleton, motion, up)))[1]
+
+
+def _find_legs(skeleton: Skeleton, motion: Motion | None, up: str) -> Legs:
     named = _named_legs(skeleton, classify_skeleton(skeleton))
     quad = {(g.limb, g.side): g for g in named if g.limb}
     if len(quad) == 4:
