@@ -604,10 +604,12 @@ def test_check_plausibility_cache_reuses_a_report_only_for_the_same_joint_angles
     knee = m.channel_index("ltibia", "rx")
     bent[:, knee] += 30.0
     fresh = plaus.check_plausibility(m.with_frames(bent), [ref], cache=cache)
-    assert len(calls) == 2
+    # (measured again where the knee moves only: the last motion checked stands for a base)
+    assert len(calls) == 1
     assert fresh.to_dict() == plaus.check_plausibility(m.with_frames(bent), [ref]).to_dict()
-    other = plaus.check_plausibility(m, [ref, m], cache=cache)
-    assert len(calls) == 4 and other.to_dict() == plaus.check_plausibility(m, [ref, m]).to_dict()
+    assert len(calls) == 2
+    other = plaus.check_plausibility(m, [ref, m], cache=cache)  # (its bones measured before)
+    assert len(calls) == 2 and other.to_dict() == plaus.check_plausibility(m, [ref, m]).to_dict()
 
 
 def test_self_intersections_may_skip_pairs_a_body_apart():

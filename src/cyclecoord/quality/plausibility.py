@@ -524,15 +524,20 @@ def _intersections(
     """:func:`self_intersections` with ``far="skip"`` of an analysed motion; with
     ``cache``, kept under the joint signature ``keys[0]`` of the motion as given, and
     measured again only where the motion changes the one under ``keys[1]`` (``base``
-    of :func:`check_plausibility`), when that one is kept."""
+    of :func:`check_plausibility`), when that one is kept, else the last one kept."""
     bn = _cached_bones(motion, cache)
     if cache is None or keys is None:
         return self_intersections(motion, threshold, far="skip", bones_=bn)
     prior = None if keys[1] is None else cache.get(("intersections", keys[1], threshold))
+    if prior is None:  # (no base: this motion's joint angles checked before, else the
+        # last motion checked, when comparable)
+        prior = cache.get(("intersections", keys[0], threshold)) or cache.get(
+            ("last intersections", threshold))
     inter = None if prior is None else _changed_only(motion, bn, *prior)
     if inter is None:
         inter = self_intersections(motion, threshold, far="skip", bones_=bn)
-    cache[("intersections", keys[0], threshold)] = (motion, inter)
+    cache[("intersections", keys[0], threshold)] = cache[("last intersections", threshold)] = (
+        motion, inter)
     return inter
 
 
@@ -634,7 +639,10 @@ def check_plausibility(
         in some joints' channels only (foot pinning's trial against the motion it pins):
         the bone pairs those joints move are measured again on the frames they change,
         every other distance is ``base``'s (the same numbers: a point's position depends
-        on its ancestors' channels alone).  Without ``cache`` it changes nothing.
+        on its ancestors' channels alone).  Without ``cache`` it changes nothing.  With
+        ``cache`` and no ``base``, the motion the cache checked last stands for it when
+        it has the same skeleton, channels and length (a latent script's pins follow
+        pulls of a few frames after its last check).
     analysed : bool, default False
         ``motion`` and ``references`` are already in the analysis rig
         (:func:`~cyclecoord.rig.analysis_motion`), as a latent model's output and
