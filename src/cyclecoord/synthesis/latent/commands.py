@@ -458,13 +458,19 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         ca, cb = ma.to_channels(a), mb.to_channels(b)
         w = np.asarray(w, dtype=float).reshape(-1)
         out = (1.0 - w[:, None]) * ca + w[:, None] * cb
+        by_order: dict[str, list[np.ndarray]] = {}
         for idx, order in mb.rotation_columns():
-            Ra = Rotation.from_euler(order, ca[:, idx], degrees=True)
-            Rb = Rotation.from_euler(order, cb[:, idx], degrees=True)
+            by_order.setdefault(order, []).append(idx)
+        T = len(w)
+        for order, cols in by_order.items():  # the joints of one Euler order at once
+            idx = np.array(cols)  # (J, 3)
+            Ra = Rotation.from_euler(order, ca[:, idx].reshape(-1, 3), degrees=True)
+            Rb = Rotation.from_euler(order, cb[:, idx].reshape(-1, 3), degrees=True)
             step = (Ra.inv() * Rb).as_rotvec()
-            R = Ra * Rotation.from_rotvec(w[:, None] * step)
+            R = Ra * Rotation.from_rotvec(np.repeat(w, len(cols))[:, None] * step)
             # the Euler solution nearest the first pose's, continuous over the blend
-            out[:, idx] = continuous_euler(R.as_matrix()[:, None], order, ca[0, idx])[:, 0]
+            out[:, idx] = continuous_euler(R.as_matrix().reshape(T, len(cols), 3, 3), order,
+                                           ca[0, idx])
         return mb.to_model(out)
 
     def _into(self, src: str, to: str, angles: np.ndarray) -> np.ndarray:
