@@ -548,6 +548,30 @@ def test_a_target_after_a_takes_stand_is_reached_without_standing(cmu_dir):
     assert on_stand.max() < 0.05
 
 
+def test_a_target_in_the_stand_a_take_begins_with_says_why_the_graph_path(cmu_dir):
+    """No capture walks into 69_01's opening stand: from subject 35's walk, a target in it
+    is left to the graph path, which jumps into the stand; the note says so and names the
+    stand's frames and the first frame walked to in step.  Elsewhere no such note."""
+    from cyclecoord.synthesis.graph.phase import stand_at
+
+    a = cc.load(cmu_dir / "35" / "35_07.amc")
+    b = cc.load(cmu_dir / "69" / "69_01.amc")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(
+            [a, b])
+        gen = synth.to_target(0, 0, 1, 40)
+        walked = synth.to_target(0, 0, 1, 200)
+    field = synth.phase_field_
+    stand = stand_at(field, synth.space_.transform(synth.takes_[1][40])[0])
+    assert stand is not None and stand[0] == 1 and stand[1] == 0 and 40 < stand[2] < 160
+    assert stand_at(field, synth.space_.transform(synth.takes_[0][0])[0]) is None
+    assert gen.path.kind.startswith("graph:")
+    note = [n for n in gen.notes if "stand its take begins with" in n]
+    assert note and f"frames 0-{stand[2]}" in note[0] and f"frame {stand[2] + 1} on" in note[0]
+    assert not any("stand its take" in n for n in walked.notes)
+
+
 def test_a_target_at_the_start_of_another_gaits_take_is_reached_in_step(walks, walks_and_jog):
     """A target a few frames into its take has no frames before it to walk from: the
     cross-fade goes into a later cycle of the take at the fade's phase, walked to the

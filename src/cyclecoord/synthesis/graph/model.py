@@ -319,8 +319,29 @@ class MotionGraphSynth:
                             "hops between takes and may pop)")
         if out is None:
             out = self._result(path_to_target(self.graph_, x0, x1, speed), motion, f, name, x0)
+        if out.path.kind.startswith("graph:"):
+            said += self._stand_note(x0, x1, tname, tf)
         out.notes[:0] = said
         return out
+
+    def _stand_note(self, x0: np.ndarray, x1: np.ndarray, tname: str, tf: int) -> list[str]:
+        """Why the graph path was taken to a target in the stand its take begins with
+        (the start not in it): no capture walks into that stand (CMU 69_01's first 1.3
+        s: from subject 35's walk the graph path jumped into it at 2.1x the sources' p99
+        of acceleration)."""
+        if self.phase_field_ is None:
+            return []
+        from .phase import stand_at
+
+        stand = stand_at(self.phase_field_, x1)
+        g = self.graph_
+        if stand is None or stand[1] != int(g.frame[g.take == stand[0]].min()) or (
+                stand_at(self.phase_field_, x0) == stand):
+            return []
+        return [f"target {tname}:{tf} is in the stand its take begins with (frames "
+                f"{stand[1]}-{stand[2]}, where the pose holds still): no capture walks into "
+                "it, and the graph path jumps into the stand (a stop stepping into a stand "
+                f"is not made); a target from frame {stand[2] + 1} on is walked to in step"]
 
     def _crosses(self, motion: Motion) -> bool:
         """Whether two limbs of ``motion`` come closer than the training takes ever do."""

@@ -539,6 +539,26 @@ def moving_frames(points: np.ndarray, rate: np.ndarray) -> np.ndarray:
     return keep if keep.sum() >= min(T, cycle) else every
 
 
+def stand_at(field: PhaseField, x: np.ndarray) -> tuple[int, int, int] | None:
+    """``(take, first, last)``: the take and frames (its own numbering) of the stand that
+    holds the graph frame nearest latent point ``x`` (a stretch where the take's pose
+    holds still, :func:`moving_frames`); None where the take moves there."""
+    g = field.graph
+    node = int(g.tree.query(np.asarray(x, dtype=float).reshape(-1))[1])
+    take = np.flatnonzero(g.take == g.take[node])
+    moving = moving_frames(g.points[take], field.rate[take])
+    i = int(np.flatnonzero(take == node)[0])
+    if moving[i]:
+        return None
+    a = i
+    while a > 0 and not moving[a - 1]:
+        a -= 1
+    b = i
+    while b + 1 < take.size and not moving[b + 1]:
+        b += 1
+    return int(g.take[node]), int(g.frame[take[a]]), int(g.frame[take[b]])
+
+
 def phase_across(
     field: PhaseField, start: np.ndarray, target: np.ndarray, step_scale: float = 2.0,
     later: float = 0.0,
