@@ -92,12 +92,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one command line; returns the exit code (errors become one line on stderr)."""
-    try:  # a Ctrl-C while the parser is built (it imports the commands) is one line too
-        parser = build_parser()
-        args = parser.parse_args(argv)
+    try:  # a Ctrl-C anywhere in it is one line (also while the parser imports the commands,
+        # and while the paths are checked: CI once caught one there, a traceback)
+        return _run(argv)
     except KeyboardInterrupt:
         print("cyclecoord: interrupted", file=sys.stderr)
         return 130
+
+
+def _run(argv: Sequence[str] | None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_USAGE
@@ -119,9 +124,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except PermissionError as exc:
         print(f"cyclecoord: error: {exc}", file=sys.stderr)
         return EXIT_ERROR
-    except KeyboardInterrupt:
-        print("cyclecoord: interrupted", file=sys.stderr)
-        return 130
     except BrokenPipeError:  # output piped into `head` and the like
         import os
 
