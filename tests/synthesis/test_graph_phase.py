@@ -525,19 +525,28 @@ def test_moving_frames_leave_out_a_takes_stand():
     assert moving_frames(points[:110], np.full(110, 1 / 40.0)).all()
 
 
-def test_a_target_after_a_takes_stand_is_reached_without_standing(cmu_dir):
+@pytest.fixture(scope="module")
+def walk_and_stand(cmu_dir):
+    """A graph of subject 35's walk 35_07 and subject 69's 69_01, which stands for its
+    first 1.3 s."""
+    a = cc.load(cmu_dir / "35" / "35_07.amc")
+    b = cc.load(cmu_dir / "69" / "69_01.amc")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(
+            [a, b])
+
+
+def test_a_target_after_a_takes_stand_is_reached_without_standing(walk_and_stand):
     """Subject 35's walk 35_07 and subject 69's 69_01, which stands for its first 1.3 s:
     a target 0.45 s into 69_01's walk was reached by a cross-fade into its stand (the
     frames at the fade's phase three quarters of a cycle before the target), and the
     figure stood 0.28 s mid-path.  The fade now goes into the frames where the take moves
     (from under a cycle before the target where it moves no longer): no freeze, largest
     acceleration 0.50x the takes' p99."""
-    a = cc.load(cmu_dir / "35" / "35_07.amc")
-    b = cc.load(cmu_dir / "69" / "69_01.amc")
+    synth = walk_and_stand
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(
-            [a, b])
         gen = synth.to_target(0, 0, 1, 200)
         q = measure_generated(gen.motion, reference=synth.reference(gen))
     assert gen.path.kind == "field:phase:across-to-target"
@@ -548,18 +557,15 @@ def test_a_target_after_a_takes_stand_is_reached_without_standing(cmu_dir):
     assert on_stand.max() < 0.05
 
 
-def test_a_target_in_the_stand_a_take_begins_with_says_why_the_graph_path(cmu_dir):
+def test_a_target_in_the_stand_a_take_begins_with_says_why_the_graph_path(walk_and_stand):
     """No capture walks into 69_01's opening stand: from subject 35's walk, a target in it
     is left to the graph path, which jumps into the stand; the note says so and names the
     stand's frames and the first frame walked to in step.  Elsewhere no such note."""
     from cyclecoord.synthesis.graph.phase import stand_at
 
-    a = cc.load(cmu_dir / "35" / "35_07.amc")
-    b = cc.load(cmu_dir / "69" / "69_01.amc")
+    synth = walk_and_stand
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        synth = MotionGraphSynth(method="delaunay+phase", dims="auto", step_scale=2.0).fit(
-            [a, b])
         gen = synth.to_target(0, 0, 1, 40)
         walked = synth.to_target(0, 0, 1, 200)
     field = synth.phase_field_
