@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -176,7 +177,7 @@ class Gait:
 
     def sampler(
         self, segment: int, u: np.ndarray, fade: float = SEAM_FADE, seam: np.ndarray | None = None
-    ):
+    ) -> Callable[[np.ndarray], np.ndarray]:
         """:meth:`at` at phases ``u`` for any per-training-frame values: a function of
         the values ``(N, ...)``, the frames and the seam's cross-fade found once (a gait
         step samples a dozen arrays at one set of phases: the path, each part of the

@@ -17,7 +17,7 @@ between two gaits in step, a part of :class:`~.commands.Synthesizer`.
 from __future__ import annotations
 
 import functools
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -58,7 +58,9 @@ class GaitMixin:
         (:meth:`seam_fade`)."""
         return self.gait_sampler(name, segment, u)(values)
 
-    def gait_sampler(self, name: str, segment: int, u: np.ndarray):
+    def gait_sampler(
+        self, name: str, segment: int, u: np.ndarray
+    ) -> Callable[[np.ndarray], np.ndarray]:
         """:meth:`gait_at` at phases ``u`` as a function of the values (the frames found
         once for the several arrays a step samples)."""
         return self.gait(name).sampler(segment, u, fade=self.seam_fade(name, segment),
