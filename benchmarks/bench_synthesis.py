@@ -360,7 +360,9 @@ def random_targets(data: Path, pairs: int, seed: int = 1) -> list[dict]:
                     figs[label].append((0.0, False))
                 else:
                     # (both judged alike: by the gaits the path drew on, ours' grouping)
-                    q = measure_generated(gen.motion, reference=ours.reference(gen))
+                    # (a stand the target asked for is not a freeze: gen.hold)
+                    q = measure_generated(gen.motion, reference=ours.reference(gen),
+                                          hold=gen.hold)
                     figs[label].append((q.largest_accel, bool(q.freezes)))
                 if label == "ours":
                     figs["kinds"].append(gen.path.kind.split(":")[-1] if gen.path.kind.startswith(

@@ -375,15 +375,16 @@ def figures_line(s: dict) -> str:
 
 
 def _lead(
-    motion, sources: list, feet: str | None = None, reference=None, shares=None
+    motion, sources: list, feet: str | None = None, reference=None, shares=None, hold=None
 ) -> dict | None:
     """Print the measure of generated motion against ``sources`` (or their figures
-    ``reference``, or each source's mixed by ``shares``; the console's first lines) and
-    return its report dict (None when it cannot be measured)."""
+    ``reference``, or each source's mixed by ``shares``; ``hold``: frames of an asked
+    stand; the console's first lines) and return its report dict (None when it cannot be
+    measured)."""
     from ..quality.generated import lead_lines
 
     quality, lines = lead_lines(motion, sources, feet=feet or None, reference=reference,
-                                shares=shares)
+                                shares=shares, hold=hold)
     for line in lines:
         print(line)
     return quality

@@ -343,7 +343,7 @@ def _generate(args: argparse.Namespace, inputs: list[str], motions: list, out: O
         gen = synth.generate(args.frames, start, frame)
     from .blend import _lead
 
-    quality = _lead(gen.motion, motions, reference=synth.reference(gen))
+    quality = _lead(gen.motion, motions, reference=synth.reference(gen), hold=gen.hold)
     conn = synth.graph_.connectivity()
     field = ("phase-aware" if synth.phase_field_ is not None else synth.field_.name)
     print(

@@ -62,12 +62,16 @@ class Generation:
     path : GraphPath
     start : dict
         ``take`` (name), ``frame`` and ``latent`` (the projected start pose).
+    hold : ndarray of bool, shape (T,), or None
+        Frames of a stand the target asked for (a target in a take's stand), which the
+        measure of generated motion counts as asked, not as a freeze.
     """
 
     motion: Motion
     path: GraphPath
     start: dict
     notes: list = field(default_factory=list)
+    hold: np.ndarray | None = None
 
 
 class MotionGraphSynth:
@@ -276,7 +280,7 @@ class MotionGraphSynth:
         tmotion, tf, tname = self._start(target, target_frame)
         x0 = self.space_.transform(motion[f])[0]
         x1 = self.space_.transform(tmotion[tf])[0]
-        path = None
+        path = stand = None
         if self.phase_field_ is not None:
             from .phase import phase_to_target
 
@@ -291,14 +295,25 @@ class MotionGraphSynth:
                         f"target {tname}:{tf} is on another gait (the start's comes no nearer "
                         f"than {miss:.2f} of the latent radius): a half-cycle cross-fade in "
                         "step into its take, then walked to it")
-            if path is None:
+            held = None if path is not None else self._opening_stand(x0, x1)
+            if held is not None:
+                from .phase import phase_to_stand
+
+                path, stops = phase_to_stand(self.phase_field_, x0, x1, 2.0 * float(speed))
+                stand = (stops, path.points.shape[0])
+                said.append(
+                    f"target {tname}:{tf} is in the stand its take begins with (frames "
+                    f"{held[0]}-{held[1]}, where the pose holds still), which no capture "
+                    "walks into: the path walks the start's gait and over its last cycle "
+                    "fades its strides into the stand's pose")
+            elif path is None:
                 said.append(
                     f"target {tname}:{tf} is not on the start's gait (the gait comes no "
                     f"nearer than {miss:.2f} of the latent radius): the shortest graph path "
                     "instead, which hops between takes and may pop")
         out = None
         if path is not None:
-            out = self._result(path, motion, f, name, x0)
+            out = self._result(path, motion, f, name, x0, stand=stand)
             if path.kind.endswith("across-to-target") and self._crosses(out.motion):
                 # the fade brought two limbs too close: a fade a half or a whole cycle
                 # later, else the graph path
@@ -319,29 +334,40 @@ class MotionGraphSynth:
                             "hops between takes and may pop)")
         if out is None:
             out = self._result(path_to_target(self.graph_, x0, x1, speed), motion, f, name, x0)
-        if out.path.kind.startswith("graph:"):
-            said += self._stand_note(x0, x1, tname, tf)
         out.notes[:0] = said
         return out
 
-    def _stand_note(self, x0: np.ndarray, x1: np.ndarray, tname: str, tf: int) -> list[str]:
-        """Why the graph path was taken to a target in the stand its take begins with
-        (the start not in it): no capture walks into that stand (CMU 69_01's first 1.3
-        s: from subject 35's walk the graph path jumped into it at 2.1x the sources' p99
-        of acceleration)."""
-        if self.phase_field_ is None:
-            return []
+    def _opening_stand(self, x0: np.ndarray, x1: np.ndarray) -> tuple[int, int] | None:
+        """The frames (first, last) of the stand its take begins with that holds the
+        target ``x1``, when the start ``x0`` is not in it (no capture walks into such a
+        stand: CMU 69_01's first 1.3 s; from subject 35's walk the graph path jumped into
+        it at 2.1x the sources' p99 of acceleration); else None."""
         from .phase import stand_at
 
         stand = stand_at(self.phase_field_, x1)
         g = self.graph_
         if stand is None or stand[1] != int(g.frame[g.take == stand[0]].min()) or (
                 stand_at(self.phase_field_, x0) == stand):
-            return []
-        return [f"target {tname}:{tf} is in the stand its take begins with (frames "
-                f"{stand[1]}-{stand[2]}, where the pose holds still): no capture walks into "
-                "it, and the graph path jumps into the stand (a stop stepping into a stand "
-                f"is not made); a target from frame {stand[2] + 1} on is walked to in step"]
+            return None
+        return stand[1:]
+
+    def _closed(self, motion: Motion, stand: tuple[int, int], notes: list[str]) -> Motion:
+        """``motion`` with the closing step of :mod:`~cyclecoord.synthesis.stance` over the
+        frames ``stand`` (the stop's fade, a gait cycle long) where its feet end apart."""
+        from ...errors import CycleCoordError
+        from ...quality.legs import find_feet
+        from ..carry import channel_bounds
+        from ..stance import close_stands
+
+        try:
+            feet = find_feet(motion.skeleton, motion)
+        except CycleCoordError:
+            return motion
+        done = close_stands(motion, feet, [stand], cycle=(stand[1] - stand[0]) / motion.fps,
+                            bounds=channel_bounds(self.takes_), references=self.takes_)
+        if done.line:
+            notes.append(done.line)
+        return done.motion
 
     def _crosses(self, motion: Motion) -> bool:
         """Whether two limbs of ``motion`` come closer than the training takes ever do."""
@@ -470,7 +496,8 @@ class MotionGraphSynth:
         return parts[0][0] if len(parts) == 1 else mixed_reference(parts)
 
     def _result(
-        self, path: GraphPath, motion: Motion, f: int, name: str, x0: np.ndarray
+        self, path: GraphPath, motion: Motion, f: int, name: str, x0: np.ndarray,
+        stand: tuple[int, int] | None = None,
     ) -> Generation:
         root = root_trajectory(self.takes_, path, motion, f)
         detail = None
@@ -497,6 +524,8 @@ class MotionGraphSynth:
                 )
                 out = locked.motion
                 notes.append(locked.line)
+                if stand is not None:  # (phase_to_stand's stop: feet left apart close)
+                    out = self._closed(out, stand, notes)
         if self.rig_ is not None:  # back in the takes' own rig
             out = self.rig_.restore(out)
         out = out.with_frames(
@@ -506,11 +535,16 @@ class MotionGraphSynth:
                 "start": f"{name}:{f}",
             },
         )
+        hold = None
+        if stand is not None:
+            hold = np.zeros(out.n_frames, dtype=bool)
+            hold[stand[0] : stand[1]] = True
         return Generation(
             motion=out,
             path=path,
             start={"take": name, "frame": f, "latent": x0.tolist()},
             notes=notes,
+            hold=hold,
         )
 
 
