@@ -271,9 +271,12 @@ class MotionGraphSynth:
         its captured cadence and eases onto the target at its phase
         (:func:`~.phase.phase_to_target`, ``speed`` times the captured speed); a target
         the gait does not come near (another gait) is reached by a cross-fade in step
-        into its take (:func:`~.phase.phase_across`), and failing that by the paper's
-        shortest graph path (§V-A, :func:`~.paths.path_to_target`), a note saying which;
-        the other fields always take the graph path.
+        into its take (:func:`~.phase.phase_across`); a target in the stand a take begins
+        with, which no capture walks into, by the gait fading into the stand over a cycle
+        (:func:`~.phase.phase_to_stand`, the stand's frames in :attr:`Generation.hold`);
+        failing those by the paper's shortest graph path (§V-A,
+        :func:`~.paths.path_to_target`), a note saying which; the other fields always take
+        the graph path.
         """
         motion, f, name = self._start(start, frame)
         f, said = self._past_reference(start, f, name)
