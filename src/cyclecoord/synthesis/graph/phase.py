@@ -48,7 +48,8 @@ from .paths import MAX_STEP_SCALE, GraphPath
 
 __all__ = [
     "PhaseField", "TakePhases", "take_phases", "align_phases", "match_phase", "match_misfit",
-    "follow_phase", "phase_to_target", "phase_across", "amplitude_gain",
+    "follow_phase", "phase_to_target", "phase_across", "phase_to_stand", "stand_at",
+    "amplitude_gain",
 ]
 
 #: Neighbours of the phase-aware field, the pull per frame towards their next states
