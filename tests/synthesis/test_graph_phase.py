@@ -595,6 +595,30 @@ def test_a_target_in_the_stand_a_take_begins_with_is_reached_by_a_stop(walk_and_
     assert walked.path.kind == "field:phase:across-to-target" and walked.hold is None
 
 
+def test_a_start_in_a_takes_stand_stands_as_asked(walk_and_stand):
+    """From 69_01's frame 11, in its opening stand, the path stands as the capture does
+    before it walks (0.7 s): those frames are an asked hold (``Generation.hold``: the
+    first frames whose neighbours are mostly stand frames), not a freeze; a path of
+    walking frames has none, and a path that stands on its way still freezes."""
+    synth = walk_and_stand
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        gen = synth.to_target(1, 11, 0, 261)
+        walk = synth.to_target(0, 100, 0, 261)
+        q = measure_generated(gen.motion, reference=synth.reference(gen))
+        q_held = measure_generated(gen.motion, reference=synth.reference(gen), hold=gen.hold)
+    assert q.freezes and not q_held.freezes  # (standing, then walking)
+    assert gen.hold is not None and gen.hold[0] and not gen.hold[-1]
+    assert walk.hold is None
+    # a stand on the way (into 69_01 just before its walk's frame 160) is no asked hold
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        through = synth.to_target(0, 0, 1, 160)
+        q = measure_generated(through.motion, reference=synth.reference(through),
+                              hold=through.hold)
+    assert q.freezes and through.hold is None
+
+
 def test_a_target_at_the_start_of_another_gaits_take_is_reached_in_step(walks, walks_and_jog):
     """A target a few frames into its take has no frames before it to walk from: the
     cross-fade goes into a later cycle of the take at the fade's phase, walked to the

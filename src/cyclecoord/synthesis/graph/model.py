@@ -63,8 +63,8 @@ class Generation:
     start : dict
         ``take`` (name), ``frame`` and ``latent`` (the projected start pose).
     hold : ndarray of bool, shape (T,), or None
-        Frames of a stand the target asked for (a target in a take's stand), which the
-        measure of generated motion counts as asked, not as a freeze.
+        Frames of a stand the start or target asked for (one in a take's stand), which
+        the measure of generated motion counts as asked, not as a freeze.
     """
 
     motion: Motion
@@ -354,6 +354,32 @@ class MotionGraphSynth:
             return None
         return stand[1:]
 
+    def _in_stands(self, path: GraphPath) -> np.ndarray:
+        """(T,) the path's first and last frames whose neighbours lie mostly (half the
+        weight or more) in a take's stand (:func:`~.phase.moving_frames`): a start or
+        target in a stand stands as its capture does (CMU 69_01 from its frame 11 stood
+        0.7 s before its walk), which is asked for, not a freeze (none without the
+        phase-aware field)."""
+        hold = np.zeros(path.points.shape[0], dtype=bool)
+        field = self.phase_field_
+        if field is None or path.neighbours is None or not path.neighbours.size:
+            return hold
+        from .phase import moving_frames
+
+        g = field.graph
+        still = np.zeros(g.n_nodes, dtype=bool)
+        for t in np.unique(g.take):
+            rows = np.flatnonzero(g.take == t)
+            still[rows] = ~moving_frames(g.points[rows], field.rate[rows])
+        held = (path.weights * still[path.neighbours]).sum(axis=1) >= 0.5
+        # at the start and the end only: a path that stands on its way (through a stand
+        # to a target just after it) freezes
+        first = int(np.argmin(held)) if not held.all() else held.size
+        last = held.size - int(np.argmin(held[::-1])) if not held.all() else 0
+        hold[:first] = True
+        hold[last:] = True
+        return hold
+
     def _closed(self, motion: Motion, stand: tuple[int, int], notes: list[str]) -> Motion:
         """``motion`` with the closing step of :mod:`~cyclecoord.synthesis.stance` over the
         frames ``stand`` (the stop's fade, a gait cycle long) where its feet end apart."""
@@ -538,10 +564,13 @@ class MotionGraphSynth:
                 "start": f"{name}:{f}",
             },
         )
-        hold = None
+        hold = self._in_stands(path)
+        if hold.any() and stand is None:  # (a stop into a stand says so itself)
+            notes.append(f"the path stands {hold.sum()} frames where its takes stand (a start "
+                         "or target in a take's stand): counted as asked, not as freezes")
         if stand is not None:
-            hold = np.zeros(out.n_frames, dtype=bool)
             hold[stand[0] : stand[1]] = True
+        hold = hold if hold.any() else None
         return Generation(
             motion=out,
             path=path,
