@@ -364,14 +364,9 @@ class MotionGraphSynth:
         field = self.phase_field_
         if field is None or path.neighbours is None or not path.neighbours.size:
             return hold
-        from .phase import moving_frames
+        from .phase import standing
 
-        g = field.graph
-        still = np.zeros(g.n_nodes, dtype=bool)
-        for t in np.unique(g.take):
-            rows = np.flatnonzero(g.take == t)
-            still[rows] = ~moving_frames(g.points[rows], field.rate[rows])
-        held = (path.weights * still[path.neighbours]).sum(axis=1) >= 0.5
+        held = (path.weights * standing(field)[path.neighbours]).sum(axis=1) >= 0.5
         # at the start and the end only: a path that stands on its way (through a stand
         # to a target just after it) freezes
         first = int(np.argmin(held)) if not held.all() else held.size

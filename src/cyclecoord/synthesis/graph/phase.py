@@ -49,7 +49,7 @@ from .paths import MAX_STEP_SCALE, GraphPath
 __all__ = [
     "PhaseField", "TakePhases", "take_phases", "align_phases", "match_phase", "match_misfit",
     "follow_phase", "phase_to_target", "phase_across", "phase_to_stand", "stand_at",
-    "amplitude_gain",
+    "standing", "amplitude_gain",
 ]
 
 #: Neighbours of the phase-aware field, the pull per frame towards their next states
@@ -540,6 +540,17 @@ def moving_frames(points: np.ndarray, rate: np.ndarray) -> np.ndarray:
     return keep if keep.sum() >= min(T, cycle) else every
 
 
+def standing(field: PhaseField) -> np.ndarray:
+    """``(n,)`` bool: the graph's frames where their take stands (not
+    :func:`moving_frames`, take by take)."""
+    g = field.graph
+    still = np.zeros(g.n_nodes, dtype=bool)
+    for t in np.unique(g.take):
+        rows = np.flatnonzero(g.take == t)
+        still[rows] = ~moving_frames(g.points[rows], field.rate[rows])
+    return still
+
+
 def stand_at(field: PhaseField, x: np.ndarray) -> tuple[int, int, int] | None:
     """``(take, first, last)``: the take and frames (its own numbering) of the stand that
     holds the graph frame nearest latent point ``x`` (a stretch where the take's pose
@@ -547,7 +558,7 @@ def stand_at(field: PhaseField, x: np.ndarray) -> tuple[int, int, int] | None:
     g = field.graph
     node = int(g.tree.query(np.asarray(x, dtype=float).reshape(-1))[1])
     take = np.flatnonzero(g.take == g.take[node])
-    moving = moving_frames(g.points[take], field.rate[take])
+    moving = ~standing(field)[take]
     i = int(np.flatnonzero(take == node)[0])
     if moving[i]:
         return None
