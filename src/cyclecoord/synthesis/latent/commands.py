@@ -572,6 +572,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             and _isfinite(speed) and speed > 0
         ):
             raise ParameterError(f"MOVE speed must be a positive number, got {speed!r}")
+        stepped = None
         if isinstance(to, dict) and "ahead" in to:
             if set(to) != {"ahead"}:
                 raise ParameterError(f"an ahead target takes no other keys, got {sorted(to)}")
@@ -586,7 +587,13 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         else:
             along = None
             goal = self.target(to)
-            if path == "line":
+            stepped = self.step_to(goal) if path == "line" else None
+            if stepped is not None:  # from a gait: stepping on to the goal's phase
+                poly, times = stepped
+                along = self._path_detail
+                if radius is None:
+                    radius = AHEAD_RADIUS * self.params.radius
+            elif path == "line":
                 poly, nodes = np.vstack([self.x, goal]), [-1, -1]
             elif path == "graph":
                 if self.current not in self._graphs:
@@ -594,7 +601,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
                 poly, nodes = self._graphs[self.current].path(self.x, goal, nodes=True)
             else:
                 raise ParameterError(f"MOVE path must be 'line' or 'graph', got {path!r}")
-            times = _path_times(m, poly, nodes)
+            if stepped is None:
+                times = _path_times(m, poly, nodes)
         times = times / speed
         if duration is not None:
             if not (
@@ -618,7 +626,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         if along is not None:
             detail = {k: interp_rows(u, times, v)[1:] for k, v in along.items()}
         self._run(samples, radius, ride=True, detail=detail)
-        self._stepping = isinstance(to, dict) and "ahead" in to
+        self._stepping = stepped is not None or (isinstance(to, dict) and "ahead" in to)
 
     def idle(
         self, at: Any = None, duration: float = 1.0, radius: float | None = None,

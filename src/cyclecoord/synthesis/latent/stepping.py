@@ -33,6 +33,9 @@ __all__ = ["FADE_TIE", "GaitMixin", "IN_STEP_LONGEST", "SEAM_FADES"]
 #: An in-step blend is raised (and said) up to this many seconds at most, so the
 #: TRANSITION completes within a second of the command.
 IN_STEP_LONGEST = 1.0
+#: An in-step blend whose frames accelerate a joint over this many times the faster
+#: model's training 99th percentile is lengthened (:meth:`GaitMixin.gait_hop`).
+HOP_ACCELERATION = 1.5
 #: A MOVE ahead that stops looks for a stance (both feet down) on a phase grid of this
 #: many bins (:meth:`GaitMixin.stop_ahead`).
 STANCE_BINS = 50
@@ -118,6 +121,15 @@ class GaitMixin:
         X = at(m.X_)
         self._next_cursor = (self.current, seg, float(u[-1]))
         self._path_detail = self._detail_at(self.current, seg, u, at)
+        cursor = self._cursor
+        if cursor is not None and cursor[0] == self.current and len(cursor) > 3:
+            # after a MOVE to a frame (:meth:`step_to`), which ended on the frame where
+            # the loop passes its phase elsewhere: the path's offset from the loop fades
+            # out over half a cycle rather than in a frame
+            f = min(n, max(1, int(round(0.5 / self._rate(self.current, seg)))))
+            w = np.ones(n + 1)
+            w[: f + 1] = np.concatenate([[0.0], smootherstep(f - 1), [1.0]])
+            X = X + (1.0 - w)[:, None] * cursor[3]
         X[0] = self.x
         return X, np.arange(n + 1) / self.fps
 
@@ -192,6 +204,50 @@ class GaitMixin:
             else None
         )
         return X, t - t0
+
+    def step_to(self, goal: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """A MOVE along a line to latent point ``goal`` from a gait the particle is
+        stepping along (the last command stepped): the latent path ``(M, q)`` and its
+        times ``(M,)``, stepping on at the training cadence to the gait phase of the
+        training frame nearest ``goal``, at least as long as the line takes at the
+        model's latent speed, the latent offset from the gait easing from the particle's
+        to the goal's, and from the particle's segment to the goal's; None where the
+        particle is not stepping or the goal's frame has no gait phase (a line then).
+
+        Played as a line, such a MOVE put the goal's phase of the stride after the phase
+        the legs were at: on a random subject 35 script a one-frame MOVE to frame 34
+        between a TRANSITION and a MOVE ahead swapped the legs in a frame and the toes
+        accelerated 2.0x the run's 99th percentile."""
+        name = self.current
+        if self._cursor is None or self._cursor[0] != name:
+            return None
+        m, g = self.models[name], self.gait(name)
+        k = int(m.nearest_frame(goal[None])[0])
+        s1 = int(g.segments[k])
+        if s1 not in g.usable or not np.isfinite(g.phase[k]):
+            return None
+        s0, u0 = self._cursor[1], self._cursor[2]
+        rate = self._rate(name, s1)
+        line = float(np.linalg.norm(goal - self.x)) / m.speed_ * self.fps * rate  # cycles
+        du = (float(g.phase[k]) - u0) % 1.0
+        du += max(0.0, float(np.ceil(line - du)))
+        n = max(1, int(round(du / rate)))
+        u = u0 + du * np.arange(n + 1) / n
+        w = np.concatenate([[0.0], smootherstep(n - 1), [1.0]])[:, None]
+        at = self.gait_sampler(name, s1, u)
+        X, detail = at(m.X_), self._detail_at(name, s1, u, at)
+        if s0 != s1:  # from the particle's segment to the goal's, in step
+            at0 = self.gait_sampler(name, s0, u)
+            X = (1.0 - w) * at0(m.X_) + w * X
+            if detail is not None:
+                d0 = self._detail_at(name, s0, u, at0)
+                detail = {key: (1.0 - w.reshape((-1,) + (1,) * (v.ndim - 1))) * d0[key]
+                          + w.reshape((-1,) + (1,) * (v.ndim - 1)) * v
+                          for key, v in detail.items()}
+        self._next_cursor = (name, s1, float(u[-1]), goal - X[-1])
+        X = X + (1.0 - w) * (self.x - X[0]) + w * (goal - X[-1])
+        self._path_detail = detail
+        return X, np.arange(n + 1) / self.fps
 
     def stance(self, name: str) -> np.ndarray | None:
         """(N,) per training frame of model ``name``: the higher of its legs' lowest foot
@@ -319,6 +375,66 @@ class GaitMixin:
                 f"poses {dist:.3g} units apart faster would accelerate joints over "
                 f"{BLEND_ACCELERATION:g}x the models' training 99th percentile"
             )
+        # the blended frames measured: changing cadence, stride and lean at once, a blend
+        # the poses' distance allowed still popped (a Bandai walk -> run over 0.31 s: the
+        # hands at 1.67x the run's 99th percentile)
+        n0, longest = n, max(n, int(IN_STEP_LONGEST * self.fps))
+        hop = self._in_step(src, to, (sa, ua), (sb, ub), n, count=False)
+        tried = [(self._hop_peak(src, to, hop["blended"], hop["root"]), n, hop)]
+        while tried[-1][0] > HOP_ACCELERATION and n < longest:
+            n = min(longest, n + max(1, n // 4))
+            hop = self._in_step(src, to, (sa, ua), (sb, ub), n, count=False)
+            tried.append((self._hop_peak(src, to, hop["blended"], hop["root"]), n, hop))
+        # the shortest under the limit, else the one that accelerates least
+        peak, n, hop = min(tried, key=lambda t: (t[0] > HOP_ACCELERATION,
+                                                  t[1] if t[0] <= HOP_ACCELERATION else t[0]))
+        if n != n0:
+            was = f"{blend:g}" if n0 == asked else f"{n0 / self.fps:.2f}"
+            self.notes.append(
+                f"commands[{self.command}] TRANSITION {src} -> {to}: blend raised from "
+                f"{was} s ({plural(n0, 'frame')}) to {n / self.fps:.2f} s "
+                f"({n} frames): over {n0} frames its joints accelerated {tried[0][0]:.2f}x "
+                f"the faster model's training 99th percentile (limit {HOP_ACCELERATION:g}x; "
+                f"{peak:.2f}x now)"
+            )
+        self._clip(src, hop["Pa"])  # (counted once, on the frames kept)
+        self._clip(to, hop["Pb"])
+        w, du, Xb, blended = hop["w"], hop["du"], hop["Xb"], hop["blended"]
+        root, detail, on_path, Pb, Da = (hop[k] for k in ("root", "detail", "on_path", "Pb", "Da"))
+        self._emit(to, Xb, blended, root, clip=False, detail=detail,
+                   targets=functools.cache(
+                       functools.partial(self._hop_targets, src, to, on_path, Xb, Pb, Da, w)))
+        c = self.crossings_threshold(src)
+        self.events.append(
+            {
+                "command": self.command,
+                "transition": [src, to],
+                "route": [src, to],
+                "in_step": True,
+                "phase": float(ua % 1.0),
+                "bridge_frame": int(m1.nearest_frame(self.x[None])[0]),
+                "target_frame": int(m2.nearest_frame(Xb[:1])[0]),
+                "bridge_distance": dist,
+                "threshold": c,
+                "under_threshold": bool(dist < c),
+                "bridges": 0,
+                "blend_frames": n,
+                "blend_asked_frames": asked,
+                "start_frame": self.n_frames - n,
+            }
+        )
+        self.current, self.x = to, Xb[-1]
+        self.v = (Xb[-1] - Xb[-2]) * self.fps if n > 1 else np.zeros_like(self.x)
+        self._cursor = (to, sb, float(ub + du[-1]))
+        self._stepping = True
+
+    def _in_step(self, src: str, to: str, place_a: tuple[int, float], place_b: tuple[int, float],
+             n: int, count: bool = True) -> dict:
+        """The frames of an in-step blend of ``n`` frames from ``src`` at ``place_a`` (its
+        segment and unwrapped phase) into ``to`` at ``place_b``: paths, root motion,
+        detail, the two gaits' poses and their blend (``to``'s chart)."""
+        m1, m2 = self.models[src], self.models[to]
+        (sa, ua), (sb, ub) = place_a, place_b
         w = smootherstep(n)
         ra, rb = self._rate(src, sa), self._rate(to, sb)
         steps = (1.0 - w) * ra + w * rb
@@ -349,33 +465,30 @@ class GaitMixin:
                 for k in Da
             }
             root = {k: root[k] + detail[k] for k in root}
-        blended = self._mix(src, to, self._clip(src, Pa), self._clip(to, Pb), w)
-        self._emit(to, Xb, blended, root, clip=False, detail=detail,
-                   targets=functools.cache(
-                       functools.partial(self._hop_targets, src, to, on_path, Xb, Pb, Da, w)))
-        c = self.crossings_threshold(src)
-        self.events.append(
-            {
-                "command": self.command,
-                "transition": [src, to],
-                "route": [src, to],
-                "in_step": True,
-                "phase": float(ua % 1.0),
-                "bridge_frame": int(m1.nearest_frame(self.x[None])[0]),
-                "target_frame": int(m2.nearest_frame(Xb[:1])[0]),
-                "bridge_distance": dist,
-                "threshold": c,
-                "under_threshold": bool(dist < c),
-                "bridges": 0,
-                "blend_frames": n,
-                "blend_asked_frames": asked,
-                "start_frame": self.n_frames - n,
-            }
-        )
-        self.current, self.x = to, Xb[-1]
-        self.v = (Xb[-1] - Xb[-2]) * self.fps if n > 1 else np.zeros_like(self.x)
-        self._cursor = (to, sb, float(ub + du[-1]))
-        self._stepping = True
+        blended = self._mix(src, to, self._clip(src, Pa, count), self._clip(to, Pb, count), w)
+        return {"w": w, "du": du, "Xb": Xb, "on_path": on_path, "root": root, "detail": detail,
+                "Pa": Pa, "Pb": Pb, "Da": Da, "blended": blended}
+
+    def _hop_peak(self, src: str, to: str, blended: np.ndarray, root: dict) -> float:
+        """The largest joint acceleration relative to the root of an in-step blend's
+        frames (``to``'s chart, after the last two frames before it; the root's tilt and
+        turn included, as the report measures: a walk-to-run blend tilts the whole body
+        forward), over the faster of the two models' training 99th percentile measured
+        so (:meth:`~.output.OutputMixin._lock_acc99`, in the models' own units)."""
+        from .model import heading_matrix
+
+        m2 = self.models[to]
+        if blended.shape[0] < 3:
+            return 0.0
+        U, _, Vt = np.linalg.svd(root["tilt"])
+        U[:, :, 2] *= np.sign(np.linalg.det(U @ Vt))[:, None]
+        theta = np.concatenate([[0.0], np.cumsum(root["turn"][:-1]) / self.fps])
+        rot = heading_matrix(theta) @ (U @ Vt)
+        p = np.einsum("tab,tpb->tpa", rot,
+                      pose_points(m2.to_channels(blended), m2.channels_, m2.skeleton_))
+        acc = float(np.linalg.norm(np.diff(p, 2, axis=0), axis=2).max()) * self.fps**2
+        ref = max(self._lock_acc99(k) / self.sizes.get(k, 1.0) for k in (src, to))
+        return acc / max(ref, 1e-12)
 
     def _hop_targets(self, src, to, Xa, Xb, Pb, Da, w) -> tuple[np.ndarray, np.ndarray]:
         """What untangling pulls an in-step blend's frames toward (``_Chunk.targets``):
