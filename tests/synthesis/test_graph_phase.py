@@ -610,13 +610,42 @@ def test_a_start_in_a_takes_stand_stands_as_asked(walk_and_stand):
     assert q.freezes and not q_held.freezes  # (standing, then walking)
     assert gen.hold is not None and gen.hold[0] and not gen.hold[-1]
     assert walk.hold is None
-    # a stand on the way (into 69_01 just before its walk's frame 160) is no asked hold
+    # a stand on the way is no asked hold: a path whose middle frames' neighbours lie in
+    # 69_01's stand (its nodes from 360) holds nowhere
+    from dataclasses import replace
+
+    from cyclecoord.synthesis.graph.phase import standing
+
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         through = synth.to_target(0, 0, 1, 160)
-        q = measure_generated(through.motion, reference=synth.reference(through),
-                              hold=through.hold)
-    assert q.freezes and through.hold is None
+    nb = np.array(through.path.neighbours)
+    T = nb.shape[0]
+    assert standing(synth.phase_field_)[370] and not synth._in_stands(through.path).any()
+    nb[T // 3 : 2 * T // 3] = 370
+    held = synth._in_stands(replace(through.path, neighbours=nb))
+    assert not held.any()
+    nb[: T // 3] = 370  # (from the start on: the start's stand, asked)
+    held = synth._in_stands(replace(through.path, neighbours=nb))
+    assert held[: 2 * T // 3].all() and not held[2 * T // 3 :].any()
+
+
+def test_a_target_just_after_a_takes_stand_is_reached_standing_briefly(walk_and_stand):
+    """Into 69_01 just after its stand (its walk's frame 160): no frame where the take
+    moves lies far enough before the target, so the path fades into the stand.  Faded in
+    at the first of its frames the start's gait met, it stood 0.22-0.28 s (a freeze) from
+    5 of 10 starts (frames 0, 50, 100, 300 of 35_07 to 69_01's frames 160 and 200); faded
+    in at the latest such frame (the gait walking on up to a cycle longer), none."""
+    synth = walk_and_stand
+    for start, target in ((0, 160), (50, 160), (100, 160), (300, 160), (50, 200),
+                          (300, 200)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            gen = synth.to_target(0, start, 1, target)
+            q = measure_generated(gen.motion, reference=synth.reference(gen), hold=gen.hold)
+        assert gen.path.kind == "field:phase:across-to-target" and gen.hold is None
+        assert not q.freezes and q.largest_accel <= 1.0, (start, target, q.freezes,
+                                                          q.largest_accel)
 
 
 def test_a_target_at_the_start_of_another_gaits_take_is_reached_in_step(walks, walks_and_jog):
