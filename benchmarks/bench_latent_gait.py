@@ -259,7 +259,8 @@ def _own_accel(motion, rep: dict, spec: dict, refs: dict, paced: bool = False) -
     """The largest acceleration of a script's motion, each run of one model's frames over
     its own takes' p99 and each TRANSITION's over the faster model's (a frame and its
     neighbours: the whole motion over its models' mix read a short run's strides against
-    the walk's p99).  ``paced``: over that p99 times the square of the fastest ``speed``
+    the walk's p99), a script's first TRANSITION's too (it leaves the start's model: judged
+    by its target's alone, a run -> walk blend read 1.89x the walk's p99, 0.71x the run's).  ``paced``: over that p99 times the square of the fastest ``speed``
     over 1 a MOVE of the run asked for (a MOVE at ``speed`` plays its path that much
     faster, so its strides accelerate ``speed**2`` times the captures': a run asked at
     1.29x read 1.59x the p99, 1.10x at its captured pace)."""
@@ -277,7 +278,9 @@ def _own_accel(motion, rep: dict, spec: dict, refs: dict, paced: bool = False) -
             runs[-1][2] = seg["stop"]
             runs[-1][3].add(seg["model"])
         else:
-            before = {runs[-1][0] or next(iter(runs[-1][3]))} if runs and blend else set()
+            # a blend's models: the one it leaves (the frames before it, or the start's)
+            before = ({runs[-1][0] or next(iter(runs[-1][3]))} if runs
+                      else {spec["start"]["model"]}) if blend else set()
             runs.append([key, seg["start"], seg["stop"], {seg["model"]} | before, 1.0])
         runs[-1][4] = max(runs[-1][4], pace)
     worst = 0.0

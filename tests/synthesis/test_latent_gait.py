@@ -931,6 +931,16 @@ def test_the_benchmark_runs_scripts_no_one_chose(models, tmp_path, capsys):
     refs = {k: source_figures(training_takes(models, [k]), 30.0) for k in models}
     assert bench._own_accel(motion, rep, walk, refs) == pytest.approx(
         measure_generated(motion, reference=refs["walk"]).largest_accel)
+    # a script's first TRANSITION leaves the start's model: judged by the faster of the
+    # two, also where the report gives it one segment of its target (an in-step blend:
+    # by the walk's takes alone, a synthetic run -> walk blend read 1.89x their p99)
+    run = {**walk, "start": {"model": "run", "at": {"frame": 0}},
+           "commands": [{"command": "TRANSITION", "to": "walk", "blend": 0.5}]}
+    one = {"commands": [{"command": 0, "model": "walk", "start": 0, "stop": motion.n_frames}]}
+    faster = max(refs.values(), key=lambda r: r.accel_p99)
+    assert faster is refs["run"] and faster.accel_p99 > refs["walk"].accel_p99
+    assert bench._own_accel(motion, one, run, refs) == pytest.approx(
+        measure_generated(motion, reference=faster).largest_accel)
 
 
 def test_foot_pins_ease_over_a_tenth_of_the_quickest_leg_cycle(made):
