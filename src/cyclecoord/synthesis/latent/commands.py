@@ -265,6 +265,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self._given_models = self.models  # (start() sizes them to its model's skeleton)
         #: the models start() sized to the output skeleton: the scale of each
         self.sizes: dict[str, float] = {}
+        #: the model whose skeleton the frames are written on (the first start's)
+        self.skeleton_model: str | None = None
         self._size_notes: dict[str, str] = {}  # (said once a model's frames are made)
         self.sim_seconds = 0.0
         self.sim_cpu_seconds = 0.0
@@ -523,6 +525,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             from .sizing import size_note, sized_roots
 
             self.models, self.sizes = sized_roots(self._given_models, model, self.feet)
+            self.skeleton_model = model
             self._size_notes = {k: size_note(k, s, model) for k, s in self.sizes.items()}
         self.current = model
         k = None

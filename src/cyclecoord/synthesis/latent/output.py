@@ -193,7 +193,7 @@ class OutputMixin:
         are then found again on those only, :meth:`~cyclecoord.motion.Motion.with_frames`)."""
         from ...conventions import continuous_euler
 
-        first = self.models[self.chunks[0].model]
+        first = self.models[self.skeleton_model]
         T = angles.shape[0]
         angles = self._stand_legs(angles)
         turn = root["turn"][:-1]
@@ -256,7 +256,7 @@ class OutputMixin:
         from ...conventions import continuous_euler
         from ..carry import STAND_AFTER
 
-        first = self.models[self.chunks[0].model]
+        first = self.models[self.skeleton_model]
         legs = self._leg_mask(first)
         if not legs.any():
             return angles
@@ -459,7 +459,7 @@ class OutputMixin:
 
         from ...conventions import continuous_euler
 
-        first = self.models[self.chunks[0].model]
+        first = self.models[self.skeleton_model]
         joints = {}
         for name in dict.fromkeys(c.model for c in self.chunks):
             for idx, order, _ in self.models[name].chart():

@@ -560,7 +560,7 @@ def run_script(
         "frames": motion.n_frames,
         "duration_s": motion.duration,
         "models": {k: m.describe() for k, m in models.items()},
-        "output_skeleton_from": syn.chunks[0].model,
+        "output_skeleton_from": syn.skeleton_model,
         "commands": syn.segments(),
         "transitions": syn.events,
         "clamped_to_training_range": syn.clamped,
@@ -581,7 +581,7 @@ def run_script(
     if len(sizes) > 1:
         report["notes"] += [
             "the models' skeletons have the same joints but different bone lengths; "
-            f"the output uses {syn.chunks[0].model!r}'s"
+            f"the output uses {syn.skeleton_model!r}'s"
         ]
     if check:
         from ...quality.plausibility import check_plausibility
