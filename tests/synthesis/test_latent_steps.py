@@ -114,3 +114,24 @@ def test_an_in_step_blend_that_would_pop_is_lengthened_and_said(models, monkeypa
     assert 6 < ev["blend_frames"] <= 30 and peak <= 0.9
     assert len(said) == 1 and "blend raised from 0.2 s (6 frames)" in said[0]
     assert "(limit 0.9x;" in said[0]
+
+
+def test_a_gait_begun_after_a_line_eases_in(models):
+    """A MOVE ahead after a MOVE to a frame played as a line (the particle moving, but not
+    stepping) starts its steps from rest, as from a start or an IDLE: at full cadence at
+    once, a random Bandai script's run (an IDLE, a line to a run frame, a MOVE ahead)
+    jumped into its stride."""
+    syn = Synthesizer(models, fps=30, seed=0, plant="off")
+    syn.start("walk", {"frame": 0})
+    syn.command += 1
+    syn.move({"frame": 40}, path="line", stop=False)
+    assert syn.chunks[-1].path is None and not syn._stepping  # (a line, from rest)
+    syn.command += 1
+    syn.move({"ahead": 1.0}, stop=False)
+    steps = np.linalg.norm(np.diff(syn.chunks[-1].path, axis=0), axis=1)
+    assert steps[0] < 0.3 * np.median(steps)
+    # stepping on from a MOVE ahead: no ease
+    syn.command += 1
+    syn.move({"ahead": 1.0}, stop=False)
+    steps = np.linalg.norm(np.diff(syn.chunks[-1].path, axis=0), axis=1)
+    assert steps[0] > 0.7 * np.median(steps)

@@ -618,6 +618,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             times = times * (duration / max(times[-1], 1e-12))
         ramp = int(round(self.ease * self.fps))
         still = self.v is None or np.linalg.norm(self.v) < 0.25 * m.speed_
+        if along is not None and stepped is None and not self._stepping:
+            still = True  # (a gait begun from a line or an idle: its steps ease in)
         r_in, r_out = (ramp if still else 0), (ramp if stop else 0)
         with np.errstate(all="ignore"):
             frames = np.round(times[-1] * self.fps)
