@@ -139,14 +139,20 @@ class OutputMixin:
             return self._assemble(*self._posed(pull, whole), like=motion)
         a, b = max(int(stuck.min()) - 2 * w, 0), int(stuck.max()) + 2 * w + 1
         best = None
+        joined = np.flatnonzero(whole)  # (frames taken whole in an earlier round nearby)
+        joined = joined[np.abs(joined[:, None] - stuck[None, :]).min(axis=1) <= w]
         for kind in (2, 1):
             trial = whole.copy()
             trial[stuck] = kind
+            if kind == 2:  # one run with them
+                trial[joined] = 2
             out = self._assemble(*self._posed(pull, trial), like=motion)
             peak = float(_accel(out)[a:b].max())
             if best is None or peak < best[0]:
                 best = (peak, out, kind)
         whole[stuck] = best[2]
+        if best[2] == 2:
+            whole[joined] = 2
         return best[1]
 
     def _note_pulled(self, frames: set[int], lead: str) -> None:
@@ -436,12 +442,15 @@ class OutputMixin:
         if some:
             target[k] = m.frame_angles()[m.nearest_frame(c.path[k])]
         if played.size:  # about those frames the capture played on at its pace
-            k = played
             fa, w = m.frame_angles(), max(1, int(round(UNTANGLE_WIDTH * self.fps)))
+            # one anchor per run of such frames (its middle one): consecutive frames
+            # anchored apart jumped between two strides
+            runs = np.split(played, np.flatnonzero(np.diff(played) > w) + 1)
+            k = np.array([r[len(r) // 2] for r in runs])
             near = m.nearest_frame(c.path[k])
-            t = np.unique(np.clip((k[:, None] + np.arange(-w, w + 1)).ravel(), 0,
-                                  len(target) - 1))
-            i = np.abs(t[:, None] - k[None, :]).argmin(axis=1)  # each frame's nearest of k
+            t = np.unique(np.concatenate([np.arange(r[0] - w, r[-1] + w + 1) for r in runs]))
+            t = t[(t >= 0) & (t < len(target))]
+            i = np.abs(t[:, None] - k[None, :]).argmin(axis=1)  # each frame's anchor
             at = near[i] + (t - k[i]) * m.fps_ / self.fps
             for seg in np.unique(m.segments_[near[i]]):  # (within its frame's take)
                 rows = np.flatnonzero(m.segments_ == seg)
