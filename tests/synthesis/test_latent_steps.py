@@ -177,3 +177,33 @@ def test_a_frame_taken_whole_can_take_the_capture_played_about_it(models):
     whole = np.zeros(motion.n_frames, dtype=np.int8)
     syn._whole_frames(motion, pull, whole, np.array([f]), 4)
     assert peaks[1] != peaks[2] and whole[f] == min(peaks, key=peaks.get), peaks
+
+
+def test_a_first_transition_steps_from_the_start_frame(models, monkeypatch, tmp_path):
+    """A script that starts on a walk frame and begins with a TRANSITION to the run (a
+    random script of the benchmark's): the figure steps :data:`~.crossing.START_LEAD` s
+    of the walk's gait from the start frame, then blends in step, and says so; crossed
+    while both idle (before), it stood still at its start frame, mid-stride (a freeze in
+    the report)."""
+    import json
+
+    from cyclecoord.synthesis.latent.crossing import START_LEAD, CrossingMixin
+    from cyclecoord.synthesis.latent.script import run_script
+
+    for name, m in models.items():
+        m.save(tmp_path / f"{name}.npz")
+    spec = {"fps": 30, "seed": 8, "models": {"walk": "walk.npz", "run": "run.npz"},
+            "start": {"model": "walk", "at": {"frame": 32}},
+            "commands": [{"command": "TRANSITION", "to": "run", "blend": 0.37},
+                         {"command": "MOVE", "to": {"ahead": 1.0}}]}
+    path = tmp_path / "first.json"
+    path.write_text(json.dumps(spec))
+    motion, rep = run_script(path)
+    first = rep["commands"][0]
+    assert first["model"] == "walk" and first["stop"] - first["start"] >= round(START_LEAD * 30)
+    assert rep["transitions"][0]["in_step"]
+    assert [n for n in rep["notes"] if "first frames step 0.25 s along 'walk'" in n]
+    assert not rep["motion_quality"]["freezes"]
+    monkeypatch.setattr(CrossingMixin, "_starts_on_gait", lambda self, name: False)
+    motion, rep = run_script(path)
+    assert not rep["transitions"][0].get("in_step") and rep["motion_quality"]["freezes"]
