@@ -922,6 +922,11 @@ def test_the_benchmark_runs_scripts_no_one_chose(models, tmp_path, capsys):
     out = capsys.readouterr().out
     assert re.search(r"random scripts \(3, seed 11\): largest accel median [0-9.]+x", out), out
     assert "failed 0" in out
+    bench.random_scripts(models, tmp_path, 2, seed=12)  # (--random-seeds: kept-back seeds)
+    assert "random scripts (2, seed 12)" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        bench.main(["--no-shared", "--random-seeds", "eleven"])
+    assert "--random-seeds: whole numbers" in capsys.readouterr().err
     walk = {"fps": 30, "seed": 0, "models": {"walk": "walk.npz", "run": "run.npz"},
             "start": {"model": "walk", "at": {"frame": 0}},
             "commands": [{"command": "MOVE", "to": {"ahead": 2.0}}]}
