@@ -31,6 +31,7 @@ __all__ = [
     "local_rotations",
     "continuous_euler",
     "continuous_channels",
+    "nearest_rotations",
     "check_order",
     "wrap_degrees",
     "in_conventions_of",
@@ -84,6 +85,14 @@ def local_rotations(motion: Motion, skeleton: Skeleton | None = None) -> np.ndar
         mats = Rotation.from_euler(j.rotation_order, vals, degrees=True).as_matrix()
         out[i] = j.axis @ mats @ j.axis.T
     return out
+
+
+def nearest_rotations(mats: np.ndarray) -> np.ndarray:
+    """The rotation nearest each matrix ``(T, 3, 3)`` (a weighted mean of rotations, such
+    as a latent model's root tilt mixed over training frames), never a reflection."""
+    U, _, Vt = np.linalg.svd(mats)
+    U[:, :, 2] *= np.sign(np.linalg.det(U @ Vt))[:, None]
+    return U @ Vt
 
 
 def continuous_euler(

@@ -222,7 +222,7 @@ class OutputMixin:
         """A motion from every frame's joint angles and root motion (root integrated);
         ``like``: an earlier assembly, which it changes on some frames (its positions
         are then found again on those only, :meth:`~cyclecoord.motion.Motion.with_frames`)."""
-        from ...conventions import continuous_euler
+        from ...conventions import continuous_euler, nearest_rotations
 
         first = self.models[self.skeleton_model]
         T = angles.shape[0]
@@ -242,11 +242,7 @@ class OutputMixin:
         world = np.einsum("tab,tb->ta", head, step) / self.fps
         pos = np.concatenate([np.zeros((1, 3)), np.cumsum(world[:-1], axis=0)])
         pos[:, 1] = root["height"]
-        U, _, Vt = np.linalg.svd(root["tilt"])
-        # the nearest rotation to the weighted mean of rotations (never a reflection)
-        U[:, :, 2] *= np.sign(np.linalg.det(U @ Vt))[:, None]
-        tilt = U @ Vt
-        mats = head @ tilt
+        mats = head @ nearest_rotations(root["tilt"])  # (the tilt: a mean of rotations)
         rj = first.skeleton_.joints[0]
         if not np.allclose(rj.axis, np.eye(3)):
             mats = rj.axis.T @ mats @ rj.axis

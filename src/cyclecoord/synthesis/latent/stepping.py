@@ -28,7 +28,7 @@ from .easing import smootherstep
 from .gait import FADE_TIE, SEAM_FADES, Gait, choose_seam_fade
 from .influence import pose_points
 
-__all__ = ["FADE_TIE", "GaitMixin", "IN_STEP_LONGEST", "SEAM_FADES"]
+__all__ = ["FADE_TIE", "GaitMixin", "HOP_ACCELERATION", "IN_STEP_LONGEST", "SEAM_FADES"]
 
 #: An in-step blend is raised (and said) up to this many seconds at most, so the
 #: TRANSITION completes within a second of the command.
@@ -428,8 +428,8 @@ class GaitMixin:
         self._cursor = (to, sb, float(ub + du[-1]))
         self._stepping = True
 
-    def _in_step(self, src: str, to: str, place_a: tuple[int, float], place_b: tuple[int, float],
-             n: int, count: bool = True) -> dict:
+    def _in_step(self, src: str, to: str, place_a: tuple[int, float],
+                 place_b: tuple[int, float], n: int, count: bool = True) -> dict:
         """The frames of an in-step blend of ``n`` frames from ``src`` at ``place_a`` (its
         segment and unwrapped phase) into ``to`` at ``place_b``: paths, root motion,
         detail, the two gaits' poses and their blend (``to``'s chart)."""
@@ -471,19 +471,18 @@ class GaitMixin:
 
     def _hop_peak(self, src: str, to: str, blended: np.ndarray, root: dict) -> float:
         """The largest joint acceleration relative to the root of an in-step blend's
-        frames (``to``'s chart, after the last two frames before it; the root's tilt and
-        turn included, as the report measures: a walk-to-run blend tilts the whole body
-        forward), over the faster of the two models' training 99th percentile measured
-        so (:meth:`~.output.OutputMixin._lock_acc99`, in the models' own units)."""
+        frames (``to``'s chart; the root's tilt and turn included, as the report
+        measures: a walk-to-run blend tilts the whole body forward), over the faster of
+        the two models' training 99th percentile measured so
+        (:meth:`~.output.OutputMixin._lock_acc99`, in the models' own units)."""
+        from ...conventions import nearest_rotations
         from .model import heading_matrix
 
         m2 = self.models[to]
         if blended.shape[0] < 3:
             return 0.0
-        U, _, Vt = np.linalg.svd(root["tilt"])
-        U[:, :, 2] *= np.sign(np.linalg.det(U @ Vt))[:, None]
         theta = np.concatenate([[0.0], np.cumsum(root["turn"][:-1]) / self.fps])
-        rot = heading_matrix(theta) @ (U @ Vt)
+        rot = heading_matrix(theta) @ nearest_rotations(root["tilt"])
         p = np.einsum("tab,tpb->tpa", rot,
                       pose_points(m2.to_channels(blended), m2.channels_, m2.skeleton_))
         acc = float(np.linalg.norm(np.diff(p, 2, axis=0), axis=2).max()) * self.fps**2
