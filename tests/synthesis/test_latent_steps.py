@@ -207,3 +207,21 @@ def test_a_first_transition_steps_from_the_start_frame(models, monkeypatch, tmp_
     monkeypatch.setattr(CrossingMixin, "_starts_on_gait", lambda self, name: False)
     motion, rep = run_script(path)
     assert not rep["transitions"][0].get("in_step") and rep["motion_quality"]["freezes"]
+
+
+def test_a_line_takes_no_less_than_a_blend_between_its_poses(models, monkeypatch):
+    """A MOVE along a line is timed by its latent length at the model's latent speed, and
+    no faster than a blend between its two poses (``blend_frames``): in the latent
+    space a short line can join far poses."""
+    from cyclecoord.synthesis.latent.crossing import CrossingMixin
+
+    def line_frames(need):
+        monkeypatch.setattr(CrossingMixin, "blend_frames", lambda self, *a: need)
+        syn = Synthesizer(models, fps=30, seed=0, plant="off")
+        syn.start("walk", {"frame": 10})
+        syn.command += 1
+        syn.move({"frame": 12}, path="line", stop=False)
+        return syn.chunks[-1].X.shape[0]
+
+    short = line_frames(1)
+    assert line_frames(40) >= 40 > short

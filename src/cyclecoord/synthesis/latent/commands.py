@@ -560,9 +560,13 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
 
         The path is timed from the training takes: a stretch between two consecutive
         training frames of a segment takes the time it took in the capture, the rest
-        (a line, a jump between takes) its length at the model's median latent speed;
-        ``speed`` scales and ``duration`` sets the whole.  The particle speeds up over
-        ``ease`` seconds only when it starts from rest and slows down only with ``stop``
+        (a line, a jump between takes) its length at the model's median latent speed, a
+        line no faster than a blend between its two poses
+        (``blend_frames``: a short line in the latent space
+        between far poses threw a Bandai run's joints 2.1x its p99, a random script's
+        MOVE to a frame after a TRANSITION crossed while idle); ``speed`` scales and
+        ``duration`` sets the whole.  The particle speeds up over ``ease`` seconds only
+        when it starts from rest and slows down only with ``stop``
         (a script passes ``stop=False`` when a MOVE or TRANSITION follows), so a chain of
         MOVEs flows through its waypoints.  A MOVE ahead that stops ends where both feet
         are down, the nearest such phase of the gait within a quarter of a cycle of the
@@ -606,6 +610,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
                 raise ParameterError(f"MOVE path must be 'line' or 'graph', got {path!r}")
             if stepped is None:
                 times = _path_times(m, poly, nodes)
+                if path == "line":  # no faster than a blend between its two poses
+                    need = self.blend_frames(self.current, self.current, self.x, goal) / self.fps
+                    if times[-1] < need:
+                        times = times * (need / max(times[-1], 1e-12))
         times = times / speed
         if duration is not None:
             if not (
