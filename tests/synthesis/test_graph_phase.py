@@ -634,7 +634,7 @@ def test_a_target_just_after_a_takes_stand_is_reached_standing_briefly(walk_and_
     """Into 69_01 just after its stand (its walk's frame 160): no frame where the take
     moves lies far enough before the target, so the path fades into the stand.  Faded in
     at the first of its frames the start's gait met, it stood 0.22-0.28 s (a freeze) from
-    5 of 10 starts (frames 0, 50, 100, 300 of 35_07 to 69_01's frames 160 and 200); faded
+    6 of 10 pairs (frames 0, 50, 100, 200, 300 of 35_07 to 69_01's frames 160 and 200); faded
     in at the latest such frame (the gait walking on up to a cycle longer), none."""
     synth = walk_and_stand
     for start, target in ((0, 160), (50, 160), (100, 160), (300, 160), (50, 200),

@@ -657,7 +657,7 @@ def phase_across(
             continue
         # from a stand, the latest of its frames any join meets: the start's gait walks up
         # to a cycle longer, the path stands less (from the first join met, the paths into
-        # CMU 69_01 just after its stand stood 0.22-0.28 s from 5 starts in 10)
+        # CMU 69_01 just after its stand stood 0.22-0.28 s from 6 of 10 start and target pairs)
         join, b0 = max(found, key=lambda jb: (float(field.unwrapped[jb[1]]), -jb[0]))
         # (b0 under a cycle before the target: the cut is looked for from before it)
         if n < 3:
