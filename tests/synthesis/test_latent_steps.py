@@ -205,6 +205,8 @@ def test_a_first_transition_steps_from_the_start_frame(models, monkeypatch, tmp_
     assert [n for n in rep["notes"] if "first frames step 0.25 s along 'walk'" in n]
     assert not rep["motion_quality"]["freezes"]
     monkeypatch.setattr(CrossingMixin, "_starts_on_gait", lambda self, name: False)
+    # (as before the lead: a start frame mid-stride is no stand, its stillness not asked)
+    monkeypatch.setattr(CrossingMixin, "_standing", lambda self: False)
     motion, rep = run_script(path)
     assert not rep["transitions"][0].get("in_step") and rep["motion_quality"]["freezes"]
 
@@ -225,3 +227,50 @@ def test_a_line_takes_no_less_than_a_blend_between_its_poses(models, monkeypatch
 
     short = line_frames(1)
     assert line_frames(40) >= 40 > short
+
+
+@pytest.mark.parametrize("seed", [2, 3])
+def test_a_crossing_after_an_idle_stands_as_asked_and_nothing_else_does(models, seed):
+    """A TRANSITION crossed while both models idle right after an IDLE is a standing
+    figure changing its stance: its frames are asked stillness for the freeze measure
+    (which found 0.3 s freezes there) and are said to be; the motion is posed as before,
+    and a crossing after a MOVE that stopped is not counted so."""
+    from cyclecoord.quality.generated import measure_generated
+    from cyclecoord.synthesis.latent.script import training_takes
+
+    def run(standing=None):
+        syn = Synthesizer(models, fps=30, seed=seed)
+        if standing is not None:
+            syn._standing = lambda: standing
+        syn.start("walk", {"frame": 0})
+        syn.command += 1
+        syn.move({"ahead": 1.0})
+        syn.command += 1
+        syn.idle(duration=1.0)
+        syn.command += 1
+        syn.transition("run", blend=0.4)
+        syn.command += 1
+        syn.move({"ahead": 1.0})
+        return syn, syn.motion()
+
+    syn, motion = run()
+    (a, b), = syn.held
+    move = next(s for s in syn.segments() if s["command"] == 3)
+    assert syn.stood == [(b, move["start"])]
+    assert any("TRANSITION walk -> run: crossed standing" in n for n in syn.notes)
+    assert not syn.hold_mask(motion.n_frames)[b:].any()  # (the motion holds the IDLE only)
+    takes = training_takes(syn.models, ["walk", "run"])
+    slow = measure_generated(motion, takes, hold=syn.hold_mask(motion.n_frames)).freezes
+    assert slow and all(b <= f0 and f1 <= syn.stood[0][1] for f0, f1 in slow)
+    asked = syn.hold_mask(motion.n_frames, asked=True)
+    assert not measure_generated(motion, takes, hold=asked).freezes
+    _, before = run(standing=False)
+    assert np.array_equal(before.frames, motion.frames)
+
+    moved = Synthesizer(models, fps=30, seed=seed)
+    moved.start("walk", {"frame": 0})
+    moved.command += 1
+    moved.move({"ahead": 1.0})
+    moved.command += 1
+    moved.transition("run", blend=0.4)
+    assert not moved.stood and not moved._standing()

@@ -272,6 +272,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         self.sim_cpu_seconds = 0.0
         self.clamped = {"values": 0, "max_deg": 0.0}
         self.held: list[tuple[int, int]] = []  # frame ranges of IDLE commands
+        # those of TRANSITIONs crossed standing (after an IDLE): asked still, not held
+        self.stood: list[tuple[int, int]] = []
         self.stands: list[tuple[int, int]] = []  # those of IDLEs at one pose (legs held)
         #: each stand after a stride: its closing step, or why none (:meth:`motion`)
         self.stand_steps: list[dict] = []

@@ -625,10 +625,12 @@ class OutputMixin:
                 self._feet_found.append(None)
         return self._feet_found[0]
 
-    def hold_mask(self, n_frames: int) -> np.ndarray:
-        """(T,) frames an IDLE command made."""
+    def hold_mask(self, n_frames: int, asked: bool = False) -> np.ndarray:
+        """(T,) frames an IDLE command made; with ``asked``, also those of TRANSITIONs
+        crossed standing (``stood``: the stillness the script asked for, which the
+        freeze measure does not count)."""
         hold = np.zeros(n_frames, dtype=bool)
-        for a, b in self.held:
+        for a, b in self.held + (self.stood if asked else []):
             hold[a:b] = True
         return hold
 

@@ -364,7 +364,7 @@ def script_quality(syn, motion, commands: list, feet=None) -> tuple[dict | None,
                 figures[key] = (takes, None)  # measured (and refused) as before
         return figures[key]
 
-    hold = syn.hold_mask(motion.n_frames)
+    hold = syn.hold_mask(motion.n_frames, asked=True)
     sources, ref = measured({c.model for c in syn.chunks})
     runs = model_sections(syn, commands, shortest=0.0)
     sections = [s for s in runs if s["stop"] - s["start"] >= MIN_SECTION * syn.fps]
