@@ -274,3 +274,50 @@ def test_a_crossing_after_an_idle_stands_as_asked_and_nothing_else_does(models, 
     moved.command += 1
     moved.transition("run", blend=0.4)
     assert not moved.stood and not moved._standing()
+
+
+def test_a_crossing_blend_too_close_is_pulled_to_the_captured_frames_blended(
+        models, monkeypatch):
+    """A TRANSITION crossed while both models idle blends the two particles' poses; a
+    frame there whose limbs come closer than the takes' (the jog actor's hand into the
+    walk's hip, subject 35) takes the two nearest captured frames blended at its weight,
+    its neighbours part way."""
+    from types import SimpleNamespace
+
+    import cyclecoord.quality.plausibility as P
+
+    def crossed():
+        syn = Synthesizer(models, fps=30, seed=2, plant="off")
+        syn.start("walk", {"frame": 0})
+        syn.command += 1
+        syn.move({"ahead": 1.0})
+        syn.command += 1
+        syn.idle(duration=1.0)
+        syn.command += 1
+        syn.transition("run", blend=0.4)
+        return syn
+
+    plain = crossed()
+    before = plain._assemble(*plain._posed())
+    k = len(plain.chunks) - 1
+    chunk = plain.chunks[k]
+    assert chunk.targets is not None and chunk.path is None and not chunk.particle
+    start = sum(c.X.shape[0] for c in plain.chunks[:k])
+    f = start + chunk.X.shape[0] // 2
+    calls = []
+
+    def fake(motion, refs, *a, **kw):
+        calls.append(1)
+        return SimpleNamespace(new_contact_frames=[f] if len(calls) == 1 else [])
+
+    monkeypatch.setattr(P, "check_plausibility", fake)
+    syn = crossed()
+    near, whole = syn.chunks[k].targets()
+    assert np.array_equal(near, whole)
+    m = models["run"]
+    cols = [before.channel_index(*c) for c in m.channels_]
+    assert not np.allclose(before.frames[f, cols], m.to_channels(near)[f - start], atol=1e-3)
+    after = syn._untangled()
+    np.testing.assert_allclose(after.frames[f, cols], m.to_channels(near)[f - start],
+                               atol=1e-6)
+    assert not np.allclose(after.frames[f + 1, cols], before.frames[f + 1, cols])

@@ -163,7 +163,8 @@ class _Chunk:
     #: for an in-step blend, a function giving the angles ``(T, C)`` (this chunk's
     #: model's chart) the untangling pulls toward (the two gaits' captured poses at the
     #: blend's phases, blended without the particle's stray) and, second, each gait's
-    #: nearest whole captured frame blended (:meth:`OutputMixin._untangled`); asked only
+    #: nearest whole captured frame blended (:meth:`OutputMixin._untangled`); for a
+    #: crossing's blend, both the two particles' nearest captured frames blended; asked only
     #: when a frame there is pulled (computing them on every hop cost 8 % of a script's
     #: time); None elsewhere
     targets: Callable[[], tuple[np.ndarray, np.ndarray]] | None = None

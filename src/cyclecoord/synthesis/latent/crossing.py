@@ -350,7 +350,18 @@ class CrossingMixin:
         blended = self._mix(
             src, to, self._clip(src, m1.pose(X1)), self._clip(to, m2.pose(X2)), w[:, 0]
         )
-        self._emit(to, X2, blended, root, clip=False)
+        k1, k2 = int(m1.nearest_frame(x1[None])[0]), int(m2.nearest_frame(x2[None])[0])
+
+        def targets() -> tuple[np.ndarray, np.ndarray]:
+            # untangling pulls toward the two nearest captured frames blended: the jog
+            # actor's hand passed into the walk's hip in the blend of the particles'
+            # poses (subject 35, refused by animate; 6 frames of one script -> 0)
+            a1 = np.repeat(m1.frame_angles()[k1][None], len(w), axis=0)
+            a2 = np.repeat(m2.frame_angles()[k2][None], len(w), axis=0)
+            near = self._mix(src, to, a1, a2, w[:, 0])
+            return near, near
+
+        self._emit(to, X2, blended, root, clip=False, targets=targets)
         self.events.append(
             {
                 "command": self.command,

@@ -82,7 +82,8 @@ class OutputMixin:
         shin (on a Bandai run, a shin and a foot 5.1 units apart against the takes'
         closest 6.3, and animate refused three script seeds in ten).
         With the gait detail on the Bandai walk-run script, legs passed 1-2 cm closer
-        than the captures on one or two frames in eight script seeds of fifteen."""
+        than the captures on one or two frames in eight script seeds of fifteen.  Blends
+        are pulled toward their chunk's targets (``_Chunk.targets``)."""
         motion = self._assemble(*self._posed())
         if not self._on_path().any():
             return motion
@@ -210,7 +211,8 @@ class OutputMixin:
         return motion
 
     def _on_path(self) -> np.ndarray:
-        """(T,) frames of chunks that followed a gait's path."""
+        """(T,) frames of chunks that followed a gait's path or blend with a pose to pull
+        toward (``_Chunk.targets``: in-step blends and crossings)."""
         sizes = [c.X.shape[0] for c in self.chunks]
         return np.repeat(
             [c.path is not None or c.targets is not None for c in self.chunks], sizes
@@ -423,7 +425,8 @@ class OutputMixin:
         """The angles ``(T, C)`` untangling pulls chunk ``c``'s frames toward: along a
         gait's path, the captured pose at each frame's phase (the path's pose plus its
         detail), or where ``whole`` the captured frame nearest the path; in an in-step
-        blend, the same of both gaits blended (``_Chunk.targets``)."""
+        blend, the same of both gaits blended; in a crossing's blend, the two particles'
+        nearest captured frames blended (``_Chunk.targets``)."""
         some = whole is not None and whole.any()
         k = np.flatnonzero(whole) if some else None
         played = np.flatnonzero(whole == 2) if some else np.zeros(0, dtype=int)
