@@ -248,11 +248,13 @@ def test_frames_whose_limbs_come_too_close_are_pulled_to_the_captured_pose(model
     """A new limb contact at frame 10 of a MOVE chain (and one on the IDLE after it): the
     gait frame is posed as the captured frame at its phase (the path's pose plus its
     detail), its neighbours part way, frames further than UNTANGLE_WIDTH unchanged; the
-    IDLE frame, on no gait's path, is left as it was; a note says so."""
+    IDLE frame, on no gait's path, is pulled toward one captured frame (the one nearest
+    the IDLE's mean latent point) over UNTANGLE_OFF_WIDTH, easing in from the IDLE's
+    first frame, which barely moves; a note says so."""
     from types import SimpleNamespace
 
     import cyclecoord.quality.plausibility as P
-    from cyclecoord.synthesis.latent.output import UNTANGLE_WIDTH
+    from cyclecoord.synthesis.latent.untangle import UNTANGLE_OFF_WIDTH, UNTANGLE_WIDTH
 
     plain = _moves_then_idle(models)
     before = plain._assemble(*plain._posed())
@@ -275,10 +277,23 @@ def test_frames_whose_limbs_come_too_close_are_pulled_to_the_captured_pose(model
     np.testing.assert_allclose(after.frames[10, cols], m.to_channels(target)[10 - start],
                                atol=1e-6)
     w = int(round(UNTANGLE_WIDTH * 30))
-    far = [f for f in range(after.n_frames) if abs(f - 10) > w]
+    first = idle - 10  # the IDLE's first frame
+    far = [f for f in range(first) if abs(f - 10) > w]
     np.testing.assert_allclose(after.frames[far], before.frames[far], atol=1e-9)
     assert not np.allclose(after.frames[11, cols], before.frames[11, cols])
-    assert any(n.startswith("limbs: 1 frame came closer") and "(frame 10)" in n
+    # the IDLE: toward the captured frame nearest its mean point, by the ease from its start
+    k = int(m.nearest_frame(syn.chunks[-1].X.mean(axis=0)[None])[0])
+    w2 = int(round(UNTANGLE_OFF_WIDTH * 30))
+    e = 11 / (w2 + 1.0)
+    g = e * e * (3.0 - 2.0 * e)
+    posed = syn._posed()[0][idle]  # (the particle's pose, before the pull)
+    target = syn._clip("walk", m.frame_angles()[k][None], count=False)[0]
+    pulled = syn._posed(np.eye(1, after.n_frames, idle)[0] * g)[0][idle]
+    np.testing.assert_allclose(pulled, posed + g * (target - posed), atol=1e-9)
+    assert 0.5 < g < 1.0 and not np.allclose(after.frames[idle, cols], before.frames[idle, cols])
+    assert np.abs(after.frames[first, cols] - before.frames[first, cols]).max() < 0.05 * np.abs(
+        after.frames[idle, cols] - before.frames[idle, cols]).max()
+    assert any(n.startswith("limbs: 2 frames came closer") and "(frames 10-" in n
                for n in syn.notes)
 
 
@@ -293,7 +308,7 @@ def test_frames_that_pop_are_pulled_to_the_captured_pose_and_idle_frames_are_not
     note says so.  A pull that makes the pop worse is taken back; without pops nothing
     changes."""
     import cyclecoord.synthesis.carry as carry
-    from cyclecoord.synthesis.latent.output import POP_PULL, UNTANGLE_WIDTH
+    from cyclecoord.synthesis.latent.untangle import POP_PULL, UNTANGLE_WIDTH
 
     plain = _moves_then_idle(models)
     before = plain._assemble(*plain._posed())
