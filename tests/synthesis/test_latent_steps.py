@@ -19,9 +19,9 @@ def models():
     return gait_pair()
 
 
-def _ahead_then_frame(models, frame: int, stepped: bool = True):
-    """A MOVE ahead in the walk, a MOVE to ``frame`` along a line, a TRANSITION to the
-    run (``stepped`` false: the MOVE to the frame played as a plain line, as before)."""
+def _ahead_then_frame(models, frame: int, stepped: bool = True, path: str = "line"):
+    """A MOVE ahead in the walk, a MOVE to ``frame`` along ``path``, a TRANSITION to the
+    run (``stepped`` false: the MOVE to the frame played along its path, as before)."""
     syn = Synthesizer(models, fps=30, seed=0, plant="off")
     if not stepped:
         syn.step_to = lambda goal: None
@@ -30,7 +30,7 @@ def _ahead_then_frame(models, frame: int, stepped: bool = True):
     syn.move({"ahead": 0.6}, stop=False)
     u0 = syn._cursor[2]
     syn.command += 1
-    syn.move({"frame": frame}, path="line", stop=False)
+    syn.move({"frame": frame}, path=path, stop=False)
     move = syn.segments()[-1]
     chunk = syn.chunks[-1]
     syn.command += 1
@@ -38,9 +38,10 @@ def _ahead_then_frame(models, frame: int, stepped: bool = True):
     return syn, u0, move, chunk
 
 
-@pytest.mark.parametrize("frame", [40, 57, 100])
-def test_a_move_to_a_frame_from_a_gait_steps_on_to_its_phase(models, frame):
-    syn, u0, move, chunk = _ahead_then_frame(models, frame)
+@pytest.mark.parametrize("frame, path", [(40, "line"), (57, "line"), (100, "line"),
+                                         (57, "graph")])
+def test_a_move_to_a_frame_from_a_gait_steps_on_to_its_phase(models, frame, path):
+    syn, u0, move, chunk = _ahead_then_frame(models, frame, path=path)
     m, g = models["walk"], syn.gait("walk")
     rate = m.fps_ / (g.period[g.segments[frame]] * 30)  # cycles per output frame
     ahead = (g.phase[frame] - u0) % 1.0  # cycles to the frame's phase
@@ -61,9 +62,10 @@ def test_a_move_to_a_frame_played_as_a_line_stopped_the_gait(models):
     """What the step replaces (the test above can fail): played as a line, the MOVE to a
     frame took the frames the latent distance takes and left the particle idle, so the
     TRANSITION after it was not in step."""
-    syn, _, move, chunk = _ahead_then_frame(models, 40, stepped=False)
-    assert chunk.path is None
-    assert [n for n in syn.notes if "not in step" in n]
+    for path in ("line", "graph"):
+        syn, _, move, chunk = _ahead_then_frame(models, 40, stepped=False, path=path)
+        assert chunk.path is None
+        assert [n for n in syn.notes if "not in step" in n]
 
 
 def test_a_move_to_a_frame_from_rest_is_still_a_line(models):

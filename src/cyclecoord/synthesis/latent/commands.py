@@ -574,7 +574,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         MOVEs flows through its waypoints.  A MOVE ahead that stops ends where both feet
         are down, the nearest such phase of the gait within a quarter of a cycle of the
         asked seconds (:meth:`~.stepping.GaitMixin.stop_ahead`; ``at_stance=False``:
-        exactly the seconds asked).
+        exactly the seconds asked).  From a stepping particle, a MOVE to a training frame
+        with a gait phase steps on to that phase along either path
+        (:meth:`~.stepping.GaitMixin.step_to`; along the graph's training frames, the
+        phase jumped where the path left the gait: a Bandai walk's toes 1.5x its p99).
         """
         m = self._need_start("MOVE")
         if not (
@@ -597,7 +600,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         else:
             along = None
             goal = self.target(to)
-            stepped = self.step_to(goal) if path == "line" else None
+            stepped = self.step_to(goal) if path in ("line", "graph") else None
             if stepped is not None:  # from a gait: stepping on to the goal's phase
                 poly, times = stepped
                 along = self._path_detail

@@ -206,13 +206,14 @@ class GaitMixin:
         return X, t - t0
 
     def step_to(self, goal: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-        """A MOVE along a line to latent point ``goal`` from a gait the particle is
+        """A MOVE (along a line or the graph) to latent point ``goal`` from a gait the particle is
         stepping along (the last command stepped): the latent path ``(M, q)`` and its
         times ``(M,)``, stepping on at the training cadence to the gait phase of the
         training frame nearest ``goal``, at least as long as the line takes at the
         model's latent speed, the latent offset from the gait easing from the particle's
         to the goal's, and from the particle's segment to the goal's; None where the
-        particle is not stepping or the goal's frame has no gait phase (a line then).
+        particle is not stepping or the goal's frame has no gait phase (the path asked
+        then).
 
         Played as a line, such a MOVE put the goal's phase of the stride after the phase
         the legs were at: on a random subject 35 script a one-frame MOVE to frame 34
