@@ -927,3 +927,36 @@ def test_the_fast_contact_fraction_is_given_beside_the_sources():
     assert q.sliding_fraction == pytest.approx(q.source_sliding_fraction)
     assert q.to_dict()["sources_fast_contact_fraction"] == pytest.approx(q.sliding_fraction)
     assert f"(sources {100 * q.sliding_fraction:.0f}%" in "\n".join(q.summary())
+
+
+def test_strides_are_judged_where_the_motion_does_not_stand_as_asked():
+    """A walk that then stands 6 s as asked: its knee and hip ranges and leg cycle are the
+    walk's (a stand is no stride: counted with it, a script that stood half its frames read
+    its knees at 0.39 of the sources'), and the console says over which frames; a motion
+    that stands nearly throughout is measured over all its frames and says it stands."""
+    import cyclecoord as cc
+    from cyclecoord.quality.generated import STRIDE_SECONDS
+
+    walk = cc.datasets.make_periodic_capture(
+        kind="walk", n_frames=600, period=120, noise=0.3, random_state=0).motion[::4]
+    stand = np.repeat(walk.frames[-1:], int(6 * walk.fps), axis=0)
+    then = walk.with_frames(np.vstack([walk.frames, stand]))
+    hold = np.r_[np.zeros(walk.n_frames, bool), np.ones(len(stand), bool)]
+    q, q_walk = measure_generated(then, [walk], hold=hold), measure_generated(walk, [walk])
+    np.testing.assert_allclose(q.knee_range, q_walk.knee_range)
+    np.testing.assert_allclose(q.hip_range, q_walk.hip_range)
+    assert q.cycle_s == pytest.approx(q_walk.cycle_s)
+    assert q.stride_frames == walk.n_frames and q.to_dict()["stride_frames"] == walk.n_frames
+    assert f"strides (over the {walk.n_frames} frames outside the holds)" in "\n".join(
+        q.summary())
+    unasked = measure_generated(then, [walk])  # the stand counted: other ranges
+    assert not np.allclose(unasked.knee_range, q.knee_range)
+    # standing nearly throughout: all frames, and said
+    short = int(0.5 * STRIDE_SECONDS * walk.fps)
+    mostly = walk.with_frames(np.vstack([walk.frames[:short], stand]))
+    held = np.r_[np.zeros(short, bool), np.ones(len(stand), bool)]
+    q2 = measure_generated(mostly, [walk], hold=held)
+    assert q2.stride_frames == mostly.n_frames
+    np.testing.assert_allclose(q2.knee_range, measure_generated(mostly, [walk]).knee_range)
+    assert f"stands on {len(stand)} of its {mostly.n_frames} frames, as asked" in "\n".join(
+        q2.summary())

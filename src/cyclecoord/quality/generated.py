@@ -17,10 +17,13 @@ figure of the source captures (resampled to the motion's rate):
   relative to the root, heading removed) is under :data:`FREEZE_FRACTION` of the sources'
   median, outside the frames where a hold was asked (``hold``);
 * **stride amplitude**: knee and hip flexion p1-p99 ranges per leg against the sources'
-  median (over takes and legs);
+  median (over takes and legs), over the frames outside the asked holds when at least
+  :data:`STRIDE_SECONDS` of them are left (a stand is no stride: a script that stood 3
+  of its 6 s read its knees at 0.39 of the sources');
 * **cadence**: the leg cycle (peak of the knee angle's autocorrelation between 0.4 and
-  2.5 s) against the sources' cycle at the same root speed (interpolated between the
-  takes' median root speeds);
+  2.5 s; over the longest run of frames outside the holds when it spans two of the
+  sources' cycles, else over all) against the sources' cycle at the same root speed
+  (interpolated between the takes' median root speeds);
 * **pops**: the largest pose step and the largest joint acceleration relative to the
   root (heading removed) against the sources' 99th percentiles;
 * **root speed**: median horizontal root speed over 0.5 s windows (outside the holds
@@ -84,12 +87,16 @@ __all__ = [
     "measure_generated",
     "FREEZE_FRACTION",
     "FREEZE_SECONDS",
+    "STRIDE_SECONDS",
 ]
 
 #: A frame is frozen when its pose speed is under this fraction of the sources' median.
 FREEZE_FRACTION = 0.1
 #: A freeze lasts longer than this, in seconds.
 FREEZE_SECONDS = 0.2
+#: Seconds outside the asked holds from which strides and cadence are measured (fewer:
+#: over every frame, and the console says the motion mostly stands).
+STRIDE_SECONDS = 1.0
 #: Support-foot slip up to this multiple of the sources' is "planted" (the issue's target).
 PLANTED_RATIO = 1.5
 #: Above this multiple the feet "glide" (between the two they "slip").
@@ -333,6 +340,9 @@ class GeneratedQuality:
     #: bigger body than its sources' is not a faster or more violent one
     body_scale: float = 1.0
     source_sliding_fraction: float = float("nan")
+    #: frames the stride ranges and the cadence are measured on (those outside the asked
+    #: holds when :data:`STRIDE_SECONDS` of them are left, else all; 0: all, as before)
+    stride_frames: int = 0
 
     # ---- derived
     @property
@@ -415,8 +425,14 @@ class GeneratedQuality:
             )
         hips = "/".join(f"{r:.2f}" for r in self.hip_ratio)
         knees = "/".join(f"{r:.2f}" for r in self.knee_ratio)
+        where = ""
+        if self.held_frames and self.stride_frames and self.stride_frames < self.frames:
+            where = f" (over the {self.stride_frames} frames outside the holds)"
+        elif self.held_frames and self.frames - self.held_frames < STRIDE_SECONDS * self.fps:
+            where = (f" (the motion stands on {self.held_frames} of its {self.frames} frames, "
+                     "as asked: no stride to judge)")
         lines.append(
-            f"  strides: knee range {knees}, hip range {hips} of the sources' "
+            f"  strides{where}: knee range {knees}, hip range {hips} of the sources' "
             f"({self.source_knee_range:.0f} / {self.source_hip_range:.0f} deg); leg cycle "
             + (
                 f"{self.cycle_s:.2f} s against the sources' {self.source_cycle_s:.2f} s at "
@@ -467,6 +483,7 @@ class GeneratedQuality:
             "freezes": [list(r) for r in self.freezes],
             "longest_freeze_s": f(self.longest_freeze_s),
             "held_frames": self.held_frames,
+            "stride_frames": self.stride_frames,
             "knee_range_deg": [f(x) for x in self.knee_range],
             "knee_p99_deg": [f(x) for x in self.knee_p99],
             "hip_range_deg": [f(x) for x in self.hip_range],
@@ -558,7 +575,15 @@ def measure_generated(
     rs_all = kin.root_speed()
     free = _windows(~held, rs_all.size)  # an asked hold's stand is not the gait's speed
     rs = float(np.median(rs_all[free] if free.any() else rs_all))
-    cycle = kin.cycle()
+    unheld = ~held
+    knee, hip, cycle, stride_frames = kin.knee, kin.hip, None, kin.n
+    if unheld.sum() >= STRIDE_SECONDS * kin.fps:  # strides where the script did not stand
+        knee, hip, stride_frames = kin.knee[unheld], kin.hip[unheld], int(unheld.sum())
+        a, b = max(contact_runs(unheld), key=lambda r: r[1] - r[0])
+        expected = ref.cycle_at(rs / body)
+        if np.isfinite(expected) and b - a >= 2.0 * expected * kin.fps:
+            cycle = _cycle(kin.knee[a:b, 0], kin.fps)  # (two cycles at least, else all)
+    cycle = kin.cycle() if cycle is None else cycle
     notes = []
     if motion.fps != ref.fps:
         notes.append(f"sources measured at {ref.fps:g} fps, the motion at {motion.fps:g}")
@@ -580,8 +605,8 @@ def measure_generated(
         source_penetration_fraction=ref.penetration,
         freezes=freezes,
         longest_freeze_s=float(longest),
-        knee_range=tuple(float(x) for x in _ranges(kin.knee)),
-        hip_range=tuple(float(x) for x in _ranges(kin.hip)),
+        knee_range=tuple(float(x) for x in _ranges(knee)),
+        hip_range=tuple(float(x) for x in _ranges(hip)),
         source_knee_range=ref.knee_range,
         source_hip_range=ref.hip_range,
         cycle_s=cycle,
@@ -593,6 +618,7 @@ def measure_generated(
         root_speed=rs * m,
         source_root_speed=ref.root_speed * m,
         held_frames=int(held.sum()),
+        stride_frames=stride_frames,
         notes=notes,
         knee_p99=tuple(float(x) for x in np.percentile(kin.knee, 99, axis=0)),
         source_knee_legs=ref.knee_range_legs,
