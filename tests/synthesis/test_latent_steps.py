@@ -323,3 +323,46 @@ def test_a_crossing_blend_too_close_is_pulled_to_the_captured_frames_blended(
     np.testing.assert_allclose(after.frames[f, cols], m.to_channels(near)[f - start],
                                atol=1e-6)
     assert not np.allclose(after.frames[f + 1, cols], before.frames[f + 1, cols])
+
+
+def test_a_pull_that_untangles_by_popping_is_taken_back(models, monkeypatch):
+    """Limbs too close at frame 10 of a MOVE chain, and the pose to pull toward far off
+    (60 degrees on every channel): pulled within UNTANGLE_WIDTH the frames would
+    accelerate far over UNTANGLE_POP times the training p99, so the pull is taken back,
+    the frames left as posed (animate then refuses for the limbs) and a note says so;
+    allowed any acceleration, the same pull is kept."""
+    from types import SimpleNamespace
+
+    import cyclecoord.quality.plausibility as P
+    from cyclecoord.synthesis.latent import untangle
+
+    def chain():
+        syn = Synthesizer(models, fps=30, seed=0, plant="off", lock=False)
+        syn.start("walk", {"frame": 0})
+        for _ in range(3):
+            syn.command += 1
+            syn.move({"ahead": 0.3}, stop=False)
+        far = untangle.UntangleMixin._untangle_target
+        syn._untangle_target = lambda c, whole, anchor=None: far(syn, c, whole, anchor) + 60.0
+        return syn
+
+    plain = chain()
+    before = plain._assemble(*plain._posed())
+    calls = []
+
+    def fake(motion, refs, *a, **kw):
+        calls.append(1)
+        return SimpleNamespace(new_contact_frames=[10] if len(calls) == 1 else [])
+
+    monkeypatch.setattr(P, "check_plausibility", fake)
+    syn = chain()
+    after = syn._untangled()
+    np.testing.assert_allclose(after.frames, before.frames, atol=1e-9)
+    assert any("too close left as posed (frames " in n for n in syn.notes), syn.notes
+    assert not any(n.startswith("limbs: 1 frame came closer") for n in syn.notes)
+    calls.clear()
+    monkeypatch.setattr(untangle, "UNTANGLE_POP", 1e9)
+    syn = chain()
+    kept = syn._untangled()
+    assert not np.allclose(kept.frames[10], before.frames[10])
+    assert any(n.startswith("limbs: 1 frame came closer") for n in syn.notes)

@@ -10,7 +10,10 @@ import numpy as np
 from ..._words import plural
 from ...motion import Motion
 
-__all__ = ["POP_PULL", "POP_ROUNDS", "UNTANGLE_OFF_WIDTH", "UNTANGLE_ROUNDS", "UNTANGLE_WIDTH"]
+__all__ = [
+    "POP_PULL", "POP_ROUNDS", "UNTANGLE_OFF_WIDTH", "UNTANGLE_POP", "UNTANGLE_ROUNDS",
+    "UNTANGLE_WIDTH",
+]
 
 #: Seconds each side of a frame whose limbs came too close over which the pull toward the
 #: captured pose eases off, and the passes that look again.
@@ -24,6 +27,9 @@ UNTANGLE_OFF_WIDTH = 0.5
 #: up to this many times.
 POP_PULL = 1.4
 POP_ROUNDS = 3
+#: A pull that untangles limbs but makes its frames accelerate over this many times the
+#: training 99th percentile (and faster than before it) is taken back.
+UNTANGLE_POP = 2.0
 
 
 class UntangleMixin:
@@ -44,7 +50,7 @@ class UntangleMixin:
         With the gait detail on the Bandai walk-run script, legs passed 1-2 cm closer
         than the captures on one or two frames in eight script seeds of fifteen.  Blends
         are pulled toward their chunk's targets (``_Chunk.targets``)."""
-        motion = self._assemble(*self._posed())
+        motion = plain = self._assemble(*self._posed())
         if not self._on_path(particles=True).any():
             return motion
         takes = [self.models[k].training_motion() for k in sorted({c.model for c in self.chunks})]
@@ -97,6 +103,8 @@ class UntangleMixin:
                 pull[a:b] = np.maximum(pull[a:b], add)
             pulled.update(int(f) for f in frames)
             before, motion = motion, self._whole_frames(motion, pull, whole, stuck, w)
+        if pulled:
+            motion = self._unpulled_pops(plain, motion, pull, whole, pulled)
         motion = self._unpopped(motion, pull, whole, bump)
         if pulled:
             idle = sum(bool(off[f]) for f in pulled)
@@ -104,6 +112,38 @@ class UntangleMixin:
                               "the training takes' and", "" if not idle else
                               f"; {idle} in an IDLE toward one captured frame of its own")
         return motion
+
+    def _unpulled_pops(self, plain: Motion, motion: Motion, pull: np.ndarray,
+                       whole: np.ndarray, pulled: set[int]) -> Motion:
+        """``motion`` with each run of pulled frames whose pull made it accelerate over
+        :data:`UNTANGLE_POP` times the training 99th percentile, and faster than the posed
+        ``plain`` there, posed as before (``pull``, ``whole`` and ``pulled`` changed in
+        place; a note says where).  Its limbs then stay too close and animate refuses the
+        script, where the pull wrote a pop: a subject 35 MOVE ahead easing in after an
+        IDLE had its first frames pulled toward the captured pose at their phase within
+        0.15 s, 1.46x -> 2.86x, and its limbs were still too close."""
+        from ...quality.contacts import contact_runs
+        from ..carry import _accel
+
+        limit = UNTANGLE_POP * self._frame_acc99(motion.n_frames)
+        was, now = _accel(plain) / limit, _accel(motion) / limit
+        undone = []
+        for a, b in contact_runs(pull > 0):
+            lo, hi = max(a - 1, 0), min(b + 1, now.size)
+            if now[lo:hi].max() > 1.0 and now[lo:hi].max() > was[lo:hi].max():
+                pull[a:b], whole[a:b] = 0.0, 0
+                undone.append((a, b))
+        if not undone:
+            return motion
+        gone = {f for f in pulled if any(a <= f < b for a, b in undone)}
+        pulled -= gone
+        if gone:
+            spans = ", ".join(f"{a}-{b - 1}" for a, b in undone)
+            self.notes.append(f"limbs: {plural(len(gone), 'frame')} too close left as posed "
+                              f"(frames {spans}): pulled toward the captured pose they "
+                              f"accelerated over {UNTANGLE_POP:g}x the training 99th "
+                              "percentile")
+        return self._assemble(*self._posed(pull, whole), like=motion)
 
     def _whole_frames(self, motion: Motion, pull: np.ndarray, whole: np.ndarray,
                       stuck: np.ndarray, w: int) -> Motion:
