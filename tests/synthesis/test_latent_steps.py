@@ -231,6 +231,22 @@ def test_a_line_takes_no_less_than_a_blend_between_its_poses(models, monkeypatch
     assert line_frames(40) >= 40 > short
 
 
+def _walk_idle_cross(models, seed: int, standing=None, **options):
+    """A MOVE ahead in the walk that stops, an IDLE of 1 s, a TRANSITION to the run
+    (crossed while both models idle); ``standing``: what ``_standing`` answers, if given."""
+    syn = Synthesizer(models, fps=30, seed=seed, **options)
+    if standing is not None:
+        syn._standing = lambda: standing
+    syn.start("walk", {"frame": 0})
+    syn.command += 1
+    syn.move({"ahead": 1.0})
+    syn.command += 1
+    syn.idle(duration=1.0)
+    syn.command += 1
+    syn.transition("run", blend=0.4)
+    return syn
+
+
 @pytest.mark.parametrize("seed", [2, 3])
 def test_a_crossing_after_an_idle_stands_as_asked_and_nothing_else_does(models, seed):
     """A TRANSITION crossed while both models idle right after an IDLE is a standing
@@ -241,16 +257,7 @@ def test_a_crossing_after_an_idle_stands_as_asked_and_nothing_else_does(models, 
     from cyclecoord.synthesis.latent.script import training_takes
 
     def run(standing=None):
-        syn = Synthesizer(models, fps=30, seed=seed)
-        if standing is not None:
-            syn._standing = lambda: standing
-        syn.start("walk", {"frame": 0})
-        syn.command += 1
-        syn.move({"ahead": 1.0})
-        syn.command += 1
-        syn.idle(duration=1.0)
-        syn.command += 1
-        syn.transition("run", blend=0.4)
+        syn = _walk_idle_cross(models, seed, standing=standing)
         syn.command += 1
         syn.move({"ahead": 1.0})
         return syn, syn.motion()
@@ -289,15 +296,7 @@ def test_a_crossing_blend_too_close_is_pulled_to_the_captured_frames_blended(
     import cyclecoord.quality.plausibility as P
 
     def crossed():
-        syn = Synthesizer(models, fps=30, seed=2, plant="off")
-        syn.start("walk", {"frame": 0})
-        syn.command += 1
-        syn.move({"ahead": 1.0})
-        syn.command += 1
-        syn.idle(duration=1.0)
-        syn.command += 1
-        syn.transition("run", blend=0.4)
-        return syn
+        return _walk_idle_cross(models, 2, plant="off")
 
     plain = crossed()
     before = plain._assemble(*plain._posed())
