@@ -49,7 +49,10 @@ class UntangleMixin:
         closest 6.3, and animate refused three script seeds in ten).
         With the gait detail on the Bandai walk-run script, legs passed 1-2 cm closer
         than the captures on one or two frames in eight script seeds of fifteen.  Blends
-        are pulled toward their chunk's targets (``_Chunk.targets``)."""
+        are pulled toward their chunk's targets (``_Chunk.targets``), an IDLE's frames
+        toward one captured frame of its own over :data:`UNTANGLE_OFF_WIDTH` (within the
+        IDLE), and a pull that makes its frames pop is taken back
+        (:meth:`_unpulled_pops`)."""
         motion = plain = self._assemble(*self._posed())
         if not self._on_path(particles=True).any():
             return motion
