@@ -44,6 +44,10 @@ APPROACH_SPEED = 0.6
 START_LEAD = 0.25
 #: Longest blend, seconds.
 MAX_BLEND = 4.0
+#: What the console adds for a crossing that a standing figure makes (``_standing``).
+_STOOD = ("; crossed standing (after an IDLE, or from a start frame without a gait): a "
+          "standing figure changing its stance, asked to stand still, so its frames are not "
+          "counted as freezes")
 #: Without a bridge, pairs within this factor of the closest distance are candidates
 #: (the one nearest the particle is taken).
 CLOSE_ENOUGH = 1.1
@@ -241,7 +245,8 @@ class CrossingMixin:
             )
         if src == to:
             raise ParameterError(f"TRANSITION to {to!r}: the particle is already in it")
-        if in_step and self.can_step_across(src, to):
+        across = in_step and self.can_step_across(src, to)
+        if across:
             if not self._stepping and self._starts_on_gait(src):
                 self.move({"ahead": START_LEAD}, stop=False, at_stance=False)
                 self.notes.append(
@@ -251,6 +256,8 @@ class CrossingMixin:
             if self._stepping:
                 self.gait_hop(src, to, blend)
                 return
+        standing = self._standing()
+        if across:
             # from an IDLE or a MOVE to a target the particle has no step to keep: the
             # gaits blended in step from there popped at 1.1-6.5x the run's p99 of
             # acceleration over ten seeds of a Bandai script, 0.4-1.7x at a bridge
@@ -258,22 +265,21 @@ class CrossingMixin:
                 f"commands[{self.command}] TRANSITION {src} -> {to}: not in step, crossed "
                 "while both models idle (the particle was not stepping: in step needs a "
                 "MOVE ahead, a PLAY or a TRANSITION in step before it)"
+                + (_STOOD if standing else "")
             )
         hops = [src, to]
         if route:
             c = self.crossings(src, to)
             if not (c.distances < c.threshold).any():
                 hops = self.route(src, to)
-        standing = self._standing()
         first = self.n_frames
         for a, b in zip(hops[:-1], hops[1:]):
             self._hop(a, b, blend, radius, hops)
         if standing:
             self.stood.append((first, self.n_frames))
-            self.notes.append(
-                f"commands[{self.command}] TRANSITION {src} -> {to}: crossed standing (after "
-                "an IDLE, or from a start frame without a gait): a standing figure changing "
-                "its stance, asked to stand still, so its frames are not counted as freezes")
+            if not across:
+                self.notes.append(f"commands[{self.command}] TRANSITION {src} -> {to}: crossed "
+                                  "while both models idle" + _STOOD)
 
     def _standing(self) -> bool:
         """Whether the figure stands before a crossing while both models idle: the
