@@ -366,3 +366,23 @@ def test_a_pull_that_untangles_by_popping_is_taken_back(models, monkeypatch):
     kept = syn._untangled()
     assert not np.allclose(kept.frames[10], before.frames[10])
     assert any(n.startswith("limbs: 1 frame came closer") for n in syn.notes)
+
+
+def test_a_move_to_a_frame_continues_the_path_not_the_lagging_particle(models):
+    """After a MOVE ahead the particle lags the loop it rides; the MOVE to a frame starts
+    from the loop (the path the particle was riding), not from the particle: offset by the
+    lag, its path stepped back at its first frame (a Bandai run's MOVE ahead into a MOVE
+    to a frame popped 1.59x its p99 there, 1.42x from the loop)."""
+    syn, u0, move, chunk = _ahead_then_frame(models, 57)
+    ahead = next(c for c in syn.chunks if c.command == 1)
+    lag = np.linalg.norm(ahead.X[-1] - ahead.path[-1])
+    assert lag > 0.05  # (the particle does lag)
+    g = syn.gait("walk")
+    seg = int(g.segments[57])
+    # the first frame's point: the loop one frame's share of the MOVE's phases on from
+    # where the MOVE ahead ended (the goal's offset has barely begun to ease in)
+    n = chunk.X.shape[0]
+    du = (float(g.phase[57]) - u0) % 1.0
+    du += np.ceil(max(0.0, n * syn._rate("walk", seg) - du))
+    loop = syn.gait_sampler("walk", seg, np.array([u0 + du / n]))(models["walk"].X_)[0]
+    assert np.linalg.norm(chunk.path[0] - loop) < 0.25 * lag

@@ -246,7 +246,13 @@ class GaitMixin:
                           + w.reshape((-1,) + (1,) * (v.ndim - 1)) * v
                           for key, v in detail.items()}
         self._next_cursor = (name, s1, float(u[-1]), goal - X[-1])
-        X = X + (1.0 - w) * (self.x - X[0]) + w * (goal - X[-1])
+        # from the path the particle was riding (the loop, or a MOVE to a frame's offset
+        # from it), not from the particle, which lags it: offset by the particle's lag,
+        # the path stepped back at its first frame and the captured pose there jerked
+        # (a Bandai run's MOVE ahead into a MOVE to a frame, 1.4x its own loop's peak)
+        off = self._cursor[3] if len(self._cursor) > 3 else np.zeros_like(goal)
+        X = X + (1.0 - w) * off + w * (goal - X[-1])
+        X[0] = self.x
         self._path_detail = detail
         return X, np.arange(n + 1) / self.fps
 
