@@ -249,7 +249,8 @@ class GaitMixin:
         # from the path the particle was riding (the loop, or a MOVE to a frame's offset
         # from it), not from the particle, which lags it: offset by the particle's lag,
         # the path stepped back at its first frame and the captured pose there jerked
-        # (a Bandai run's MOVE ahead into a MOVE to a frame, 1.4x its own loop's peak)
+        # (a Bandai run's MOVE ahead into a MOVE to a frame read 1.59x its p99 there,
+        # 1.42x from the loop)
         off = self._cursor[3] if len(self._cursor) > 3 else np.zeros_like(goal)
         X = X + (1.0 - w) * off + w * (goal - X[-1])
         X[0] = self.x
