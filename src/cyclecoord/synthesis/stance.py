@@ -11,7 +11,12 @@ and raised back towards its mid-stance height as far as the legs reach.  A stand
 frames follow ends with the opening step: the leading foot steps out by the same gap and
 the rest of the motion is moved forward by it, so the next stride starts from where the
 feet now are.  A step the legs cannot reach, or that brings two limbs closer than the
-training takes ever do, is not made: that stand keeps its stance, and says why.
+training takes ever do, is not made: that stand keeps its stance, and says why.  A stand
+that did not travel before it and ends the motion (a script that starts on a frame
+mid-stride and stands there) takes the same closing step, forward being where the toes
+point and each foot point set at the height it rests at when planted; with frames after
+it, its opening step would have to start their stride again, and it is left alone (seven
+random scripts popped there, up to 3.7x).
 """
 
 from __future__ import annotations
@@ -210,7 +215,7 @@ def _close_one(motion, contacts, legs, layout, a, b, n_step, bounds):
     half before it; the frames after it are moved by what the feet stepped."""
     before = int(round(0.5 * motion.fps))
     follows = b < motion.n_frames
-    if a < before or b - a < n_step * (2 if follows else 1) + int(round(0.2 * motion.fps)):
+    if b - a < n_step * (2 if follows else 1) + int(round(0.2 * motion.fps)):
         return ""
     w0 = max(0, a - 3 * before)
     got = _close_part(motion[w0:b], contacts, legs, layout, a - w0, n_step, bounds, follows)
@@ -240,19 +245,23 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
     root = wpos[:, 0]
     travel = np.zeros(3)
     travel[horiz] = root[a, horiz] - root[max(0, a - 2 * before), horiz]
-    if np.linalg.norm(travel) < 0.1 * contacts.leg_length:
-        return ""  # (not stepping before the stand)
+    moving = np.linalg.norm(travel) >= 0.1 * contacts.leg_length
+    if not moving and (follows or len(legs[0][1]) < 2):
+        return ""  # (not stepping before the stand, and frames after it: see the module)
     # where the feet stand once the stand has settled (the body still travels, easing to
     # a stop, over its first STAND_AFTER s, and a run stopped in its flight lands there)
     settled = min(a + int(round(STAND_AFTER * fps)), b - 1)
     # forward: square to the hips, the way the body travelled (the root's last half
-    # second of a synthetic walk's stop swayed more sideways than it went on)
+    # second of a synthetic walk's stop swayed more sideways than it went on), or where
+    # the toes point for a stand that did not travel before it
     across = wpos[settled, legs[1][2][0]] - wpos[settled, legs[0][2][0]]
     f = np.zeros(3)
     f[horiz] = [-across[horiz[1]], across[horiz[0]]]
-    if np.linalg.norm(f) < 1e-9:
+    way = travel if moving else sum(
+        wpos[settled, pts[-1]] - wpos[settled, pts[0]] for _, pts, _ in legs)
+    if np.linalg.norm(f) < 1e-9 or abs(f @ way) < 1e-9:
         return ""
-    f *= np.sign(f @ travel) / np.linalg.norm(f)
+    f *= np.sign(f @ way) / np.linalg.norm(f)
     ankles = [wpos[settled, pts[0]] for _, pts, _ in legs]
     ahead = [float(p @ f) for p in ankles]
     lead = int(np.argmax(ahead))
@@ -272,7 +281,12 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
     move = gap + wide * side  # what the trailing foot travels, and the motion after
     # flat heights: each foot point's lowest (5th percentile) over the stride before
     lo = max(0, a - 3 * before)
-    flat = {p: float(np.percentile(wpos[lo:a, p, up], 5)) for _, pts, _ in legs for p in pts}
+    if moving:
+        flat = {p: float(np.percentile(wpos[lo:a, p, up], 5)) for _, pts, _ in legs
+                for p in pts}
+    else:  # (no stride before: the height each point rests at when planted)
+        flat = {p: float(contacts.contact_level[c]) for cols, pts, _ in legs
+                for c, p in zip(cols, pts)}
     t = np.arange(T)
     close = _ease((t - a) / n_step)  # 0 -> 1 over the closing step
     opening = _ease((t - (b - n_step)) / n_step) if follows else np.zeros(T)
@@ -310,7 +324,8 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
     # (and the rest of the motion by the whole gap), raised towards its mid-stance height
     # as far as the legs reach (their longest hip-to-ankle span in the stride before)
     world = (0.5 * close + 0.5 * opening)[:, None] * move[None, :]
-    rise = max(0.0, float(root[a - before : a, up].max() - root[a, up]))
+    stride = root[max(0, a - before) : a, up]
+    rise = max(0.0, float(stride.max() - root[a, up])) if moving and stride.size else 0.0
     world[:, up] += rise * settle
     cols = [layout.column("t" + ax) for ax in "xyz"]
     per = _channel_map(motion, cols)
@@ -318,8 +333,9 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
     frames[a:, cols] += np.linalg.lstsq(per, world[a:].T, rcond=None)[0].T
     mpos, _ = world_transforms(motion.with_frames(frames))
     over = np.zeros(rows.size)
+    reach = slice(lo, a) if a > lo else slice(a, a + 1)  # (the stride before, or the stand)
     for (_, pts, chain), (tg, _) in zip(legs, targets):
-        span = np.linalg.norm(wpos[lo:a, pts[0]] - wpos[lo:a, chain[0]], axis=1).max()
+        span = np.linalg.norm(wpos[reach, pts[0]] - wpos[reach, chain[0]], axis=1).max()
         hip = mpos[rows, chain[0]]
         flat_d = np.linalg.norm((tg[:, 0] - hip)[:, horiz], axis=1)
         top = tg[:, 0, up] + np.sqrt(np.maximum((0.99 * span) ** 2 - flat_d**2, 0.0))
