@@ -18,7 +18,7 @@ import numpy as np
 from ..._words import plural
 from ...errors import ParameterError
 from .bridges import DEFAULT_THRESHOLD, Bridges, check_compatible, find_bridges
-from .easing import smootherstep
+from .easing import mix_rows, smootherstep
 from .influence import pose_points
 from .particle import simulate
 
@@ -346,11 +346,7 @@ class CrossingMixin:
         )
         w = smootherstep(n)[:, None]
         r1, r2 = self._root(m1, X1), self._root(m2, X2)
-        root = {
-            k: (1 - w.reshape((-1,) + (1,) * (r1[k].ndim - 1))) * r1[k]
-            + w.reshape((-1,) + (1,) * (r1[k].ndim - 1)) * r2[k]
-            for k in r1
-        }
+        root = {k: mix_rows(r1[k], r2[k], w) for k in r1}
         # each model's pose is clipped to its own range before the blend, so the frames
         # after the blend continue without a jump
         blended = self._mix(

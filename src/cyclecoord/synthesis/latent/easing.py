@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["smootherstep", "smoothstep", "eased", "resample"]
+__all__ = ["smootherstep", "smoothstep", "eased", "mix_rows", "resample"]
 
 
 def smootherstep(n: int) -> np.ndarray:
@@ -13,6 +13,13 @@ def smootherstep(n: int) -> np.ndarray:
     velocity and acceleration at both ends, so a blend adds no jump in acceleration."""
     u = (np.arange(n) + 1.0) / (n + 1.0)
     return u * u * u * (u * (6.0 * u - 15.0) + 10.0)
+
+
+def mix_rows(a: np.ndarray, b: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """``(1 - w) a + w b`` row by row: ``a`` and ``b`` ``(T, ...)``, ``w`` one weight per
+    row (``(T,)`` or ``(T, 1)``)."""
+    w = np.reshape(w, (-1,) + (1,) * (np.ndim(a) - 1))
+    return (1.0 - w) * a + w * b
 
 
 def smoothstep(n: int) -> np.ndarray:

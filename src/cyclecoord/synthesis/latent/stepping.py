@@ -24,7 +24,7 @@ import numpy as np
 from ..._words import plural
 from ...errors import ParameterError
 from .crossing import BLEND_ACCELERATION, blend_asked
-from .easing import smootherstep
+from .easing import mix_rows, smootherstep
 from .gait import FADE_TIE, SEAM_FADES, Gait, choose_seam_fade
 from .influence import pose_points
 
@@ -242,9 +242,7 @@ class GaitMixin:
             X = (1.0 - w) * at0(m.X_) + w * X
             if detail is not None:
                 d0 = self._detail_at(name, s0, u, at0)
-                detail = {key: (1.0 - w.reshape((-1,) + (1,) * (v.ndim - 1))) * d0[key]
-                          + w.reshape((-1,) + (1,) * (v.ndim - 1)) * v
-                          for key, v in detail.items()}
+                detail = {key: mix_rows(d0[key], v, w) for key, v in detail.items()}
         self._next_cursor = (name, s1, float(u[-1]), goal - X[-1])
         # from the path the particle was riding (the loop, or a MOVE to a frame's offset
         # from it), not from the particle, which lags it: offset by the particle's lag,
@@ -457,21 +455,13 @@ class GaitMixin:
         Xa = Xa + (1.0 - w)[:, None] * stray[None, :]
         Xb = at_b(m2.X_)
         r1, r2 = self._root(m1, Xa), self._root(m2, Xb)
-        root = {
-            k: (1 - w.reshape((-1,) + (1,) * (r1[k].ndim - 1))) * r1[k]
-            + w.reshape((-1,) + (1,) * (r1[k].ndim - 1)) * r2[k]
-            for k in r1
-        }
+        root = {k: mix_rows(r1[k], r2[k], w) for k in r1}
         Da, Db = self._detail_at(src, sa, ua + du, at_a), self._detail_at(to, sb, ub + du, at_b)
         Pa, Pb = m1.pose(Xa), m2.pose(Xb)
         detail = None
         if Da is not None:
             Pa, Pb = Pa + Da["angles"], Pb + Db["angles"]
-            detail = {
-                k: (1 - w.reshape((-1,) + (1,) * (Da[k].ndim - 1))) * Da[k]
-                + w.reshape((-1,) + (1,) * (Da[k].ndim - 1)) * Db[k]
-                for k in Da
-            }
+            detail = {k: mix_rows(Da[k], Db[k], w) for k in Da}
             root = {k: root[k] + detail[k] for k in root}
         blended = self._mix(src, to, self._clip(src, Pa, count), self._clip(to, Pb, count), w)
         return {"w": w, "du": du, "Xb": Xb, "on_path": on_path, "root": root, "detail": detail,
