@@ -54,7 +54,8 @@ class UntangleMixin:
         IDLE), and a pull that makes its frames pop is taken back
         (:meth:`_unpulled_pops`)."""
         motion = plain = self._assemble(*self._posed())
-        if not self._on_path(particles=True).any():
+        pullable = self._on_path(particles=True)
+        if not pullable.any():
             return motion
         takes = [self.models[k].training_motion() for k in sorted({c.model for c in self.chunks})]
         from ...quality.contacts import contact_runs
@@ -69,7 +70,7 @@ class UntangleMixin:
         bump = u * u * (3.0 - 2.0 * u)
         # an IDLE's pose can lie far from its captured frame: pulled over a wider window,
         # within the IDLE, easing in from the frames before and after it
-        off = self._on_path(True) & ~self._on_path()
+        off = pullable & ~self._on_path()
         w2 = max(w, int(round(UNTANGLE_OFF_WIDTH * self.fps)))
         u2 = 1.0 - np.abs(np.arange(-w2, w2 + 1)) / (w2 + 1.0)
         wide = u2 * u2 * (3.0 - 2.0 * u2)
@@ -90,7 +91,7 @@ class UntangleMixin:
                 dtype=int,
             )
             frames = frames - int(motion.start_frame)
-            frames = frames[self._on_path(True)[frames]] if frames.size else frames
+            frames = frames[pullable[frames]] if frames.size else frames
             # a frame already at the captured pose of its phase and still too close: that
             # pose lies between two captured frames (a swinging foot passing the other
             # shin cuts the corner between them), so it takes the nearer captured frame
