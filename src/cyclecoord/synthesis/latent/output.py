@@ -53,10 +53,23 @@ class OutputMixin(UntangleMixin):
     def motion(self) -> Motion:
         """The frames so far as a motion on the first model's skeleton (root integrated),
         limbs kept from passing closer than the training takes' (:meth:`_untangled`),
-        then the root carried by the feet."""
+        then the root carried by the feet, and limbs still too close turned apart at the
+        shoulder or hip (:func:`~cyclecoord.synthesis.clearance.push_limbs_apart`)."""
         if not self.chunks:
             raise ParameterError("the script made no frames")
-        return self._plant_feet(self._untangled())
+        return self._pushed_apart(self._plant_feet(self._untangled()))
+
+    def _pushed_apart(self, motion: Motion) -> Motion:
+        """:func:`~cyclecoord.synthesis.clearance.push_limbs_apart` against the training
+        takes, said on the console."""
+        from ..clearance import push_limbs_apart
+
+        takes = [self.models[k].training_motion() for k in sorted({c.model for c in self.chunks})]
+        out, pushed = push_limbs_apart(motion, takes, cache=self._plausibility,
+                                       feet=self.feet_of(motion) or ())
+        if pushed.line():
+            self.notes.append(pushed.line())
+        return out
 
     def _assemble(
         self, angles: np.ndarray, root: dict[str, np.ndarray], like: Motion | None = None
