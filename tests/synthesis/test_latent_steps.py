@@ -386,3 +386,54 @@ def test_a_move_to_a_frame_continues_the_path_not_the_lagging_particle(models):
     du += np.ceil(max(0.0, n * syn._rate("walk", seg) - du))
     loop = syn.gait_sampler("walk", seg, np.array([u0 + du / n]))(models["walk"].X_)[0]
     assert np.linalg.norm(chunk.path[0] - loop) < 0.25 * lag
+
+
+def test_a_pop_off_the_gaits_paths_is_softened_in_the_latent_space(models, monkeypatch):
+    """Frames of a line MOVE (no gait path) accelerating over POP_PULL x the limit are
+    posed again from their latent path smoothed over POP_SOFTEN, the frames about them
+    eased; their acceleration drops, far frames do not change, a note says where; a
+    softening that would not lower the acceleration is taken back."""
+    from cyclecoord.synthesis.latent.untangle import POP_PULL, UNTANGLE_WIDTH
+
+    def line(limit_scale):
+        syn = Synthesizer(models, fps=30, seed=0, plant="off", lock=False)
+        syn.start("walk", {"frame": 0})
+        syn.command += 1
+        syn.move({"frame": 60}, path="line")
+        syn.command += 1
+        syn.idle(duration=0.5)
+        plain = syn._assemble(*syn._posed())
+        acc = _accel(plain)
+        real = syn._frame_acc99
+        # the limit set so that the MOVE's largest acceleration is a pop
+        monkeypatch.setattr(syn, "_frame_acc99", lambda n: real(n) * 0 + limit_scale *
+                            acc.max() / POP_PULL)
+        return syn, plain, acc
+
+    syn, plain, acc = line(0.8)
+    worst = int(np.argmax(acc))
+    from cyclecoord.synthesis.latent.untangle import UntangleMixin
+
+    softened = UntangleMixin._softened
+    monkeypatch.setattr(UntangleMixin, "_softened", lambda self, m, *a: m)
+    base = syn._untangled()  # everything else untangling does, unsoftened
+    monkeypatch.setattr(UntangleMixin, "_softened", softened)
+    out = syn._untangled()
+    assert _accel(out)[worst] < _accel(base)[worst]
+    w = int(round(UNTANGLE_WIDTH * 30))
+    popped = np.flatnonzero(acc > 0.8 * acc.max())
+    assert popped.max() + w + 3 < plain.n_frames - 5  # the IDLE's last frames: far from them
+    far = np.arange(popped.max() + w + 3, plain.n_frames)
+    # (the root's track is integrated from its velocity and turn: it moves on as a whole)
+    root = plain.skeleton.joints[0].name
+    joints = [i for i, (j, _) in enumerate(plain.channels) if j != root]
+    np.testing.assert_allclose(out.frames[np.ix_(far, joints)], base.frames[np.ix_(far, joints)],
+                               atol=1e-9)
+    assert not np.allclose(out.frames[worst, joints], base.frames[worst, joints])
+    assert any("off the gaits' paths" in n and "latent path smoothed" in n for n in syn.notes)
+    # nothing over the limit: nothing changes
+    syn2, plain2, _ = line(1.5)
+    out2 = syn2._untangled()
+    monkeypatch.setattr(UntangleMixin, "_softened", lambda self, m, *a: m)
+    np.testing.assert_array_equal(out2.frames, syn2._untangled().frames)
+    assert not any("latent path smoothed" in n for n in syn2.notes)

@@ -10,7 +10,7 @@ import numpy as np
 from ...errors import ParameterError
 from ...motion import Motion
 from .model import heading_matrix
-from .untangle import UntangleMixin
+from .untangle import POP_SOFTEN, UntangleMixin
 
 __all__ = [
     "DETAIL_FADE",
@@ -197,12 +197,15 @@ class OutputMixin(UntangleMixin):
         return cache[key]
 
     def _posed(
-        self, pull: np.ndarray | None = None, whole: np.ndarray | None = None
+        self, pull: np.ndarray | None = None, whole: np.ndarray | None = None,
+        soften: np.ndarray | None = None,
     ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Every frame's joint angles ``(T, C)`` and root motion, the particle's path
         smoothed; with ``pull`` ``(T,)``, frames along a gait's path moved that fraction of
         the way to the captured pose at their phase (:meth:`_untangled`), or with ``whole``
-        ``(T,)`` bool to the captured frame nearest the path there.
+        ``(T,)`` bool to the captured frame nearest the path there; with ``soften``
+        ``(T,)``, a particle's path that fraction of the way to its path smoothed by a
+        Gaussian of :data:`~.untangle.POP_SOFTEN` seconds (:meth:`_unpopped`).
 
         Each run of consecutive particle chunks of one model (MOVEs, IDLEs) is posed again
         from its latent path smoothed by a Gaussian of ``params.smooth`` seconds
@@ -244,6 +247,12 @@ class OutputMixin(UntangleMixin):
             u = np.clip(u, 0.0, 1.0)
             w = u * u * (3.0 - 2.0 * u)
             Xs = X + w[:, None] * (gaussian_filter1d(X, sigma, axis=0, mode="nearest") - X)
+            if soften is not None:
+                a0 = sum(c.X.shape[0] for c in chunks[:i])
+                s = w * soften[a0 : a0 + X.shape[0]]
+                if s.any():
+                    wide = gaussian_filter1d(X, POP_SOFTEN * self.fps, axis=0, mode="nearest")
+                    Xs = Xs + s[:, None] * (wide - Xs)
             m = self.models[chunks[i].model]
             P, R = m.pose(Xs), self._root(m, Xs)
             edges = np.cumsum([0] + [c.X.shape[0] for c in chunks[i : j + 1]])
