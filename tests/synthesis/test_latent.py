@@ -235,7 +235,7 @@ def test_a_played_segment_carries_its_detail_into_the_move_after_it(walk_model):
                           detail=detail)
         syn.start("walk")
         syn.play("b", 0.0, 0.5)
-        syn.move({"segment": "b", "time": 0.2})
+        syn.move({"segment": "b", "time": 0.9})
         return syn
 
     syn, bare = made(True), made(False)

@@ -184,9 +184,9 @@ def test_a_frame_taken_whole_can_take_the_capture_played_about_it(models):
 def test_a_first_transition_steps_from_the_start_frame(models, monkeypatch, tmp_path):
     """A script that starts on a walk frame and begins with a TRANSITION to the run (a
     random script of the benchmark's): the figure steps :data:`~.crossing.START_LEAD` s
-    of the walk's gait from the start frame, then blends in step, and says so; crossed
-    while both idle (before), it stood still at its start frame, mid-stride (a freeze in
-    the report)."""
+    of the walk's gait from the start frame, then blends in step, and says so; before,
+    it crossed while both idle from its start frame, mid-stride (and its approach to the
+    bridge crawled over two full ease ramps: a freeze in the report)."""
     import json
 
     from cyclecoord.synthesis.latent.crossing import START_LEAD, CrossingMixin
@@ -210,7 +210,7 @@ def test_a_first_transition_steps_from_the_start_frame(models, monkeypatch, tmp_
     # (as before the lead: a start frame mid-stride is no stand, its stillness not asked)
     monkeypatch.setattr(CrossingMixin, "_standing", lambda self: False)
     motion, rep = run_script(path)
-    assert not rep["transitions"][0].get("in_step") and rep["motion_quality"]["freezes"]
+    assert not rep["transitions"][0].get("in_step")
 
 
 def test_a_line_takes_no_less_than_a_blend_between_its_poses(models, monkeypatch):
@@ -271,7 +271,9 @@ def test_a_crossing_after_an_idle_stands_as_asked_and_nothing_else_does(models, 
     assert not syn.hold_mask(motion.n_frames)[b:].any()  # (the motion holds the IDLE only)
     takes = training_takes(syn.models, ["walk", "run"])
     slow = measure_generated(motion, takes, hold=syn.hold_mask(motion.n_frames)).freezes
-    assert slow and all(b <= f0 and f1 <= syn.stood[0][1] for f0, f1 in slow)
+    # (a crossing's approach from a pose near its bridge no longer crawls over two full
+    # ramps: on some seeds the crossing is quick enough to find no freeze at all)
+    assert all(b <= f0 and f1 <= syn.stood[0][1] for f0, f1 in slow)
     asked = syn.hold_mask(motion.n_frames, asked=True)
     assert not measure_generated(motion, takes, hold=asked).freezes
     _, before = run(standing=False)
@@ -387,6 +389,24 @@ def test_a_move_to_a_frame_continues_the_path_not_the_lagging_particle(models):
     loop = syn.gait_sampler("walk", seg, np.array([u0 + du / n]))(models["walk"].X_)[0]
     assert np.linalg.norm(chunk.path[0] - loop) < 0.25 * lag
 
+
+def test_a_move_to_a_point_shorter_than_its_ramps_eases_over_its_own_length(models):
+    """A MOVE to the training frame next to the start frame is a frame or two of travel:
+    it eases in and out over those, not over two full ramps of crawling (a Bandai
+    script's MOVE to the neighbouring frame crawled 0.3 s: a freeze); a MOVE ahead keeps
+    its ramps (its steps ease in from rest)."""
+    syn = Synthesizer(models, fps=30, seed=0, plant="off")
+    syn.start("walk", {"frame": 20})
+    ramp = int(round(syn.ease * syn.fps))
+    syn.command += 1
+    syn.move({"frame": 21}, path="line")
+    near = syn.chunks[-1].X.shape[0]
+    assert ramp >= 6 and near < ramp
+    ahead = Synthesizer(models, fps=30, seed=0, plant="off")
+    ahead.start("walk", {"frame": 20})
+    ahead.command += 1
+    ahead.move({"ahead": 0.1})
+    assert ahead.chunks[-1].X.shape[0] >= ramp
 
 def test_a_pop_off_the_gaits_paths_is_softened_in_the_latent_space(models, monkeypatch):
     """Frames of a line MOVE (no gait path) accelerating over POP_PULL x the limit are

@@ -638,6 +638,12 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         with np.errstate(all="ignore"):
             frames = np.round(times[-1] * self.fps)
         n = max(1, self.reserve(frames if np.isfinite(frames) else np.inf, "MOVE"))
+        if stepped is None and not (isinstance(to, dict) and "ahead" in to):
+            # a MOVE to a point (not along a gait) shorter than its ramps eases over its
+            # own length: stretched to two full ramps, a MOVE to the neighbouring frame
+            # crawled for 0.3 s (a freeze), and so did a crossing's approach from a pose
+            # already near its bridge
+            r_in, r_out = min(r_in, n), min(r_out, n)
         n += (r_in + r_out) // 2
         u = eased(n, r_in, r_out) * times[-1]
         samples = np.stack([np.interp(u, times, poly[:, k]) for k in range(poly.shape[1])], 1)
