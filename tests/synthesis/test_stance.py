@@ -262,3 +262,41 @@ def test_the_closing_steps_pelvis_drop_eases_in_from_the_stands_first_frame(mode
                 # the first frame moves a third of the drop's first frames at most
                 assert abs(drop[a]) < 0.35 * np.abs(drop[a : a + 6]).max(), np.round(drop, 3)
     assert lowered >= 4
+
+
+def test_an_opening_step_frame_that_hops_is_solved_again_from_the_frame_before(
+        models, monkeypatch):
+    """The opening step is solved with the closing one, from the motion's own poses; a
+    frame whose solution hops (here made to: one angle 30 degrees off on the third frame
+    from the end) is solved again from the frame before it, turning at most OPENING_TURN
+    from it: a Bandai run's ankle turned 35 degrees in one frame there (2.4x its p99)."""
+    import cyclecoord.synthesis.footlock as footlock
+    import cyclecoord.synthesis.stance as stance
+
+    seen = {}
+    real_close, real_solve = stance.close_stands, footlock._solve
+
+    def spy(motion, feet, stands, **kw):
+        seen.update(motion=motion, feet=feet, stands=stands, kw=kw)
+        return real_close(motion, feet, stands, **kw)
+
+    monkeypatch.setattr(stance, "close_stands", spy)
+    stop(models, "walk", 1, then=3)
+    (a, b), = seen["stands"]
+
+    def hopping(ik, rows, *args, **kw):
+        q = real_solve(ik, rows, *args, **kw)
+        if rows.size > 1 and np.diff(rows).max() > 1:  # the steps' frames, solved at once
+            q = q.copy()
+            q[-3, 0] += 30.0
+            seen.setdefault("hops", []).append((int(rows[-3]), ik.vars[0][2]))
+        return q
+
+    monkeypatch.setattr(footlock, "_solve", hopping)
+    done = real_close(seen["motion"], seen["feet"], seen["stands"], **seen["kw"])
+    assert done.closed == [(a, b)] and len(seen["hops"]) == 2  # both legs
+    cap = stance.OPENING_TURN * 30.0 / seen["motion"].fps
+    for row, col in seen["hops"]:
+        assert b - 4 <= row < b
+        steps = np.abs(np.diff(done.motion.frames[row - 1 : row + 2, col]))
+        assert steps.max() <= cap + 1e-6, steps

@@ -361,6 +361,20 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
     return motion.with_frames(frames), gap_len, move
 
 
+#: Degrees a leg's angle may turn per frame (at 30 fps) in a stand's opening step,
+#: solved frame by frame: a Bandai run's knee and ankle, at the edge of the training
+#: range, otherwise hopped to another solution in one frame (the ankle 35 degrees).
+OPENING_TURN = 8.0
+
+
+def _miss(got, tg, wt, clear) -> np.ndarray:
+    """Per frame and foot point, how far ``got`` is from the targets ``tg`` (length
+    units; a toe within the ankle's range and a foot in the air weigh less)."""
+    miss = np.linalg.norm((got - tg) * (wt >= 1), axis=-1)
+    miss[:, 1:] *= 0.5  # (a toe within the ankle's range pitches the foot a little)
+    return miss / np.where(clear > 0.1, 3.0, 1.0)[:, None]  # (in the air, off its path)
+
+
 def _solve_legs(moved, frames, legs, targets, rows, held, horiz, scale, bounds) -> float:
     """Both legs of ``moved`` (its root placed) solved onto their ``targets`` on ``rows``,
     written into ``frames``; the held frames kept on the landing's foot points.  Returns
@@ -381,30 +395,62 @@ def _solve_legs(moved, frames, legs, targets, rows, held, horiz, scale, bounds) 
         moving = ~held
         if first >= 0:
             moving[first] = True
+        late = moving & (rows > rows[held][-1]) if first >= 0 else np.zeros_like(held)
         some = rows[moving]
         q = _solve(ik, some, tg[moving], wt[moving], scale,
                    box=_box(ik, some, bounds))
         for v, (_, _, c) in enumerate(ik.vars):
             frames[some, c] = q[:, v]
         got = ik.positions(q, some)
-        miss = np.linalg.norm((got - tg[moving]) * (wt[moving] >= 1), axis=-1)
-        miss[:, 1:] *= 0.5  # (a toe within the ankle's range pitches the foot a little)
-        miss /= np.where(clear[moving] > 0.1, 3.0, 1.0)[:, None]  # (in the air, off its path)
+        miss = _miss(got, tg[moving], wt[moving], clear[moving])[~late[moving]]
         worst = max(worst, float(miss.max()) / scale)
-        if first >= 0:
-            # between the steps the foot stays exactly where it landed: every point held
-            # (the toe's loose direction let the foot swivel a centimetre as the body
-            # swayed, read as a slide), solved from the landing's pose
-            k = int(np.flatnonzero(rows[moving] == rows[first])[0])
-            sub = rows[held]
-            for v, (_, _, c) in enumerate(ik.vars):
-                frames[sub, c] = q[k, v]
-            ik = _LegIK(moved.with_frames(frames), chain, pts, mrot, mpos)
-            tg = np.repeat(got[k][None], sub.size, axis=0)
-            q = _solve(ik, sub, tg, np.ones(tg.shape), scale,
-                       box=_box(ik, sub, bounds))
-            for v, (_, _, c) in enumerate(ik.vars):
-                frames[sub, c] = q[:, v]
-            miss = np.linalg.norm(ik.positions(q, sub) - tg, axis=-1)
-            worst = max(worst, float(miss.max()) / scale)
+        if first < 0:
+            continue
+        # between the steps the foot stays exactly where it landed: every point held
+        # (the toe's loose direction let the foot swivel a centimetre as the body
+        # swayed, read as a slide), solved from the landing's pose
+        k = int(np.flatnonzero(rows[moving] == rows[first])[0])
+        sub = rows[held]
+        for v, (_, _, c) in enumerate(ik.vars):
+            frames[sub, c] = q[k, v]
+        ik = _LegIK(moved.with_frames(frames), chain, pts, mrot, mpos)
+        land = np.repeat(got[k][None], sub.size, axis=0)
+        q = _solve(ik, sub, land, np.ones(land.shape), scale, box=_box(ik, sub, bounds))
+        for v, (_, _, c) in enumerate(ik.vars):
+            frames[sub, c] = q[:, v]
+        worst = max(worst, float(np.linalg.norm(ik.positions(q, sub) - land, axis=-1).max())
+                    / scale)
+        if late.any():
+            worst = max(worst, _opening(moved, frames, ik, chain, pts, mrot, mpos, rows,
+                                        late, q[-1], tg, wt, clear, scale, bounds))
     return worst
+
+
+def _opening(moved, frames, ik, chain, pts, mrot, mpos, rows, late, prev, tg, wt, clear,
+             scale, bounds) -> float:
+    """The opening step after the held frames, as solved with the closing one from the
+    motion's own poses, but a frame that hops from the one before (a loose toe bent
+    another way; a knee and ankle at the edge of the training range taking another
+    solution: a Bandai run's ankle turned 35 degrees in one frame, 2.4x its p99) solved
+    again from the frame before, turning at most :data:`OPENING_TURN` from it.  Written
+    into ``frames``; returns the worst miss of the step's frames (leg lengths)."""
+    from .footlock import _box, _LegIK, _solve
+
+    cols = [c for _, _, c in ik.vars]
+    cap = OPENING_TURN * 30.0 / moved.fps
+    for i in np.flatnonzero(late):
+        row = rows[i : i + 1]
+        got = frames[row[0], cols]
+        if np.abs(got - prev).max() > cap:
+            frames[row[0], cols] = prev
+            ik = _LegIK(moved.with_frames(frames), chain, pts, mrot, mpos)
+            box = _box(ik, row, bounds) or (np.full((1, prev.size), -np.inf),
+                                            np.full((1, prev.size), np.inf))
+            box = (np.maximum(box[0], prev - cap), np.minimum(box[1], prev + cap))
+            got = _solve(ik, row, tg[i : i + 1], wt[i : i + 1], scale, box=box)[0]
+            frames[row[0], cols] = got
+        prev = got
+    ik = _LegIK(moved.with_frames(frames), chain, pts, mrot, mpos)
+    steps = rows[late]
+    got = ik.positions(frames[np.ix_(steps, cols)], steps)
+    return float(_miss(got, tg[late], wt[late], clear[late]).max()) / scale
