@@ -131,3 +131,25 @@ def test_a_latent_script_turns_apart_the_limbs_its_pulls_left_too_close(monkeypa
     assert changed_joints(bad, out) == {"lhumerus"}
     assert any(n.startswith("limbs turned apart") and "lhumerus by up to" in n
                for n in syn.notes)
+
+
+def test_a_leg_does_not_turn_while_its_foot_is_planted(walk, monkeypatch):
+    """Given the feet, a leg's turn is zero on the frames its foot is planted and eases
+    back in away from them (turned over the frames about a contact, it slid the foot)."""
+    from types import SimpleNamespace
+
+    import cyclecoord.quality.contacts as contacts
+
+    bad = moved(walk, "rfemur", "rz", 15.0, 30, 50)
+    feet = ("lfoot", "ltoes", "rfoot", "rtoes")
+    free, _ = push_limbs_apart(bad, [walk], analysed=False, feet=feet)  # (no contact found)
+    turned = np.flatnonzero(np.abs(free.frames - bad.frames).max(axis=1) > 1e-9)
+    planted = np.zeros((walk.n_frames, 4), dtype=bool)
+    down = turned[: len(turned) // 4]  # the right foot down on the first quarter of them
+    planted[down, 2] = True
+    monkeypatch.setattr(contacts, "foot_contacts",
+                        lambda motion, f, **kw: SimpleNamespace(planted=planted))
+    out, pushed = push_limbs_apart(bad, [walk], analysed=False, feet=feet)
+    cols = [walk.channel_index("rfemur", d) for d in ("rx", "ry", "rz")]
+    np.testing.assert_array_equal(out.frames[np.ix_(down, cols)], bad.frames[np.ix_(down, cols)])
+    assert not np.array_equal(out.frames[:, cols], bad.frames[:, cols])

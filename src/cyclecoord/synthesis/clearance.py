@@ -11,7 +11,7 @@ the root and the other limbs are untouched.  Which limb moves:
 
 * an arm against the trunk or a leg: the arm (a leg carries the body);
 * a leg against the other leg: the leg whose foot is higher on that frame (the swinging
-  one; the planted foot stays where it is);
+  one), and not while its foot is planted (given ``feet``): a planted foot stays put;
 * an arm against the other arm: both, half the angle each.
 
 A contact that needs more than :data:`PUSH_MAX_DEG` at the pivot is left as it is (the
@@ -172,6 +172,39 @@ def _wanted_turns(motion, contacts, thr, pivot, kind, feet_height) -> dict[int, 
     return want
 
 
+def _legs_free(motion: Motion, feet: Sequence[str], pivot: np.ndarray, width: int
+               ) -> dict[int, np.ndarray]:
+    """Per leg (its hip joint's index), a weight ``(T,)`` from 0 to 1 of how far it may
+    turn: 0 where one of its ``feet`` is planted
+    (:func:`~cyclecoord.quality.contacts.foot_contacts`: low and still), easing to 1 over
+    a third of ``width`` frames from each planted run (eased over the frames about a
+    contact, a leg's turn would slide its planted foot).  Empty when the contacts cannot
+    be found."""
+    from ..errors import CycleCoordError
+    from ..quality.contacts import foot_contacts
+
+    names = list(motion.positions().names)
+    try:
+        planted = foot_contacts(motion, tuple(feet)).planted
+    except CycleCoordError:
+        return {}
+    T = motion.n_frames
+    ramp = max(1, width // 3)
+    out: dict[int, np.ndarray] = {}
+    for j in {int(pivot[names.index(f)]) for f in feet if f in names} - {-1}:
+        cols = [c for c, f in enumerate(feet) if f in names and pivot[names.index(f)] == j]
+        down = np.flatnonzero(planted[:, cols].any(axis=1))
+        if not down.size:
+            continue
+        t = np.arange(T)
+        at = np.clip(np.searchsorted(down, t), 1, down.size) - 1
+        gap = np.minimum(np.abs(t - down[at]), np.abs(t - down[np.minimum(at + 1,
+                                                                            down.size - 1)]))
+        u = np.clip(gap / (ramp + 1.0), 0.0, 1.0)  # frames from the nearest planted one
+        out[j] = u * u * (3.0 - 2.0 * u)
+    return out
+
+
 def _eased_turn(angle: np.ndarray, axis: np.ndarray, width: int) -> np.ndarray:
     """The turns ``angle`` about ``axis`` (in the pivot's parent's axes) of the frames
     short of room as one turn eased over ``width`` frames each side (rotation vectors
@@ -256,7 +289,8 @@ def push_limbs_apart(
     cache, analysed
         Passed to :func:`~cyclecoord.quality.plausibility.check_plausibility`.
     feet : sequence of str
-        Foot joint names; with two legs touching, the leg whose foot is higher turns.
+        Foot joint names: with two legs touching, the leg whose foot is higher turns, and
+        a leg does not turn where one of its feet is planted.
     width : float, default :data:`PUSH_WIDTH`
         Seconds each side of a contact over which the turn eases in and out.
     max_deg : float, default :data:`PUSH_MAX_DEG`
@@ -298,12 +332,15 @@ def push_limbs_apart(
                 if j >= 0:
                     heights[j] = pos[:, names.index(f), 1]
         want = _wanted_turns(out, new, rep.threshold, pivot, kind, heights)
+        free = _legs_free(out, feet, pivot, n) if feet else {}
         step = {}
         world = world_transforms(out)[1] if want else None
         for j, (angle, axis) in want.items():
             parent = int(parents[j])
             rot = world[:, parent] if parent >= 0 else np.broadcast_to(np.eye(3), world[:, j].shape)
             vec = _eased_turn(angle, np.einsum("nji,nj->ni", rot, axis), n)
+            if j in free:  # a leg: not while its foot is planted
+                vec *= free[j][:, None]
             deg = np.degrees(np.linalg.norm(vec, axis=1))
             if not deg.any() or deg.max() > max_deg:
                 continue

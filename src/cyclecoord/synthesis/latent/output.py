@@ -205,7 +205,7 @@ class OutputMixin(UntangleMixin):
         the way to the captured pose at their phase (:meth:`_untangled`), or with ``whole``
         ``(T,)`` bool to the captured frame nearest the path there; with ``soften``
         ``(T,)``, a particle's path that fraction of the way to its path smoothed by a
-        Gaussian of :data:`~.untangle.POP_SOFTEN` seconds (:meth:`_unpopped`).
+        Gaussian of :data:`~.untangle.POP_SOFTEN` seconds (:meth:`_softened`).
 
         Each run of consecutive particle chunks of one model (MOVEs, IDLEs) is posed again
         from its latent path smoothed by a Gaussian of ``params.smooth`` seconds
