@@ -36,6 +36,15 @@ POP_SOFTEN = 3.0 / 30.0
 UNTANGLE_POP = 2.0
 
 
+def _spread(weights: np.ndarray, frames: np.ndarray, bump: np.ndarray) -> None:
+    """``weights`` ``(T,)`` raised in place to ``bump`` (odd length, its peak at the
+    middle) centred on each of ``frames``."""
+    w, T = (bump.size - 1) // 2, weights.size
+    for f in frames:
+        a, b = max(f - w, 0), min(f + w + 1, T)
+        weights[a:b] = np.maximum(weights[a:b], bump[a - f + w : b - f + w])
+
+
 class UntangleMixin:
     """:meth:`_untangled` and :meth:`_unpopped` of :class:`~.output.OutputMixin`."""
 
@@ -212,7 +221,6 @@ class UntangleMixin:
         limit = POP_PULL * self._frame_acc99(motion.n_frames)
         if not on.any():
             return self._softened(motion, pull, whole, bump, limit, on)
-        w = (bump.size - 1) // 2
         popped: set[int] = set()
         acc = _accel(motion)
         for _ in range(POP_ROUNDS):
@@ -220,9 +228,7 @@ class UntangleMixin:
             if not bad.size:
                 break
             was = pull.copy()
-            for f in bad:
-                a, b = max(f - w, 0), min(f + w + 1, motion.n_frames)
-                pull[a:b] = np.maximum(pull[a:b], bump[a - f + w : b - f + w])
+            _spread(pull, bad, bump)
             trial = self._assemble(*self._posed(pull, whole), like=motion)
             near = pull > was
             after = _accel(trial)
@@ -257,16 +263,13 @@ class UntangleMixin:
         off &= ~on
         acc = _accel(motion)
         soften = np.zeros(motion.n_frames)
-        w = (bump.size - 1) // 2
         done: set[int] = set()
         for _ in range(POP_ROUNDS):
             bad = np.flatnonzero((acc > limit) & off & (soften < 1.0))
             if not bad.size:
                 break
             was = soften.copy()
-            for f in bad:
-                a, b = max(f - w, 0), min(f + w + 1, motion.n_frames)
-                soften[a:b] = np.maximum(soften[a:b], bump[a - f + w : b - f + w])
+            _spread(soften, bad, bump)
             trial = self._assemble(*self._posed(pull, whole, soften), like=motion)
             near = soften > was
             after = _accel(trial)
