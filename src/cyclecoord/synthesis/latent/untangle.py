@@ -45,6 +45,35 @@ def _spread(weights: np.ndarray, frames: np.ndarray, bump: np.ndarray) -> None:
         weights[a:b] = np.maximum(weights[a:b], bump[a - f + w : b - f + w])
 
 
+def _rounds(motion: Motion, weights: np.ndarray, eligible: np.ndarray, limit: np.ndarray,
+            bump: np.ndarray, pose, strict: bool = False) -> tuple[Motion, set[int]]:
+    """Up to :data:`POP_ROUNDS` rounds: the ``eligible`` frames accelerating over ``limit``
+    (whose ``weights`` are under 1) get ``bump`` in ``weights`` (in place) and ``pose(weights,
+    motion)`` is tried; a round that makes the raised frames pop worse than before
+    (``strict``: or no better) is taken back and ends them.  Returns the motion and the
+    frames the kept rounds raised."""
+    from ..carry import _accel
+
+    acc = _accel(motion)
+    done: set[int] = set()
+    for _ in range(POP_ROUNDS):
+        bad = np.flatnonzero((acc > limit) & eligible & (weights < 1.0))
+        if not bad.size:
+            break
+        was = weights.copy()
+        _spread(weights, bad, bump)
+        trial = pose(weights, motion)
+        near = weights > was
+        after = _accel(trial)
+        worse, before = (after[near] / limit[near]).max(), (acc[near] / limit[near]).max()
+        if worse > before or (strict and worse == before):
+            weights[:] = was
+            break
+        done.update(int(f) for f in bad)
+        motion, acc = trial, after
+    return motion, done
+
+
 class UntangleMixin:
     """:meth:`_untangled` and :meth:`_unpopped` of :class:`~.output.OutputMixin`."""
 
@@ -215,30 +244,16 @@ class UntangleMixin:
         pop worse is taken back: on a latent model of the Xsens walk, whose gait loops
         through its turn, the captured pose at the phase popped at 3.9x where the
         particle's popped at 2.6x."""
-        from ..carry import _accel
 
         on = self._on_path()
         limit = POP_PULL * self._frame_acc99(motion.n_frames)
         if not on.any():
             return self._softened(motion, pull, whole, bump, limit, on)
-        popped: set[int] = set()
-        acc = _accel(motion)
-        for _ in range(POP_ROUNDS):
-            bad = np.flatnonzero((acc > limit) & on & (pull < 1.0))
-            if not bad.size:
-                break
-            was = pull.copy()
-            _spread(pull, bad, bump)
-            trial = self._assemble(*self._posed(pull, whole), like=motion)
-            near = pull > was
-            after = _accel(trial)
-            if (after[near] / limit[near]).max() > (acc[near] / limit[near]).max():
-                # the captured pose there pops too (a seam of the gait's loop through a
-                # take's turn): the particle's own pose is kept
-                pull[:] = was
-                break
-            popped.update(int(f) for f in bad)
-            motion, acc = trial, after
+        motion, popped = _rounds(
+            motion, pull, on, limit, bump,
+            lambda w, m: self._assemble(*self._posed(w, whole), like=m))
+        # (a round whose captured poses pop too, a seam of the gait's loop through a
+        # take's turn, is taken back: the particle's own pose is kept)
         if popped:
             self._note_pulled(popped, f"pops: {plural(len(popped), 'frame')} accelerating over "
                               f"{POP_PULL:g}x the training 99th percentile")
@@ -256,28 +271,14 @@ class UntangleMixin:
         crossing's approach from an IDLE, 1.68x), and no captured pose at a phase is
         there to pull toward.  The pose stays a pose of the model (the path is smoothed
         in its latent space, not the joint angles)."""
-        from ..carry import _accel
 
         off = np.repeat([c.particle and c.path is None and c.targets is None
                          for c in self.chunks], [c.X.shape[0] for c in self.chunks])
         off &= ~on
-        acc = _accel(motion)
         soften = np.zeros(motion.n_frames)
-        done: set[int] = set()
-        for _ in range(POP_ROUNDS):
-            bad = np.flatnonzero((acc > limit) & off & (soften < 1.0))
-            if not bad.size:
-                break
-            was = soften.copy()
-            _spread(soften, bad, bump)
-            trial = self._assemble(*self._posed(pull, whole, soften), like=motion)
-            near = soften > was
-            after = _accel(trial)
-            if (after[near] / limit[near]).max() >= (acc[near] / limit[near]).max():
-                soften[:] = was
-                break
-            done.update(int(f) for f in bad)
-            motion, acc = trial, after
+        motion, done = _rounds(
+            motion, soften, off, limit, bump,
+            lambda w, m: self._assemble(*self._posed(pull, whole, w), like=m), strict=True)
         if done:
             spans = sorted(done)
             where = f"frames {spans[0]}-{spans[-1]}" if len(spans) > 1 else f"frame {spans[0]}"
