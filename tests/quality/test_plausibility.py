@@ -674,3 +674,22 @@ def test_check_plausibility_analysed_skips_finding_the_rig_and_reads_the_same():
     plain = check_plausibility(m, [ref]).to_dict()
     assert check_plausibility(m, [ref], analysed=True).to_dict() == plain
     assert check_plausibility(m, [ref], cache={}, analysed=True).to_dict() == plain
+
+
+def test_segment_parameters_give_the_closest_points():
+    """The fractions along each segment give points as far apart as segment_distances
+    says, inside both segments, and no sampled pair of points is closer."""
+    from cyclecoord.quality.bones import segment_parameters
+
+    rng = np.random.default_rng(3)
+    p0, p1, q0, q1 = rng.normal(size=(4, 200, 3))
+    p1[:5] = p0[:5]  # a point against a segment
+    s, t = segment_parameters(p0, p1, q0, q1)
+    assert ((s >= 0) & (s <= 1) & (t >= 0) & (t <= 1)).all()
+    gap = np.linalg.norm(p0 + s[:, None] * (p1 - p0) - q0 - t[:, None] * (q1 - q0), axis=1)
+    np.testing.assert_allclose(gap, segment_distances(p0, p1, q0, q1), atol=1e-12)
+    u = np.linspace(0, 1, 41)
+    a = p0[:, None] + u[None, :, None] * (p1 - p0)[:, None]
+    b = q0[:, None] + u[None, :, None] * (q1 - q0)[:, None]
+    sampled = np.linalg.norm(a[:, :, None] - b[:, None, :], axis=-1).min(axis=(1, 2))
+    assert (gap <= sampled + 1e-12).all()

@@ -11,7 +11,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..motion import Motion
 
-__all__ = ["Bones", "bones", "segment_distances"]
+__all__ = ["Bones", "bones", "segment_distances", "segment_parameters"]
 
 #: Frames x bone pairs per chunk in the distance computation.
 _CHUNK = 400_000
@@ -141,21 +141,27 @@ def bones(motion: Motion) -> Bones:
     )
 
 
-def segment_distances(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
-    """Closest distance between segments ``p0-p1`` and ``q0-q1``, elementwise.
+def segment_parameters(
+    p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Where segments ``p0-p1`` and ``q0-q1`` come closest, elementwise: the fractions
+    ``s`` and ``t`` (0 to 1) along each, so that the closest points are ``p0 + s (p1 -
+    p0)`` and ``q0 + t (q1 - q0)`` (:func:`segment_distances` says how).
 
     Parameters
     ----------
     p0, p1, q0, q1 : ndarray, shape (..., 3)
-        Segment end points (broadcast together).
 
     Returns
     -------
-    ndarray, shape (...)
-        Distances.  The closest points are found by minimising over the first
-        segment's parameter with the second's clamped, then re-clamping the first (the
-        exact solution for segments); degenerate (zero-length) segments work as points.
+    s, t : ndarray, shape (...)
     """
+    return _parameters(p0, p1, q0, q1)[:2]
+
+
+def _parameters(p0, p1, q0, q1):
+    """``s, t`` of :func:`segment_parameters` and the vectors ``p1 - p0``, ``q1 - q0``,
+    ``p0 - q0``."""
     u = p1 - p0
     v = q1 - q0
     w = p0 - q0
@@ -185,6 +191,25 @@ def segment_distances(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.nda
     point_p = a <= 0
     s = np.where(point_p, 0.0, s)
     t = np.where(point_p, np.clip(e / safe_c, 0.0, 1.0), t)
+    return s, t, u, v, w
+
+
+def segment_distances(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
+    """Closest distance between segments ``p0-p1`` and ``q0-q1``, elementwise.
+
+    Parameters
+    ----------
+    p0, p1, q0, q1 : ndarray, shape (..., 3)
+        Segment end points (broadcast together).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Distances.  The closest points are found by minimising over the first
+        segment's parameter with the second's clamped, then re-clamping the first (the
+        exact solution for segments); degenerate (zero-length) segments work as points.
+    """
+    s, t, u, v, w = _parameters(p0, p1, q0, q1)
     diff = w + s[..., None] * u - t[..., None] * v
     return np.sqrt(np.einsum("...i,...i->...", diff, diff))
 

@@ -106,21 +106,12 @@ def _pivots(motion: Motion) -> tuple[np.ndarray, list[str]]:
 
 
 def _closest(p0, p1, q0, q1) -> tuple[np.ndarray, np.ndarray]:
-    """Closest points ``(T, 3)`` on segments ``p0-p1`` and ``q0-q1`` per row."""
-    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
-    a = np.einsum("ij,ij->i", d1, d1)
-    e = np.einsum("ij,ij->i", d2, d2)
-    f = np.einsum("ij,ij->i", d2, r)
-    c = np.einsum("ij,ij->i", d1, r)
-    b = np.einsum("ij,ij->i", d1, d2)
-    den = a * e - b * b
-    tiny = 1e-12
-    s = np.where(den > tiny, np.clip((b * f - c * e) / np.where(den > tiny, den, 1.0), 0, 1), 0.0)
-    t = (b * s + f) / np.where(e > tiny, e, 1.0)
-    s = np.where(t < 0, np.clip(-c / np.where(a > tiny, a, 1.0), 0, 1), s)
-    s = np.where(t > 1, np.clip((b - c) / np.where(a > tiny, a, 1.0), 0, 1), s)
-    t = np.clip(t, 0, 1)
-    return p0 + s[:, None] * d1, q0 + t[:, None] * d2
+    """Closest points ``(T, 3)`` on segments ``p0-p1`` and ``q0-q1`` per row
+    (:func:`~cyclecoord.quality.bones.segment_parameters`)."""
+    from ..quality.bones import segment_parameters
+
+    s, t = segment_parameters(p0, p1, q0, q1)
+    return p0 + s[:, None] * (p1 - p0), q0 + t[:, None] * (q1 - q0)
 
 
 def _wanted_turns(motion, contacts, thr, pivot, kind, feet_height) -> dict[int, tuple]:
