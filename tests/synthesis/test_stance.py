@@ -101,6 +101,12 @@ def test_a_stand_that_frames_follow_steps_out_into_them(models):
     q = measure_generated(motion[a - 15 : b + 30], training_takes(models, ["walk"]))
     assert q.largest_step <= 1.2 and q.largest_accel <= 1.2
     assert q.longest_freeze_s <= 2.0  # (the stand itself was asked for)
+    # the step lands on the stand's last frame in the pose the walk goes on from: landing
+    # on the frame after, the stepping knee was 13.5 degrees more bent than that frame's
+    legs = [i for i, (j, c) in enumerate(motion.channels)
+            if j in ("lfemur", "rfemur", "ltibia", "rtibia", "lfoot", "rfoot")]
+    jump = np.abs(motion.frames[b, legs] - motion.frames[b - 1, legs])
+    assert jump.max() < 6.0, dict(zip([motion.channels[i] for i in legs], jump.round(1)))
 
 
 def test_a_stand_from_a_start_frame_mid_stride_closes_its_feet_and_ends_the_script(models):

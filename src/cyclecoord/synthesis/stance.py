@@ -289,14 +289,19 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
                 for c, p in zip(cols, pts)}
     t = np.arange(T)
     close = _ease((t - a) / n_step)  # 0 -> 1 over the closing step
-    opening = _ease((t - (b - n_step)) / n_step) if follows else np.zeros(T)
+    # (the opening step lands on the stand's last frame, in the pose the motion after it
+    # goes on from: landing on the frame after, the last frame's foot hung 1 % of a leg
+    # above it, and a leg near straight there bent its knee 13 degrees more than that
+    # frame's)
+    u_open = (t - (b - n_step)) / (n_step - 1.0)
+    opening = _ease(u_open) if follows else np.zeros(T)
     # sideways the closing foot moves out early and the opening one in late: each passes
     # the other leg beside it
     close_side = _ease(2.0 * (t - a) / n_step)
-    opening_side = _ease(2.0 * (t - (b - n_step)) / n_step - 1.0) if follows else np.zeros(T)
+    opening_side = _ease(2.0 * u_open - 1.0) if follows else np.zeros(T)
     settle = close * (1.0 - opening)  # heights flat and pelvis raised, then back
     swing = np.sin(np.pi * np.clip((t - a) / n_step, 0, 1))
-    swing_out = np.sin(np.pi * np.clip((t - (b - n_step)) / n_step, 0, 1)) if follows else 0 * t
+    swing_out = np.sin(np.pi * np.clip(u_open, 0, 1)) if follows else 0 * t
     # the feet's targets (they do not depend on the root)
     rows = np.arange(a, b)
     targets = []
@@ -351,11 +356,13 @@ def _close_part(motion, contacts, legs, layout, a, n_step, bounds, follows):
         # in a frame, its knee bent 15 degrees (1.6x the walk's p99 of acceleration)
         lower = np.zeros((T, 3))
         lower[rows, up] = -np.maximum(drop, over) * _ease((rows - a + 1) / (w + 1.0))
+        if follows:  # (and out to its last frame, which the motion after goes on from)
+            lower[rows, up] *= _ease((b - rows) / (w + 1.0))
         frames[:, cols] += np.linalg.lstsq(per, lower.T, rcond=None)[0].T
     moved = motion.with_frames(frames)
     held = (rows >= a + n_step) & (rows < (b - n_step if follows else b))
     worst = _solve_legs(moved, frames, legs, targets, rows, held, horiz, contacts.leg_length,
-                        bounds)
+                        bounds, motion.frames[b - 1])
     if worst > REACH_TOLERANCE:
         return f"the legs could not reach the closed stance: {worst:.2f} leg lengths short"
     return motion.with_frames(frames), gap_len, move
@@ -375,10 +382,11 @@ def _miss(got, tg, wt, clear) -> np.ndarray:
     return miss / np.where(clear > 0.1, 3.0, 1.0)[:, None]  # (in the air, off its path)
 
 
-def _solve_legs(moved, frames, legs, targets, rows, held, horiz, scale, bounds) -> float:
+def _solve_legs(moved, frames, legs, targets, rows, held, horiz, scale, bounds, end) -> float:
     """Both legs of ``moved`` (its root placed) solved onto their ``targets`` on ``rows``,
-    written into ``frames``; the held frames kept on the landing's foot points.  Returns
-    the worst miss (leg lengths; a foot in the air and a toe weigh less)."""
+    written into ``frames``; the held frames kept on the landing's foot points, the
+    opening step ending on the stand's own last pose ``end`` (a frame of channel values).
+    Returns the worst miss (leg lengths; a foot in the air and a toe weigh less)."""
     from .._kinematics import world_transforms
     from .footlock import _box, _LegIK, _solve
 
@@ -422,34 +430,52 @@ def _solve_legs(moved, frames, legs, targets, rows, held, horiz, scale, bounds) 
                     / scale)
         if late.any():
             worst = max(worst, _opening(moved, frames, ik, chain, pts, mrot, mpos, rows,
-                                        late, q[-1], tg, wt, clear, scale, bounds))
+                                        late, q[-1], tg, wt, clear, scale, bounds, end))
     return worst
 
 
 def _opening(moved, frames, ik, chain, pts, mrot, mpos, rows, late, prev, tg, wt, clear,
-             scale, bounds) -> float:
+             scale, bounds, end) -> float:
     """The opening step after the held frames, as solved with the closing one from the
     motion's own poses, but a frame that hops from the one before (a loose toe bent
     another way; a knee and ankle at the edge of the training range taking another
-    solution: a Bandai run's ankle turned 35 degrees in one frame, 2.4x its p99) solved
-    again from the frame before, turning at most :data:`OPENING_TURN` from it.  Written
-    into ``frames``; returns the worst miss of the step's frames (leg lengths)."""
+    solution: a Bandai run's ankle turned 35 degrees in one frame, 2.4x its p99), or
+    strays from the way to the stand's own last pose ``end`` (the legs the motion after
+    the stand goes on from), solved again within a box: at most :data:`OPENING_TURN`
+    from the frame before, and within reach of ``end`` at that rate.  Capped from the
+    frame before alone, a Bandai run's step lagged and its leg turned the rest of the
+    way into the frame after (1.36x its p99; 1.21x kept within reach of ``end``).
+    Written into ``frames``; returns the worst miss of the step's frames (leg lengths).
+    """
     from .footlock import _box, _LegIK, _solve
 
     cols = [c for _, _, c in ik.vars]
-    cap = OPENING_TURN * 30.0 / moved.fps
-    for i in np.flatnonzero(late):
+    idx = np.flatnonzero(late)
+    home = np.asarray(end, dtype=float)[cols]
+    # frames from the one before the step's first to the frame after the stand
+    n = rows[-1] + 1 - (rows[idx[0]] - 1)
+    rate = np.maximum(OPENING_TURN * 30.0 / moved.fps, np.abs(prev - home) / n)
+    for i in idx:
         row = rows[i : i + 1]
         got = frames[row[0], cols]
-        if np.abs(got - prev).max() > cap:
-            frames[row[0], cols] = prev
+        left = rows[-1] + 1 - row[0]  # frames to the one after the stand
+        lo = np.maximum(prev - rate, home - rate * left)
+        hi = np.minimum(prev + rate, home + rate * left)
+        if (got < lo).any() or (got > hi).any():
+            frames[row[0], cols] = np.clip(got, lo, hi)
             ik = _LegIK(moved.with_frames(frames), chain, pts, mrot, mpos)
             box = _box(ik, row, bounds) or (np.full((1, prev.size), -np.inf),
                                             np.full((1, prev.size), np.inf))
-            box = (np.maximum(box[0], prev - cap), np.minimum(box[1], prev + cap))
+            box = (np.clip(box[0], lo, hi), np.clip(box[1], lo, hi))
             got = _solve(ik, row, tg[i : i + 1], wt[i : i + 1], scale, box=box)[0]
             frames[row[0], cols] = got
         prev = got
+    # in the air, each frame a quarter of the way to its neighbours: re-solved within the
+    # box, a foot's loose roll hopped from edge to edge (8 degrees back and forth)
+    air = idx[(clear[idx] > 0.1) & (idx > idx[0]) & (idx < idx[-1])]
+    if air.size:
+        q = frames[np.ix_(rows, cols)]
+        frames[np.ix_(rows[air], cols)] = 0.25 * q[air - 1] + 0.5 * q[air] + 0.25 * q[air + 1]
     ik = _LegIK(moved.with_frames(frames), chain, pts, mrot, mpos)
     steps = rows[late]
     got = ik.positions(frames[np.ix_(steps, cols)], steps)
