@@ -299,6 +299,16 @@ def _own_accel(motion, rep: dict, spec: dict, refs: dict, paced: bool = False) -
     return worst
 
 
+def _root_accel(motion) -> np.ndarray:
+    """(T - 3,) horizontal acceleration of the root (m/s^2), its velocity first averaged
+    over three frames."""
+    from scipy.ndimage import uniform_filter1d
+
+    root = motion.positions().positions[:, 0][:, [0, 2]] * cc.rig.metres_per_unit(motion)
+    v = uniform_filter1d(np.diff(root, axis=0) * motion.fps, 3, axis=0, mode="nearest")
+    return np.linalg.norm(np.diff(v, axis=0), axis=1) * motion.fps
+
+
 def random_scripts(models: dict, d: Path, n: int, seed: int = 11) -> None:
     """``n`` seeded :func:`random_script` scripts, run as ``cyclecoord animate`` runs them
     and judged by their reports (against the models that made their frames; the largest
@@ -313,7 +323,10 @@ def random_scripts(models: dict, d: Path, n: int, seed: int = 11) -> None:
 
     rng = np.random.default_rng(seed)
     refs = {k: source_figures(training_takes(models, [k]), 30.0) for k in models}
+    # (the joint measure is relative to the root: a root that lurches is not in it)
+    root99 = max(float(np.percentile(_root_accel(t), 99)) for t in training_takes(models))
     acc, paced, slip, frozen, limbs, failed, worst = [], [], [], 0, 0, 0, []
+    lurch = []
     for i in range(n):
         path = d / f"random_{i}.json"
         path.write_text(json.dumps(random_script(models, rng)))
@@ -330,6 +343,7 @@ def random_scripts(models: dict, d: Path, n: int, seed: int = 11) -> None:
         frozen += bool(q.get("freezes"))
         limbs += bool((rep.get("plausibility") or {}).get("new_contact_frames"))
         worst.append((acc[-1], i))
+        lurch.append((float(_root_accel(motion).max()) / root99, i))
     acc, slip = np.array(acc), np.array(slip)
     top = ", ".join(f"#{i} {a:.2f}x" for a, i in sorted(worst, reverse=True)[:3])
     over = [f"#{i} {a:.2f}x" for a, i in sorted(paced, reverse=True) if a > 1.5]
@@ -339,6 +353,10 @@ def random_scripts(models: dict, d: Path, n: int, seed: int = 11) -> None:
           f"{' (' + ', '.join(over[:3]) + ')' if over else ''}; slip over 1.5x the "
           f"sources' on {int((slip > 1.5).sum())}; a freeze outside IDLE on {frozen}; new "
           f"limb contacts (refused by animate) on {limbs}; failed {failed}")
+    big = sorted((x for x in lurch if x[0] > 2.0), reverse=True)
+    print(f"    root acceleration (horizontal, not in the joint measure) over 2x the takes' p99 "
+          f"({root99:.1f} m/s^2) on {len(big)}"
+          f"{' (' + ', '.join(f'#{i} {a:.2f}x' for a, i in big[:3]) + ')' if big else ''}")
 
 
 def stops(models: dict, d: Path, n: int = 12) -> None:
