@@ -143,6 +143,11 @@ class CommandGraph:
         return (poly, [-1] + list(path[1:-1]) + [-1]) if nodes else poly
 
 
+def _paced(root: dict[str, np.ndarray], pace: np.ndarray) -> dict[str, np.ndarray]:
+    """``root`` with its travel and turn scaled by ``pace`` ``(T,)``."""
+    return {**root, "velocity": root["velocity"] * pace[:, None], "turn": root["turn"] * pace}
+
+
 @dataclass
 class _Chunk:
     model: str
@@ -168,6 +173,9 @@ class _Chunk:
     #: when a frame there is pulled (computing them on every hop cost 8 % of a script's
     #: time); None elsewhere
     targets: Callable[[], tuple[np.ndarray, np.ndarray]] | None = None
+    #: ``(T,)`` how fast the particle's path plays the training takes' time (0 at rest,
+    #: 1 at the captured pace): the root's own travel and turn scale with it; None: 1
+    pace: np.ndarray | None = None
 
 
 @dataclass
@@ -404,6 +412,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         ride: bool = False,
         detail: dict[str, np.ndarray] | None = None,
         sway: float = 1.0,
+        pace: np.ndarray | None = None,
     ) -> None:
         m = self._need_start("moving")
         self._cursor, self._next_cursor = self._next_cursor, None
@@ -417,9 +426,11 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         if detail is not None:
             pose = pose + detail["angles"]
             root = {k: root[k] + detail[k] for k in root}
+        if pace is not None:
+            root = _paced(root, pace)
         self._emit(
             self.current, X, pose, root, particle=True, detail=detail,
-            path=None if detail is None else np.array(path[1:], dtype=float),
+            path=None if detail is None else np.array(path[1:], dtype=float), pace=pace,
         )
         self.sim_seconds += time.perf_counter() - t0
         self.sim_cpu_seconds += time.process_time() - c0
@@ -443,48 +454,6 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             self.clamped["max_deg"] = max(self.clamped["max_deg"], float(over.max(initial=0.0)))
         return clipped
 
-    def _mix(
-        self, src: str, to: str, a: np.ndarray, b: np.ndarray, w: np.ndarray
-    ) -> np.ndarray:
-        """``(1 - w) a + w b`` of model ``src``'s angles ``a`` and model ``to``'s ``b``
-        (each ``(T, C)``, ``w`` ``(T,)``), in ``to``'s chart, each joint's rotation
-        slerped: linear in the rig's channels elsewhere.
-
-        Linear in ``to``'s chart, a joint ``to`` models about its mean rotation mixed a
-        pose far from that mean written in it, whose Euler angles there flip from frame
-        to frame: at the Bandai walk-run hop the right elbow swung 17 degrees a frame
-        with the run's weight at 0.05 and the hand accelerated 2.3x the run's 99th
-        percentile."""
-        from scipy.spatial.transform import Rotation
-
-        from ...conventions import continuous_euler
-
-        ma, mb = self.models[src], self.models[to]
-        ca, cb = ma.to_channels(a), mb.to_channels(b)
-        w = np.asarray(w, dtype=float).reshape(-1)
-        out = (1.0 - w[:, None]) * ca + w[:, None] * cb
-        by_order: dict[str, list[np.ndarray]] = {}
-        for idx, order in mb.rotation_columns():
-            by_order.setdefault(order, []).append(idx)
-        T = len(w)
-        for order, cols in by_order.items():  # the joints of one Euler order at once
-            idx = np.array(cols)  # (J, 3)
-            Ra = Rotation.from_euler(order, ca[:, idx].reshape(-1, 3), degrees=True)
-            Rb = Rotation.from_euler(order, cb[:, idx].reshape(-1, 3), degrees=True)
-            step = (Ra.inv() * Rb).as_rotvec()
-            R = Ra * Rotation.from_rotvec(np.repeat(w, len(cols))[:, None] * step)
-            # the Euler solution nearest the first pose's, continuous over the blend
-            out[:, idx] = continuous_euler(R.as_matrix().reshape(T, len(cols), 3, 3), order,
-                                           ca[0, idx])
-        return mb.to_model(out)
-
-    def _into(self, src: str, to: str, angles: np.ndarray) -> np.ndarray:
-        """Model ``src``'s angles ``(T, C)`` in model ``to``'s chart: the same rotations
-        (:meth:`~.model.LatentModel.chart`), so a blend mixes like with like."""
-        if src == to:
-            return angles
-        return self.models[to].to_model(self.models[src].to_channels(angles))
-
     def _emit(
         self,
         name,
@@ -496,13 +465,14 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         detail=None,
         path=None,
         targets=None,
+        pace=None,
     ) -> None:
         if name in self._size_notes:  # said once a model's frames are made
             self.notes.append(self._size_notes.pop(name))
         if clip:
             angles = self._clip(name, angles)
         self.chunks.append(
-            _Chunk(name, X, angles, root, self.command, particle, detail, path, targets)
+            _Chunk(name, X, angles, root, self.command, particle, detail, path, targets, pace)
         )
         self.t += X.shape[0] / self.fps
 
@@ -571,7 +541,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         ``duration`` sets the whole.  The particle speeds up over ``ease`` seconds only
         when it starts from rest and slows down only with ``stop``
         (a script passes ``stop=False`` when a MOVE or TRANSITION follows), so a chain of
-        MOVEs flows through its waypoints.  A MOVE ahead that stops ends where both feet
+        MOVEs flows through its waypoints; the root's own travel and turn go at the
+        same pace (``_Chunk.pace``).  A MOVE ahead that stops ends where both feet
         are down, the nearest such phase of the gait within a quarter of a cycle of the
         asked seconds (:meth:`~.stepping.GaitMixin.stop_ahead`; ``at_stance=False``:
         exactly the seconds asked).  From a stepping particle, a MOVE to a training frame
@@ -620,6 +591,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
                     need = self.blend_frames(self.current, self.current, self.x, goal) / self.fps
                     if times[-1] < need:
                         times = times * (need / max(times[-1], 1e-12))
+        captured = times[-1]  # (the path's seconds at the training takes' pace)
         times = times / speed
         if duration is not None:
             if not (
@@ -650,7 +622,11 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         detail = None
         if along is not None:
             detail = {k: interp_rows(u, times, v)[1:] for k, v in along.items()}
-        self._run(samples, radius, ride=True, detail=detail)
+        # the root travels and turns at the pace the poses play the takes: easing in
+        # from rest, it had the captured speed at once (a run from an IDLE lurched from
+        # 0 to 3.5 m/s in two frames, its planted foot dragged and snapped free)
+        pace = np.diff(u) * self.fps * (captured / max(times[-1], 1e-12))
+        self._run(samples, radius, ride=True, detail=detail, pace=pace)
         self._stepping = stepped is not None or (isinstance(to, dict) and "ahead" in to)
 
     def idle(
@@ -703,6 +679,17 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             if len(points) == 1:  # (between several poses the legs move on purpose)
                 self.stands.append((first, self.n_frames))
 
+    def _stopping(self, n: int) -> np.ndarray:
+        """``(n,)`` pace of an IDLE's frames: the root's own travel goes on from the
+        pace the frames before it had (a MOVE that stops eases its pace to 0, a blend's
+        is 1) and eases to 0 over :data:`~cyclecoord.synthesis.carry.STAND_AFTER` s."""
+        from ..carry import STAND_AFTER
+
+        last = self.chunks[-1] if self.chunks else None
+        before = 1.0 if last is None or last.pace is None else float(last.pace[-1])
+        u = np.clip(np.arange(1, n + 1) / max(1.0, STAND_AFTER * self.fps), 0.0, 1.0)
+        return before * (1.0 - u * u * (3.0 - 2.0 * u))
+
     def _idle(self, points, end: float, radius, hover: float, sway: float = 1.0) -> None:
         duration = end - self.t
         while self.t < end - 0.5 / self.fps:
@@ -716,7 +703,8 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             n = max(
                 1, int(round(min(hover if len(points) > 1 else duration, end - self.t) * self.fps))
             )
-            self._run(np.repeat(p[None, :], n + 1, axis=0), radius, sway=sway)
+            self._run(np.repeat(p[None, :], n + 1, axis=0), radius, sway=sway,
+                      pace=self._stopping(n))
 
     def play(self, segment: str, start: float = 0.0, stop: float | None = None) -> None:
         """PLAY a training segment of the current model as it was (seconds ``start..stop``)."""

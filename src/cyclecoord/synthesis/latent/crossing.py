@@ -305,6 +305,48 @@ class CrossingMixin:
         k = int(m.nearest_frame(self.x[None])[0])
         return bool(np.isin(g.segments[k], g.usable) and np.isfinite(g.phase[k]))
 
+    def _mix(
+        self, src: str, to: str, a: np.ndarray, b: np.ndarray, w: np.ndarray
+    ) -> np.ndarray:
+        """``(1 - w) a + w b`` of model ``src``'s angles ``a`` and model ``to``'s ``b``
+        (each ``(T, C)``, ``w`` ``(T,)``), in ``to``'s chart, each joint's rotation
+        slerped: linear in the rig's channels elsewhere.
+
+        Linear in ``to``'s chart, a joint ``to`` models about its mean rotation mixed a
+        pose far from that mean written in it, whose Euler angles there flip from frame
+        to frame: at the Bandai walk-run hop the right elbow swung 17 degrees a frame
+        with the run's weight at 0.05 and the hand accelerated 2.3x the run's 99th
+        percentile."""
+        from scipy.spatial.transform import Rotation
+
+        from ...conventions import continuous_euler
+
+        ma, mb = self.models[src], self.models[to]
+        ca, cb = ma.to_channels(a), mb.to_channels(b)
+        w = np.asarray(w, dtype=float).reshape(-1)
+        out = (1.0 - w[:, None]) * ca + w[:, None] * cb
+        by_order: dict[str, list[np.ndarray]] = {}
+        for idx, order in mb.rotation_columns():
+            by_order.setdefault(order, []).append(idx)
+        T = len(w)
+        for order, cols in by_order.items():  # the joints of one Euler order at once
+            idx = np.array(cols)  # (J, 3)
+            Ra = Rotation.from_euler(order, ca[:, idx].reshape(-1, 3), degrees=True)
+            Rb = Rotation.from_euler(order, cb[:, idx].reshape(-1, 3), degrees=True)
+            step = (Ra.inv() * Rb).as_rotvec()
+            R = Ra * Rotation.from_rotvec(np.repeat(w, len(cols))[:, None] * step)
+            # the Euler solution nearest the first pose's, continuous over the blend
+            out[:, idx] = continuous_euler(R.as_matrix().reshape(T, len(cols), 3, 3), order,
+                                           ca[0, idx])
+        return mb.to_model(out)
+
+    def _into(self, src: str, to: str, angles: np.ndarray) -> np.ndarray:
+        """Model ``src``'s angles ``(T, C)`` in model ``to``'s chart: the same rotations
+        (:meth:`~.model.LatentModel.chart`), so a blend mixes like with like."""
+        if src == to:
+            return angles
+        return self.models[to].to_model(self.models[src].to_channels(angles))
+
     def _hop(self, src: str, to: str, blend: float, radius: float | None, hops) -> None:
         """One crossing from the current model ``src`` into ``to``."""
         m1, m2 = self.models[src], self.models[to]
