@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import cyclecoord as cc
-from _gait_models import gait_pair  # tests/ is on the path (rootdir conftest)
+from _bench import load_bench  # tests/ is on the path (rootdir conftest)
+from _gait_models import gait_pair
 from cyclecoord.synthesis.carry import STAND_AFTER
 from cyclecoord.synthesis.latent import Synthesizer
 
@@ -19,12 +19,8 @@ def models():
 
 
 def _root_accel(motion) -> np.ndarray:
-    """Horizontal root acceleration (m/s^2), velocity averaged over three frames."""
-    from scipy.ndimage import uniform_filter1d
-
-    root = motion.positions().positions[:, 0][:, [0, 2]] * cc.rig.metres_per_unit(motion)
-    v = uniform_filter1d(np.diff(root, axis=0) * motion.fps, 3, axis=0, mode="nearest")
-    return np.linalg.norm(np.diff(v, axis=0), axis=1) * motion.fps
+    """Horizontal root acceleration (m/s^2): the latent benchmark's diagnostic."""
+    return load_bench("bench_latent_gait")._root_accel(motion)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

@@ -35,7 +35,7 @@ from .crossing import (  # noqa: F401  (re-exported: the module's names before t
     Crossings,
     Point,
 )
-from .easing import eased, resample, smootherstep, smoothstep  # noqa: F401
+from .easing import eased, paced_root, resample, smootherstep, smoothstep  # noqa: F401
 from .gplvm import sqdist
 from .model import LatentModel
 from .output import (  # noqa: F401
@@ -141,11 +141,6 @@ class CommandGraph:
             g.remove_nodes_from(["a", "b"])
         poly = np.vstack([a] + [X[k] for k in path[1:-1]] + [b])
         return (poly, [-1] + list(path[1:-1]) + [-1]) if nodes else poly
-
-
-def _paced(root: dict[str, np.ndarray], pace: np.ndarray) -> dict[str, np.ndarray]:
-    """``root`` with its travel and turn scaled by ``pace`` ``(T,)``."""
-    return {**root, "velocity": root["velocity"] * pace[:, None], "turn": root["turn"] * pace}
 
 
 @dataclass
@@ -427,7 +422,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             pose = pose + detail["angles"]
             root = {k: root[k] + detail[k] for k in root}
         if pace is not None:
-            root = _paced(root, pace)
+            root = paced_root(root, pace)
         self._emit(
             self.current, X, pose, root, particle=True, detail=detail,
             path=None if detail is None else np.array(path[1:], dtype=float), pace=pace,

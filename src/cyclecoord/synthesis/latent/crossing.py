@@ -18,7 +18,7 @@ import numpy as np
 from ..._words import plural
 from ...errors import ParameterError
 from .bridges import DEFAULT_THRESHOLD, Bridges, check_compatible, find_bridges
-from .easing import mix_rows, smootherstep
+from .easing import mix_rows, paced_root, smootherstep, smoothstep
 from .influence import pose_points
 from .particle import simulate
 
@@ -277,9 +277,26 @@ class CrossingMixin:
             self._hop(a, b, blend, radius, hops)
         if standing:
             self.stood.append((first, self.n_frames))
+            self._set_off(first)
             if not across:
                 self.notes.append(f"commands[{self.command}] TRANSITION {src} -> {to}: crossed "
                                   "while both models idle" + _STOOD)
+
+    def _set_off(self, first: int) -> None:
+        """The frames from ``first`` on, a crossing made standing, set off from rest: their
+        chunks' pace rises from 0 to 1 (smoothstep) over them, their root's travel and
+        turn with it (read from the pose, a standing figure in a running pose went with a
+        run's speed: after an IDLE, a Bandai run -> walk crossing lurched from 0.03 to 1.5
+        m/s in two frames, its feet gliding with it)."""
+        ramp = smoothstep(self.n_frames - first)
+        start = 0
+        for c in self.chunks:
+            k = c.X.shape[0]
+            if start >= first:
+                seg = ramp[start - first : start - first + k]
+                c.root = paced_root(c.root, seg)
+                c.pace = seg if c.pace is None else c.pace * seg
+            start += k
 
     def _standing(self) -> bool:
         """Whether the figure stands before a crossing while both models idle: the

@@ -1,11 +1,12 @@
-"""Curves for commands: blend weights rising smoothly, eased arc-length fractions, and
-polylines resampled at constant speed (used by :mod:`.commands`)."""
+"""Curves for commands: blend weights rising smoothly, eased arc-length fractions, a
+root's travel scaled by its pace, and polylines resampled at constant speed (used by
+:mod:`.commands`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["smootherstep", "smoothstep", "eased", "mix_rows", "resample"]
+__all__ = ["smootherstep", "smoothstep", "eased", "mix_rows", "paced_root", "resample"]
 
 
 def smootherstep(n: int) -> np.ndarray:
@@ -42,6 +43,12 @@ def eased(n: int, ramp: int, ramp_out: int | None = None) -> np.ndarray:
     v = np.minimum(rise * rise * (3 - 2 * rise), fall * fall * (3 - 2 * fall))
     c = np.concatenate([[0.0], np.cumsum(v)])
     return c / c[-1]
+
+
+def paced_root(root: dict[str, np.ndarray], pace: np.ndarray) -> dict[str, np.ndarray]:
+    """A latent root motion (``velocity`` ``(T, 2)``, ``turn`` ``(T,)``, ...) with its
+    travel and turn scaled by ``pace`` ``(T,)`` (how fast its frames play the takes)."""
+    return {**root, "velocity": root["velocity"] * pace[:, None], "turn": root["turn"] * pace}
 
 
 def resample(points: np.ndarray, step: float) -> np.ndarray:

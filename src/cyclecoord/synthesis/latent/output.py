@@ -90,11 +90,10 @@ class OutputMixin(UntangleMixin):
             from ..carry import _moving
 
             turn = turn * _moving(self.hold_mask(T), self.fps)
-        go = self._setting_off(T)
-        theta = np.concatenate([[0.0], np.cumsum(turn * 0.5 * (go[1:] + go[:-1])) / self.fps])
+        theta = np.concatenate([[0.0], np.cumsum(turn) / self.fps])
         head = heading_matrix(theta)
         step = np.zeros((T, 3))
-        step[:, 0], step[:, 2] = go * root["velocity"][:, 0], go * root["velocity"][:, 1]
+        step[:, 0], step[:, 2] = root["velocity"][:, 0], root["velocity"][:, 1]
         world = np.einsum("tab,tb->ta", head, step) / self.fps
         pos = np.concatenate([np.zeros((1, 3)), np.cumsum(world[:-1], axis=0)])
         pos[:, 1] = root["height"]
@@ -121,20 +120,6 @@ class OutputMixin(UntangleMixin):
             skeleton=first.skeleton_,
             source="synthetic:latent",
         )
-
-    def _setting_off(self, n_frames: int) -> np.ndarray:
-        """(T,) factor on the root's own travel and turn: 1, but on the frames of each
-        crossing made standing (``stood``) easing up from 0 at its first frame to 1 at
-        its last.  The models' root velocity is read from the pose, and a standing figure
-        in a running pose went with a run's speed: after an IDLE, a Bandai run -> walk
-        crossing lurched from 0.03 to 1.5 m/s in two frames, its feet gliding with it."""
-        go = np.ones(n_frames)
-        for a, b in self.stood:
-            b = min(b, n_frames)
-            if b > a:
-                u = (np.arange(a, b) - a + 1.0) / (b - a + 1.0)
-                go[a:b] = u * u * (3.0 - 2.0 * u)
-        return go
 
     def _stand_legs(self, angles: np.ndarray) -> np.ndarray:
         """``angles`` ``(T, C)`` with the legs of each IDLE at one pose (a stand; an IDLE
