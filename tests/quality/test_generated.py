@@ -960,3 +960,34 @@ def test_strides_are_judged_where_the_motion_does_not_stand_as_asked():
     np.testing.assert_allclose(q2.knee_range, measure_generated(mostly, [walk]).knee_range)
     assert f"stands on {len(stand)} of its {mostly.n_frames} frames, as asked" in "\n".join(
         q2.summary())
+
+
+def test_the_roots_own_lurch_is_a_pop_the_joints_cannot_see():
+    """Sources walking at 1 unit/s give or take 0.2 at 1 Hz: their root accelerates at
+    most 0.2 * 2 pi units/s^2 (times sin(6 w / 2) / (6 sin(w / 2)), w = 2 pi / 64: the
+    average over 0.1 s, 6 frames at 64 fps, of a 64-frame sine).  The same legs standing
+    for 32 frames, then at 1 unit/s from one frame to the next: averaged over 6 frames
+    the speed takes a sixth of it a frame, 64 / 6 units/s^2 on six steps (reported
+    within them: equal but for rounding).  The joints, measured against the root, are
+    the sources' own (1x)."""
+    src, knees, _ = _knee_sources()
+    tz = src.channels.index(("root", "tz"))
+    t = np.arange(128) / 64
+    f = src.frames.copy()
+    f[:, knees] = 10 * np.sin(2 * np.pi * t)[:, None]
+    f[:, tz] = t - 0.2 * np.cos(2 * np.pi * t) / (2 * np.pi)  # speed 1 + 0.2 sin
+    sources = [src.with_frames(f)]
+    g = f.copy()
+    g[:, tz] = np.maximum(np.arange(128) - 32, 0) / 64
+    q = measure_generated(src.with_frames(g), sources)
+    w = 2 * np.pi / 64
+    peak = 0.2 * 2 * np.pi * np.sin(3 * w) / (6 * np.sin(w / 2))
+    assert q.largest_root_accel == pytest.approx((64 / 6) / peak, rel=0.02)
+    assert 28 <= q.largest_root_accel_frame <= 35
+    assert q.largest_accel == pytest.approx(1.0, abs=0.02)
+    assert any(f"root acceleration {q.largest_root_accel:.2f}x" in s for s in q.summary())
+    assert q.to_dict()["largest_root_accel_ratio"] == pytest.approx(q.largest_root_accel,
+                                                                     rel=1e-3)
+    # the sources themselves: 1x
+    assert measure_generated(sources[0], sources).largest_root_accel == pytest.approx(
+        1.0, rel=0.02)

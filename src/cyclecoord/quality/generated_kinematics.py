@@ -17,6 +17,10 @@ from .legs import Legs, find_legs, legs_of_feet
 
 #: Window of the root speed, seconds.
 ROOT_WINDOW = 0.5
+#: Seconds the root's horizontal velocity is averaged over before its acceleration is
+#: taken (3 frames at 30 fps; at 120 fps a 3-frame average left the frame-to-frame
+#: jitter of a graph walk's carried root, 1.1-2.2 m/s from one frame to the next).
+ROOT_ACCEL_WINDOW = 0.1
 #: A take's frames count as moving where its pose speed, averaged over a second, is at
 #: least this fraction of that average's 90th percentile (:func:`_moving`): the sources'
 #: root speed, support foot, pose speeds and accelerations are theirs while they move.
@@ -114,6 +118,17 @@ class _Kin:
         if r.shape[0] <= k:
             k = max(1, r.shape[0] - 1)
         return np.linalg.norm(r[k:] - r[:-k], axis=-1) * self.fps / k
+
+    def root_accel(self) -> np.ndarray:
+        """(T-2,) horizontal root acceleration (units/s^2), its velocity averaged over
+        :data:`ROOT_ACCEL_WINDOW`: the root's own lurches, which :meth:`accel`
+        (relative to the root) does not see."""
+        from scipy.ndimage import uniform_filter1d
+
+        v = np.diff(self.pos[:, 0, :][:, [0, 2]], axis=0) * self.fps
+        k = max(1, int(round(ROOT_ACCEL_WINDOW * self.fps)))
+        v = uniform_filter1d(v, k, axis=0, mode="nearest")
+        return np.linalg.norm(np.diff(v, axis=0), axis=-1) * self.fps
 
     def cycle(self) -> float:
         """Leg cycle in seconds (NaN when too short or aperiodic)."""
