@@ -156,6 +156,8 @@ def _fmt(d: dict) -> list[str]:
         f"{knee[0]:.0f} / {knee[1]:.0f}",
         f"{ratio:.2f}",
         f"{d['largest_accel_ratio']:.2f}",
+        "-" if d.get("largest_root_accel_ratio") is None
+        else f"{d['largest_root_accel_ratio']:.2f}",
         f"{d['cadence_ratio']:.2f}" if d["cadence_ratio"] is not None else "-",
         f"{d['root_speed_m_per_s']:.2f}",
         "-" if d["limb_frames"] is None else str(d["limb_frames"]),
@@ -163,7 +165,7 @@ def _fmt(d: dict) -> list[str]:
 
 
 HEAD = ["method", "slip m/s", "freezes (longest)", "knee p99 L / R", "knee,hip range",
-        "accel / p99", "cycle ratio", "root m/s", "limb frames"]
+        "accel / p99", "root acc / p99", "cycle ratio", "root m/s", "limb frames"]
 
 
 def _span(values: list[str]) -> str:

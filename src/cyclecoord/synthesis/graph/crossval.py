@@ -554,6 +554,7 @@ def _long_row(ev, space, train, take, field_, start, n, integrator, step_scale) 
     from ...errors import CycleCoordError
     from ...quality.generated import measure_generated
     from ..carry import carry_by_feet
+    from .model import CARRY_SMOOTH
     from .paths import root_trajectory
 
     path = follow_field(field_, start, n, integrator, step_scale)
@@ -562,7 +563,7 @@ def _long_row(ev, space, train, take, field_, start, n, integrator, step_scale) 
     row["frames"] = n
     try:
         root = root_trajectory(train, path, take, 0)
-        motion = carry_by_feet(space.motion(path.points, train[0], root))
+        motion = carry_by_feet(space.motion(path.points, train[0], root), smooth=CARRY_SMOOTH)
         q = measure_generated(motion, train)
     except CycleCoordError as exc:
         row["not_measured"] = str(exc)
@@ -608,8 +609,9 @@ def _phase_row(method, ev, space, train, take, dims, k, integrator, step_scale, 
         lrow["frames"] = n * int(horizon)
         try:
             from ..carry import carry_by_feet
+            from .model import CARRY_SMOOTH
 
-            q = measure_generated(carry_by_feet(long_gen.motion), train)
+            q = measure_generated(carry_by_feet(long_gen.motion, smooth=CARRY_SMOOTH), train)
             lrow.update(longest_freeze_s=q.longest_freeze_s,
                         freezes=[list(f) for f in q.freezes],
                         support_slip=q.support_slip, slip_ratio=q.slip_ratio)
