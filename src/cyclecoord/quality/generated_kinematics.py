@@ -18,8 +18,8 @@ from .legs import Legs, find_legs, legs_of_feet
 #: Window of the root speed, seconds.
 ROOT_WINDOW = 0.5
 #: Seconds the root's horizontal velocity is averaged over before its acceleration is
-#: taken (3 frames at 30 fps; at 120 fps a 3-frame average left the frame-to-frame
-#: jitter of a graph walk's carried root, 1.1-2.2 m/s from one frame to the next).
+#: taken: 3 frames at 30 fps, the same time at any rate (a window in frames would judge
+#: a 120 fps motion and its captures over 25 ms, where their frame-to-frame noise lies).
 ROOT_ACCEL_WINDOW = 0.1
 #: A take's frames count as moving where its pose speed, averaged over a second, is at
 #: least this fraction of that average's 90th percentile (:func:`_moving`): the sources'
