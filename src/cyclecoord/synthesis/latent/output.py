@@ -9,6 +9,7 @@ import numpy as np
 
 from ...errors import ParameterError
 from ...motion import Motion
+from .easing import paced_root
 from .model import heading_matrix
 from .untangle import POP_SOFTEN, UntangleMixin
 
@@ -264,13 +265,12 @@ class OutputMixin(UntangleMixin):
                     P[a:b] += c.detail["angles"]
                     for key in keys:
                         R[key][a:b] += c.detail[key]
-                if c.pace is not None:
-                    R["velocity"][a:b] *= c.pace[:, None]
-                    R["turn"][a:b] *= c.pace
             A = self._clip(chunks[i].model, P, count=False)
             for n, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
                 angles[i + n] = A[a:b]
                 roots[i + n] = {key: R[key][a:b] for key in keys}
+                if chunks[i + n].pace is not None:  # (travel at the chunk's pace)
+                    roots[i + n] = paced_root(roots[i + n], chunks[i + n].pace)
             i = j + 1
         angles, roots = self._fade_detail(angles, roots)
         if pull is not None:
