@@ -148,6 +148,30 @@ def test_stands_out_of_reach_are_left_alone(models):
     assert out.to_dict() == [{"start": a, "closed": False, "why": why}]
 
 
+def test_a_step_that_pops_is_not_made(models):
+    """With a ``limit``, a step that takes a frame past it (and past the motion given) is
+    not made: a Bandai walk's knee, held straight at its bound for three frames of a
+    closing step, bent 30 degrees in the next (2.0x its p99)."""
+    from cyclecoord.synthesis.carry import _accel
+
+    feet = Synthesizer(models, fps=30, seed=0).feet_of(models["walk"].training_motion())
+    syn, _ = stop(models, "walk", 0)
+    motion = syn._untangled()
+    free = close_stands(motion, feet, syn.stands, cycle=1.1)
+    assert free.closed  # (this stand's step is made without a limit)
+    a, b = syn.stands[0]
+    given, stepped = _accel(motion), _accel(free.motion)
+    # a limit the step stays under where it moves the frames, and one it passes
+    roomy = close_stands(motion, feet, syn.stands, cycle=1.1, limit=1.01 * stepped.max())
+    assert roomy.closed and np.array_equal(roomy.motion.frames, free.motion.frames)
+    tight = np.maximum(given, 1e-9)  # (the motion given's own: any rise of over 5 % is past it)
+    assert (stepped[a - 1 : b + 2] > 1.05 * given[a - 1 : b + 2]).any()
+    out = close_stands(motion, feet, syn.stands, cycle=1.1, limit=tight)
+    assert out.motion is motion and not out.closed
+    (first, why), = out.kept
+    assert first == a and "its step made a joint accelerate" in why
+
+
 def test_the_benchmark_reports_how_far_apart_a_stop_stands(models, tmp_path, capsys):
     """``bench_latent_gait.stops`` prints the ankles' distance at the stand's end (it
     crashed on its first run: a name reused for the folder)."""

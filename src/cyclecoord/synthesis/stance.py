@@ -134,6 +134,7 @@ def close_stands(
     references: list[Motion] | None = None,
     plausibility_cache: dict | None = None,
     analysed: bool = False,
+    limit: float | np.ndarray | None = None,
 ) -> StandOutcome:
     """Close the feet of each stand that follows a stride (see the module's text).
 
@@ -158,6 +159,11 @@ def close_stands(
         (:func:`~cyclecoord.quality.plausibility.check_plausibility`'s ``cache``).
     analysed : bool, default False
         ``motion`` and ``references`` are in the analysis rig (a latent model's are).
+    limit : float or ndarray of shape (T,), optional
+        Joint acceleration relative to the root (length units/s^2, as
+        :func:`~cyclecoord.synthesis.carry.lock_where_clean` takes it): a step that takes a
+        frame past it, and past what the motion given had there, is not made (the stand
+        keeps its stance).  Without it no acceleration is checked.
 
     Returns
     -------
@@ -194,6 +200,9 @@ def close_stands(
             if got:
                 kept.append((a, got))
             continue
+        if limit is not None and (why := _pops(out, got[0], limit, a, b)):
+            kept.append((a, why))
+            continue
         if references:
             from .carry import _crossed
 
@@ -207,6 +216,25 @@ def close_stands(
         closed.append((a, b))
         gaps.append(gap / contacts.leg_length)
     return StandOutcome(out, closed, kept, gaps)
+
+
+def _pops(given: Motion, stepped: Motion, limit, a: int, b: int) -> str:
+    """Why the step of the stand ``[a, b)`` is not made when it takes a frame from the
+    stand's to two after it past ``limit`` and past the motion given there ("" when it
+    does not).  The legs' solve can meet a joint's range at the end of a near-straight
+    leg and leave it in one frame: a Bandai walk's knee held straight at its bound for
+    three frames of a closing step bent 30 degrees in the next (2.0x its p99)."""
+    from .carry import _accel
+
+    lo, hi = max(0, a - 1), min(b + 2, given.n_frames)
+    before, after = _accel(given)[lo:hi], _accel(stepped)[lo:hi]
+    lim = np.broadcast_to(np.asarray(limit, dtype=float), (given.n_frames,))[lo:hi]
+    bad = np.flatnonzero((after > lim) & (after > 1.05 * before))
+    if not bad.size:
+        return ""
+    k = int(bad[np.argmax(after[bad] / lim[bad])])
+    return (f"its step made a joint accelerate {after[k] / lim[k]:.1f}x the limit at frame "
+            f"{lo + k}")
 
 
 def _close_one(motion, contacts, legs, layout, a, b, n_step, bounds):

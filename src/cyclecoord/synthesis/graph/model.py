@@ -384,7 +384,8 @@ class MotionGraphSynth:
 
     def _closed(self, motion: Motion, stand: tuple[int, int], notes: list[str]) -> Motion:
         """``motion`` with the closing step of :mod:`~cyclecoord.synthesis.stance` over the
-        frames ``stand`` (the stop's fade, a gait cycle long) where its feet end apart."""
+        frames ``stand`` (the stop's fade, a gait cycle long) where its feet end apart, not
+        made where it would accelerate a joint past the pins' limit (``accel_limit_``)."""
         from ...errors import CycleCoordError
         from ...quality.legs import find_feet
         from ..carry import channel_bounds
@@ -395,7 +396,8 @@ class MotionGraphSynth:
         except CycleCoordError:
             return motion
         done = close_stands(motion, feet, [stand], cycle=(stand[1] - stand[0]) / motion.fps,
-                            bounds=channel_bounds(self.takes_), references=self.takes_)
+                            bounds=channel_bounds(self.takes_), references=self.takes_,
+                            limit=self.accel_limit_)
         if done.line:
             notes.append(done.line)
         return done.motion
