@@ -25,6 +25,8 @@ import networkx as nx
 import numpy as np
 
 from ...errors import ParameterError
+from ..carry import STAND_AFTER
+from . import easing
 from .bridges import Bridges
 from .crossing import (  # noqa: F401  (re-exported: the module's names before the split)
     APPROACH_SPEED,
@@ -408,6 +410,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         detail: dict[str, np.ndarray] | None = None,
         sway: float = 1.0,
         pace: np.ndarray | None = None,
+        settle: int | None = None,
     ) -> None:
         m = self._need_start("moving")
         self._cursor, self._next_cursor = self._next_cursor, None
@@ -417,6 +420,10 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         t0, c0 = time.perf_counter(), time.process_time()
         self.reserve(path.shape[0] - 1)
         X, V = simulate(m, path, self.x, self.v, self.fps, params, self.force, self.t, ride)
+        if settle is not None:  # (an IDLE's last frames: back to its pose at frame settle)
+            n = max(1, round(STAND_AFTER * self.fps))
+            u = min(1.0, 0.5 * (len(X) - 1) / n)  # (as far as its stand holds the legs)
+            X, V = easing.settle(X, V, X[min(settle, len(X) - 1)], n, u * u * (3 - 2 * u))
         pose, root = m.pose(X), self._root(m, X)
         if detail is not None:
             pose = pose + detail["angles"]
@@ -678,8 +685,6 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         """``(n,)`` pace of an IDLE's frames: the root's own travel goes on from the
         pace the frames before it had (a MOVE that stops eases its pace to 0, a blend's
         is 1) and eases to 0 over :data:`~cyclecoord.synthesis.carry.STAND_AFTER` s."""
-        from ..carry import STAND_AFTER
-
         last = self.chunks[-1] if self.chunks else None
         before = 1.0 if last is None or last.pace is None else float(last.pace[-1])
         u = np.clip(np.arange(1, n + 1) / max(1.0, STAND_AFTER * self.fps), 0.0, 1.0)
@@ -698,8 +703,15 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
             n = max(
                 1, int(round(min(hover if len(points) > 1 else duration, end - self.t) * self.fps))
             )
-            self._run(np.repeat(p[None, :], n + 1, axis=0), radius, sway=sway,
-                      pace=self._stopping(n))
+            path = np.repeat(p[None, :], n + 1, axis=0)
+            # one pose: the hover ends back at its first frame's, where the stand holds
+            # its legs (``_stand_legs``: in an IDLE under 1 s only part of the way, and
+            # the hover goes back as far), so the motion after goes on from them (the
+            # particle drifted 0.1 s of travel along a synthetic run's stride, and the
+            # legs eased out of the stand swapped their stride while the feet were
+            # pinned: a foot swept 0.4 m in 2 frames)
+            self._run(path, radius, sway=sway, pace=self._stopping(n),
+                      settle=0 if len(points) == 1 else None)
 
     def play(self, segment: str, start: float = 0.0, stop: float | None = None) -> None:
         """PLAY a training segment of the current model as it was (seconds ``start..stop``)."""

@@ -1,12 +1,14 @@
 """Curves for commands: blend weights rising smoothly, eased arc-length fractions, a
-root's travel scaled by its pace, and polylines resampled at constant speed (used by
-:mod:`.commands`)."""
+root's travel scaled by its pace, a particle's path settling back to a pose, and
+polylines resampled at constant speed (used by :mod:`.commands`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["smootherstep", "smoothstep", "eased", "mix_rows", "paced_root", "resample"]
+__all__ = [
+    "smootherstep", "smoothstep", "eased", "mix_rows", "paced_root", "resample", "settle",
+]
 
 
 def smootherstep(n: int) -> np.ndarray:
@@ -61,3 +63,15 @@ def resample(points: np.ndarray, step: float) -> np.ndarray:
     n = max(1, int(np.ceil(total / step)))
     u = np.linspace(0.0, total, n + 1)
     return np.stack([np.interp(u, s, points[:, k]) for k in range(points.shape[1])], axis=1)
+
+
+def settle(
+    X: np.ndarray, V: np.ndarray, target: np.ndarray, k: int, amount: float = 1.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Positions ``X`` and velocities ``V`` ``(T, q)`` eased ``amount`` of the way to
+    ``target`` (a smoothstep) over their last ``k`` frames (at most half of them), the
+    velocities as much towards 0."""
+    k = min(int(k), X.shape[0] // 2)
+    u = np.clip((np.arange(X.shape[0]) - (X.shape[0] - k)) / max(k - 1, 1), 0.0, 1.0)
+    w = amount * (u * u * (3.0 - 2.0 * u))[:, None]
+    return X + w * (np.asarray(target, dtype=float) - X), V * (1.0 - w)

@@ -520,7 +520,7 @@ class OutputMixin(UntangleMixin):
                 done = close_stands(
                     out, feet, self.stands, cycle=self._cycle_at(self.stands[0][0]),
                     bounds=channel_bounds(takes), references=takes,
-                    plausibility_cache=self._plausibility, analysed=True,
+                    plausibility_cache=self._plausibility, analysed=True, limit=limit,
                 )
                 if done.line:
                     self.notes.append(done.line)
