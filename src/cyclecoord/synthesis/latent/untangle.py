@@ -248,7 +248,7 @@ class UntangleMixin:
         on = self._on_path()
         limit = POP_PULL * self._frame_acc99(motion.n_frames)
         if not on.any():
-            return self._softened(motion, pull, whole, bump, limit, on)
+            return self._softened(motion, pull, whole, bump, limit)
         motion, popped = _rounds(
             motion, pull, on, limit, bump,
             lambda w, m: self._assemble(*self._posed(w, whole), like=m))
@@ -257,12 +257,13 @@ class UntangleMixin:
         if popped:
             self._note_pulled(popped, f"pops: {plural(len(popped), 'frame')} accelerating over "
                               f"{POP_PULL:g}x the training 99th percentile")
-        return self._softened(motion, pull, whole, bump, limit, on)
+        return self._softened(motion, pull, whole, bump, limit)
 
     def _softened(self, motion: Motion, pull: np.ndarray, whole: np.ndarray,
-                  bump: np.ndarray, limit: np.ndarray, on: np.ndarray) -> Motion:
+                  bump: np.ndarray, limit: np.ndarray) -> Motion:
         """``motion`` with a particle's frames off any gait's path (a MOVE to a point or
-        along the command graph, a crossing's approach) that accelerate over
+        along the command graph, a crossing's approach), or on one after
+        :meth:`_unpopped`'s pull, that accelerate over
         :data:`POP_PULL` times the training 99th percentile posed again from their latent
         path smoothed by a Gaussian of :data:`POP_SOFTEN` seconds, fully at the frame and
         easing off over the ``bump``, up to :data:`POP_ROUNDS` times while it helps.
@@ -271,10 +272,10 @@ class UntangleMixin:
         crossing's approach from an IDLE, 1.68x), and no captured pose at a phase is
         there to pull toward.  The pose stays a pose of the model (the path is smoothed
         in its latent space, not the joint angles)."""
-
-        off = np.repeat([c.particle and c.path is None and c.targets is None
-                         for c in self.chunks], [c.X.shape[0] for c in self.chunks])
-        off &= ~on
+        # (and a particle's frames along a gait's path that the pull toward the captured
+        # poses left over the limit: a Bandai run's toes at 1.54x on a held-out script)
+        off = np.repeat([c.particle and c.targets is None for c in self.chunks],
+                        [c.X.shape[0] for c in self.chunks])
         soften = np.zeros(motion.n_frames)
         motion, done = _rounds(
             motion, soften, off, limit, bump,
@@ -282,7 +283,7 @@ class UntangleMixin:
         if done:
             spans = sorted(done)
             where = f"frames {spans[0]}-{spans[-1]}" if len(spans) > 1 else f"frame {spans[0]}"
-            self.notes.append(f"pops: {plural(len(done), 'frame')} off the gaits' paths "
+            self.notes.append(f"pops: {plural(len(done), 'frame')} "
                               f"accelerating over {POP_PULL:g}x the training 99th percentile "
                               f"had their latent path smoothed ({where})")
         return motion
