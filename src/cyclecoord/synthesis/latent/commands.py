@@ -39,6 +39,7 @@ from .crossing import (  # noqa: F401  (re-exported: the module's names before t
 )
 from .easing import eased, paced_root, resample, smootherstep, smoothstep  # noqa: F401
 from .gplvm import sqdist
+from .idling import IDLE_SWAY, IdleMixin  # noqa: F401  (IDLE_SWAY: re-exported)
 from .model import LatentModel
 from .output import (  # noqa: F401
     LOCK_BLEND,
@@ -55,9 +56,6 @@ __all__ = ["CommandGraph", "Crossings", "Synthesizer", "resample", "smootherstep
 
 #: A latent target whose density proxy is below this lies outside the model.
 OUTSIDE_DENSITY = 0.05
-#: Share of the particle's random force while an IDLE hovers (its ``sway``): a stand
-#: sways, it does not step (see :meth:`Synthesizer.idle`).
-IDLE_SWAY = 0.3
 #: Joint angles may pass the training range by at most this fraction of it (eased).
 LIMIT_MARGIN = 0.1
 #: Path radius of a MOVE ahead along the gait, as a fraction of the particle's: on the
@@ -176,7 +174,7 @@ class _Chunk:
 
 
 @dataclass
-class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
+class Synthesizer(IdleMixin, CrossingMixin, OutputMixin, GaitMixin):
     """Runs commands over named latent models and collects the frames.
 
     Parameters
@@ -281,6 +279,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         # those of TRANSITIONs crossed standing (after an IDLE): asked still, not held
         self.stood: list[tuple[int, int]] = []
         self.stands: list[tuple[int, int]] = []  # those of IDLEs at one pose (legs held)
+        self.rests: dict[int, int] = {}  # a stand's first frame -> frames to its rest
         #: each stand after a stride: its closing step, or why none (:meth:`motion`)
         self.stand_steps: list[dict] = []
         self.notes: list[str] = []
@@ -410,7 +409,7 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         detail: dict[str, np.ndarray] | None = None,
         sway: float = 1.0,
         pace: np.ndarray | None = None,
-        settle: int | None = None,
+        settle: int | np.ndarray | None = None,
     ) -> None:
         m = self._need_start("moving")
         self._cursor, self._next_cursor = self._next_cursor, None
@@ -420,10 +419,11 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         t0, c0 = time.perf_counter(), time.process_time()
         self.reserve(path.shape[0] - 1)
         X, V = simulate(m, path, self.x, self.v, self.fps, params, self.force, self.t, ride)
-        if settle is not None:  # (an IDLE's last frames: back to its pose at frame settle)
+        if settle is not None:  # (an IDLE's last frames: back to a point, or its frame's)
             n = max(1, round(STAND_AFTER * self.fps))
             u = min(1.0, 0.5 * (len(X) - 1) / n)  # (as far as its stand holds the legs)
-            X, V = easing.settle(X, V, X[min(settle, len(X) - 1)], n, u * u * (3 - 2 * u))
+            to = X[min(settle, len(X) - 1)] if isinstance(settle, int) else settle
+            X, V = easing.settle(X, V, to, n, u * u * (3 - 2 * u))
         pose, root = m.pose(X), self._root(m, X)
         if detail is not None:
             pose = pose + detail["angles"]
@@ -630,88 +630,6 @@ class Synthesizer(CrossingMixin, OutputMixin, GaitMixin):
         pace = np.diff(u) * self.fps * (captured / max(times[-1], 1e-12))
         self._run(samples, radius, ride=True, detail=detail, pace=pace)
         self._stepping = stepped is not None or (isinstance(to, dict) and "ahead" in to)
-
-    def idle(
-        self, at: Any = None, duration: float = 1.0, radius: float | None = None,
-        hover: float = 1.0, sway: float | None = None,
-    ) -> None:
-        """IDLE within ``radius`` of one point (default: where the particle is) or several.
-
-        While it hovers the particle's random force is ``sway`` (default
-        :data:`IDLE_SWAY`) of the model's: a stand sways, it does not step.  At the full
-        force the particle wandered along a walk model's stride loop and the legs stepped
-        in place (pose speed 9-34 % of the walk's median); the pins that would hold the
-        feet then crossed the legs and were let go, and the feet glided (0.45 m/s on
-        subject 35's script seed 4 of 15; 0.32 m/s on a Bandai seed with two-cycle seam
-        fades).  At 0.3 no seed of 30 glides (at most 0.001 m/s) and the pose sways at
-        2-10 % of the walk's pose speed; ``sway=1`` gives the old behaviour.  Moves
-        between several IDLE points keep the full force."""
-        self._need_start("IDLE")
-        sway = IDLE_SWAY if sway is None else sway
-        if not (
-            isinstance(sway, (int, float)) and not isinstance(sway, bool)
-            and _isfinite(sway) and 0 <= sway <= 1
-        ):
-            raise ParameterError(f"IDLE sway must be a number from 0 to 1, got {sway!r}")
-        if not (
-            isinstance(duration, (int, float)) and not isinstance(duration, bool)
-            and _isfinite(duration) and duration > 0
-        ):
-            raise ParameterError(
-                f"IDLE duration must be a positive number of seconds, got {duration!r}"
-            )
-        if not (
-            isinstance(hover, (int, float)) and not isinstance(hover, bool)
-            and _isfinite(hover) and hover > 0
-        ):
-            raise ParameterError(f"IDLE hover must be a positive number of seconds, got {hover!r}")
-        self.reserve(duration * self.fps, "IDLE")
-        many = isinstance(at, list) and at and all(isinstance(a, (dict, list)) for a in at)
-        points = (
-            [self.target(a) for a in at]
-            if many
-            else [self.target(at) if at is not None else self.x.copy()]
-        )
-        end = self.t + duration
-        first = self.n_frames
-        try:
-            self._idle(points, end, radius, hover, sway)
-        finally:
-            self.held.append((first, self.n_frames))
-            if len(points) == 1:  # (between several poses the legs move on purpose)
-                self.stands.append((first, self.n_frames))
-
-    def _stopping(self, n: int) -> np.ndarray:
-        """``(n,)`` pace of an IDLE's frames: the root's own travel goes on from the
-        pace the frames before it had (a MOVE that stops eases its pace to 0, a blend's
-        is 1) and eases to 0 over :data:`~cyclecoord.synthesis.carry.STAND_AFTER` s."""
-        last = self.chunks[-1] if self.chunks else None
-        before = 1.0 if last is None or last.pace is None else float(last.pace[-1])
-        u = np.clip(np.arange(1, n + 1) / max(1.0, STAND_AFTER * self.fps), 0.0, 1.0)
-        return before * (1.0 - u * u * (3.0 - 2.0 * u))
-
-    def _idle(self, points, end: float, radius, hover: float, sway: float = 1.0) -> None:
-        duration = end - self.t
-        while self.t < end - 0.5 / self.fps:
-            p = points[int(self.rng.integers(len(points)))] if len(points) > 1 else points[0]
-            m = self.models[self.current]
-            gap = float(np.linalg.norm(p - self.x))
-            if gap > self.params.radius * m.speed_:
-                self.move(Point(p), radius=radius)
-                if self.t >= end:
-                    break
-            n = max(
-                1, int(round(min(hover if len(points) > 1 else duration, end - self.t) * self.fps))
-            )
-            path = np.repeat(p[None, :], n + 1, axis=0)
-            # one pose: the hover ends back at its first frame's, where the stand holds
-            # its legs (``_stand_legs``: in an IDLE under 1 s only part of the way, and
-            # the hover goes back as far), so the motion after goes on from them (the
-            # particle drifted 0.1 s of travel along a synthetic run's stride, and the
-            # legs eased out of the stand swapped their stride while the feet were
-            # pinned: a foot swept 0.4 m in 2 frames)
-            self._run(path, radius, sway=sway, pace=self._stopping(n),
-                      settle=0 if len(points) == 1 else None)
 
     def play(self, segment: str, start: float = 0.0, stop: float | None = None) -> None:
         """PLAY a training segment of the current model as it was (seconds ``start..stop``)."""
