@@ -134,12 +134,13 @@ def test_the_particle_path_is_smoothed_before_it_is_posed(models):
 
 
 def _moves_then_idle(models, **options):
-    """Three MOVEs ahead in the walk and a 1 s IDLE; no planting, no lock."""
+    """Three MOVEs ahead in the walk, the last one stopping (as a script's MOVE before an
+    IDLE does), and a 1 s IDLE; no planting, no lock."""
     syn = Synthesizer(models, fps=30, seed=0, plant="off", lock=False, **options)
     syn.start("walk", {"frame": 0})
-    for _ in range(3):
+    for k in range(3):
         syn.command += 1
-        syn.move({"ahead": 0.3}, stop=False)
+        syn.move({"ahead": 0.3}, stop=k == 2)
     syn.command += 1
     syn.idle(duration=1.0)
     return syn

@@ -52,3 +52,61 @@ def test_a_stand_goes_on_from_the_legs_it_holds(models, seed):
     (idle,) = [c for c in syn.chunks if c.pace is not None and c.pace[-1] == 0.0
                and c.X.shape[0] == b - a]
     np.testing.assert_allclose(idle.X[-1], idle.X[0])
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_an_idle_after_an_in_step_transition_first_stops_along_the_gait(models, seed):
+    """An in-step TRANSITION's blend ends stepping at the gait's latent pace; held where
+    it was, the particle overshot, met the IDLE's radius and turned back within a frame
+    (a Bandai run's knee 2.2x its p99).  The IDLE first comes to a stop along the gait,
+    as a MOVE ahead that stops does, and says so; it stands as any IDLE does."""
+    from cyclecoord.synthesis.carry import _accel
+
+    syn = Synthesizer(models, fps=30, seed=seed)
+    syn.start("walk", {"frame": 0})
+    syn.command += 1
+    syn.move({"ahead": 1.0}, stop=False)
+    syn.command += 1
+    syn.transition("run", blend=0.4)
+    a = syn.n_frames
+    assert syn._moving_on()  # (the blend ends stepping on)
+    syn.command += 1
+    syn.idle(duration=1.0)
+    assert any(n.startswith("commands[2] IDLE: stepping on at the gait's pace, it first came "
+                            "to a stop along the gait") for n in syn.notes)
+    assert syn.held == syn.stands == [(a, syn.n_frames)]
+    # (the stand's legs are held where the stop ended, the hover's first frame)
+    hover = syn.chunks[-1]
+    assert syn.rests[a] == syn.n_frames - a - hover.X.shape[0] > 0
+    stop = next(c for c in syn.chunks if c.command == 2)
+    assert stop.pace[-1] < 0.1  # (it came to rest)
+    motion = syn.motion()
+    acc = _accel(motion) / syn._frame_acc99(motion.n_frames)
+    assert acc[a - 3 : a + 25].max() < 1.5
+
+
+def test_two_crossings_in_a_row_do_not_stop_between_them(models):
+    """Crossed while both models idle after a MOVE to a frame, each crossing's approach
+    stopped at its bridge: two in a row stood still for 0.23-0.3 s between them on 2 of
+    these 10 seeds (a freeze).  From a figure that moves the approach flows into the
+    blend; it stops only where the figure stood."""
+    from cyclecoord.quality.generated import measure_generated
+    from cyclecoord.synthesis.latent.script import training_takes
+
+    longest = []
+    for seed in range(10):
+        syn = Synthesizer(models, fps=30, seed=seed)
+        syn.start("walk", {"frame": 10})
+        syn.command += 1
+        syn.move({"frame": 60}, path="graph")
+        for to in ("run", "walk"):
+            syn.command += 1
+            syn.transition(to, blend=0.6)
+        syn.command += 1
+        syn.move({"ahead": 1.0})
+        motion = syn.motion()
+        q = measure_generated(motion, training_takes(models),
+                              hold=syn.hold_mask(motion.n_frames, asked=True))
+        assert not q.freezes, (seed, q.freezes)
+        longest.append(q.longest_freeze_s)
+    assert max(longest) <= 0.2

@@ -128,8 +128,9 @@ class OutputMixin(UntangleMixin):
     def _stand_legs(self, angles: np.ndarray) -> np.ndarray:
         """``angles`` ``(T, C)`` with the legs of each IDLE at one pose (a stand; an IDLE
         moving between several poses moves its legs on purpose) held near their pose where
-        it began: each leg joint's rotation keeps :data:`STAND_LEG_SWAY` of its turn away
-        from that pose, easing in over the stand's first
+        it came to rest (its first frame's, or where the stop along the gait it began
+        with ended: ``rests``): each leg joint's rotation keeps :data:`STAND_LEG_SWAY` of
+        its turn away from that pose, easing in over the stand's first
         :data:`~cyclecoord.synthesis.carry.STAND_AFTER` s (and out over its last as
         long when frames follow).  The particle's sway moves the whole pose; in the legs
         it lifted a heel and then the foot of a standing figure (subject 35's walk model,
@@ -173,12 +174,13 @@ class OutputMixin(UntangleMixin):
             key = (a, b, block.tobytes())
             if key not in cache:
                 k = keep[a:b, None]
+                r = min(self.rests.get(a, 0), b - a - 1)  # (where the pose came to rest)
                 # a joint with one or two angles: its channels eased linearly
-                held = block[0] + k * (block - block[0])
+                held = block[r] + k * (block - block[r])
                 for idx, order in balls:  # a ball joint: its rotation turned
                     j = np.searchsorted(cols, idx)
                     R = Rotation.from_euler(order, block[:, j], degrees=True)
-                    R0 = Rotation.from_euler(order, block[0, j], degrees=True)
+                    R0 = Rotation.from_euler(order, block[r, j], degrees=True)
                     turn = (R0.inv() * R).as_rotvec() * k
                     mats = (R0 * Rotation.from_rotvec(turn)).as_matrix()
                     held[:, j] = continuous_euler(mats[:, None], order, block[0, j])[:, 0]
