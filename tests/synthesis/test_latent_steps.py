@@ -276,11 +276,13 @@ def test_a_crossing_after_an_idle_stands_as_asked_and_nothing_else_does(models, 
     assert all(b <= f0 and f1 <= syn.stood[0][1] for f0, f1 in slow)
     asked = syn.hold_mask(motion.n_frames, asked=True)
     assert not measure_generated(motion, takes, hold=asked).freezes
-    # posed alike up to near the stand's end (the stand's opening step and the carried
-    # root's smoothing reach a few frames back); over the crossing the root's own travel
-    # and turn set off from rest (read from the pose, a run's speed came back at once)
+    # posed alike before the IDLE (a crossing from a figure that moves does not stop at
+    # its bridge: the stand's pins and steps, solved over the stand, feel the approach
+    # after it, up to 0.24 degrees; before the stand the leg pins' joint solve within
+    # 1e-3); over the crossing the root's own travel and turn set off from rest (read
+    # from the pose, a run's speed came back at once)
     _, before = run(standing=False)
-    assert np.array_equal(before.frames[: b - 15], motion.frames[: b - 15])
+    np.testing.assert_allclose(before.frames[:a], motion.frames[:a], atol=1e-3)
     c0, c1 = syn.stood[0]
     u = (np.arange(c0, c1) - c0 + 1.0) / (c1 - c0 + 1.0)
     ramp = u * u * (3 - 2 * u)  # by hand: a smoothstep over the crossing's frames

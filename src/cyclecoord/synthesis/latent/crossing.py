@@ -377,7 +377,9 @@ class CrossingMixin:
         b = int(pool[np.argmin(((c.source_points[pool] - self.x) ** 2).sum(1))])
         x1, x2 = c.source_points[b], c.target_points[b]
         small = 0.5 * (self.params.radius if radius is None else radius)
-        self.move(Point(x1), radius=small, speed=APPROACH_SPEED)
+        # (from a figure that moves, the approach flows into the blend: stopping at the
+        # bridge first, two crossings in a row stood still 0.27 s between them, a freeze)
+        self.move(Point(x1), radius=small, speed=APPROACH_SPEED, stop=self._standing())
         asked = blend_asked(blend, self.fps)
         n = min(max(asked, self.blend_frames(src, to, x1, x2)), int(MAX_BLEND * self.fps))
         self.reserve(n + 1, "TRANSITION")
