@@ -433,6 +433,42 @@ def test_joint_range_by_hand():
         joint_range_violations("m", [ref])
 
 
+def test_a_ball_joint_is_judged_by_its_rotation_not_its_euler_angles():
+    """A joint with three rotation channels (ZXY) whose references turn it (z, x, y) =
+    (10, 30, 20) and (20, 40, 30): (190, 150, 200) is the same rotation as the first
+    (the other Euler solution, z + 180, 180 - x, y + 180), so its channels' 170-180 degree
+    excesses are no violation; (10, 30, 120) is 100 degrees from either, and its y
+    channel is out (z and x are within their ranges); (10, 32, 22), 3 degrees away, is in
+    on every channel."""
+    from scipy.spatial.transform import Rotation
+
+    from cyclecoord.skeleton import Joint, Skeleton
+
+    sk = Skeleton((Joint("root", -1, [0, 0, 0], ("tx", "ty", "tz"), ""),
+                   Joint("ball", 0, [0, 1.0, 0], ("rz", "rx", "ry"), "ZXY"),
+                   Joint("tip", 1, [0, 1.0, 0]),
+                   Joint("side", 0, [1.0, 0, 0]),
+                   Joint("side_tip", 3, [1.0, 0, 0])))
+
+    def motion(rows):
+        f = np.zeros((len(rows), 6))
+        f[:, 3:] = rows
+        return cc.Motion(f, sk.channels, fps=30, skeleton=sk)
+
+    ref = motion([[10.0, 30.0, 20.0], [20.0, 40.0, 30.0]])
+    same = Rotation.from_euler("ZXY", [190.0, 150.0, 200.0], degrees=True)
+    assert same.approx_equal(Rotation.from_euler("ZXY", [10.0, 30.0, 20.0], degrees=True))
+    assert joint_range_violations(motion([[190.0, 150.0, 200.0]]), [ref]) == []
+    assert joint_range_violations(motion([[10.0, 32.0, 22.0]]), [ref]) == []
+    (far,) = joint_range_violations(motion([[10.0, 30.0, 120.0]]), [ref])
+    assert far.channel == ("ball", "ry") and far.excess == pytest.approx(85.0)
+    # the same through check_plausibility's cached path
+    report = check_plausibility(motion([[190.0, 150.0, 200.0], [10.0, 30.0, 120.0]]), [ref],
+                                cache={})
+    assert [(v.channel, v.frames, v.first_frame) for v in report.joint_range] == [
+        (("ball", "ry"), 1, 1)]
+
+
 def test_new_contacts_against_the_references_closest_approach():
     """Clearance 1.5 on (a, b), at sqrt(5 + 4 cos th).  A reference that comes within
     sqrt(3) (th = 120, beyond the clearance) lets the motion come to 1.5 - 0.15 = 1.35

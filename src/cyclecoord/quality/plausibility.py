@@ -25,6 +25,10 @@ from ..motion import Motion
 from .bones import (
     Bones, _element_distances, _near_elements, _pair_distances, bones, segment_distances,
 )
+from .joint_ranges import (
+    JointRangeViolation, _channel_ranges, _in_convention_of, _near_rotations,
+    _range_violations, joint_range_violations,
+)
 
 __all__ = [
     "Bones",
@@ -174,145 +178,6 @@ def self_intersections(
     )
 
 
-# ---------------------------------------------------------------- joint ranges
-@dataclass(frozen=True)
-class JointRangeViolation:
-    """A joint angle channel leaving the range the reference motions showed.
-
-    Attributes
-    ----------
-    channel : (str, str)
-        ``(joint, dof)``.
-    frames : int
-        Number of frames outside the allowed range.
-    first_frame : int
-        First such frame (the motion's numbering).
-    low, high : float
-        Allowed range, degrees (reference min - margin, max + margin).
-    worst : float
-        Value furthest outside, degrees.
-    excess : float
-        How far outside, degrees.
-    """
-
-    channel: tuple
-    frames: int
-    first_frame: int
-    low: float
-    high: float
-    worst: float
-    excess: float
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "channel": ".".join(self.channel),
-            "frames": self.frames,
-            "first_frame": self.first_frame,
-            "allowed": [self.low, self.high],
-            "worst": self.worst,
-            "excess_deg": self.excess,
-        }
-
-
-def _joint_angle_columns(motion: Motion) -> list[int]:
-    root = set(motion.root_channels())
-    return [
-        i for i, (_, d) in enumerate(motion.channels) if d in ("rx", "ry", "rz") and i not in root
-    ]
-
-
-def joint_range_violations(
-    motion: Motion,
-    reference_motions: Sequence[Motion],
-    margin_deg: float = 5.0,
-) -> list[JointRangeViolation]:
-    """Joint angles outside ``[min - margin, max + margin]`` of the reference motions.
-
-    Only joint rotation channels are checked (not the root's position or orientation).
-    Angles are compared modulo 360: each value is taken on the turn nearest the
-    middle of the reference range.
-
-    Parameters
-    ----------
-    motion : Motion
-    reference_motions : sequence of Motion
-        Motions that define what is normal (e.g. the inputs of a blend); channels they
-        lack are not checked.  References of a skeleton with the same joints in other
-        conventions (ASF against BVH) are re-expressed in ``motion``'s first.
-    margin_deg : float, default 5
-        Tolerance in degrees.
-
-    Returns
-    -------
-    list of JointRangeViolation
-        Worst excess first.
-    """
-    if not isinstance(motion, Motion):
-        raise ParameterError(f"expected a Motion, got {type(motion).__name__}")
-    refs = list(reference_motions)
-    if not refs or not all(isinstance(r, Motion) for r in refs):
-        raise ParameterError("joint_range_violations needs at least one reference Motion")
-    if not np.isfinite(margin_deg) or margin_deg < 0:
-        raise ParameterError(f"margin_deg must be a non-negative number, got {margin_deg!r}")
-    return _range_violations(motion, _channel_ranges(motion, refs, margin_deg))
-
-
-def _channel_ranges(
-    motion: Motion, refs: Sequence[Motion], margin_deg: float
-) -> list[tuple[int, float, float]]:
-    """``(column, low, high)`` of each joint angle channel of ``motion`` the references
-    have: their range in ``motion``'s conventions, on one turn, widened by the margin."""
-    refs = [_in_convention_of(r, motion) for r in refs]
-    cols = _joint_angle_columns(motion)
-    C = len(cols)
-    mean, low, high = (np.full((len(refs), C), np.nan) for _ in range(3))
-    for i, r in enumerate(refs):  # each reference's channels unwrapped at once
-        have = [k for k, c in enumerate(cols) if motion.channels[c] in r.channels]
-        if not have or r.n_frames == 0:
-            continue
-        rc = [r.channel_index(*motion.channels[cols[k]]) for k in have]
-        v = np.unwrap(np.asarray(r.frames, float)[:, rc], period=360.0, axis=0)
-        mean[i, have], low[i, have], high[i, have] = v.mean(axis=0), v.min(axis=0), v.max(axis=0)
-    out = []
-    for k, c in enumerate(cols):
-        known = np.flatnonzero(np.isfinite(mean[:, k]))
-        if not known.size:
-            continue
-        # bring every reference onto one turn (nearest the first's mean), then the range
-        shift = 360.0 * np.round((mean[known, k] - mean[known[0], k]) / 360.0)
-        lo = float((low[known, k] - shift).min()) - margin_deg
-        hi = float((high[known, k] - shift).max()) + margin_deg
-        out.append((c, lo, hi))
-    return out
-
-
-def _range_violations(
-    motion: Motion, ranges: list[tuple[int, float, float]]
-) -> list[JointRangeViolation]:
-    """The channels of ``motion`` leaving ``ranges`` (:func:`_channel_ranges`), worst
-    excess first; each value is taken on the turn nearest the middle of its range."""
-    out: list[JointRangeViolation] = []
-    if not ranges:
-        return out
-    cols = np.array([c for c, _, _ in ranges], dtype=int)
-    lo = np.array([r[1] for r in ranges])
-    hi = np.array([r[2] for r in ranges])
-    x = motion.frames[:, cols]
-    x = x - 360.0 * np.round((x - 0.5 * (lo + hi)) / 360.0)
-    excess = np.maximum(lo - x, x - hi)  # (T, channels)
-    for i in np.flatnonzero((excess > 0).any(axis=0)):
-        bad = np.flatnonzero(excess[:, i] > 0)
-        k = bad[np.argmax(excess[bad, i])]
-        out.append(JointRangeViolation(
-            channel=motion.channels[cols[i]], frames=int(bad.size),
-            first_frame=int(bad[0] + motion.start_frame),
-            low=float(lo[i]), high=float(hi[i]), worst=float(x[k, i]),
-            excess=float(excess[k, i]),
-        ))
-    out.sort(key=lambda v: -v.excess)
-    return out
-
-
 # -------------------------------------------------------------------- the report
 @dataclass
 class PlausibilityReport:
@@ -372,17 +237,6 @@ class PlausibilityReport:
                 parts.append(f"{len(self.joint_range)} joint angles outside the inputs' range")
             head = "plausibility: " + "; ".join(parts)
         return "\n".join([head] + [f"  {n}" for n in self.notes])
-
-
-def _in_convention_of(reference: Motion, motion: Motion) -> Motion:
-    """The reference written with ``motion``'s channels when the skeletons share joints.
-
-    A blend of an AMC capture with a BVH cycle is written in one convention; comparing
-    joint angles needs the references in the same one.
-    """
-    from ..conventions import in_conventions_of
-
-    return in_conventions_of(reference, motion)
 
 
 def _reference_views(reference: Motion, motion: Motion) -> list[Motion]:
@@ -589,7 +443,9 @@ def _cached_violations(
                for j in skel.joints))
     if key not in cache:
         cache[key] = _channel_ranges(motion, references, margin_deg)
-    return _range_violations(motion, cache[key])
+    ranges = cache[key]
+    return _range_violations(motion, ranges, _near_rotations(
+        motion, references, ranges, margin_deg, cache, ("rotations",) + key[1:]))
 
 
 def check_plausibility(

@@ -690,7 +690,7 @@ def channel_bounds(
     script, whose continuous output sat a turn away from the takes on some joint on
     every frame: the range check was off, and a pinned knee twisted 21 degrees about
     its long axis (the takes' range -0.8 to 0.1)."""
-    from ..quality.plausibility import _channel_ranges
+    from ..quality.joint_ranges import _channel_ranges
 
     frames = np.concatenate([m.frames for m in takes])
     lo, hi = frames.min(axis=0) - margin, frames.max(axis=0) + margin
