@@ -118,10 +118,9 @@ def _near_rotations(
     skel = motion.skeleton
     if skel is None or motion.n_frames == 0:
         return {}
-    x = motion.frames[:, [c for c, _, _ in ranges]] if ranges else np.zeros((0, 0))
-    lo = np.array([r[1] for r in ranges])
-    hi = np.array([r[2] for r in ranges])
-    x = x - 360.0 * np.round((x - 0.5 * (lo + hi)) / 360.0)
+    if not ranges:
+        return {}
+    x, lo, hi = _on_turn(motion, ranges)
     outside = (x < lo) | (x > hi)  # (T, channels)
     by_joint: dict[str, list[int]] = {}
     for i, (c, _, _) in enumerate(ranges):
@@ -189,6 +188,17 @@ def _channel_ranges(
     return out
 
 
+def _on_turn(
+    motion: Motion, ranges: list[tuple[int, float, float]]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(x, low, high)``: the ranges' channels of ``motion`` ``(T, channels)``, each value
+    on the turn nearest the middle of its range, and the ranges' ends."""
+    lo = np.array([r[1] for r in ranges])
+    hi = np.array([r[2] for r in ranges])
+    x = motion.frames[:, [c for c, _, _ in ranges]]
+    return x - 360.0 * np.round((x - 0.5 * (lo + hi)) / 360.0), lo, hi
+
+
 def _range_violations(
     motion: Motion, ranges: list[tuple[int, float, float]],
     near: dict[int, np.ndarray] | None = None,
@@ -200,10 +210,7 @@ def _range_violations(
     if not ranges:
         return out
     cols = np.array([c for c, _, _ in ranges], dtype=int)
-    lo = np.array([r[1] for r in ranges])
-    hi = np.array([r[2] for r in ranges])
-    x = motion.frames[:, cols]
-    x = x - 360.0 * np.round((x - 0.5 * (lo + hi)) / 360.0)
+    x, lo, hi = _on_turn(motion, ranges)
     excess = np.maximum(lo - x, x - hi)  # (T, channels)
     for i, c in enumerate(cols):
         if near and int(c) in near:
