@@ -24,7 +24,7 @@ def _ahead_then_frame(models, frame: int, stepped: bool = True, path: str = "lin
     run (``stepped`` false: the MOVE to the frame played along its path, as before)."""
     syn = Synthesizer(models, fps=30, seed=0, plant="off")
     if not stepped:
-        syn.step_to = lambda goal: None
+        syn.step_to = lambda goal, **k: None
     syn.start("walk", {"frame": 0})
     syn.command += 1
     syn.move({"ahead": 0.6}, stop=False)
@@ -475,3 +475,63 @@ def test_a_pop_off_the_gaits_paths_is_softened_in_the_latent_space(models, monke
     monkeypatch.setattr(UntangleMixin, "_softened", lambda self, m, *a: m)
     np.testing.assert_array_equal(out2.frames, syn2._untangled().frames)
     assert not any("latent path smoothed" in n for n in syn2.notes)
+
+
+
+def test_a_move_along_the_graph_from_rest_steps_on_and_never_plays_the_gait_backwards(models):
+    """From rest at a frame of the gait, a MOVE along the graph to another frame followed
+    the training frames there, back along the gait where they led back (a subject 35 run
+    from frame 33 to 21 played backwards while the root went forward: the feet slid
+    5.4 m/s, 8.8x the takes'; here frame 50 to 10 stepped back at its start).  It now
+    steps on along the gait from the start frame's phase, easing in, to the goal's."""
+    m = models["walk"]
+    g = m.gait()
+    syn = Synthesizer(models, fps=30, seed=0, plant="off")
+    syn.start("walk", {"frame": 50})
+    syn.command += 1
+    syn.move({"frame": 10}, path="graph")
+    chunk = syn.chunks[-1]
+    assert chunk.path is not None and syn._stepping
+    phase = g.phase[m.nearest_frame(chunk.X)]
+    step = (np.diff(phase) + 0.5) % 1.0 - 0.5
+    assert step.min() > -0.01 and step.sum() > 0.5  # forward all the way, past half a cycle
+    assert abs((syn._cursor[2] - g.phase[10] + 0.5) % 1.0 - 0.5) < 1e-6  # at frame 10's phase
+    # a path that goes forward along the gait is still the graph's
+    syn = Synthesizer(models, fps=30, seed=0, plant="off")
+    syn.start("walk", {"frame": 10})
+    syn.command += 1
+    syn.move({"frame": 20}, path="graph")
+    assert syn.chunks[-1].path is None and not syn._stepping
+
+
+def test_an_in_step_blend_carries_on_the_particles_velocity(models, monkeypatch):
+    """The blend's first gait path starts where the particle is and at its velocity, which
+    dies away over :data:`~.stepping.CARRY_SECONDS`: faded from rest, a subject 35 jog's
+    particle catching up on its path (0.25 latent units a frame against the path's 0.18)
+    stopped doing so at the blend's first frame, and both feet accelerated 1.5x the
+    jog's p99 there (1.72x the script's; 1.28x now).  Without the carry the first step
+    is the path's own."""
+    hops = []
+    real = stepping.GaitMixin._in_step
+    monkeypatch.setattr(stepping.GaitMixin, "_in_step",
+                        lambda self, *a, **k: hops.append(real(self, *a, **k)) or hops[-1])
+    syn = Synthesizer(models, fps=30, seed=0, plant="off")
+    syn.start("walk", {"frame": 0})
+    syn.command += 1
+    syn.move({"ahead": 0.6}, stop=False)
+    syn.command += 1
+    syn.move({"frame": 100}, path="line", stop=False)  # (ends off the loop, catching up)
+    x, v = syn.x.copy(), syn.v.copy()
+    syn.command += 1
+    syn.transition("run", blend=0.4)
+    hop = hops[-1]
+    Xa, on_path, w = hop["Xa"], hop["on_path"], hop["w"]
+    step = Xa[0] - x
+    assert np.linalg.norm(step - v / syn.fps) < 0.1 * np.linalg.norm(v / syn.fps)
+    k = int(round(stepping.CARRY_SECONDS * syn.fps))
+    stray = Xa[k:] - on_path[k:]  # (after it, the stray's fade alone)
+    np.testing.assert_allclose(stray, (1.0 - w[k:, None]) * stray[:1] / (1.0 - w[k]),
+                               atol=1e-9)
+    # (and here it matters: the first step without the carry is far from the particle's)
+    plain = on_path[0] + (1.0 - w[0]) * stray[0] / (1.0 - w[k]) - x
+    assert np.linalg.norm(plain - v / syn.fps) > 0.3 * np.linalg.norm(v / syn.fps)

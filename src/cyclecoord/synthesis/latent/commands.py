@@ -87,6 +87,23 @@ _FRAME_BYTES_PER_TRAINING_FRAME = 8 * 4
 PACE_GAP = 2
 
 
+#: A MOVE along the graph whose training frames' gait phases go back by this many cycles
+#: in all steps along the gait instead, from rest at a gait's pose
+BACKWARDS_CYCLES = 0.1
+
+
+def _backwards(gait, nodes: list[int]) -> float:
+    """Cycles a graph path (``nodes``: training frames, -1 for the ends) plays its gait
+    backwards: minus the sum of its steps' gait-phase changes (each the nearest way round,
+    over frames with a phase on a usable segment), 0 where that goes forward."""
+    ok = [k for k in nodes if k >= 0 and np.isfinite(gait.phase[k])
+          and np.isin(gait.segments[k], gait.usable)]
+    if len(ok) < 2:
+        return 0.0
+    step = (np.diff(gait.phase[ok]) + 0.5) % 1.0 - 0.5
+    return max(0.0, -float(step.sum()))
+
+
 def _path_times(m: LatentModel, poly: np.ndarray, nodes: list[int]) -> np.ndarray:
     """Seconds at each vertex of a MOVE's polyline (``nodes``: its training frames, -1
     for the ends): consecutive frames of a segment at their captured pace, the rest at
@@ -550,7 +567,9 @@ class Synthesizer(IdleMixin, CrossingMixin, OutputMixin, GaitMixin):
         exactly the seconds asked).  From a stepping particle, a MOVE to a training frame
         with a gait phase steps on to that phase along either path
         (:meth:`~.stepping.GaitMixin.step_to`; along the graph's training frames, the
-        phase jumped where the path left the gait: a Bandai walk's toes 1.5x its p99).
+        phase jumped where the path left the gait: a Bandai walk's toes 1.5x its p99),
+        and so does a MOVE along the graph from rest at a pose of the gait whose path
+        would play the gait backwards (:data:`BACKWARDS_CYCLES`).
         """
         m = self._need_start("MOVE")
         if not (
@@ -574,19 +593,27 @@ class Synthesizer(IdleMixin, CrossingMixin, OutputMixin, GaitMixin):
             along = None
             goal = self.target(to)
             stepped = self.step_to(goal) if path in ("line", "graph") else None
+            if stepped is None and path == "line":
+                poly, nodes = np.vstack([self.x, goal]), [-1, -1]
+            elif stepped is None and path == "graph":
+                if self.current not in self._graphs:
+                    self._graphs[self.current] = CommandGraph(m)
+                poly, nodes = self._graphs[self.current].path(self.x, goal, nodes=True)
+                if _backwards(self.gait(self.current), nodes) > BACKWARDS_CYCLES:
+                    # the training frames lead back along the gait (the poses nearest in
+                    # the latent space: on 40 random pairs of gait frames of each shared
+                    # model, 11-18 went back over a tenth of a cycle): from rest at a
+                    # gait's pose the steps go on instead (played back, a subject 35 run
+                    # from frame 33 to 21 went backwards while its root went forward: the
+                    # feet slid 5.4 m/s, 8.8x the takes')
+                    stepped = self.step_to(goal, from_rest=True)
+            elif path not in ("line", "graph"):
+                raise ParameterError(f"MOVE path must be 'line' or 'graph', got {path!r}")
             if stepped is not None:  # from a gait: stepping on to the goal's phase
                 poly, times = stepped
                 along = self._path_detail
                 if radius is None:
                     radius = AHEAD_RADIUS * self.params.radius
-            elif path == "line":
-                poly, nodes = np.vstack([self.x, goal]), [-1, -1]
-            elif path == "graph":
-                if self.current not in self._graphs:
-                    self._graphs[self.current] = CommandGraph(m)
-                poly, nodes = self._graphs[self.current].path(self.x, goal, nodes=True)
-            else:
-                raise ParameterError(f"MOVE path must be 'line' or 'graph', got {path!r}")
             if stepped is None:
                 times = _path_times(m, poly, nodes)
                 if path == "line":  # no faster than a blend between its two poses

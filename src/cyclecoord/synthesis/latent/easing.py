@@ -18,6 +18,16 @@ def smootherstep(n: int) -> np.ndarray:
     return u * u * u * (u * (6.0 * u - 15.0) + 10.0)
 
 
+def carried(n: int) -> np.ndarray:
+    """How far a velocity of one unit a frame carries over ``n`` frames as it dies away
+    (ends excluded, as :func:`smootherstep`): the quintic ``t - 6t^3 + 8t^4 - 3t^5`` in
+    frames, slope 1 and no acceleration at the start, at rest at the end.  Added to
+    ``(1 - smootherstep(n)) d``, an offset ``d`` that moved by ``r`` a frame keeps that
+    rate at the first frame and reaches 0 at rest."""
+    t = (np.arange(n) + 1.0) / (n + 1.0)
+    return (t - 6.0 * t**3 + 8.0 * t**4 - 3.0 * t**5) * (n + 1.0)
+
+
 def mix_rows(a: np.ndarray, b: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``(1 - w) a + w b`` row by row: ``a`` and ``b`` ``(T, ...)``, ``w`` one weight per
     row (``(T,)`` or ``(T, 1)``)."""

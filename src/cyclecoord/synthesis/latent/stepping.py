@@ -24,7 +24,7 @@ import numpy as np
 from ..._words import plural
 from ...errors import ParameterError
 from .crossing import BLEND_ACCELERATION, blend_asked
-from .easing import mix_rows, smootherstep
+from .easing import carried, mix_rows, smootherstep
 from .gait import FADE_TIE, SEAM_FADES, Gait, choose_seam_fade
 from .influence import pose_points
 
@@ -36,6 +36,9 @@ IN_STEP_LONGEST = 1.0
 #: An in-step blend whose frames accelerate a joint over this many times the faster
 #: model's training 99th percentile is lengthened (:meth:`GaitMixin.gait_hop`).
 HOP_ACCELERATION = 1.5
+#: Seconds over which the particle's own velocity off the gait's path dies away at the
+#: start of an in-step blend
+CARRY_SECONDS = 0.15
 #: A MOVE ahead that stops looks for a stance (both feet down) on a phase grid of this
 #: many bins (:meth:`GaitMixin.stop_ahead`).
 STANCE_BINS = 50
@@ -205,7 +208,8 @@ class GaitMixin:
         )
         return X, t - t0
 
-    def step_to(self, goal: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    def step_to(self, goal: np.ndarray, from_rest: bool = False
+                ) -> tuple[np.ndarray, np.ndarray] | None:
         """A MOVE (along a line or the graph) to latent point ``goal`` from a gait the particle is
         stepping along (the last command stepped): the latent path ``(M, q)`` and its
         times ``(M,)``, stepping on at the training cadence to the gait phase of the
@@ -213,21 +217,36 @@ class GaitMixin:
         model's latent speed, the latent offset from the gait easing from the particle's
         to the goal's, and from the particle's segment to the goal's; None where the
         particle is not stepping or the goal's frame has no gait phase (the path asked
-        then).
+        then).  ``from_rest`` (a MOVE along the graph): also from a particle at rest
+        whose nearest training frame has a gait phase, its steps easing in from there.
 
         Played as a line, such a MOVE put the goal's phase of the stride after the phase
         the legs were at: on a random subject 35 script a one-frame MOVE to frame 34
         between a TRANSITION and a MOVE ahead swapped the legs in a frame and the toes
         accelerated 2.0x the run's 99th percentile."""
         name = self.current
-        if self._cursor is None or self._cursor[0] != name:
-            return None
         m, g = self.models[name], self.gait(name)
+        if self._cursor is not None and self._cursor[0] == name:
+            s0, u0 = self._cursor[1], self._cursor[2]
+            # from the path the particle was riding (the loop, or a MOVE to a frame's
+            # offset from it), not from the particle, which lags it: offset by the
+            # particle's lag, the path stepped back at its first frame and the captured
+            # pose there jerked (a Bandai run's MOVE ahead into a MOVE to a frame read
+            # 1.59x its p99 there, 1.42x from the loop)
+            off = self._cursor[3] if len(self._cursor) > 3 else np.zeros_like(goal)
+        elif from_rest and self._at_rest_on_gait(name):
+            # from rest at a pose of the gait (the start frame, an IDLE's): the steps ease
+            # in from its phase.  Along the graph's training frames, a MOVE from a run's
+            # frame 33 to its frame 21 played the run backwards while the root went
+            # forward: the feet slid 5.4 m/s
+            s0, u0 = self._gait_place(name)
+            off = self.x - self.gait_at(name, m.X_, s0, np.array([u0]))[0]
+        else:
+            return None
         k = int(m.nearest_frame(goal[None])[0])
         s1 = int(g.segments[k])
         if s1 not in g.usable or not np.isfinite(g.phase[k]):
             return None
-        s0, u0 = self._cursor[1], self._cursor[2]
         rate = self._rate(name, s1)
         line = float(np.linalg.norm(goal - self.x)) / m.speed_ * self.fps * rate  # cycles
         du = (float(g.phase[k]) - u0) % 1.0
@@ -244,16 +263,19 @@ class GaitMixin:
                 d0 = self._detail_at(name, s0, u, at0)
                 detail = {key: mix_rows(d0[key], v, w) for key, v in detail.items()}
         self._next_cursor = (name, s1, float(u[-1]), goal - X[-1])
-        # from the path the particle was riding (the loop, or a MOVE to a frame's offset
-        # from it), not from the particle, which lags it: offset by the particle's lag,
-        # the path stepped back at its first frame and the captured pose there jerked
-        # (a Bandai run's MOVE ahead into a MOVE to a frame read 1.59x its p99 there,
-        # 1.42x from the loop)
-        off = self._cursor[3] if len(self._cursor) > 3 else np.zeros_like(goal)
         X = X + (1.0 - w) * off + w * (goal - X[-1])
         X[0] = self.x
         self._path_detail = detail
         return X, np.arange(n + 1) / self.fps
+
+    def _at_rest_on_gait(self, name: str) -> bool:
+        """Whether the particle is at rest (under a quarter of model ``name``'s median
+        latent speed) and its nearest training frame has a gait phase."""
+        m, g = self.models[name], self.gait(name)
+        if self.v is not None and np.linalg.norm(self.v) >= 0.25 * m.speed_:
+            return False
+        k = int(m.nearest_frame(self.x[None])[0])
+        return bool(np.isin(g.segments[k], g.usable) and np.isfinite(g.phase[k]))
 
     def stance(self, name: str) -> np.ndarray | None:
         """(N,) per training frame of model ``name``: the higher of its legs' lowest foot
@@ -450,9 +472,18 @@ class GaitMixin:
         # the particle's stray from the path fades over the blend: jumping back onto the
         # path at the blend's first frame threw the Bandai run's hands up to 1.86x its
         # p99 of acceleration (6 script seeds in 15 over 1.5x; at most 1.40x after)
-        stray = self.x - self.gait_at(src, m1.X_, sa, np.array([ua]))[0]
+        here = self.gait_at(src, m1.X_, sa, np.array([ua]))[0]
+        stray = self.x - here
         on_path = Xa
         Xa = Xa + (1.0 - w)[:, None] * stray[None, :]
+        if self.v is not None:
+            # ... at the rate the particle was straying: its velocity carries on into the
+            # blend (faded from rest, a subject 35 jog's particle catching up 0.07 latent
+            # units a frame on its path stopped doing so at once, and both feet
+            # accelerated 1.5x the jog's p99 there)
+            rate = self.v / self.fps - (on_path[0] - here)
+            k = min(n, max(1, int(round(CARRY_SECONDS * self.fps))))
+            Xa[:k] += carried(k)[:, None] * rate[None, :]
         Xb = at_b(m2.X_)
         r1, r2 = self._root(m1, Xa), self._root(m2, Xb)
         root = {k: mix_rows(r1[k], r2[k], w) for k in r1}
@@ -464,7 +495,8 @@ class GaitMixin:
             detail = {k: mix_rows(Da[k], Db[k], w) for k in Da}
             root = {k: root[k] + detail[k] for k in root}
         blended = self._mix(src, to, self._clip(src, Pa, count), self._clip(to, Pb, count), w)
-        return {"w": w, "du": du, "Xb": Xb, "on_path": on_path, "root": root, "detail": detail,
+        return {"w": w, "du": du, "Xa": Xa, "Xb": Xb, "on_path": on_path, "root": root,
+                "detail": detail,
                 "Pa": Pa, "Pb": Pb, "Da": Da, "blended": blended}
 
     def _hop_peak(self, src: str, to: str, blended: np.ndarray, root: dict) -> float:
