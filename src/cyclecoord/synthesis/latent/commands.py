@@ -87,9 +87,12 @@ _FRAME_BYTES_PER_TRAINING_FRAME = 8 * 4
 PACE_GAP = 2
 
 
-#: A MOVE along the graph whose training frames' gait phases go back by this many cycles
-#: in all steps along the gait instead, from rest at a gait's pose
+#: A MOVE along the graph or a line whose training frames on the way (the line's nearest)
+#: go back along the gait by this many cycles in all steps along the gait instead, from
+#: rest at a gait's pose
 BACKWARDS_CYCLES = 0.1
+#: Points along a line MOVE whose nearest training frames' phases say which way it goes
+LINE_PROBES = 16
 
 
 def _backwards(gait, nodes: list[int]) -> float:
@@ -568,8 +571,8 @@ class Synthesizer(IdleMixin, CrossingMixin, OutputMixin, GaitMixin):
         with a gait phase steps on to that phase along either path
         (:meth:`~.stepping.GaitMixin.step_to`; along the graph's training frames, the
         phase jumped where the path left the gait: a Bandai walk's toes 1.5x its p99),
-        and so does a MOVE along the graph from rest at a pose of the gait whose path
-        would play the gait backwards (:data:`BACKWARDS_CYCLES`).
+        and so does a MOVE from rest at a pose of the gait whose path would play the
+        gait backwards (:data:`BACKWARDS_CYCLES`).
         """
         m = self._need_start("MOVE")
         if not (
@@ -592,23 +595,28 @@ class Synthesizer(IdleMixin, CrossingMixin, OutputMixin, GaitMixin):
         else:
             along = None
             goal = self.target(to)
-            stepped = self.step_to(goal) if path in ("line", "graph") else None
-            if stepped is None and path == "line":
-                poly, nodes = np.vstack([self.x, goal]), [-1, -1]
-            elif stepped is None and path == "graph":
-                if self.current not in self._graphs:
-                    self._graphs[self.current] = CommandGraph(m)
-                poly, nodes = self._graphs[self.current].path(self.x, goal, nodes=True)
-                if _backwards(self.gait(self.current), nodes) > BACKWARDS_CYCLES:
-                    # the training frames lead back along the gait (the poses nearest in
-                    # the latent space: on 40 random pairs of gait frames of each shared
-                    # model, 11-18 went back over a tenth of a cycle): from rest at a
-                    # gait's pose the steps go on instead (played back, a subject 35 run
-                    # from frame 33 to 21 went backwards while its root went forward: the
-                    # feet slid 5.4 m/s, 8.8x the takes')
-                    stepped = self.step_to(goal, from_rest=True)
-            elif path not in ("line", "graph"):
+            if path not in ("line", "graph"):
                 raise ParameterError(f"MOVE path must be 'line' or 'graph', got {path!r}")
+            stepped = self.step_to(goal)
+            if stepped is None:
+                if path == "line":
+                    poly, nodes = np.vstack([self.x, goal]), [-1, -1]
+                    passed = m.nearest_frame(self.x + np.linspace(0.0, 1.0, LINE_PROBES)[:, None]
+                                             * (goal - self.x)).tolist()
+                else:
+                    if self.current not in self._graphs:
+                        self._graphs[self.current] = CommandGraph(m)
+                    poly, nodes = self._graphs[self.current].path(self.x, goal, nodes=True)
+                    passed = nodes
+                if (not isinstance(to, Point)  # (a crossing's approach, an IDLE's moves)
+                        and _backwards(self.gait(self.current), passed) > BACKWARDS_CYCLES):
+                    # the poses on the way lead back along the gait (the graph's nearest
+                    # poses: on 40 random pairs of gait frames of each shared model, 11-18
+                    # went back over a tenth of a cycle): from rest at a gait's pose the
+                    # steps go on instead (played back, a subject 35 run from frame 33 to
+                    # 21 went backwards while its root went forward: the feet slid 5.4
+                    # m/s, 8.8x the takes'; a walk's line from frame 250 to 239, 2.8x)
+                    stepped = self.step_to(goal, from_rest=True)
             if stepped is not None:  # from a gait: stepping on to the goal's phase
                 poly, times = stepped
                 along = self._path_detail

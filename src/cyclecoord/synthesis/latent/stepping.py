@@ -217,8 +217,9 @@ class GaitMixin:
         model's latent speed, the latent offset from the gait easing from the particle's
         to the goal's, and from the particle's segment to the goal's; None where the
         particle is not stepping or the goal's frame has no gait phase (the path asked
-        then).  ``from_rest`` (a MOVE along the graph): also from a particle at rest
-        whose nearest training frame has a gait phase, its steps easing in from there.
+        then).  ``from_rest`` (a MOVE whose path would play the gait backwards): also
+        from a particle at rest whose nearest training frame has a gait phase, its steps
+        easing in from there.
 
         Played as a line, such a MOVE put the goal's phase of the stride after the phase
         the legs were at: on a random subject 35 script a one-frame MOVE to frame 34
