@@ -774,20 +774,21 @@ def test_the_gait_phase_advances_evenly_within_a_cycle_and_keeps_the_takes_pace(
 
 def test_foot_locks_are_limited_by_the_pace_of_the_model_posing_each_frame(made):
     """The lock's pop limit is 1.5x the 99th percentile of the training accelerations of
-    the model that posed the frame (the faster one near a change of model), not the
-    fastest model's everywhere."""
-    from cyclecoord.synthesis.latent.output import LOCK_REACH
-
+    the model that posed the frame, a TRANSITION's frames (approach and blend) the faster
+    of its models', a frame next to another's the smaller of the two; not the fastest
+    model's everywhere (nor, as before, the faster one's for 0.2 s either side of a
+    change of model: a jog's pins popped at 1.59x its own p99 five frames before its
+    TRANSITION to the walk)."""
     syn, motion = made
     per = syn._frame_acc99(motion.n_frames)
     walk, run = syn._lock_acc99("walk"), syn._lock_acc99("run")
     assert walk < run  # the synthetic jog accelerates more than the walk
-    reach = int(round(LOCK_REACH * syn.fps))
-    a, b = _span(syn, range(0, 10))  # the walk's MOVEs
-    assert np.all(per[a : b - reach] == walk)
-    c, d = _span(syn, range(11, 21))  # the run's MOVEs
-    assert np.all(per[c + reach : d - reach] == run)
-    assert a == 0 and np.all(per[b - reach : c + reach] == run)  # through the transition
+    hops = [e for e in syn.events if "transition" in e]
+    assert [e["transition"] for e in hops] == [["walk", "run"], ["run", "walk"]]
+    (a, b), (c, d) = (_span(syn, [e["command"]]) for e in hops)
+    assert np.all(per[: a + 1] == walk) and np.all(per[a + 1 : b - 1] == run)
+    assert np.all(per[b - 1 : c + 1] == run) and np.all(per[c + 1 : d - 1] == run)
+    assert np.all(per[d - 1 :] == walk)  # (the IDLE after the walk's blend)
     # a script whose chunks do not match the frames falls back to the largest figure
     np.testing.assert_array_equal(syn._frame_acc99(motion.n_frames + 1), run)
 

@@ -227,9 +227,8 @@ class Synthesizer(IdleMixin, CrossingMixin, OutputMixin, GaitMixin):
         pinned where that makes no pop
         (:func:`~cyclecoord.synthesis.carry.lock_where_clean`, limit 1.5x the 99th
         percentile of root-relative joint acceleration of the training takes of the
-        model posing each frame, the faster one
-        within ``LOCK_REACH`` of a change of model; the ``notes`` attribute says where
-        not).
+        model posing each frame, a TRANSITION's the faster one's; the ``notes``
+        attribute says where not).
         ``"transitions"``: the blend windows and
         :data:`PLANT_MARGIN` around them only, with the speed-gated contacts of before
         (the feet elsewhere glide with the training frames' root velocity); ``"off"``.
