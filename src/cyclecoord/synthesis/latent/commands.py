@@ -96,9 +96,10 @@ LINE_PROBES = 16
 
 
 def _backwards(gait, nodes: list[int]) -> float:
-    """Cycles a graph path (``nodes``: training frames, -1 for the ends) plays its gait
-    backwards: minus the sum of its steps' gait-phase changes (each the nearest way round,
-    over frames with a phase on a usable segment), 0 where that goes forward."""
+    """Cycles a MOVE's path plays its gait backwards, from the training frames it passes
+    (``nodes``, in order; -1 for none): minus the sum of their gait-phase changes (each
+    the nearest way round, over frames with a phase on a usable segment), 0 where that
+    goes forward."""
     ok = [k for k in nodes if k >= 0 and np.isfinite(gait.phase[k])
           and np.isin(gait.segments[k], gait.usable)]
     if len(ok) < 2:

@@ -483,8 +483,8 @@ class GaitMixin:
             # units a frame on its path stopped doing so at once, and both feet
             # accelerated 1.5x the jog's p99 there)
             rate = self.v / self.fps - (on_path[0] - here)
-            k = min(n, max(1, int(round(CARRY_SECONDS * self.fps))))
-            Xa[:k] += carried(k)[:, None] * rate[None, :]
+            span = min(n, max(1, int(round(CARRY_SECONDS * self.fps))))
+            Xa[:span] += carried(span)[:, None] * rate[None, :]
         Xb = at_b(m2.X_)
         r1, r2 = self._root(m1, Xa), self._root(m2, Xb)
         root = {k: mix_rows(r1[k], r2[k], w) for k in r1}
