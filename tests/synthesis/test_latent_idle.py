@@ -98,7 +98,7 @@ def test_two_crossings_in_a_row_do_not_stop_between_them(models):
         syn = Synthesizer(models, fps=30, seed=seed)
         syn.start("walk", {"frame": 10})
         syn.command += 1
-        syn.move({"frame": 60}, path="graph")
+        syn.move(models["walk"].X_[60].tolist(), path="graph")  # (not stepping)
         for to in ("run", "walk"):
             syn.command += 1
             syn.transition(to, blend=0.6)

@@ -68,12 +68,19 @@ def test_a_move_to_a_frame_played_as_a_line_stopped_the_gait(models):
         assert [n for n in syn.notes if "not in step" in n]
 
 
-def test_a_move_to_a_frame_from_rest_is_still_a_line(models):
+def test_a_move_to_a_latent_point_from_rest_is_still_a_line(models):
+    """A latent point ``[x, y, z]`` is reached along the path asked, from rest too; the
+    training frame there is stepped to along the gait."""
+    syn = Synthesizer(models, fps=30, seed=0, plant="off")
+    syn.start("walk", {"frame": 0})
+    syn.command += 1
+    syn.move(models["walk"].X_[40].tolist(), path="line", stop=False)
+    assert syn.chunks[-1].path is None and syn._cursor is None
     syn = Synthesizer(models, fps=30, seed=0, plant="off")
     syn.start("walk", {"frame": 0})
     syn.command += 1
     syn.move({"frame": 40}, path="line", stop=False)
-    assert syn.chunks[-1].path is None and syn._cursor is None
+    assert syn.chunks[-1].path is not None and syn._stepping
 
 
 def test_after_a_move_to_a_frame_a_move_ahead_fades_the_frames_offset(models):
@@ -126,7 +133,7 @@ def test_a_gait_begun_after_a_line_eases_in(models):
     syn = Synthesizer(models, fps=30, seed=0, plant="off")
     syn.start("walk", {"frame": 0})
     syn.command += 1
-    syn.move({"frame": 40}, path="line", stop=False)
+    syn.move(models["walk"].X_[40].tolist(), path="line", stop=False)
     assert syn.chunks[-1].path is None and not syn._stepping  # (a line, from rest)
     syn.command += 1
     syn.move({"ahead": 1.0}, stop=False)
@@ -224,7 +231,7 @@ def test_a_line_takes_no_less_than_a_blend_between_its_poses(models, monkeypatch
         syn = Synthesizer(models, fps=30, seed=0, plant="off")
         syn.start("walk", {"frame": 10})
         syn.command += 1
-        syn.move({"frame": 12}, path="line", stop=False)
+        syn.move(models["walk"].X_[12].tolist(), path="line", stop=False)
         return syn.chunks[-1].X.shape[0]
 
     short = line_frames(1)
@@ -417,7 +424,7 @@ def test_a_move_to_a_point_shorter_than_its_ramps_eases_over_its_own_length(mode
     syn.start("walk", {"frame": 20})
     ramp = int(round(syn.ease * syn.fps))
     syn.command += 1
-    syn.move({"frame": 21}, path="line")
+    syn.move(models["walk"].X_[21].tolist(), path="line")
     near = syn.chunks[-1].X.shape[0]
     assert ramp >= 6 and near < ramp
     ahead = Synthesizer(models, fps=30, seed=0, plant="off")
@@ -437,7 +444,7 @@ def test_a_pop_off_the_gaits_paths_is_softened_in_the_latent_space(models, monke
         syn = Synthesizer(models, fps=30, seed=0, plant="off", lock=False)
         syn.start("walk", {"frame": 0})
         syn.command += 1
-        syn.move({"frame": 60}, path="line")
+        syn.move(models["walk"].X_[60].tolist(), path="line")
         syn.command += 1
         syn.idle(duration=0.5)
         plain = syn._assemble(*syn._posed())
@@ -479,11 +486,13 @@ def test_a_pop_off_the_gaits_paths_is_softened_in_the_latent_space(models, monke
 
 
 def test_a_move_from_rest_steps_on_and_never_plays_the_gait_backwards(models):
-    """From rest at a frame of the gait, a MOVE along the graph to another frame followed
-    the training frames there, back along the gait where they led back (a subject 35 run
-    from frame 33 to 21 played backwards while the root went forward: the feet slid
-    5.4 m/s, 8.8x the takes'; here frame 50 to 10 stepped back at its start).  It now
-    steps on along the gait from the start frame's phase, easing in, to the goal's."""
+    """From rest at a frame of the gait, a MOVE to another frame followed its path: the
+    graph's training frames led back along the gait where they went back (a subject 35
+    run from frame 33 to 21 played backwards while the root went forward: the feet slid
+    5.4 m/s, 8.8x the takes'; here frame 50 to 10 stepped back at its start), a line
+    morphed the legs (a walk's line from frame 250 to 239: 2.8x), and a MOVE between
+    like poses stood nearly still (a freeze).  It now steps on along the gait from the
+    start frame's phase, easing in, to the goal's."""
     m = models["walk"]
     g = m.gait()
     syn = Synthesizer(models, fps=30, seed=0, plant="off")
@@ -496,16 +505,22 @@ def test_a_move_from_rest_steps_on_and_never_plays_the_gait_backwards(models):
     step = (np.diff(phase) + 0.5) % 1.0 - 0.5
     assert step.min() > -0.01 and step.sum() > 0.5  # forward all the way, past half a cycle
     assert abs((syn._cursor[2] - g.phase[10] + 0.5) % 1.0 - 0.5) < 1e-6  # at frame 10's phase
-    # a path that goes forward along the gait is still the graph's or the line's; a line
-    # back along it steps on too (a subject 35 walk's line from frame 250 to 239 slid the
-    # support foot 2.8x the takes')
-    for path, a, b, steps in (("graph", 10, 20, False), ("line", 50, 60, False),
-                              ("line", 50, 40, True)):
+    # within a take, either path, forward or back: steps; to the other take (frames
+    # 120-239) only where the path goes back; a latent point: the path asked
+    for path, a, b, steps in (("graph", 10, 20, True), ("line", 50, 60, True),
+                              ("line", 50, 40, True), ("line", 10, 140, False),
+                              ("graph", 50, 180, False), ("line", 10, 130, True),
+                              ("graph", 50, 170, True)):
         syn = Synthesizer(models, fps=30, seed=0, plant="off")
         syn.start("walk", {"frame": a})
         syn.command += 1
         syn.move({"frame": b}, path=path)
         assert (syn.chunks[-1].path is not None) == steps == syn._stepping, (path, a, b)
+    syn = Synthesizer(models, fps=30, seed=0, plant="off")
+    syn.start("walk", {"frame": 50})
+    syn.command += 1
+    syn.move(m.X_[60].tolist(), path="line")
+    assert syn.chunks[-1].path is None and not syn._stepping
 
 
 def test_an_in_step_blend_carries_on_the_particles_velocity(models, monkeypatch):

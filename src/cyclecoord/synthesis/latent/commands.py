@@ -87,9 +87,9 @@ _FRAME_BYTES_PER_TRAINING_FRAME = 8 * 4
 PACE_GAP = 2
 
 
-#: A MOVE along the graph or a line whose training frames on the way (the line's nearest)
-#: go back along the gait by this many cycles in all steps along the gait instead, from
-#: rest at a gait's pose
+#: A MOVE from rest at a gait's pose to another take's frame steps along the gait
+#: (rather than following its path) where the training frames on its path (a line's
+#: nearest) go back along the gait by this many cycles in all
 BACKWARDS_CYCLES = 0.1
 #: Points along a line MOVE whose nearest training frames' phases say which way it goes
 LINE_PROBES = 16
@@ -571,8 +571,10 @@ class Synthesizer(IdleMixin, CrossingMixin, OutputMixin, GaitMixin):
         with a gait phase steps on to that phase along either path
         (:meth:`~.stepping.GaitMixin.step_to`; along the graph's training frames, the
         phase jumped where the path left the gait: a Bandai walk's toes 1.5x its p99),
-        and so does a MOVE from rest at a pose of the gait whose path would play the
-        gait backwards (:data:`BACKWARDS_CYCLES`).
+        and so does a MOVE to a training frame (``{"frame": k}``, ``{"segment": s,
+        "time": t}``) from rest at a pose of the gait (to another take's frame only where
+        its path would play the gait backwards: :data:`BACKWARDS_CYCLES`); a latent point
+        ``[x, y, z]`` is reached along the path asked.
         """
         m = self._need_start("MOVE")
         if not (
@@ -608,15 +610,19 @@ class Synthesizer(IdleMixin, CrossingMixin, OutputMixin, GaitMixin):
                         self._graphs[self.current] = CommandGraph(m)
                     poly, nodes = self._graphs[self.current].path(self.x, goal, nodes=True)
                     passed = nodes
-                if (not isinstance(to, Point)  # (a crossing's approach, an IDLE's moves)
-                        and _backwards(self.gait(self.current), passed) > BACKWARDS_CYCLES):
-                    # the poses on the way lead back along the gait (the graph's nearest
-                    # poses: on 40 random pairs of gait frames of each shared model, 11-18
-                    # went back over a tenth of a cycle): from rest at a gait's pose the
-                    # steps go on instead (played back, a subject 35 run from frame 33 to
-                    # 21 went backwards while its root went forward: the feet slid 5.4
-                    # m/s, 8.8x the takes'; a walk's line from frame 250 to 239, 2.8x)
-                    stepped = self.step_to(goal, from_rest=True)
+                if isinstance(to, dict):  # (a training frame's: not a latent point)
+                    # from rest at a gait's pose, to a frame of the gait, the steps go on
+                    # along it: the path (the latent space's nearest poses) morphed the
+                    # legs or played the gait backwards while the root went forward (on
+                    # 40 random pairs of gait frames of each shared model 11-18 went back
+                    # over a tenth of a cycle: a subject 35 run from frame 33 to 21 slid
+                    # the feet 5.4 m/s, 8.8x the takes'; a walk's line from frame 250 to
+                    # 239, 2.8x), or stood nearly still where the two poses were alike (a
+                    # Bandai run's line from frame 28 to 79, two cycles on: 0.27 s under
+                    # a tenth of the takes' pose speed, a freeze).  To another take only
+                    # where the path goes back (:data:`BACKWARDS_CYCLES`).
+                    back = _backwards(self.gait(self.current), passed) > BACKWARDS_CYCLES
+                    stepped = self.step_to(goal, from_rest=True, across=back)
             if stepped is not None:  # from a gait: stepping on to the goal's phase
                 poly, times = stepped
                 along = self._path_detail

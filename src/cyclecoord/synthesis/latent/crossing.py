@@ -264,7 +264,8 @@ class CrossingMixin:
             self.notes.append(
                 f"commands[{self.command}] TRANSITION {src} -> {to}: not in step, crossed "
                 "while both models idle (the particle was not stepping: in step needs a "
-                "MOVE ahead, a PLAY or a TRANSITION in step before it)"
+                "MOVE ahead, a MOVE to a frame of the gait, a PLAY or a TRANSITION in step "
+                "before it)"
                 + (_STOOD if standing else "")
             )
         hops = [src, to]
