@@ -228,7 +228,8 @@ class GaitMixin:
         accelerated 2.0x the run's 99th percentile."""
         name = self.current
         m, g = self.models[name], self.gait(name)
-        if self._cursor is not None and self._cursor[0] == name:
+        stepping = self._cursor is not None and self._cursor[0] == name
+        if stepping:
             s0, u0 = self._cursor[1], self._cursor[2]
             # from the path the particle was riding (the loop, or a MOVE to a frame's
             # offset from it), not from the particle, which lags it: offset by the
@@ -249,7 +250,7 @@ class GaitMixin:
         s1 = int(g.segments[k])
         if s1 not in g.usable or not np.isfinite(g.phase[k]):
             return None
-        if s0 != s1 and not across and not (self._cursor and self._cursor[0] == name):
+        if s0 != s1 and not (across or stepping):
             return None
         rate = self._rate(name, s1)
         line = float(np.linalg.norm(goal - self.x)) / m.speed_ * self.fps * rate  # cycles
