@@ -258,7 +258,7 @@ class CrossingMixin:
                 return
         standing = self._standing()
         if across:
-            # from an IDLE or a MOVE to a target the particle has no step to keep: the
+            # from an IDLE or a MOVE to a latent point the particle has no step to keep: the
             # gaits blended in step from there popped at 1.1-6.5x the run's p99 of
             # acceleration over ten seeds of a Bandai script, 0.4-1.7x at a bridge
             self.notes.append(
