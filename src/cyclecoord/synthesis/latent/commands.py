@@ -443,7 +443,7 @@ class Synthesizer(IdleMixin, CrossingMixin, OutputMixin, GaitMixin):
             n = max(1, round(STAND_AFTER * self.fps))
             u = min(1.0, 0.5 * (len(X) - 1) / n)  # (as far as its stand holds the legs)
             to = X[min(settle, len(X) - 1)] if isinstance(settle, int) else settle
-            X, V = easing.settle(X, V, to, n, u * u * (3 - 2 * u))
+            X, V = easing.settle(X, V, to, n, easing.smooth(u))
         pose, root = m.pose(X), self._root(m, X)
         if detail is not None:
             pose = pose + detail["angles"]

@@ -35,10 +35,14 @@ def mix_rows(a: np.ndarray, b: np.ndarray, w: np.ndarray) -> np.ndarray:
     return (1.0 - w) * a + w * b
 
 
+def smooth(u):
+    """The smoothstep ``u^2 (3 - 2u)`` of ``u`` in [0, 1] (a number or an array)."""
+    return u * u * (3.0 - 2.0 * u)
+
+
 def smoothstep(n: int) -> np.ndarray:
     """Blend weights rising smoothly from 0 to 1 over ``n`` frames (ends excluded)."""
-    u = (np.arange(n) + 1.0) / (n + 1.0)
-    return u * u * (3.0 - 2.0 * u)
+    return smooth((np.arange(n) + 1.0) / (n + 1.0))
 
 
 def eased(n: int, ramp: int, ramp_out: int | None = None) -> np.ndarray:
@@ -52,7 +56,7 @@ def eased(n: int, ramp: int, ramp_out: int | None = None) -> np.ndarray:
     r2 = max(1e-9, min(float(ramp_out), n / 2.0))
     rise = np.clip(k / r, 0, 1) if ramp > 0 else np.ones(n)
     fall = np.clip((n - k) / r2, 0, 1) if ramp_out > 0 else np.ones(n)
-    v = np.minimum(rise * rise * (3 - 2 * rise), fall * fall * (3 - 2 * fall))
+    v = np.minimum(smooth(rise), smooth(fall))
     c = np.concatenate([[0.0], np.cumsum(v)])
     return c / c[-1]
 
@@ -83,5 +87,5 @@ def settle(
     velocities as much towards 0."""
     k = min(int(k), X.shape[0] // 2)
     u = np.clip((np.arange(X.shape[0]) - (X.shape[0] - k)) / max(k - 1, 1), 0.0, 1.0)
-    w = amount * (u * u * (3.0 - 2.0 * u))[:, None]
+    w = amount * smooth(u)[:, None]
     return X + w * (np.asarray(target, dtype=float) - X), V * (1.0 - w)

@@ -12,6 +12,7 @@ import numpy as np
 from ...errors import ParameterError
 from ..carry import STAND_AFTER
 from .crossing import Point
+from .easing import smooth
 
 __all__ = ["IDLE_SWAY", "IdleMixin"]
 
@@ -103,7 +104,7 @@ class IdleMixin:
         last = self.chunks[-1] if self.chunks else None
         before = 1.0 if last is None or last.pace is None else float(last.pace[-1])
         u = np.clip(np.arange(1, n + 1) / max(1.0, STAND_AFTER * self.fps), 0.0, 1.0)
-        return before * (1.0 - u * u * (3.0 - 2.0 * u))
+        return before * (1.0 - smooth(u))
 
     def _idle(self, points, end: float, radius, hover: float, sway: float = 1.0) -> None:
         duration = end - self.t

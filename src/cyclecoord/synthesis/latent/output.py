@@ -9,7 +9,7 @@ import numpy as np
 
 from ...errors import ParameterError
 from ...motion import Motion
-from .easing import paced_root
+from .easing import paced_root, smooth
 from .model import heading_matrix
 from .untangle import POP_SOFTEN, UntangleMixin
 
@@ -155,7 +155,7 @@ class OutputMixin(UntangleMixin):
             u = np.clip((t - a) / n, 0.0, 1.0)
             if b < T:
                 u = np.minimum(u, np.clip((b - 1 - t) / n, 0.0, 1.0))
-            u = u * u * (3.0 - 2.0 * u)
+            u = smooth(u)
             keep[a:b] = np.minimum(keep[a:b], 1.0 - (1.0 - STAND_LEG_SWAY) * u)
         if np.all(keep == 1.0):
             return angles
@@ -248,7 +248,7 @@ class OutputMixin(UntangleMixin):
             if j + 1 < len(chunks):  # and the chunk after: its last frame kept
                 u = np.minimum(u, (k[-1] - k) / fade)
             u = np.clip(u, 0.0, 1.0)
-            w = u * u * (3.0 - 2.0 * u)
+            w = smooth(u)
             Xs = X + w[:, None] * (gaussian_filter1d(X, sigma, axis=0, mode="nearest") - X)
             if soften is not None:
                 a0 = sum(c.X.shape[0] for c in chunks[:i])
@@ -314,7 +314,7 @@ class OutputMixin(UntangleMixin):
                 if f is None or abs(f - t) > F or chunks[which[f]].model != chunks[c].model:
                     continue
                 u = 1.0 - abs(f - t) / (F + 1.0)
-                near.append((u * u * (3.0 - 2.0 * u), chunks[which[f]].detail, local[f]))
+                near.append((smooth(u), chunks[which[f]].detail, local[f]))
             if not near:
                 continue
             # a short stretch between two gait runs takes a mix of their details, never
@@ -369,7 +369,7 @@ class OutputMixin(UntangleMixin):
             for ev in self.events:
                 a, b = ev["start_frame"], ev["start_frame"] + ev["blend_frames"]
                 u = np.clip(1.0 - np.maximum(a - k, k - b + 1) / (margin + 1.0), 0.0, 1.0)
-                weight = np.maximum(weight, u * u * (3.0 - 2.0 * u))
+                weight = np.maximum(weight, smooth(u))
         return weight
 
     def _plant_feet(self, motion: Motion) -> Motion:

@@ -24,7 +24,7 @@ import numpy as np
 from ..._words import plural
 from ...errors import ParameterError
 from .crossing import BLEND_ACCELERATION, blend_asked
-from .easing import carried, mix_rows, smootherstep
+from .easing import carried, mix_rows, smooth, smootherstep
 from .gait import FADE_TIE, SEAM_FADES, Gait, choose_seam_fade
 from .influence import pose_points
 
@@ -161,7 +161,7 @@ class GaitMixin:
         off = at(means) - m.pose(X)
         a = np.clip((np.sqrt((off**2).mean(axis=1)) / self._frame_step(name, means) - GAP_FROM)
                     / (GAP_FULL - GAP_FROM), 0.0, 1.0)
-        w = a * a * (3.0 - 2.0 * a)
+        w = smooth(a)
         if not w.any():
             return out
         out["angles"] = out["angles"] + w[:, None] * off

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..._words import plural
 from ...motion import Motion
+from .easing import smooth
 
 __all__ = [
     "POP_PULL", "POP_ROUNDS", "POP_SOFTEN", "UNTANGLE_OFF_WIDTH", "UNTANGLE_POP", "UNTANGLE_ROUNDS",
@@ -113,20 +114,20 @@ class UntangleMixin:
         w = max(1, int(round(UNTANGLE_WIDTH * self.fps)))
         k = np.arange(-w, w + 1)
         u = 1.0 - np.abs(k) / (w + 1.0)
-        bump = u * u * (3.0 - 2.0 * u)
+        bump = smooth(u)
         # an IDLE's pose can lie far from its captured frame: pulled over a wider window,
         # within the IDLE, easing in from the frames before and after it
         off = pullable & ~self._on_path()
         w2 = max(w, int(round(UNTANGLE_OFF_WIDTH * self.fps)))
         u2 = 1.0 - np.abs(np.arange(-w2, w2 + 1)) / (w2 + 1.0)
-        wide = u2 * u2 * (3.0 - 2.0 * u2)
+        wide = smooth(u2)
         cap = np.zeros(motion.n_frames)
         for a, b in contact_runs(off):
             t = np.arange(a, b, dtype=float)
             edge = np.minimum(t - a + 1 if a > 0 else np.inf,
                               b - t if b < motion.n_frames else np.inf)
             e = np.clip(edge / (w2 + 1.0), 0.0, 1.0)
-            cap[a:b] = e * e * (3.0 - 2.0 * e)
+            cap[a:b] = smooth(e)
         pulled: set[int] = set()
         before = None  # the last round's motion: only its pulled frames are checked again
         for _ in range(UNTANGLE_ROUNDS):
